@@ -1,0 +1,53 @@
+# voiga: set-up, build, run and test in two commands (`make run`, `make test`).
+# Every target first installs what is missing (Debian packages through apt-get,
+# Python packages through pip), so a fresh Debian 12 machine needs nothing else.
+
+CASE    ?= cases/ironing/m1-NN2.2.nml
+PYTHON  ?= python3
+PREFIX  := build/install
+VOIGA   := $(PREFIX)/bin/voiga
+APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev
+SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: all deps build run test test-fortran test-python clean
+
+all: build
+
+## deps: install missing system and Python packages
+deps:
+	@missing=""; \
+	command -v gfortran >/dev/null 2>&1 || missing="yes"; \
+	command -v pkg-config >/dev/null 2>&1 || missing="yes"; \
+	pkg-config --exists hdf5 2>/dev/null || missing="yes"; \
+	pkg-config --exists lapack 2>/dev/null || missing="yes"; \
+	[ -f /usr/include/suitesparse/umfpack.h ] || missing="yes"; \
+	if [ -n "$$missing" ]; then \
+	  echo "deps: installing Debian packages: $(APT_PKGS)"; \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PKGS) >/dev/null; \
+	fi
+	@if ! $(PYTHON) -c "import numpy, h5py, matplotlib, splipy, f90nml, tqdm, scipy, pytest" 2>/dev/null \
+	   || ! command -v fpm >/dev/null 2>&1; then \
+	  echo "deps: installing Python packages from requirements.txt"; \
+	  $(PYTHON) -m pip install -q -r requirements.txt; \
+	fi
+
+## build: release build, installed to build/install/bin/voiga
+build: deps
+	fpm install --profile release --prefix $(PREFIX)
+
+## run: build and run CASE (default: the ironing m1 NN2.2 discretization check)
+run: build
+	$(VOIGA) $(CASE) --check
+
+## test: Fortran unit tests (fpm test) and Python tests (pytest)
+test: build test-fortran test-python
+
+test-fortran: deps
+	fpm test
+
+test-python: build
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m pytest -q
+
+clean:
+	rm -rf build

@@ -1,0 +1,125 @@
+!> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet]`.
+program voiga_main
+    use voiga_error, only: error_t, error_code
+    use voiga_version, only: voiga_version_string
+    use voiga_io_case, only: case_t, read_case
+    use voiga_io_hdf5, only: h5file_t
+    use voiga_io_dump, only: write_discretization
+    use voiga_discretization_patch, only: discretization_t
+    use voiga_discretization_bodies, only: discretize_bodies
+    implicit none
+
+    character(len=:), allocatable :: case_path, dump_path, arg
+    logical :: check, quiet
+    type(case_t) :: case
+    type(discretization_t), allocatable :: discs(:)
+    type(error_t), allocatable :: error
+    type(h5file_t) :: h5
+    integer :: i, n, total
+
+    check = .false.
+    quiet = .false.
+    n = command_argument_count()
+    i = 0
+    do while (i < n)
+        i = i + 1
+        arg = get_arg(i)
+        select case (arg)
+        case ('-h', '--help')
+            call usage()
+            stop
+        case ('--version')
+            write (*, '(a)') 'voiga '//voiga_version_string
+            stop
+        case ('--check')
+            check = .true.
+        case ('--quiet', '-q')
+            quiet = .true.
+        case ('--dump')
+            if (i == n) call fail_usage('--dump needs a file name')
+            i = i + 1
+            dump_path = get_arg(i)
+        case default
+            if (arg(1:1) == '-') call fail_usage("unknown option '"//arg//"'")
+            if (allocated(case_path)) call fail_usage("more than one case file given ('"// &
+                                                      case_path//"', '"//arg//"')")
+            case_path = arg
+        end select
+    end do
+    if (.not. allocated(case_path)) call fail_usage('no case file given')
+
+    call read_case(case_path, case, error)
+    if (allocated(error)) call fail(error)
+    call discretize_bodies(case, discs, error)
+    if (allocated(error)) call fail(error)
+
+    total = 0
+    do i = 1, size(discs)
+        write (*, '(a,4(a,i0))') 'dofs '//trim(case%bodies(i)%name), ' interface=', &
+            discs(i)%interface_dofs, ' bulk=', discs(i)%bulk_dofs, ' total=', discs(i)%total_dofs, &
+            ' elements=', discs(i)%nel
+        total = total + discs(i)%total_dofs
+    end do
+    write (*, '(a,i0)') 'dofs all total=', total
+
+    if (allocated(dump_path)) then
+        call h5%open(dump_path, 'w', error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'title', case%title)
+        call h5%write_attr('/', 'scene', case%scene)
+        call h5%write_attr('/', 'mesh', case%mesh)
+        call h5%write_attr('/', 'layout', case%layout)
+        call h5%write_attr('/', 'voiga_version', voiga_version_string)
+        do i = 1, size(discs)
+            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
+        end do
+        call h5%close()
+        if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
+    end if
+
+    if (.not. check) then
+        write (*, '(a)') 'voiga: solving is not available yet in this version; '// &
+            'only --check (validate and discretize) runs'
+        stop 1
+    end if
+
+contains
+
+    function get_arg(k) result(val)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: val
+        integer :: length
+        call get_command_argument(k, length=length)
+        allocate (character(len=length) :: val)
+        call get_command_argument(k, val)
+    end function get_arg
+
+    subroutine usage()
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet]', &
+            '  --check        validate the case, build the discretization, print DOF counts', &
+            '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
+            '  --quiet        less output', &
+            '  --version      print the version'
+    end subroutine usage
+
+    subroutine fail_usage(message)
+        character(len=*), intent(in) :: message
+        write (0, '(a)') 'voiga: '//message
+        call usage()
+        error stop 2
+    end subroutine fail_usage
+
+    subroutine fail(err)
+        type(error_t), intent(in) :: err
+        write (0, '(a)') 'voiga: error: '//err%message
+        select case (err%code)
+        case (error_code%input)
+            error stop 2
+        case (error_code%numeric)
+            error stop 3
+        case default
+            error stop 1
+        end select
+    end subroutine fail
+
+end program voiga_main

@@ -1,0 +1,42 @@
+!> From a case to the discretized bodies: read each body's coarse patch from the
+!> geometry file and build its discretization with the case's layout.
+module voiga_discretization_bodies
+    use voiga_error, only: error_t
+    use voiga_io_case, only: case_t
+    use voiga_io_hdf5, only: h5file_t
+    use voiga_io_geometry, only: read_patch
+    use voiga_nurbs_surface, only: nurbs_surface_t
+    use voiga_discretization_patch, only: discretization_t, new_discretization
+    implicit none
+    private
+
+    public :: discretize_bodies
+
+contains
+
+    !> Discretize every body of `case`; `discs` has one entry per body, in order.
+    subroutine discretize_bodies(case, discs, error)
+        type(case_t), intent(in) :: case
+        type(discretization_t), allocatable, intent(out) :: discs(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: geo
+        type(nurbs_surface_t) :: coarse
+        integer :: i
+
+        call geo%open(case%geometry, 'r', error)
+        if (allocated(error)) then
+            error%message = case%path//': &case: geometry: '//error%message
+            return
+        end if
+        allocate (discs(size(case%bodies)))
+        do i = 1, size(case%bodies)
+            call read_patch(geo, case%bodies(i)%name, coarse, error)
+            if (allocated(error)) exit
+            call new_discretization(discs(i), coarse, case%bodies(i)%layout, &
+                                    case%path//": &body '"//trim(case%bodies(i)%name)//"': ", error)
+            if (allocated(error)) exit
+        end do
+        call geo%close()
+    end subroutine discretize_bodies
+
+end module voiga_discretization_bodies

@@ -1,0 +1,158 @@
+!> Reading the coarse exact patches of a scene from its geometry HDF5 file
+!> (schema in docs/formats.md), with every value validated.
+module voiga_io_geometry
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_io_hdf5, only: h5file_t
+    use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels
+    implicit none
+    private
+
+    public :: read_patch, validate_knots
+
+contains
+
+    !> Read body `name`'s patch from the open geometry file `h5`.
+    subroutine read_patch(h5, name, surf, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        type(nurbs_surface_t), intent(out) :: surf
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: g, where, label
+        integer, allocatable :: degree(:)
+        real(dp), allocatable :: cp(:, :, :), w(:, :)
+        integer :: i, j, k
+
+        g = '/bodies/'//trim(name)
+        where = h5%path//": body '"//trim(name)//"': "
+        if (.not. h5%exists(g)) then
+            call fatal_error(error, h5%path//": no body '"//trim(name)//"' (group "//g// &
+                             " is missing)", error_code%input)
+            return
+        end if
+        call h5%read(g//'/degree', degree, error)
+        if (allocated(error)) return
+        if (size(degree) /= 2) then
+            call fatal_error(error, where//'degree must have 2 entries', error_code%input)
+            return
+        end if
+        if (any(degree < 1) .or. any(degree > 20)) then
+            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
+            return
+        end if
+        surf%degree = degree
+        call h5%read(g//'/knots_xi', surf%knots_xi, error)
+        if (allocated(error)) return
+        call h5%read(g//'/knots_eta', surf%knots_eta, error)
+        if (allocated(error)) return
+        call h5%read(g//'/control_points', cp, error)
+        if (allocated(error)) return
+        call h5%read(g//'/weights', w, error)
+        if (allocated(error)) return
+        if (size(cp, 1) /= 2) then
+            call fatal_error(error, where//'control_points must have shape (n_eta, n_xi, 2)', &
+                             error_code%input)
+            return
+        end if
+        if (size(w, 1) /= size(cp, 2) .or. size(w, 2) /= size(cp, 3)) then
+            call fatal_error(error, where//'weights must have shape (n_eta, n_xi) like control_points', &
+                             error_code%input)
+            return
+        end if
+        call validate_knots(surf%knots_xi, degree(1), size(cp, 2), where//'knots_xi', error)
+        if (allocated(error)) return
+        call validate_knots(surf%knots_eta, degree(2), size(cp, 3), where//'knots_eta', error)
+        if (allocated(error)) return
+        if (.not. all(ieee_is_finite(cp))) then
+            call fatal_error(error, where//'control_points must be finite', error_code%input)
+            return
+        end if
+        do k = 1, size(w, 2)
+            do j = 1, size(w, 1)
+                if (.not. (w(j, k) > 0.0_dp .and. ieee_is_finite(w(j, k)))) then
+                    call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
+                    return
+                end if
+            end do
+        end do
+        surf%cp = cp
+        surf%w = w
+        do i = 1, 4
+            label = 'edge_'//trim(edge_labels(i))
+            if (h5%has_attr(g, label)) then
+                block
+                    character(len=:), allocatable :: value
+                    call h5%read_attr_str(g, label, value, error)
+                    if (allocated(error)) return
+                    if (len_trim(value) == 0 .or. len_trim(value) > len(surf%edge_names(i))) then
+                        call fatal_error(error, where//'attribute '//label// &
+                                         ' must be a name of 1 to 32 characters', error_code%input)
+                        return
+                    end if
+                    surf%edge_names(i) = value
+                end block
+            end if
+        end do
+        do i = 1, 4
+            do j = i + 1, 4
+                if (surf%edge_names(i) == surf%edge_names(j)) then
+                    call fatal_error(error, where//"edge name '"//trim(surf%edge_names(i))// &
+                                     "' is used twice", error_code%input)
+                    return
+                end if
+            end do
+        end do
+    end subroutine read_patch
+
+    !> A knot vector of `n` functions of degree `p`: length n+p+1, finite,
+    !> non-decreasing, open (end multiplicity p+1) on [0, 1], interior
+    !> multiplicity <= p. `what` names it in messages.
+    pure subroutine validate_knots(knots, p, n, what, error)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: p, n
+        character(len=*), intent(in) :: what
+        type(error_t), allocatable, intent(out) :: error
+        character(len=80) :: buf
+        integer :: i, m, mult
+
+        m = size(knots)
+        if (m /= n + p + 1) then
+            write (buf, '(a,i0,a,i0,a,i0)') ' has ', m, ' values; expected n + p + 1 = ', n, ' + ', p
+            call fatal_error(error, what//trim(buf)//' + 1', error_code%input)
+            return
+        end if
+        if (.not. all(ieee_is_finite(knots))) then
+            call fatal_error(error, what//' must be finite', error_code%input)
+            return
+        end if
+        do i = 2, m
+            if (knots(i) < knots(i - 1)) then
+                write (buf, '(a,i0,a,i0)') ' decreases between entries ', i - 1, ' and ', i
+                call fatal_error(error, what//trim(buf)//' (knot vectors must be non-decreasing)', &
+                                 error_code%input)
+                return
+            end if
+        end do
+        if (knots(1) /= 0.0_dp .or. knots(m) /= 1.0_dp) then
+            call fatal_error(error, what//' must run from 0 to 1', error_code%input)
+            return
+        end if
+        if (any(knots(1:p + 1) /= knots(1)) .or. any(knots(m - p:m) /= knots(m))) then
+            call fatal_error(error, what//' must be open (first and last knots repeated degree + 1 times)', &
+                             error_code%input)
+            return
+        end if
+        i = p + 2
+        do while (i <= m - p - 1)
+            mult = count(knots(p + 2:m - p - 1) == knots(i))
+            if (mult > p) then
+                call fatal_error(error, what//' has an interior knot repeated more than degree times '// &
+                                 '(the patch would be discontinuous)', error_code%input)
+                return
+            end if
+            i = i + mult
+        end do
+    end subroutine validate_knots
+
+end module voiga_io_geometry

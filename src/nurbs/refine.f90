@@ -1,0 +1,233 @@
+!> Refinement of B-spline curves in homogeneous form (The NURBS Book, ch. 5):
+!> knot insertion (Boehm) and degree elevation (algorithm A5.9).
+!>
+!> Rational curves are refined through their homogeneous control points
+!> `pw(:, i) = [w_i x_i, w_i y_i, ..., w_i]`; both operations keep the curve exactly.
+!> Every routine here is dimension-agnostic: `pw` has shape [ndim, n].
+module voiga_nurbs_refine
+    use voiga_kinds, only: dp
+    use voiga_nurbs_basis, only: find_span
+    implicit none
+    private
+
+    public :: insert_knot, insert_knots, elevate_degree
+
+contains
+
+    !> Insert the value `u` once into `knots` (degree `p`), updating `pw`.
+    !> `u` must lie strictly inside the knot range.
+    pure subroutine insert_knot(p, knots, pw, u)
+        integer, intent(in) :: p
+        !> Knot vector, shape [n+p+1] on entry, [n+p+2] on exit.
+        real(dp), allocatable, intent(inout) :: knots(:)
+        !> Homogeneous control points, shape [ndim, n] on entry, [ndim, n+1] on exit.
+        real(dp), allocatable, intent(inout) :: pw(:, :)
+        real(dp), intent(in) :: u
+        real(dp), allocatable :: kn(:), qw(:, :)
+        real(dp) :: alpha
+        integer :: n, k, i
+
+        n = size(pw, 2)
+        ! 1-based span: knots(k) <= u < knots(k+1); functions k-p..k nonzero.
+        k = find_span(knots, p, u)
+        allocate (kn(size(knots) + 1), qw(size(pw, 1), n + 1))
+        kn(1:k) = knots(1:k)
+        kn(k + 1) = u
+        kn(k + 2:) = knots(k + 1:)
+        ! In 1-based terms: Q_i = P_i for i <= k-p, Q_i = P_(i-1) for i >= k+1,
+        ! blended in between with alpha_i = (u - U_i)/(U_(i+p) - U_i).
+        qw(:, 1:k - p) = pw(:, 1:k - p)
+        qw(:, k + 1:n + 1) = pw(:, k:n)
+        do i = k - p + 1, k
+            alpha = (u - knots(i))/(knots(i + p) - knots(i))
+            qw(:, i) = alpha*pw(:, i) + (1.0_dp - alpha)*pw(:, i - 1)
+        end do
+        call move_alloc(kn, knots)
+        call move_alloc(qw, pw)
+    end subroutine insert_knot
+
+    !> Insert each value of `values` once (values may repeat to insert several times).
+    pure subroutine insert_knots(p, knots, pw, values)
+        integer, intent(in) :: p
+        real(dp), allocatable, intent(inout) :: knots(:)
+        real(dp), allocatable, intent(inout) :: pw(:, :)
+        real(dp), intent(in) :: values(:)
+        integer :: i
+        do i = 1, size(values)
+            call insert_knot(p, knots, pw, values(i))
+        end do
+    end subroutine insert_knots
+
+    !> Raise the degree of a B-spline curve from `p` to `p + t` (A5.9): every
+    !> distinct knot gains multiplicity `t`, so the continuity is unchanged.
+    pure subroutine elevate_degree(p, knots, pw, t)
+        !> Degree on entry; `p + t` on exit.
+        integer, intent(inout) :: p
+        real(dp), allocatable, intent(inout) :: knots(:)
+        real(dp), allocatable, intent(inout) :: pw(:, :)
+        integer, intent(in) :: t
+        real(dp), allocatable :: uh(:), qw(:, :), bezalfs(:, :), bpts(:, :), ebpts(:, :), &
+                                 nextbpts(:, :), alfs(:)
+        real(dp) :: ua, ub, inv, numer, den, bet, alf, gam
+        integer :: nd, n, m, ph, ph2, i, j, k, mpi, mh, kind, r, a, b, cind, mul, oldr, &
+                   lbz, rbz, save, s, first, last, tr, kj, nbreak
+
+        if (t <= 0) return
+        nd = size(pw, 1)
+        n = size(pw, 2) - 1          ! book's n: last control point index (0-based)
+        m = n + p + 1                ! book's m: last knot index
+        ph = p + t
+        ph2 = ph/2
+        nbreak = 0
+        do i = 2, size(knots)
+            if (knots(i) > knots(i - 1)) nbreak = nbreak + 1
+        end do
+        ! Result sizes: each distinct knot gains t copies.
+        allocate (uh(0:size(knots) + t*(nbreak + 1) - 1))
+        allocate (qw(nd, 0:size(uh) - ph - 2))
+        allocate (bezalfs(0:ph, 0:p), bpts(nd, 0:p), ebpts(nd, 0:ph), nextbpts(nd, 0:max(p - 2, 0)), &
+                  alfs(0:max(p - 2, 0)))
+        bezalfs = 0.0_dp
+        bezalfs(0, 0) = 1.0_dp
+        bezalfs(ph, p) = 1.0_dp
+        do i = 1, ph2
+            inv = 1.0_dp/binomial(ph, i)
+            mpi = min(p, i)
+            do j = max(0, i - t), mpi
+                bezalfs(i, j) = inv*binomial(p, j)*binomial(t, i - j)
+            end do
+        end do
+        do i = ph2 + 1, ph - 1
+            mpi = min(p, i)
+            do j = max(0, i - t), mpi
+                bezalfs(i, j) = bezalfs(ph - i, p - j)
+            end do
+        end do
+        mh = ph
+        kind = ph + 1
+        r = -1
+        a = p
+        b = p + 1
+        cind = 1
+        ua = knots(1)
+        qw(:, 0) = pw(:, 1)
+        uh(0:ph) = ua
+        do i = 0, p
+            bpts(:, i) = pw(:, i + 1)
+        end do
+        do while (b < m)
+            i = b
+            do while (b < m)
+                if (knots(b + 1) /= knots(b + 2)) exit
+                b = b + 1
+            end do
+            mul = b - i + 1
+            mh = mh + mul + t
+            ub = knots(b + 1)
+            oldr = r
+            r = p - mul
+            if (oldr > 0) then
+                lbz = (oldr + 2)/2
+            else
+                lbz = 1
+            end if
+            if (r > 0) then
+                rbz = ph - (r + 1)/2
+            else
+                rbz = ph
+            end if
+            if (r > 0) then
+                ! insert ub r times to get the Bezier segment
+                numer = ub - ua
+                do k = p, mul + 1, -1
+                    alfs(k - mul - 1) = numer/(knots(a + k + 1) - ua)
+                end do
+                do j = 1, r
+                    save = r - j
+                    s = mul + j
+                    do k = p, s, -1
+                        bpts(:, k) = alfs(k - s)*bpts(:, k) + (1.0_dp - alfs(k - s))*bpts(:, k - 1)
+                    end do
+                    nextbpts(:, save) = bpts(:, p)
+                end do
+            end if
+            ! degree-elevate the Bezier segment
+            do i = lbz, ph
+                ebpts(:, i) = 0.0_dp
+                mpi = min(p, i)
+                do j = max(0, i - t), mpi
+                    ebpts(:, i) = ebpts(:, i) + bezalfs(i, j)*bpts(:, j)
+                end do
+            end do
+            if (oldr > 1) then
+                ! remove the knot ua oldr times
+                first = kind - 2
+                last = kind
+                den = ub - ua
+                bet = (ub - uh(kind - 1))/den
+                do tr = 1, oldr - 1
+                    i = first
+                    j = last
+                    kj = j - kind + 1
+                    do while (j - i > tr)
+                        if (i < cind) then
+                            alf = (ub - uh(i))/(ua - uh(i))
+                            qw(:, i) = alf*qw(:, i) + (1.0_dp - alf)*qw(:, i - 1)
+                        end if
+                        if (j >= lbz) then
+                            if (j - tr <= kind - ph + oldr) then
+                                gam = (ub - uh(j - tr))/den
+                                ebpts(:, kj) = gam*ebpts(:, kj) + (1.0_dp - gam)*ebpts(:, kj + 1)
+                            else
+                                ebpts(:, kj) = bet*ebpts(:, kj) + (1.0_dp - bet)*ebpts(:, kj + 1)
+                            end if
+                        end if
+                        i = i + 1
+                        j = j - 1
+                        kj = kj - 1
+                    end do
+                    first = first - 1
+                    last = last + 1
+                end do
+            end if
+            if (a /= p) then
+                do i = 0, ph - oldr - 1
+                    uh(kind) = ua
+                    kind = kind + 1
+                end do
+            end if
+            do j = lbz, rbz
+                qw(:, cind) = ebpts(:, j)
+                cind = cind + 1
+            end do
+            if (b < m) then
+                do j = 0, r - 1
+                    bpts(:, j) = nextbpts(:, j)
+                end do
+                do j = r, p
+                    bpts(:, j) = pw(:, b - p + j + 1)
+                end do
+                a = b
+                b = b + 1
+                ua = ub
+            else
+                do i = 0, ph
+                    uh(kind + i) = ub
+                end do
+            end if
+        end do
+        p = ph
+        knots = uh(0:mh)
+        pw = qw(:, 0:mh - ph - 1)
+    end subroutine elevate_degree
+
+    pure real(dp) function binomial(n, k)
+        integer, intent(in) :: n, k
+        integer :: i
+        binomial = 1.0_dp
+        do i = 1, k
+            binomial = binomial*real(n - k + i, dp)/real(i, dp)
+        end do
+    end function binomial
+
+end module voiga_nurbs_refine

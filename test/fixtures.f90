@@ -1,0 +1,80 @@
+!> Shared test fixtures: exact coarse patches of the scenes' shapes and a
+!> deterministic pseudo-random sequence.
+module voiga_test_fixtures
+    use voiga_kinds, only: dp
+    use voiga_nurbs_surface, only: nurbs_surface_t
+    implicit none
+    private
+
+    public :: annulus_sector, rectangle, lcg_t
+
+    !> Park-Miller generator: same numbers on every compiler and run.
+    type :: lcg_t
+        integer(8) :: state = 12345_8
+    contains
+        procedure :: uniform => lcg_uniform
+    end type lcg_t
+
+contains
+
+    !> Next number in [0, 1).
+    real(dp) function lcg_uniform(self)
+        class(lcg_t), intent(inout) :: self
+        ! Park-Miller minimal standard: no integer overflow in 64 bits
+        self%state = modulo(16807_8*self%state, 2147483647_8)
+        lcg_uniform = real(self%state - 1, dp)/2147483646.0_dp
+    end function lcg_uniform
+
+    !> Annular sector from angle `a0` over `nq` quarter turns (counter-clockwise),
+    !> radii `ri` (eta = 0) to `ro` (eta = 1), centre `c`: exact rational quadratic
+    !> arcs along xi (C0 between quarters), degree 1 across.
+    function annulus_sector(c, ri, ro, a0, nq) result(s)
+        real(dp), intent(in) :: c(2), ri, ro, a0
+        integer, intent(in) :: nq
+        type(nurbs_surface_t) :: s
+        real(dp) :: r(2), ang, h
+        integer :: k, j, i
+
+        s%degree = [2, 1]
+        allocate (s%knots_xi(2*nq + 4))
+        s%knots_xi(1:3) = 0.0_dp
+        do k = 1, nq - 1
+            s%knots_xi(2*k + 2:2*k + 3) = real(k, dp)/real(nq, dp)
+        end do
+        s%knots_xi(2*nq + 2:2*nq + 4) = 1.0_dp
+        s%knots_eta = [0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]
+        allocate (s%cp(2, 2*nq + 1, 2), s%w(2*nq + 1, 2))
+        r = [ri, ro]
+        h = 0.25_dp*acos(-1.0_dp)
+        do j = 1, 2
+            do i = 1, 2*nq + 1
+                ang = a0 + real(i - 1, dp)*h
+                if (mod(i, 2) == 1) then
+                    s%cp(:, i, j) = c + r(j)*[cos(ang), sin(ang)]
+                    s%w(i, j) = 1.0_dp
+                else
+                    s%cp(:, i, j) = c + r(j)/cos(h)*[cos(ang), sin(ang)]
+                    s%w(i, j) = cos(h)
+                end if
+            end do
+        end do
+        s%edge_names = [character(len=32) :: 'start', 'end', 'inner', 'outer']
+    end function annulus_sector
+
+    !> Rectangle [x0, x0+a] x [y0, y0+b], degree (1, 1), eta = 1 on top.
+    function rectangle(x0, y0, a, b) result(s)
+        real(dp), intent(in) :: x0, y0, a, b
+        type(nurbs_surface_t) :: s
+        s%degree = [1, 1]
+        s%knots_xi = [0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]
+        s%knots_eta = [0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]
+        allocate (s%cp(2, 2, 2), s%w(2, 2))
+        s%cp(:, 1, 1) = [x0, y0]
+        s%cp(:, 2, 1) = [x0 + a, y0]
+        s%cp(:, 1, 2) = [x0, y0 + b]
+        s%cp(:, 2, 2) = [x0 + a, y0 + b]
+        s%w = 1.0_dp
+        s%edge_names = [character(len=32) :: 'left', 'right', 'bottom', 'top']
+    end function rectangle
+
+end module voiga_test_fixtures
