@@ -80,7 +80,7 @@ program voiga_main
     if (.not. check) then
         write (*, '(a)') 'voiga: solving is not available yet in this version; '// &
             'only --check (validate and discretize) runs'
-        stop 1
+        stop 1, quiet=.true.
     end if
 
 contains
@@ -106,7 +106,7 @@ contains
         character(len=*), intent(in) :: message
         write (0, '(a)') 'voiga: '//message
         call usage()
-        error stop 2
+        stop 2, quiet=.true.
     end subroutine fail_usage
 
     subroutine fail(err)
@@ -114,11 +114,11 @@ contains
         write (0, '(a)') 'voiga: error: '//err%message
         select case (err%code)
         case (error_code%input)
-            error stop 2
+            stop 2, quiet=.true.
         case (error_code%numeric)
-            error stop 3
+            stop 3, quiet=.true.
         case default
-            error stop 1
+            stop 1, quiet=.true.
         end select
     end subroutine fail
 

@@ -31,7 +31,11 @@ contains
         allocate (discs(size(case%bodies)))
         do i = 1, size(case%bodies)
             call read_patch(geo, case%bodies(i)%name, coarse, error)
-            if (allocated(error)) exit
+            if (allocated(error)) then
+                error%message = case%path//": &body '"//trim(case%bodies(i)%name)//"': name: "// &
+                                error%message
+                exit
+            end if
             call new_discretization(discs(i), coarse, case%bodies(i)%layout, &
                                     case%path//": &body '"//trim(case%bodies(i)%name)//"': ", error)
             if (allocated(error)) exit
