@@ -187,3 +187,32 @@ def test_not_hdf5_geometry(run, tmp_path: Path, ironing_copy: Path) -> None:
     res = run(ironing_copy, "--check")
     assert res.returncode == 2
     assert "geometry.h5" in res.stderr and "HDF5" in res.stderr
+
+
+@pytest.mark.parametrize("edge", ["left", "right", "bottom", "top"])
+def test_reoriented_contact_edge_matches_pre(run, tmp_path: Path, ironing_copy: Path, edge: str) -> None:
+    """A contact edge on any side: voiga and `python -m pre refine` build the same nets."""
+    import subprocess
+    import sys
+
+    text = ironing_copy.read_text()
+    text = text.replace("contact_edge = 'top'", f"contact_edge = '{edge}'")
+    text = text.replace("nel_xi = 8", "nel_xi = 3").replace("nel_eta = 2", "nel_eta = 5")
+    # NN2.2 on the slab
+    slab = text[text.index("name = 'slab'"):]
+    slab_new = slab.replace("layer_degree = 0", "layer_degree = 2").replace(
+        "layer_elevations = 0", "layer_elevations = 2")
+    ironing_copy.write_text(text.replace(slab, slab_new))
+    ours = tmp_path / "voiga.h5"
+    res = run(ironing_copy, "--check", "--dump", ours)
+    assert res.returncode == 0, res.stderr
+    theirs = tmp_path / "pre.h5"
+    subprocess.run([sys.executable, "-m", "pre", "refine", str(ironing_copy), "-o", str(theirs)],
+                   check=True, cwd=REPO, capture_output=True)
+    with h5py.File(ours) as a, h5py.File(theirs) as b:
+        for key in ("bulk/knots_xi", "bulk/knots_eta", "bulk/control_points", "bulk/weights",
+                    "layer/knots", "layer/control_points", "layer/weights"):
+            np.testing.assert_allclose(a["bodies/slab"][key][()], b["bodies/slab"][key][()],
+                                       atol=1e-12, err_msg=key)
+        for attr in ("interface_dofs", "bulk_dofs", "total_dofs"):
+            assert a["bodies/slab"].attrs[attr] == b["bodies/slab"].attrs[attr]

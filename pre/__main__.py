@@ -1,0 +1,88 @@
+"""Command line: ``python -m pre <subcommand>``.
+
+Subcommands:
+  cases        write cases/<scene>/geometry.h5 and every study's namelist
+  refine       refine a case with splipy and write the discretization dump
+  plot-layout  draw a body's control nets and contact basis functions
+  figures      write the figures of docs/figures/
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _cmd_cases(args: argparse.Namespace) -> int:
+    from .cases import write_cases
+
+    written = write_cases(args.out)
+    print(f"wrote {len(written)} files under {args.out}")
+    return 0
+
+
+def _cmd_refine(args: argparse.Namespace) -> int:
+    from .refine import discretize_case, write_dump
+
+    disc = discretize_case(args.case)
+    write_dump(args.output, disc)
+    for name, b in disc.bodies.items():
+        layer = f", layer degree {b.layer.degree} x {len(b.layer.weights)}" if b.layer else ""
+        print(f"{name}: bulk degree {b.bulk.degree} {b.bulk.shape[1]} x {b.bulk.shape[0]}{layer}; "
+              f"DOF interface {b.interface_dofs} bulk {b.bulk_dofs} total {b.total_dofs}")
+    return 0
+
+
+def _cmd_plot_layout(args: argparse.Namespace) -> int:
+    from .plot import plot_layout
+
+    print(plot_layout(args.case, args.body, args.output))
+    return 0
+
+
+def _cmd_figures(args: argparse.Namespace) -> int:
+    from .plot import write_figures
+
+    for path in write_figures(args.out):
+        print(path)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argparse parser with one subparser per subcommand."""
+    p = argparse.ArgumentParser(prog="python -m pre", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("cases", help="write geometry files and case namelists")
+    s.add_argument("--out", default=str(REPO / "cases"), help="output folder (default: repo cases/)")
+    s.set_defaults(func=_cmd_cases)
+
+    s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
+    s.add_argument("case", help="case namelist (.nml)")
+    s.add_argument("-o", "--output", required=True, help="dump file (.h5)")
+    s.set_defaults(func=_cmd_refine)
+
+    s = sub.add_parser("plot-layout", help="control nets and contact basis of one body (PNG)")
+    s.add_argument("case", help="case namelist (.nml)")
+    s.add_argument("--body", required=True, help="body name")
+    s.add_argument("-o", "--output", required=True, help="PNG file")
+    s.set_defaults(func=_cmd_plot_layout)
+
+    s = sub.add_parser("figures", help="write the docs figures")
+    s.add_argument("--out", default=str(REPO / "docs" / "figures"), help="output folder")
+    s.set_defaults(func=_cmd_figures)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point."""
+    args = build_parser().parse_args(argv)
+    return int(args.func(args))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

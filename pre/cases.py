@@ -1,0 +1,199 @@
+"""Case namelists of the benchmark studies (``python -m pre cases``).
+
+One function per scene (:func:`ironing_case`, :func:`hertz_case`,
+:func:`rings_case`) returns the case as an ordered dict of namelist groups:
+``{'case': {...}, 'body': [{...}, ...]}``. A group whose value is a list is
+written once per entry (``&body`` per body). To add loads or contact groups
+later, add keys to these dicts: :func:`to_namelist_text` writes every group in
+insertion order.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+from typing import Any
+
+import f90nml
+import numpy as np
+
+from .h5io import write_geometry
+from .layouts import parse_layout
+from .meshes import (hertz_eta_knots, hertz_radial_elements, hertz_xi_knots, mesh_level)
+from .scenes import scene_bodies
+
+Groups = dict[str, Any]
+
+GEOMETRY_FILE = "geometry.h5"
+
+# ------------------------------------------------------------ materials
+MATERIALS: dict[str, dict[str, tuple[str, float, float]]] = {
+    "ironing": {"die": ("neo-hookean", 10.0, 0.3), "slab": ("neo-hookean", 1.0, 0.3)},
+    "ironing-deep": {"die": ("neo-hookean", 1000.0, 0.3), "slab": ("neo-hookean", 1.0, 0.3)},
+    "hertz": {"cylinder": ("linear", 1.0, 0.3)},
+    "rings": {"upper": ("neo-hookean", 1.0, 0.3), "lower": ("neo-hookean", 2.0, 0.3)},
+}
+"""scene -> body -> (material, youngs_modulus, poisson_ratio)."""
+
+CONTACT_EDGES: dict[str, dict[str, str]] = {
+    "ironing": {"die": "outer", "slab": "top"},
+    "ironing-deep": {"die": "outer", "slab": "top"},
+    "hertz": {"cylinder": "outer"},
+    "rings": {"upper": "outer", "lower": "outer"},
+}
+
+# ------------------------------------------------------------ meshes
+IRONING_M1 = {"die": (6, 1), "slab": (8, 2)}
+"""(nel_xi, nel_eta) at m1; m<k> multiplies both by 2^(k-1)."""
+RINGS_M1 = {"upper": (12, 2), "lower": (16, 2)}
+"""(nel_xi, nel_eta) at m1; m<k> multiplies the arc direction by 2^(k-1)."""
+
+# ------------------------------------------------------------ studies
+STUDIES: dict[str, list[tuple[str, str]]] = {}
+"""scene -> [(mesh, layout)] committed under cases/<scene>/."""
+_IRONING_LAYOUTS = ["N2", "N4", "N6", "NN4", "NN6", "NN2.1", "NN2.2", "NN2.3"]
+for _scene in ("ironing", "ironing-deep"):
+    STUDIES[_scene] = [(f"m{k}", lay) for k in range(1, 5) for lay in _IRONING_LAYOUTS]
+STUDIES["hertz"] = ([(f"m{k}", lay) for k in range(1, 6)
+                     for lay in ["L1", "N2", "N4", "NN4", "NN2.1", "NN2.2", "NN3.2"]]
+                    + [("m6", "N2")])
+STUDIES["rings"] = ([(f"m{k}", lay) for k in range(1, 4) for lay in ["N2", "N4", "NN4", "NN2.1"]]
+                    + [("ref", "N2")])
+RINGS_REF_MESH = "m4"
+"""The rings reference (file ``ref-N2.nml``) is N2 on m4 (x8 along the arcs)."""
+
+
+def case_stem(mesh: str, layout: str) -> str:
+    """File stem ``<mesh>-<layout>``."""
+    return f"{mesh}-{layout}"
+
+
+def _case_group(scene: str, mesh_label: str, mesh: str, layout: str, n_bodies: int) -> dict[str, Any]:
+    stem = case_stem(mesh_label, layout)
+    title = f"{scene} {mesh} {layout}" + (" (reference)" if mesh_label != mesh else "")
+    return {"title": title, "scene": scene, "mesh": mesh, "layout": layout,
+            "geometry": GEOMETRY_FILE, "output": f"{stem}.h5", "n_bodies": n_bodies}
+
+
+def _body_group(scene: str, name: str, layout: str, *,
+                nel: tuple[int, int] | None = None,
+                knots: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
+    """One &body group: layout settings, mesh (uniform ``nel`` or explicit
+    interior ``knots``), contact edge and material."""
+    lay = parse_layout(layout)
+    g: dict[str, Any] = {"name": name, "basis": lay.basis,
+                         "degree_xi": lay.degree_xi, "degree_eta": lay.degree_eta}
+    if knots is not None:
+        g["knots_xi"] = [float(k) for k in knots[0]]
+        g["knots_eta"] = [float(k) for k in knots[1]]
+    elif nel is not None:
+        g["nel_xi"], g["nel_eta"] = int(nel[0]), int(nel[1])
+    else:
+        raise ValueError("give nel or knots")
+    g["contact_edge"] = CONTACT_EDGES[scene][name]
+    g["layer_degree"] = lay.layer_degree
+    g["layer_elevations"] = lay.layer_elevations
+    material, e, nu = MATERIALS[scene][name]
+    g["material"], g["youngs_modulus"], g["poisson_ratio"] = material, float(e), float(nu)
+    return g
+
+
+def ironing_case(mesh: str, layout: str, scene: str = "ironing") -> Groups:
+    """ironing / ironing-deep: die and slab, both directions x 2^(k-1)."""
+    f = 2 ** (mesh_level(mesh) - 1)
+    bodies = [_body_group(scene, name, layout, nel=(nx * f, ne * f))
+              for name, (nx, ne) in IRONING_M1.items()]
+    return {"case": _case_group(scene, mesh, mesh, layout, len(bodies)), "body": bodies}
+
+
+def hertz_case(mesh: str, layout: str) -> Groups:
+    """hertz: graded arc knots (nested from m1), 49 radial control points."""
+    lay = parse_layout(layout)
+    kx = hertz_xi_knots(mesh_level(mesh))
+    ke = hertz_eta_knots(hertz_radial_elements(lay.degree_eta))
+    bodies = [_body_group("hertz", "cylinder", layout, knots=(kx, ke))]
+    return {"case": _case_group("hertz", mesh, mesh, layout, 1), "body": bodies}
+
+
+def rings_case(mesh: str, layout: str) -> Groups:
+    """rings: arc direction x 2^(k-1), radial fixed; ``mesh='ref'`` is m4."""
+    real = RINGS_REF_MESH if mesh == "ref" else mesh
+    f = 2 ** (mesh_level(real) - 1)
+    bodies = [_body_group("rings", name, layout, nel=(nx * f, ne))
+              for name, (nx, ne) in RINGS_M1.items()]
+    return {"case": _case_group("rings", mesh, real, layout, len(bodies)), "body": bodies}
+
+
+def build_case(scene: str, mesh: str, layout: str) -> Groups:
+    """The groups of one case of ``scene``."""
+    if scene in ("ironing", "ironing-deep"):
+        return ironing_case(mesh, layout, scene)
+    if scene == "hertz":
+        return hertz_case(mesh, layout)
+    if scene == "rings":
+        return rings_case(mesh, layout)
+    raise KeyError(f"unknown scene {scene!r}")
+
+
+def to_namelist(groups: Groups) -> f90nml.Namelist:
+    """An ordered f90nml Namelist of ``groups`` (lists become repeated groups)."""
+    nml = f90nml.Namelist()
+    for gname, value in groups.items():
+        if isinstance(value, list):
+            nml.create_cogroup(gname)
+            for entry in value:
+                nml.add_cogroup(gname, f90nml.Namelist(list(entry.items())))
+        else:
+            nml[gname] = f90nml.Namelist(list(value.items()))
+    nml.indent = 2
+    nml.end_comma = False
+    nml.uppercase = False
+    return nml
+
+
+def to_namelist_text(groups: Groups) -> str:
+    """Deterministic namelist text of ``groups``."""
+    buf = io.StringIO()
+    to_namelist(groups).write(buf)
+    return buf.getvalue()
+
+
+def all_cases() -> dict[str, Groups]:
+    """``'<scene>/<mesh>-<layout>.nml'`` -> groups, for every committed study."""
+    return {f"{scene}/{case_stem(mesh, layout)}.nml": build_case(scene, mesh, layout)
+            for scene, runs in STUDIES.items() for mesh, layout in runs}
+
+
+def write_cases(out: str | Path) -> list[Path]:
+    """Write every scene's geometry.h5 and case namelists under ``out``."""
+    out = Path(out)
+    written: list[Path] = []
+    for scene in STUDIES:
+        folder = out / scene
+        folder.mkdir(parents=True, exist_ok=True)
+        geo = folder / GEOMETRY_FILE
+        tmp = geo.with_name(f".{geo.name}.tmp")
+        write_geometry(tmp, scene, scene_bodies(scene))
+        os.replace(tmp, geo)  # atomic; a reader holding the old file keeps it
+        written.append(geo)
+    for rel, groups in all_cases().items():
+        path = out / rel
+        tmp = path.with_name(f".{path.name}.tmp")
+        tmp.write_text(to_namelist_text(groups))
+        os.replace(tmp, path)
+        written.append(path)
+    return written
+
+
+def read_case(path: str | Path) -> f90nml.Namelist:
+    """Parse a case namelist (group names lower-case; &body always a list)."""
+    return f90nml.read(str(path))
+
+
+def case_bodies(nml: f90nml.Namelist) -> list[dict[str, Any]]:
+    """The &body groups of a parsed case as plain dicts (always a list)."""
+    bodies = nml["body"]
+    if isinstance(bodies, dict):
+        return [dict(bodies)]
+    return [dict(b) for b in bodies]
