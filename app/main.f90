@@ -7,6 +7,10 @@ program voiga_main
     use voiga_io_dump, only: write_discretization
     use voiga_discretization_patch, only: discretization_t
     use voiga_discretization_bodies, only: discretize_bodies
+    use voiga_model, only: model_t, new_model
+    use voiga_io_results, only: results_t
+    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds
+    use voiga_kinds, only: dp
     implicit none
 
     character(len=:), allocatable :: case_path, dump_path, arg
@@ -15,6 +19,11 @@ program voiga_main
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error
     type(h5file_t) :: h5
+    type(model_t) :: model
+    type(results_t) :: results
+    type(solver_stats_t) :: stats
+    real(dp), allocatable :: u(:)
+    real(dp) :: t0
     integer :: i, n, total
 
     check = .false.
@@ -48,6 +57,7 @@ program voiga_main
     end do
     if (.not. allocated(case_path)) call fail_usage('no case file given')
 
+    t0 = wall_seconds()
     call read_case(case_path, case, error)
     if (allocated(error)) call fail(error)
     call discretize_bodies(case, discs, error)
@@ -77,11 +87,21 @@ program voiga_main
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
 
-    if (.not. check) then
-        write (*, '(a)') 'voiga: solving is not available yet in this version; '// &
-            'only --check (validate and discretize) runs'
-        stop 1, quiet=.true.
+    if (check) stop
+
+    call new_model(model, case, discs, error)
+    if (allocated(error)) call fail(error)
+    call results%open(case, model, error)
+    if (allocated(error)) call fail(error)
+    call solve_steps(model, u, stats, quiet, error, results, t0)
+    if (allocated(error)) then
+        call results%finish('failed: '//error%message, wall_seconds() - t0)
+        write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
+        call fail(error)
     end if
+    call results%finish('converged', wall_seconds() - t0)
+    write (*, '(a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps, ', stats%iterations, &
+        ' Newton iterations, ', wall_seconds() - t0, ' s; wrote '//case%output
 
 contains
 
@@ -96,6 +116,7 @@ contains
 
     subroutine usage()
         write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet]', &
+            '  (no option)    solve the case and write the result file it names', &
             '  --check        validate the case, build the discretization, print DOF counts', &
             '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
             '  --quiet        less output', &

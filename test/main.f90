@@ -5,6 +5,10 @@ program voiga_tests
     use test_basis, only: collect_basis
     use test_refine, only: collect_refine
     use test_discretization, only: collect_discretization
+    use test_solid, only: collect_solid, lame_table
+    use voiga_error, only: error_t
+    use voiga_kinds, only: dp
+    use test_sparse, only: collect_sparse
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -14,10 +18,22 @@ program voiga_tests
     suites = [ &
              new_testsuite('basis', collect_basis), &
              new_testsuite('refine', collect_refine), &
-             new_testsuite('discretization', collect_discretization) &
+             new_testsuite('discretization', collect_discretization), &
+             new_testsuite('solid', collect_solid), &
+             new_testsuite('sparse', collect_sparse) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)
+    if (trim(filter) == '--lame-table') then
+        ! the convergence table of docs/verification.md
+        block
+            real(dp) :: rates(5, 2)
+            type(error_t), allocatable :: error
+            call lame_table(rates, error, .true.)
+            if (allocated(error)) error stop 1
+        end block
+        stop
+    end if
     npass = 0
     nfail = 0
     do i = 1, size(suites)

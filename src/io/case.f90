@@ -6,10 +6,12 @@ module voiga_io_case
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_discretization_layout, only: layout_t
+    use voiga_io_namelist, only: group_error, group_names, lower
     implicit none
     private
 
-    public :: case_t, body_input_t, read_case, resolve_path
+    public :: case_t, body_input_t, solver_input_t, dirichlet_input_t, pressure_input_t
+    public :: read_case, resolve_path, known_groups
 
     !> Most explicit knots one direction of one body may list.
     integer, parameter :: max_knots = 100000
@@ -17,6 +19,11 @@ module voiga_io_case
     integer, parameter :: max_bodies = 16
     !> Marks a namelist array entry the file did not set.
     real(dp), parameter :: unset = -huge(1.0_dp)
+    !> Most load phases.
+    integer, parameter :: max_phases = 64
+    !> The namelist groups a case file may contain.
+    character(len=*), parameter :: known_groups(5) = [character(len=9) :: 'case', 'body', 'solver', &
+                                                      'dirichlet', 'pressure']
 
     !> One body as the case describes it.
     type :: body_input_t
@@ -28,6 +35,37 @@ module voiga_io_case
         type(layout_t) :: layout
     end type body_input_t
 
+    !> Load stepping and Newton settings (`&solver`).
+    type :: solver_input_t
+        !> Load steps of each phase; the number of entries is the number of phases.
+        integer, allocatable :: n_steps(:)
+        !> Newton iteration cap per step.
+        integer :: max_iterations = 25
+        !> Converged when ||r|| <= tol_residual ||r_0|| (r_0: the step's first residual) ...
+        real(dp) :: tol_residual = 1.0e-10_dp
+        !> ... or |du . r| <= tol_energy |du_1 . r_0|.
+        real(dp) :: tol_energy = 1.0e-20_dp
+        !> Gauss points per direction (0: degree + 1 in each direction).
+        integer :: n_gauss = 0
+    end type solver_input_t
+
+    !> A prescribed displacement on a named edge (`&dirichlet`).
+    type :: dirichlet_input_t
+        character(len=32) :: body = '', edge = ''
+        !> Which components are prescribed [x, y].
+        logical :: fix(2) = .false.
+        !> Value at the end of each phase, shape [2, n_phases] (linear within a phase).
+        real(dp), allocatable :: values(:, :)
+    end type dirichlet_input_t
+
+    !> A pressure (force per length, normal to the edge, reference configuration)
+    !> on a named edge (`&pressure`); positive pushes into the body.
+    type :: pressure_input_t
+        character(len=32) :: body = '', edge = ''
+        !> Value at the end of each phase, shape [n_phases].
+        real(dp), allocatable :: values(:)
+    end type pressure_input_t
+
     !> A case.
     type :: case_t
         !> The case file and its folder (with trailing '/', or '').
@@ -36,6 +74,9 @@ module voiga_io_case
         !> Geometry and output files, resolved against `dir`.
         character(len=:), allocatable :: geometry, output
         type(body_input_t), allocatable :: bodies(:)
+        type(solver_input_t) :: solver
+        type(dirichlet_input_t), allocatable :: dirichlet(:)
+        type(pressure_input_t), allocatable :: pressure(:)
     end type case_t
 
 contains
@@ -117,6 +158,11 @@ contains
             return
         end if
 
+        call check_groups(path, n_bodies, error)
+        if (allocated(error)) then
+            close (u)
+            return
+        end if
         allocate (self%bodies(n_bodies))
         rewind (u)
         do i = 1, n_bodies
@@ -134,6 +180,7 @@ contains
                 return
             end if
         end do
+        call read_loads(path, self, error)
     contains
         !> Read one assignment into the &case group (for diagnosis).
         subroutine try_case(text, ios, msg)
@@ -253,6 +300,286 @@ contains
         end subroutine try_body
     end subroutine read_body
 
+    !> Every group in the file is known, and there are exactly n_bodies &body groups.
+    subroutine check_groups(path, n_bodies, error)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: n_bodies
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32), allocatable :: names(:)
+        character(len=128) :: msg
+        integer :: i
+        call group_names(path, names)
+        do i = 1, size(names)
+            if (.not. any(known_groups == names(i))) then
+                call fatal_error(error, path//': unknown namelist group &'//trim(names(i))// &
+                                 ' (known: &case, &body, &solver, &dirichlet, &pressure)', error_code%input)
+                return
+            end if
+        end do
+        if (count(names == 'body') /= n_bodies) then
+            write (msg, '(a,i0,a,i0,a)') ': &case: n_bodies = ', n_bodies, ' but the file has ', &
+                count(names == 'body'), ' &body groups'
+            call fatal_error(error, path//trim(msg), error_code%input)
+            return
+        end if
+        if (count(names == 'case') /= 1 .or. count(names == 'solver') > 1) then
+            call fatal_error(error, path//': groups &case and &solver may appear once each', &
+                             error_code%input)
+            return
+        end if
+    end subroutine check_groups
+
+    !> Read `&solver`, every `&dirichlet` and every `&pressure` group.
+    subroutine read_loads(path, self, error)
+        character(len=*), intent(in) :: path
+        type(case_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32), allocatable :: names(:)
+        integer :: u, ios, i, nph
+        character(len=512) :: msg
+
+        call group_names(path, names)
+        open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call fatal_error(error, "case file '"//path//"' cannot be read: "//trim(msg), error_code%input)
+            return
+        end if
+        if (any(names == 'solver')) then
+            call read_solver(u, path, self%solver, error)
+            if (allocated(error)) then
+                close (u)
+                return
+            end if
+        else
+            self%solver%n_steps = [1]
+        end if
+        nph = size(self%solver%n_steps)
+        allocate (self%dirichlet(count(names == 'dirichlet')))
+        rewind (u)
+        do i = 1, size(self%dirichlet)
+            call read_dirichlet(u, path, i, nph, self, self%dirichlet(i), error)
+            if (allocated(error)) exit
+        end do
+        if (.not. allocated(error)) then
+            allocate (self%pressure(count(names == 'pressure')))
+            rewind (u)
+            do i = 1, size(self%pressure)
+                call read_pressure(u, path, i, nph, self, self%pressure(i), error)
+                if (allocated(error)) exit
+            end do
+        end if
+        close (u)
+    end subroutine read_loads
+
+    subroutine read_solver(u, path, entry, error)
+        integer, intent(in) :: u
+        character(len=*), intent(in) :: path
+        type(solver_input_t), intent(out) :: entry
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph
+        real(dp) :: tol_residual, tol_energy
+        character(len=512) :: msg
+        character(len=:), allocatable :: where
+        namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss
+
+        n_steps = -1
+        max_iterations = entry%max_iterations
+        tol_residual = entry%tol_residual
+        tol_energy = entry%tol_energy
+        n_gauss = entry%n_gauss
+        rewind (u)
+        read (u, nml=solver, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call group_error(path, 'solver', 1, ios, msg, try_solver, error)
+            return
+        end if
+        where = path//': &solver: '
+        nph = count(n_steps /= -1)
+        if (nph == 0) then
+            n_steps(1) = 1
+            nph = 1
+        end if
+        if (any(n_steps(1:nph) == -1)) then
+            call fatal_error(error, where//'n_steps must be one list starting at entry 1', error_code%input)
+            return
+        end if
+        if (any(n_steps(1:nph) < 1)) then
+            call fatal_error(error, where//'n_steps must be >= 1 in every phase', error_code%input)
+            return
+        end if
+        if (max_iterations < 1) then
+            call fatal_error(error, where//'max_iterations must be >= 1', error_code%input)
+            return
+        end if
+        if (.not. (tol_residual > 0.0_dp .and. tol_residual < 1.0_dp)) then
+            call fatal_error(error, where//'tol_residual must lie in (0, 1)', error_code%input)
+            return
+        end if
+        if (.not. (tol_energy >= 0.0_dp .and. tol_energy < 1.0_dp)) then
+            call fatal_error(error, where//'tol_energy must lie in [0, 1)', error_code%input)
+            return
+        end if
+        if (n_gauss < 0 .or. n_gauss > 30) then
+            call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
+            return
+        end if
+        entry%n_steps = n_steps(1:nph)
+        entry%max_iterations = max_iterations
+        entry%tol_residual = tol_residual
+        entry%tol_energy = tol_energy
+        entry%n_gauss = n_gauss
+    contains
+        subroutine try_solver(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+            read (text, nml=solver, iostat=ios, iomsg=msg)
+        end subroutine try_solver
+    end subroutine read_solver
+
+    !> Index of body `name` in the case, 0 if none.
+    pure integer function body_index(self, name)
+        type(case_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer :: i
+        body_index = 0
+        do i = 1, size(self%bodies)
+            if (trim(self%bodies(i)%name) == trim(name)) body_index = i
+        end do
+    end function body_index
+
+    subroutine read_dirichlet(u, path, k, nph, self, entry, error)
+        integer, intent(in) :: u, k, nph
+        character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: self
+        type(dirichlet_input_t), intent(out) :: entry
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32) :: body, edge
+        logical :: fix_x, fix_y
+        real(dp) :: ux(max_phases), uy(max_phases)
+        integer :: ios
+        character(len=512) :: msg
+        character(len=:), allocatable :: where
+        namelist /dirichlet/ body, edge, fix_x, fix_y, ux, uy
+
+        body = ''
+        edge = ''
+        fix_x = .false.
+        fix_y = .false.
+        ux = unset
+        uy = unset
+        read (u, nml=dirichlet, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call group_error(path, 'dirichlet', k, ios, msg, try_dirichlet, error)
+            return
+        end if
+        write (msg, '(a,i0,a)') ': &dirichlet (', k, '): '
+        where = path//trim(msg)
+        if (body_index(self, body) == 0) then
+            call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
+                             error_code%input)
+            return
+        end if
+        if (len_trim(edge) == 0) then
+            call fatal_error(error, where//'edge is required', error_code%input)
+            return
+        end if
+        if (.not. (fix_x .or. fix_y)) then
+            call fatal_error(error, where//'fix_x or fix_y must be .true.', error_code%input)
+            return
+        end if
+        entry%body = body
+        entry%edge = edge
+        entry%fix = [fix_x, fix_y]
+        allocate (entry%values(2, nph))
+        call phase_values(ux, fix_x, 'ux', where, nph, entry%values(1, :), error)
+        if (allocated(error)) return
+        call phase_values(uy, fix_y, 'uy', where, nph, entry%values(2, :), error)
+    contains
+        subroutine try_dirichlet(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+            read (text, nml=dirichlet, iostat=ios, iomsg=msg)
+        end subroutine try_dirichlet
+    end subroutine read_dirichlet
+
+    subroutine read_pressure(u, path, k, nph, self, entry, error)
+        integer, intent(in) :: u, k, nph
+        character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: self
+        type(pressure_input_t), intent(out) :: entry
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32) :: body, edge
+        real(dp) :: p(max_phases)
+        integer :: ios
+        character(len=512) :: msg
+        character(len=:), allocatable :: where
+        namelist /pressure/ body, edge, p
+
+        body = ''
+        edge = ''
+        p = unset
+        read (u, nml=pressure, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call group_error(path, 'pressure', k, ios, msg, try_pressure, error)
+            return
+        end if
+        write (msg, '(a,i0,a)') ': &pressure (', k, '): '
+        where = path//trim(msg)
+        if (body_index(self, body) == 0) then
+            call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
+                             error_code%input)
+            return
+        end if
+        if (len_trim(edge) == 0) then
+            call fatal_error(error, where//'edge is required', error_code%input)
+            return
+        end if
+        entry%body = body
+        entry%edge = edge
+        allocate (entry%values(nph))
+        call phase_values(p, .true., 'p', where, nph, entry%values, error)
+    contains
+        subroutine try_pressure(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+            read (text, nml=pressure, iostat=ios, iomsg=msg)
+        end subroutine try_pressure
+    end subroutine read_pressure
+
+    !> Values at the end of each phase: exactly one per phase when given; all
+    !> zero when the component is prescribed but no value is given.
+    subroutine phase_values(raw, used, name, where, nph, values, error)
+        real(dp), intent(in) :: raw(:)
+        logical, intent(in) :: used
+        character(len=*), intent(in) :: name, where
+        integer, intent(in) :: nph
+        real(dp), intent(out) :: values(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        character(len=128) :: msg
+        values = 0.0_dp
+        n = count(raw /= unset)
+        if (n == 0) return
+        if (.not. used) then
+            call fatal_error(error, where//name//' is given but its component is not fixed', &
+                             error_code%input)
+            return
+        end if
+        if (n /= nph .or. any(raw(1:nph) == unset)) then
+            write (msg, '(a,i0,a)') ' needs one value per load phase (', nph, ' phases in &solver n_steps)'
+            call fatal_error(error, where//name//trim(msg), error_code%input)
+            return
+        end if
+        if (.not. all(ieee_is_finite(raw(1:nph)))) then
+            call fatal_error(error, where//name//' must be finite', error_code%input)
+            return
+        end if
+        values = raw(1:nph)
+    end subroutine phase_values
+
     !> The entries the file set, which must be a leading block of the array.
     subroutine take_knots(raw, name, where, knots, error)
         real(dp), intent(in) :: raw(:)
@@ -273,141 +600,5 @@ contains
         end if
         knots = raw(1:n)
     end subroutine take_knots
-
-    !> Error for a namelist group that could not be read. The group's text is
-    !> re-read one assignment at a time through `try` to name the variable at fault.
-    subroutine group_error(path, group, occurrence, ios, msg, try, error)
-        character(len=*), intent(in) :: path, group
-        !> Which occurrence of the group failed (1 for the first).
-        integer, intent(in) :: occurrence
-        integer, intent(in) :: ios
-        character(len=*), intent(in) :: msg
-        interface
-            subroutine try(text, ios, msg)
-                character(len=*), intent(in) :: text
-                integer, intent(out) :: ios
-                character(len=*), intent(inout) :: msg
-            end subroutine try
-        end interface
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: assignments(:), name
-        character(len=512) :: msg1
-        integer :: k, ios1, eq
-
-        if (is_iostat_end(ios)) then
-            call fatal_error(error, path//': group &'//group//' is missing', error_code%input)
-            return
-        end if
-        call group_assignments(path, group, occurrence, assignments)
-        do k = 1, size(assignments)
-            msg1 = ''
-            call try('&'//group//' '//assignments(k)//' /', ios1, msg1)
-            if (ios1 == 0) cycle
-            eq = index(assignments(k), '=')
-            name = adjustl(assignments(k)(1:max(eq - 1, 0)))
-            name = trim(name)
-            if (index(msg1, 'Cannot match namelist object name '//name) > 0 .or. &
-                index(msg1, 'Cannot match namelist object name '//lower(name)) > 0) then
-                call fatal_error(error, path//': &'//group//": unknown variable '"//name//"'", &
-                                 error_code%input)
-            else
-                call fatal_error(error, path//': &'//group//": variable '"//name// &
-                                 "' has a value of the wrong type or form: "// &
-                                 trim(adjustl(assignments(k)(eq + 1:)))//' ('//trim(msg1)//')', &
-                                 error_code%input)
-            end if
-            return
-        end do
-        call fatal_error(error, path//': &'//group//': '//trim(msg), error_code%input)
-    end subroutine group_error
-
-    !> The `name = value` assignments of the `occurrence`-th group `group` in file
-    !> `path`, one per entry (continuation lines joined). Quoted '=' and '/' are not
-    !> special-cased beyond what our case files contain; good enough for diagnosis.
-    subroutine group_assignments(path, group, occurrence, assignments)
-        character(len=*), intent(in) :: path, group
-        integer, intent(in) :: occurrence
-        character(len=:), allocatable, intent(out) :: assignments(:)
-        character(len=4096) :: line
-        character(len=4096), allocatable :: items(:)
-        character(len=:), allocatable :: t
-        integer :: u, ios, seen, n, width
-        logical :: inside
-
-        allocate (items(0))
-        n = 0
-        seen = 0
-        inside = .false.
-        open (newunit=u, file=path, status='old', action='read', iostat=ios)
-        if (ios /= 0) then
-            allocate (character(len=1) :: assignments(0))
-            return
-        end if
-        do
-            read (u, '(a)', iostat=ios) line
-            if (ios /= 0) exit
-            t = trim(adjustl(strip_comment(line)))
-            if (.not. inside) then
-                if (len(t) > len(group) .and. lower(t(1:min(len(t), len(group) + 1))) == '&'//lower(group)) then
-                    seen = seen + 1
-                    inside = seen == occurrence
-                    t = trim(adjustl(t(len(group) + 2:)))
-                    if (.not. inside) cycle
-                else
-                    cycle
-                end if
-            end if
-            if (len(t) == 0) cycle
-            if (t(len(t):len(t)) == '/') then
-                t = t(1:len(t) - 1)
-                inside = .false.
-            end if
-            if (len_trim(t) > 0) then
-                if (index(t, '=') > 0 .or. n == 0) then
-                    items = [character(len=4096) :: items, t]
-                    n = n + 1
-                else
-                    items(n) = trim(items(n))//' '//t
-                end if
-            end if
-            if (.not. inside .and. seen >= occurrence) exit
-        end do
-        close (u)
-        width = 1
-        if (n > 0) width = max(1, maxval(len_trim(items)))
-        allocate (character(len=width) :: assignments(n))
-        assignments = items
-    end subroutine group_assignments
-
-    !> The line without a trailing '!' comment (outside quotes).
-    pure function strip_comment(line) result(code)
-        character(len=*), intent(in) :: line
-        character(len=:), allocatable :: code
-        integer :: i
-        character :: quote
-        quote = ' '
-        do i = 1, len(line)
-            if (quote /= ' ') then
-                if (line(i:i) == quote) quote = ' '
-            else if (line(i:i) == "'" .or. line(i:i) == '"') then
-                quote = line(i:i)
-            else if (line(i:i) == '!') then
-                code = line(1:i - 1)
-                return
-            end if
-        end do
-        code = line
-    end function strip_comment
-
-    !> Lower-case ASCII.
-    pure function lower(text) result(low)
-        character(len=*), intent(in) :: text
-        character(len=len(text)) :: low
-        integer :: i
-        low = text
-        do i = 1, len(text)
-            if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
-        end do
-    end function lower
 
 end module voiga_io_case

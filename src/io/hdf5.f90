@@ -17,7 +17,7 @@ module voiga_io_hdf5
                     h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
                     h5gcreate_f, h5gclose_f, h5lexists_f, &
                     h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5aexists_f, &
-                    h5aget_type_f, h5aget_space_f, &
+                    h5aget_type_f, h5aget_space_f, h5adelete_f, &
                     h5tcopy_f, h5tclose_f, h5tset_size_f, h5tget_size_f, h5tis_variable_str_f, &
                     H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_STRING, &
                     h5eset_auto_f, h5oopen_f, h5oclose_f
@@ -398,7 +398,7 @@ contains
         call h5oopen_f(self%id, path, oid, st)
     end subroutine open_object
 
-    !> Write (or overwrite is not supported: the attribute must be new) a string attribute.
+    !> Write a string attribute (replacing an existing one).
     subroutine attr_write_str(self, path, name, value)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path, name, value
@@ -407,6 +407,7 @@ contains
         integer :: st
         call open_object(self, path, oid, st)
         if (st /= 0) return
+        call delete_attr(oid, name)
         call h5screate_f(H5S_SCALAR_F, sid, st)
         call h5tcopy_f(H5T_FORTRAN_S1, tid, st)
         call h5tset_size_f(tid, int(max(len(value), 1), size_t), st)
@@ -431,6 +432,7 @@ contains
         integer :: st
         call open_object(self, path, oid, st)
         if (st /= 0) return
+        call delete_attr(oid, name)
         call h5screate_f(H5S_SCALAR_F, sid, st)
         call h5acreate_f(oid, name, H5T_NATIVE_INTEGER, sid, aid, st)
         call h5awrite_f(aid, H5T_NATIVE_INTEGER, value, dims, st)
@@ -448,6 +450,7 @@ contains
         integer :: st
         call open_object(self, path, oid, st)
         if (st /= 0) return
+        call delete_attr(oid, name)
         call h5screate_f(H5S_SCALAR_F, sid, st)
         call h5acreate_f(oid, name, H5T_NATIVE_DOUBLE, sid, aid, st)
         call h5awrite_f(aid, H5T_NATIVE_DOUBLE, value, dims, st)
@@ -455,6 +458,16 @@ contains
         call h5sclose_f(sid, st)
         call h5oclose_f(oid, st)
     end subroutine attr_write_real
+
+    !> Remove attribute `name` of object `oid` if it exists (attributes are overwritten).
+    subroutine delete_attr(oid, name)
+        integer(hid_t), intent(in) :: oid
+        character(len=*), intent(in) :: name
+        logical :: exists
+        integer :: st
+        call h5aexists_f(oid, name, exists, st)
+        if (st == 0 .and. exists) call h5adelete_f(oid, name, st)
+    end subroutine delete_attr
 
     !> Does object `path` have attribute `name`?
     logical function attr_exists(self, path, name)

@@ -116,7 +116,7 @@ BAD_CASES = [
     ("contact_edge = 'outer'", "contact_edge = 'rim'", ["&body 'die'", "contact_edge", "'rim'"]),
     ("name = 'die'", "name = 'anvil'", ["geometry", "anvil"]),
     ("geometry = 'geometry.h5'", "geometry = 'missing.h5'", ["&case", "geometry", "missing.h5"]),
-    ("n_bodies = 2", "n_bodies = 3", ["&body group 3 is missing"]),
+    ("n_bodies = 2", "n_bodies = 3", ["&case", "n_bodies = 3", "2 &body groups"]),
     ("material = 'neo-hookean'", "material = 'rubber'", ["&body 'die'", "material", "'rubber'"]),
     ("degree_xi = 2", "degree_xi = 1", ["&body 'die'", "degree_xi"]),
     ("nel_xi = 6", "nel_xi = 0", ["&body 'die'", "nel_xi"]),

@@ -1,0 +1,155 @@
+!> The result file of a run (schema in docs/hdf5.md): metadata and the
+!> discretization first, then one group per converged step, written and flushed
+!> when the step converges, and a final status.
+module voiga_io_results
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t
+    use voiga_version, only: voiga_version_string
+    use voiga_io_hdf5, only: h5file_t
+    use voiga_io_case, only: case_t
+    use voiga_io_dump, only: write_discretization
+    use voiga_model, only: model_t
+    implicit none
+    private
+
+    public :: results_t, step_record_t, stage_names
+
+    !> Stages whose seconds are recorded per step.
+    character(len=*), parameter :: stage_names(5) = [character(len=13) :: 'assembly', 'contact', &
+                                                     'factorization', 'solve', 'output']
+
+    !> What one converged step reports.
+    type :: step_record_t
+        integer :: step = 0
+        real(dp) :: time = 0.0_dp
+        integer :: iterations = 0
+        !> Residual norm (free DOFs) before each iteration and after the last, [iterations + 1].
+        real(dp), allocatable :: residual_norms(:)
+        !> |du . r| of each iteration, [iterations].
+        real(dp), allocatable :: energy_norms(:)
+        !> Resultant reaction force of each Dirichlet condition, [2, n_dirichlet].
+        real(dp), allocatable :: reactions(:, :)
+        !> Seconds per stage (order of `stage_names`).
+        real(dp) :: seconds(5) = 0.0_dp
+    end type step_record_t
+
+    !> An open result file.
+    type :: results_t
+        type(h5file_t) :: h5
+        integer :: n_written = 0
+    contains
+        procedure :: open => results_open
+        procedure :: write_step => results_write_step
+        procedure :: finish => results_finish
+    end type results_t
+
+contains
+
+    !> Create the file (status 'running') with metadata and the discretization of each body.
+    subroutine results_open(self, case, model, error)
+        class(results_t), intent(inout) :: self
+        type(case_t), intent(in) :: case
+        type(model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, k
+        character(len=:), allocatable :: g
+        character(len=16) :: buf
+        integer, allocatable :: ptr(:), conn(:), vo(:)
+        real(dp), allocatable :: ranges(:, :)
+
+        call self%h5%open(case%output, 'w', error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'voiga_version', voiga_version_string)
+        call self%h5%write_attr('/', 'title', case%title)
+        call self%h5%write_attr('/', 'scene', case%scene)
+        call self%h5%write_attr('/', 'mesh', case%mesh)
+        call self%h5%write_attr('/', 'layout', case%layout)
+        call self%h5%write_attr('/', 'case_file', case%path)
+        call self%h5%write_attr('/', 'status', 'running')
+        call self%h5%write_attr('/', 'n_dofs', model%ndof)
+        call self%h5%write_attr('/', 'n_steps_planned', sum(model%n_steps))
+        call self%h5%write_attr('/', 'n_steps_done', 0)
+        call self%h5%write_attr('/', 'wall_time', 0.0_dp)
+        do i = 1, size(model%bodies)
+            associate (b => model%bodies(i))
+                g = '/bodies/'//trim(b%name)
+                call write_discretization(self%h5, g, b%disc)
+                call self%h5%write_attr(g, 'material', trim(case%bodies(i)%material))
+                call self%h5%write_attr(g, 'youngs_modulus', b%mat%youngs_modulus)
+                call self%h5%write_attr(g, 'poisson_ratio', b%mat%poisson_ratio)
+                call self%h5%write_attr(g, 'dof_offset', b%dof0)
+                call self%h5%write(g//'/control_points', b%disc%x)
+                call self%h5%write(g//'/weights', b%disc%w)
+                allocate (ptr(b%disc%nel + 1), vo(b%disc%nel), ranges(4, b%disc%nel))
+                ptr(1) = 1
+                do k = 1, b%disc%nel
+                    ptr(k + 1) = ptr(k) + size(b%disc%elements(k)%conn)
+                    vo(k) = merge(1, 0, b%disc%elements(k)%span_layer > 0)
+                    ranges(:, k) = [b%disc%elements(k)%xi, b%disc%elements(k)%eta]
+                end do
+                allocate (conn(ptr(b%disc%nel + 1) - 1))
+                do k = 1, b%disc%nel
+                    conn(ptr(k):ptr(k + 1) - 1) = b%disc%elements(k)%conn
+                end do
+                call self%h5%write(g//'/elements/ptr', ptr)
+                call self%h5%write(g//'/elements/conn', conn)
+                call self%h5%write(g//'/elements/vo', vo)
+                call self%h5%write(g//'/elements/range', ranges)
+                do k = 1, 4
+                    call self%h5%write(g//'/edges/'//trim(b%disc%edges(k)%name), b%disc%edges(k)%cps)
+                end do
+                deallocate (ptr, vo, ranges, conn)
+            end associate
+        end do
+        do k = 1, size(model%dirichlet)
+            write (buf, '(i0)') k
+            g = '/dirichlet/'//trim(buf)
+            call self%h5%create_group(g)
+            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name))
+            call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge))
+        end do
+        call self%h5%flush()
+    end subroutine results_open
+
+    !> Write one converged step and the current displacement; flush.
+    subroutine results_write_step(self, rec, u, wall)
+        class(results_t), intent(inout) :: self
+        type(step_record_t), intent(in) :: rec
+        real(dp), intent(in) :: u(:)
+        !> Wall time so far (s).
+        real(dp), intent(in) :: wall
+        character(len=:), allocatable :: g
+        character(len=8) :: buf
+        integer :: k
+
+        write (buf, '(i6.6)') rec%step
+        g = '/steps/'//trim(buf)
+        call self%h5%create_group(g)
+        call self%h5%write_attr(g, 'step', rec%step)
+        call self%h5%write_attr(g, 'time', rec%time)
+        call self%h5%write_attr(g, 'iterations', rec%iterations)
+        do k = 1, size(stage_names)
+            call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k))
+        end do
+        call self%h5%write(g//'/residual_norms', rec%residual_norms)
+        call self%h5%write(g//'/energy_norms', rec%energy_norms)
+        if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
+        call self%h5%write(g//'/displacement', u)
+        self%n_written = self%n_written + 1
+        call self%h5%write_attr('/', 'n_steps_done', self%n_written)
+        call self%h5%write_attr('/', 'wall_time', wall)
+        call self%h5%flush()
+    end subroutine results_write_step
+
+    !> Set the final status ('converged' or 'failed: <reason>') and close.
+    subroutine results_finish(self, status, wall)
+        class(results_t), intent(inout) :: self
+        character(len=*), intent(in) :: status
+        real(dp), intent(in) :: wall
+        if (.not. self%h5%is_open()) return
+        call self%h5%write_attr('/', 'status', status)
+        call self%h5%write_attr('/', 'wall_time', wall)
+        call self%h5%close()
+    end subroutine results_finish
+
+end module voiga_io_results

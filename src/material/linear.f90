@@ -1,0 +1,48 @@
+!> Linear (small-strain) isotropic elasticity, plane strain:
+!> sigma = lambda tr(eps) I + 2 mu eps, eps = sym(grad u).
+module voiga_material_linear
+    use voiga_kinds, only: dp
+    use voiga_material, only: material_t
+    implicit none
+    private
+
+    public :: linear_elastic_t
+
+    !> Small-strain Hooke material.
+    type, extends(material_t) :: linear_elastic_t
+    contains
+        procedure :: stress => linear_stress
+    end type linear_elastic_t
+
+contains
+
+    pure subroutine linear_stress(self, grad_u, s, c, ok)
+        class(linear_elastic_t), intent(in) :: self
+        real(dp), intent(in) :: grad_u(2, 2)
+        real(dp), intent(out) :: s(2, 2), c(2, 2, 2, 2)
+        logical, intent(out) :: ok
+        real(dp) :: eps(2, 2)
+        integer :: i, j, k, l
+        eps = 0.5_dp*(grad_u + transpose(grad_u))
+        s = 2.0_dp*self%mu*eps
+        s(1, 1) = s(1, 1) + self%lambda*(eps(1, 1) + eps(2, 2))
+        s(2, 2) = s(2, 2) + self%lambda*(eps(1, 1) + eps(2, 2))
+        do l = 1, 2
+            do k = 1, 2
+                do j = 1, 2
+                    do i = 1, 2
+                        c(i, j, k, l) = self%lambda*delta(i, j)*delta(k, l) + &
+                                        self%mu*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+                    end do
+                end do
+            end do
+        end do
+        ok = .true.
+    end subroutine linear_stress
+
+    pure real(dp) function delta(i, j)
+        integer, intent(in) :: i, j
+        delta = merge(1.0_dp, 0.0_dp, i == j)
+    end function delta
+
+end module voiga_material_linear

@@ -1,0 +1,54 @@
+!> Material laws for plane-strain solids. A law returns, for a displacement
+!> gradient, the stress and the tangent moduli that the element needs:
+!> small strain: Cauchy stress sigma = c : eps with constant c;
+!> finite strain: Kirchhoff stress tau(F) and the spatial tangent c_tau with
+!> L_v tau = c_tau : d (d the rate of deformation), so that the tangent
+!> stiffness is int (grad_x N_a . c_tau . grad_x N_b + grad_x N_a . tau grad_x N_b I) dV.
+!> All in-plane: 2 x 2 stresses, 2 x 2 x 2 x 2 moduli; plane strain means F33 = 1.
+module voiga_material
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: material_t, lame_from_young
+
+    !> A material law.
+    type, abstract :: material_t
+        !> Young's modulus and Poisson's ratio (input), Lame constants and bulk modulus.
+        real(dp) :: youngs_modulus = 0.0_dp, poisson_ratio = 0.0_dp
+        real(dp) :: lambda = 0.0_dp, mu = 0.0_dp, kappa = 0.0_dp
+        !> Does the law need finite-strain kinematics (F, current configuration)?
+        logical :: finite_strain = .false.
+    contains
+        procedure(stress_interface), deferred :: stress
+    end type material_t
+
+    abstract interface
+        !> Stress and tangent for the in-plane displacement gradient `grad_u` = du/dX.
+        !> Small strain: `s` = Cauchy stress, `c` = elasticity tensor (constant).
+        !> Finite strain: `s` = Kirchhoff stress tau, `c` = spatial tangent c_tau.
+        !> `ok` is false when the state is inadmissible (J <= 0).
+        pure subroutine stress_interface(self, grad_u, s, c, ok)
+            import :: material_t, dp
+            class(material_t), intent(in) :: self
+            real(dp), intent(in) :: grad_u(2, 2)
+            real(dp), intent(out) :: s(2, 2), c(2, 2, 2, 2)
+            logical, intent(out) :: ok
+        end subroutine stress_interface
+    end interface
+
+contains
+
+    !> Fill the Lame constants and the bulk modulus from E and nu (3D relations;
+    !> plane strain uses them unchanged).
+    pure subroutine lame_from_young(self, youngs_modulus, poisson_ratio)
+        class(material_t), intent(inout) :: self
+        real(dp), intent(in) :: youngs_modulus, poisson_ratio
+        self%youngs_modulus = youngs_modulus
+        self%poisson_ratio = poisson_ratio
+        self%mu = youngs_modulus/(2.0_dp*(1.0_dp + poisson_ratio))
+        self%lambda = youngs_modulus*poisson_ratio/((1.0_dp + poisson_ratio)*(1.0_dp - 2.0_dp*poisson_ratio))
+        self%kappa = youngs_modulus/(3.0_dp*(1.0_dp - 2.0_dp*poisson_ratio))
+    end subroutine lame_from_young
+
+end module voiga_material

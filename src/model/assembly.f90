@@ -1,0 +1,228 @@
+!> Assembly of the internal force, the tangent stiffness and the external
+!> (pressure) forces of all bodies.
+module voiga_model_assembly
+    use voiga_kinds, only: dp, i8
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_model, only: model_t, body_t, phase_value
+    use voiga_discretization_element, only: element_basis, element_nfun
+    use voiga_element_quadrature, only: gauss_legendre
+    use voiga_element_solid, only: solid_point, reference_gradients
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    implicit none
+    private
+
+    public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
+
+    !> What the assembly did (to show that a scene simulates only what it asks for).
+    type :: assembly_stats_t
+        !> Quadrature points evaluated with a finite-strain / small-strain law.
+        integer(i8) :: finite_strain_points = 0, small_strain_points = 0
+    end type assembly_stats_t
+
+contains
+
+    !> Global DOFs of element `e` of `body`, local order 2(a-1)+i, shape [2 nen].
+    pure function body_dofs(body, e) result(dofs)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        integer :: dofs(2*size(body%disc%elements(e)%conn))
+        integer :: a
+        associate (conn => body%disc%elements(e)%conn)
+            do a = 1, size(conn)
+                dofs(2*a - 1) = body%dof0 + 2*conn(a) - 1
+                dofs(2*a) = body%dof0 + 2*conn(a)
+            end do
+        end associate
+    end function body_dofs
+
+    !> Internal force `fe` [2 nen] and tangent `ke` [2 nen, 2 nen] of element `e`
+    !> of `body` for the global displacement vector `u`. `ok` is false if the
+    !> Jacobian of the deformation is not positive at some quadrature point.
+    pure subroutine body_element(body, e, u, fe, ke, ok)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(out) :: fe(:), ke(:, :)
+        logical, intent(out) :: ok
+        real(dp) :: gx(body%n_gauss(1)), wx(body%n_gauss(1)), ge(body%n_gauss(2)), we(body%n_gauss(2))
+        real(dp), allocatable :: r(:), dr(:, :), d2r(:, :), dndx(:, :), x0(:, :), ue(:, :)
+        integer, allocatable :: dofs(:)
+        real(dp) :: xi, eta, det, hx, he
+        integer :: nen, i, j
+
+        nen = element_nfun(body%disc, e)
+        allocate (r(nen), dr(2, nen), d2r(3, nen), dndx(2, nen))
+        dofs = body_dofs(body, e)
+        x0 = body%disc%x(:, body%disc%elements(e)%conn)
+        ue = reshape(u(dofs), [2, nen])
+        call gauss_legendre(body%n_gauss(1), gx, wx)
+        call gauss_legendre(body%n_gauss(2), ge, we)
+        fe = 0.0_dp
+        ke = 0.0_dp
+        ok = .true.
+        associate (el => body%disc%elements(e))
+            hx = 0.5_dp*(el%xi(2) - el%xi(1))
+            he = 0.5_dp*(el%eta(2) - el%eta(1))
+            do j = 1, size(ge)
+                eta = el%eta(1) + he*(ge(j) + 1.0_dp)
+                do i = 1, size(gx)
+                    xi = el%xi(1) + hx*(gx(i) + 1.0_dp)
+                    call element_basis(body%disc, e, xi, eta, r, dr, d2r)
+                    call reference_gradients(x0, dr, dndx, det)
+                    call solid_point(body%mat, dndx, ue, wx(i)*we(j)*hx*he*abs(det), fe, ke, ok)
+                    if (.not. ok) return
+                end do
+            end do
+        end associate
+    end subroutine body_element
+
+    !> The stiffness pattern of all bodies (every element couples its DOFs).
+    subroutine stiffness_pattern(model, k, error)
+        type(model_t), intent(in) :: model
+        type(csc_matrix_t), intent(out) :: k
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: ptr(:), dofs(:)
+        integer :: ib, e, nel, n, pos
+
+        nel = 0
+        n = 0
+        do ib = 1, size(model%bodies)
+            nel = nel + model%bodies(ib)%disc%nel
+            do e = 1, model%bodies(ib)%disc%nel
+                n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
+            end do
+        end do
+        allocate (ptr(nel + 1), dofs(n))
+        ptr(1) = 1
+        pos = 0
+        do ib = 1, size(model%bodies)
+            do e = 1, model%bodies(ib)%disc%nel
+                pos = pos + 1
+                n = 2*size(model%bodies(ib)%disc%elements(e)%conn)
+                ptr(pos + 1) = ptr(pos) + n
+                dofs(ptr(pos):ptr(pos + 1) - 1) = body_dofs(model%bodies(ib), e)
+            end do
+        end do
+        call new_csc_pattern(k, model%ndof, ptr, dofs, error)
+    end subroutine stiffness_pattern
+
+    !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
+    !> Fails with a numeric error if J <= 0 at a quadrature point.
+    subroutine assemble(model, u, t, r, stats, error, k)
+        type(model_t), intent(in) :: model
+        real(dp), intent(in) :: u(:)
+        !> Load time (for the external forces).
+        real(dp), intent(in) :: t
+        real(dp), intent(out) :: r(:)
+        type(assembly_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout), optional :: k
+        real(dp), allocatable :: fe(:), ke(:, :)
+        integer, allocatable :: dofs(:)
+        integer :: ib, e, n, npts
+        logical :: ok
+        character(len=64) :: buf
+
+        r = 0.0_dp
+        if (present(k)) call k%zero()
+        do ib = 1, size(model%bodies)
+            associate (body => model%bodies(ib))
+                npts = product(body%n_gauss)
+                do e = 1, body%disc%nel
+                    n = 2*size(body%disc%elements(e)%conn)
+                    if (allocated(fe)) then
+                        if (size(fe) /= n) deallocate (fe, ke)
+                    end if
+                    if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
+                    call body_element(body, e, u, fe, ke, ok)
+                    if (.not. ok) then
+                        write (buf, '(a,i0)') ' element ', e
+                        call fatal_error(error, "body '"//trim(body%name)//"'"//trim(buf)// &
+                                         ': the deformation is inverted (J <= 0 at a quadrature point)', &
+                                         error_code%numeric)
+                        return
+                    end if
+                    dofs = body_dofs(body, e)
+                    r(dofs) = r(dofs) + fe
+                    if (present(k)) call k%add_element(dofs, ke)
+                end do
+                if (body%mat%finite_strain) then
+                    stats%finite_strain_points = stats%finite_strain_points + int(npts, i8)*body%disc%nel
+                else
+                    stats%small_strain_points = stats%small_strain_points + int(npts, i8)*body%disc%nel
+                end if
+            end associate
+        end do
+        block
+            real(dp), allocatable :: fext(:)
+            allocate (fext(size(r)))
+            call external_forces(model, t, fext)
+            r = r - fext
+        end block
+    end subroutine assemble
+
+    !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the
+    !> reference edge, N the outward unit normal.
+    subroutine external_forces(model, t, f)
+        type(model_t), intent(in) :: model
+        real(dp), intent(in) :: t
+        real(dp), intent(out) :: f(:)
+        real(dp), allocatable :: gx(:), wx(:), r(:), dr(:, :), d2r(:, :), x0(:, :)
+        integer, allocatable :: dofs(:)
+        real(dp) :: p, s, tang(2), inward(2), normal(2), xi, eta, h, jac(2, 2)
+        integer :: k, e, i, a, nen, dir, ng
+        logical :: on_edge
+
+        f = 0.0_dp
+        do k = 1, size(model%pressure)
+            p = phase_value(model%pressure(k)%values, t)
+            if (p == 0.0_dp) cycle
+            associate (body => model%bodies(model%pressure(k)%body), edge => model%pressure(k)%edge)
+                ! along xi for the eta edges (3, 4), along eta for the xi edges (1, 2)
+                dir = merge(1, 2, edge >= 3)
+                ng = body%n_gauss(dir)
+                allocate (gx(ng), wx(ng))
+                call gauss_legendre(ng, gx, wx)
+                do e = 1, body%disc%nel
+                    associate (el => body%disc%elements(e))
+                        select case (edge)
+                        case (1); on_edge = el%ix == 1
+                        case (2); on_edge = el%ix == body%disc%nel_xi
+                        case (3); on_edge = el%ie == 1
+                        case default; on_edge = el%ie == body%disc%nel_eta
+                        end select
+                        if (.not. on_edge) cycle
+                        nen = element_nfun(body%disc, e)
+                        allocate (r(nen), dr(2, nen), d2r(3, nen))
+                        x0 = body%disc%x(:, el%conn)
+                        dofs = body_dofs(body, e)
+                        h = 0.5_dp*merge(el%xi(2) - el%xi(1), el%eta(2) - el%eta(1), dir == 1)
+                        do i = 1, ng
+                            s = merge(el%xi(1), el%eta(1), dir == 1) + h*(gx(i) + 1.0_dp)
+                            select case (edge)
+                            case (1); xi = el%xi(1); eta = s
+                            case (2); xi = el%xi(2); eta = s
+                            case (3); xi = s; eta = el%eta(1)
+                            case default; xi = s; eta = el%eta(2)
+                            end select
+                            call element_basis(body%disc, e, xi, eta, r, dr, d2r)
+                            jac = matmul(x0, transpose(dr))
+                            tang = jac(:, dir)
+                            ! the other parametric direction points inward at a 0-edge
+                            inward = jac(:, 3 - dir)*merge(1.0_dp, -1.0_dp, edge == 1 .or. edge == 3)
+                            normal = [tang(2), -tang(1)]/norm2(tang)
+                            if (dot_product(normal, inward) > 0.0_dp) normal = -normal
+                            do a = 1, nen
+                                f(dofs(2*a - 1:2*a)) = f(dofs(2*a - 1:2*a)) - &
+                                                       p*r(a)*normal*norm2(tang)*wx(i)*h
+                            end do
+                        end do
+                        deallocate (r, dr, d2r)
+                    end associate
+                end do
+                deallocate (gx, wx)
+            end associate
+        end do
+    end subroutine external_forces
+
+end module voiga_model_assembly
