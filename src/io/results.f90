@@ -107,7 +107,11 @@ contains
             call self%h5%create_group(g)
             call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name))
             call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge))
+            call self%h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)))
+            call self%h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)))
+            call self%h5%write(g//'/values', model%dirichlet(k)%values)
         end do
+        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)')
         call self%h5%flush()
     end subroutine results_open
 

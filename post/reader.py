@@ -1,0 +1,372 @@
+"""Reading voiga result files (schema: ``docs/hdf5.md``).
+
+This is the only module that opens result files. :func:`read_result` returns
+plain dataclasses holding numpy arrays in *natural* order, whatever h5py
+shows for the Fortran arrays:
+
+- control points ``(ncp, 2)``, reactions ``(n_dirichlet, 2)``, element ranges
+  ``(nel, 4)``, the bulk patch ``(n_eta, n_xi, 2)`` (``docs/formats.md``);
+- every id is **0-based**: element connectivity, element pointers, edge
+  control point ids, :attr:`Body.dof_offset` (the index of the body's first
+  DOF in a step's global displacement vector);
+- byte-string attributes are decoded to ``str`` (trailing blanks and NULs of
+  Fortran fixed-length strings removed), scalar attributes to ``int`` /
+  ``float``.
+
+Files of runs that are still going (status ``'running'``) or that failed
+(``'failed: <reason>'``) are read as well: they hold the converged steps
+written so far. A step group without its displacement (a run killed while
+writing it) is skipped with a warning.
+
+Step selection (:meth:`Result.select_step`, :func:`body_displacement`, the
+``--step`` option of the command line): ``n >= 1`` is the step *number* (the
+``step`` attribute), ``n < 0`` counts converged steps from the end (``-1`` is
+the last one), ``0`` is the reference configuration (zero displacement).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from pre.h5io import read_curve, read_patch
+from pre.nurbs import Curve, Patch
+
+STAGES: tuple[str, ...] = ("assembly", "contact", "factorization", "solve", "output")
+"""Stages whose wall-clock seconds each step records (attrs ``seconds_<stage>``)."""
+
+
+def decode(value: Any) -> Any:
+    """An HDF5 attribute value as a Python ``str`` / ``int`` / ``float`` (or array)."""
+    if isinstance(value, (bytes, np.bytes_)):
+        return value.decode("ascii", errors="replace").rstrip("\x00 ")
+    if isinstance(value, str):
+        return value.rstrip("\x00 ")
+    if isinstance(value, np.ndarray):
+        if value.shape in ((), (1,)):
+            return decode(value.reshape(-1)[0])
+        if value.dtype.kind in "SO":
+            return [decode(v) for v in value.reshape(-1)]
+        return value
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def _attrs(obj: h5py.HLObject) -> dict[str, Any]:
+    return {k: decode(v) for k, v in obj.attrs.items()}
+
+
+@dataclass
+class Body:
+    """One body: its material, numbering, elements, edges and discretization."""
+
+    name: str
+    material: str
+    youngs_modulus: float
+    poisson_ratio: float
+    dof_offset: int
+    """0-based index of the body's first DOF in the global displacement vector."""
+    control_points: np.ndarray
+    """(ncp, 2) reference control points, body-local numbering (0-based row = id)."""
+    weights: np.ndarray
+    """(ncp,)"""
+    element_ptr: np.ndarray
+    """(nel + 1,) 0-based: element k uses ``element_conn[element_ptr[k]:element_ptr[k+1]]``."""
+    element_conn: np.ndarray
+    """0-based control point ids; per element: bulk tensor products (xi fastest), then layer."""
+    element_ranges: np.ndarray
+    """(nel, 4): xi_a, xi_b, eta_a, eta_b of each element."""
+    element_vo: np.ndarray
+    """(nel,) bool: True for a varying-order (contact row) element."""
+    edges: dict[str, np.ndarray]
+    """edge name -> 0-based control point ids on the edge."""
+    bulk: Patch
+    """The refined bulk patch (contact edge at eta = 1)."""
+    layer: Curve | None
+    """The VO layer curve, or None."""
+    attrs: dict[str, Any] = field(default_factory=dict)
+    """Every attribute of ``/bodies/<name>`` (decoded)."""
+
+    @property
+    def ncp(self) -> int:
+        """Number of control points."""
+        return len(self.weights)
+
+    @property
+    def n_elements(self) -> int:
+        """Number of elements."""
+        return len(self.element_ptr) - 1
+
+    @property
+    def dofs(self) -> slice:
+        """The body's DOFs in the global vector (x, y interleaved)."""
+        return slice(self.dof_offset, self.dof_offset + 2 * self.ncp)
+
+    def element(self, k: int) -> np.ndarray:
+        """0-based control point ids of element ``k`` (0-based)."""
+        return self.element_conn[self.element_ptr[k]:self.element_ptr[k + 1]]
+
+
+@dataclass
+class Dirichlet:
+    """A Dirichlet condition (``/dirichlet/<k>``), in case-file order."""
+
+    body: str
+    edge: str
+
+
+@dataclass
+class Step:
+    """One converged load step."""
+
+    step: int
+    time: float
+    iterations: int
+    residual_norms: np.ndarray
+    """(iterations + 1,) ||r|| on free DOFs before each iteration and after the last."""
+    energy_norms: np.ndarray
+    """(iterations,) |du . r| of each iteration."""
+    reactions: np.ndarray
+    """(n_dirichlet, 2) resultant reaction (x, y) of each Dirichlet condition."""
+    seconds: dict[str, float]
+    """stage (``STAGES``) -> wall-clock seconds."""
+    displacement: np.ndarray
+    """(n_dofs,) control point displacements, global numbering, x/y interleaved."""
+
+
+@dataclass
+class Result:
+    """Everything in one result file."""
+
+    path: Path
+    attrs: dict[str, Any]
+    """Every root attribute (decoded)."""
+    bodies: dict[str, Body]
+    """Bodies in global DOF order (increasing ``dof_offset``)."""
+    dirichlet: list[Dirichlet]
+    steps: list[Step]
+    """Converged steps sorted by step number."""
+
+    def _attr(self, key: str, default: Any = "") -> Any:
+        return self.attrs.get(key, default)
+
+    @property
+    def title(self) -> str:
+        return str(self._attr("title"))
+
+    @property
+    def status(self) -> str:
+        """``'running'``, ``'converged'`` or ``'failed: <reason>'``."""
+        return str(self._attr("status"))
+
+    @property
+    def scene(self) -> str:
+        return str(self._attr("scene"))
+
+    @property
+    def mesh(self) -> str:
+        return str(self._attr("mesh"))
+
+    @property
+    def layout(self) -> str:
+        return str(self._attr("layout"))
+
+    @property
+    def case_file(self) -> str:
+        return str(self._attr("case_file"))
+
+    @property
+    def voiga_version(self) -> str:
+        return str(self._attr("voiga_version"))
+
+    @property
+    def n_dofs(self) -> int:
+        return int(self._attr("n_dofs", 0))
+
+    @property
+    def n_steps_planned(self) -> int:
+        return int(self._attr("n_steps_planned", 0))
+
+    @property
+    def n_steps_done(self) -> int:
+        return int(self._attr("n_steps_done", 0))
+
+    @property
+    def wall_time(self) -> float:
+        return float(self._attr("wall_time", 0.0))
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "converged"
+
+    @property
+    def failed(self) -> bool:
+        return self.status.startswith("failed")
+
+    @property
+    def failure_reason(self) -> str | None:
+        """The reason after ``'failed: '``, or None when the run did not fail."""
+        return self.status.partition(":")[2].strip() if self.failed else None
+
+    def body(self, name: str | Body) -> Body:
+        """The body called ``name`` (a :class:`Body` is returned as is)."""
+        if isinstance(name, Body):
+            return name
+        try:
+            return self.bodies[name]
+        except KeyError:
+            raise KeyError(f"no body {name!r} in {self.path} "
+                           f"(bodies: {list(self.bodies)})") from None
+
+    def select_step(self, step: int) -> Step | None:
+        """Step ``step`` (>= 1: step number; < 0: from the end; 0: None = reference)."""
+        if step == 0:
+            return None
+        if step < 0:
+            if -step > len(self.steps):
+                raise IndexError(f"{self.path}: step index {step} but only "
+                                 f"{len(self.steps)} converged step(s) (status {self.status!r})")
+            return self.steps[step]
+        for s in self.steps:
+            if s.step == step:
+                return s
+        raise IndexError(f"{self.path}: no converged step {step} "
+                         f"(have {[s.step for s in self.steps]}, status {self.status!r})")
+
+    def dirichlet_index(self, body: str, edge: str) -> int:
+        """0-based index of the Dirichlet condition on ``body``'s ``edge``."""
+        for k, d in enumerate(self.dirichlet):
+            if d.body == body and d.edge == edge:
+                return k
+        raise KeyError(f"no Dirichlet condition on {body}/{edge}")
+
+
+def _open(path: Path) -> h5py.File:
+    """Open read-only; a file still held by a running voiga is opened without
+    HDF5 file locking (it flushes after every step)."""
+    try:
+        return h5py.File(path, "r")
+    except OSError as err:
+        if not path.is_file():
+            raise FileNotFoundError(f"no result file {path}") from err
+        try:
+            return h5py.File(path, "r", locking=False)
+        except (OSError, TypeError):
+            raise err from None
+
+
+def _read_body(name: str, g: h5py.Group) -> Body:
+    attrs = _attrs(g)
+    cp = np.asarray(g["control_points"][()], dtype=float)
+    if cp.ndim != 2 or cp.shape[1] != 2:
+        raise ValueError(f"/bodies/{name}/control_points: shape {cp.shape}, expected (ncp, 2)")
+    ncp = len(cp)
+    e = g["elements"]
+    ptr = np.asarray(e["ptr"][()], dtype=np.int64) - 1
+    conn = np.asarray(e["conn"][()], dtype=np.int64) - 1
+    ranges = np.asarray(e["range"][()], dtype=float).reshape(-1, 4)
+    vo = np.asarray(e["vo"][()]).astype(bool)
+    nel = len(ptr) - 1
+    if ptr[0] != 0 or ptr[-1] != len(conn) or np.any(np.diff(ptr) <= 0):
+        raise ValueError(f"/bodies/{name}/elements/ptr is not a valid 1-based pointer array")
+    if len(ranges) != nel or len(vo) != nel:
+        raise ValueError(f"/bodies/{name}/elements: {nel} elements in ptr but range "
+                         f"{len(ranges)}, vo {len(vo)}")
+    if len(conn) and (conn.min() < 0 or conn.max() >= ncp):
+        raise ValueError(f"/bodies/{name}/elements/conn: ids outside 1..{ncp}")
+    edges = {k: np.asarray(v[()], dtype=np.int64).reshape(-1) - 1 for k, v in g["edges"].items()} \
+        if "edges" in g else {}
+    return Body(name=name, material=str(attrs.get("material", "")),
+                youngs_modulus=float(attrs.get("youngs_modulus", np.nan)),
+                poisson_ratio=float(attrs.get("poisson_ratio", np.nan)),
+                dof_offset=int(attrs.get("dof_offset", 0)),
+                control_points=cp, weights=np.asarray(g["weights"][()], dtype=float).reshape(-1),
+                element_ptr=ptr, element_conn=conn, element_ranges=ranges, element_vo=vo,
+                edges=edges, bulk=read_patch(g["bulk"]),
+                layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs)
+
+
+def _read_step(name: str, g: h5py.Group, n_dirichlet: int) -> Step | None:
+    if "displacement" not in g:
+        warnings.warn(f"step group /steps/{name} has no displacement (incomplete); skipped",
+                      stacklevel=3)
+        return None
+    a = _attrs(g)
+    iterations = int(a.get("iterations", 0))
+    reactions = np.asarray(g["reactions"][()], dtype=float).reshape(-1, 2) if "reactions" in g \
+        else np.zeros((0, 2))
+    if len(reactions) != n_dirichlet:
+        raise ValueError(f"/steps/{name}/reactions: {len(reactions)} rows for "
+                         f"{n_dirichlet} Dirichlet conditions")
+    return Step(step=int(a.get("step", int(name))), time=float(a.get("time", np.nan)),
+                iterations=iterations,
+                residual_norms=np.asarray(g["residual_norms"][()], dtype=float).reshape(-1)
+                if "residual_norms" in g else np.zeros(0),
+                energy_norms=np.asarray(g["energy_norms"][()], dtype=float).reshape(-1)
+                if "energy_norms" in g else np.zeros(0),
+                reactions=reactions,
+                seconds={k[len("seconds_"):]: float(v) for k, v in a.items()
+                         if k.startswith("seconds_")},
+                displacement=np.asarray(g["displacement"][()], dtype=float).reshape(-1))
+
+
+def read_result(path: str | Path) -> Result:
+    """Read a result file (any status) into a :class:`Result`."""
+    path = Path(path)
+    with _open(path) as f:
+        attrs = _attrs(f)
+        bodies = [_read_body(name, g) for name, g in f["bodies"].items()] if "bodies" in f else []
+        bodies.sort(key=lambda b: b.dof_offset)
+        dirichlet = []
+        if "dirichlet" in f:
+            for key in sorted(f["dirichlet"], key=int):
+                a = _attrs(f["dirichlet"][key])
+                dirichlet.append(Dirichlet(body=str(a.get("body", "")),
+                                           edge=str(a.get("edge", ""))))
+        steps = []
+        if "steps" in f:
+            for key, g in f["steps"].items():
+                s = _read_step(key, g, len(dirichlet))
+                if s is not None:
+                    steps.append(s)
+        steps.sort(key=lambda s: s.step)
+    result = Result(path=path, attrs=attrs, bodies={b.name: b for b in bodies},
+                    dirichlet=dirichlet, steps=steps)
+    n_dofs = result.n_dofs or sum(2 * b.ncp for b in bodies)
+    for b in bodies:
+        if b.dof_offset < 0 or b.dofs.stop > n_dofs:
+            raise ValueError(f"{path}: body {b.name!r} DOFs {b.dofs.start}..{b.dofs.stop - 1} "
+                             f"outside 0..{n_dofs - 1}")
+    for s in steps:
+        if len(s.displacement) != n_dofs:
+            raise ValueError(f"{path}: step {s.step} displacement has {len(s.displacement)} "
+                             f"entries, n_dofs = {n_dofs}")
+    return result
+
+
+def body_displacement(result: Result, body: str | Body, step: int = -1) -> np.ndarray:
+    """(ncp, 2) displacement of the control points of ``body`` at ``step``
+    (step selection as in :meth:`Result.select_step`; 0 gives zeros)."""
+    b = result.body(body)
+    s = result.select_step(step)
+    if s is None:
+        return np.zeros((b.ncp, 2))
+    return s.displacement[b.dofs].reshape(b.ncp, 2).copy()
+
+
+def reaction_history(result: Result, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(times (n_steps,), reactions (n_steps, 2))`` of Dirichlet condition
+    ``k`` (0-based index into ``result.dirichlet``) over the converged steps."""
+    if not -len(result.dirichlet) <= k < len(result.dirichlet):
+        raise IndexError(f"Dirichlet index {k}: the file has {len(result.dirichlet)} condition(s)")
+    times = np.array([s.time for s in result.steps], dtype=float)
+    forces = np.array([s.reactions[k] for s in result.steps], dtype=float).reshape(-1, 2)
+    return times, forces

@@ -1,0 +1,217 @@
+"""Fixtures: small result files written by the voiga binary in temporary
+folders, and synthetic bodies (no binary needed) built with ``pre``.
+
+The binary is ``$VOIGA_BIN``, else ``build/install/bin/voiga`` under the repo
+root. Without it the tests that need a result file skip, except under CI
+(``CI`` set), where they fail.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from post.reader import Body
+from pre.refine import BodyDiscretization, discretize_case
+
+REPO = Path(__file__).resolve().parents[2]
+CASES = REPO / "cases"
+TIMEOUT = 120  # seconds per run
+
+NU = 0.3
+STRAIN = 0.01  # slab stretch: u_x = STRAIN t x at load time t (right edge: 0.09 t)
+
+SLAB = """&body
+  name = 'slab', material = '{material}', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 8, nel_eta = 2, contact_edge = 'top',
+  layer_degree = 2, layer_elevations = 2
+/
+"""
+
+STRETCH = """&case
+  title = 'slab stretch', geometry = 'geometry.h5', output = 'stretch.h5', n_bodies = 1
+/
+""" + SLAB.format(material="linear") + """&solver
+  n_steps = 2
+/
+&dirichlet
+  body = 'slab', edge = 'left', fix_x = .true., ux = 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_y = .true., uy = 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'right', fix_x = .true., ux = 0.09
+/
+"""
+
+# Two bodies, two load phases: the die (no VO layer, curved, rational) is
+# translated rigidly by its inner edge, (0.1, -0.05) then (0.2, -0.1); the
+# slab (VO layer) is stretched as above, 0.09 then 0.18 at the right edge.
+DIE_SHIFT = (0.2, -0.1)
+TWO_BODIES = """&case
+  title = 'die shift and slab stretch', scene = 'ironing', mesh = 'm1', layout = 'mixed',
+  geometry = 'geometry.h5', output = 'two.h5', n_bodies = 2
+/
+&body
+  name = 'die', material = 'linear', youngs_modulus = 10.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 6, nel_eta = 1, contact_edge = 'outer',
+  layer_degree = 0
+/
+""" + SLAB.format(material="linear") + """&solver
+  n_steps = 2, 1
+/
+&dirichlet
+  body = 'die', edge = 'inner', fix_x = .true., fix_y = .true., ux = 0.1, 0.2, uy = -0.05, -0.1
+/
+&dirichlet
+  body = 'slab', edge = 'left', fix_x = .true., ux = 0.0, 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_y = .true., uy = 0.0, 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'right', fix_x = .true., ux = 0.09, 0.18
+/
+"""
+
+# A neo-Hookean slab pushed to less than nothing in phase 2: step 1 converges,
+# step 2 inverts the elements, the run fails with exit code 3.
+CRUSH = """&case
+  title = 'slab crush', geometry = 'geometry.h5', output = 'crush.h5', n_bodies = 1
+/
+""" + SLAB.format(material="neo-hookean") + """&solver
+  n_steps = 1, 1, max_iterations = 5
+/
+&dirichlet
+  body = 'slab', edge = 'left', fix_x = .true., ux = 0.0, 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_y = .true., uy = 0.0, 0.0
+/
+&dirichlet
+  body = 'slab', edge = 'right', fix_x = .true., ux = 0.01, -10.0
+/
+"""
+
+
+def exact_stretch(x: np.ndarray, time: float) -> np.ndarray:
+    """Exact displacement of the linear (plane strain) slab stretch at ``x`` (..., 2)."""
+    x = np.asarray(x, dtype=float)
+    ux = STRAIN * time * x[..., 0]
+    uy = -NU / (1 - NU) * STRAIN * time * (x[..., 1] + 3.0)
+    return np.stack([ux, uy], axis=-1)
+
+
+def _voiga_bin() -> Path | None:
+    env = os.environ.get("VOIGA_BIN")
+    path = Path(env) if env else REPO / "build" / "install" / "bin" / "voiga"
+    return path if path.is_file() and os.access(path, os.X_OK) else None
+
+
+@pytest.fixture(scope="session")
+def voiga() -> Path:
+    """The voiga binary (skip without it; fail under CI)."""
+    path = _voiga_bin()
+    if path is None:
+        where = os.environ.get("VOIGA_BIN") or "build/install/bin/voiga"
+        _skip_or_fail(f"voiga binary not found ({where}); run `make build` or set VOIGA_BIN")
+    return path
+
+
+def _skip_or_fail(msg: str) -> None:
+    if os.environ.get("CI"):
+        pytest.fail(msg)
+    pytest.skip(msg)
+
+
+def run_case(voiga: Path, folder: Path, text: str, output: str, expect: int = 0) -> Path:
+    """Write ``case.nml`` (and the ironing geometry) into ``folder``, run
+    ``voiga case.nml --quiet`` there, check the exit code; returns the result
+    file. A binary built before the solver existed skips (fails under CI)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    shutil.copy(CASES / "ironing" / "geometry.h5", folder / "geometry.h5")
+    (folder / "case.nml").write_text(text)
+    run = subprocess.run([str(voiga), "case.nml", "--quiet"], cwd=folder, capture_output=True,
+                         text=True, timeout=TIMEOUT, stdin=subprocess.DEVNULL)
+    if run.returncode != expect and "solving is not available" in run.stdout + run.stderr:
+        _skip_or_fail(f"{voiga} has no solver (stale build): run `make build` or set VOIGA_BIN")
+    if run.returncode != expect:
+        pytest.fail(f"voiga exit code {run.returncode} (expected {expect}) in {folder}:\n"
+                    f"{run.stdout[-2000:]}\n{run.stderr[-2000:]}")
+    path = folder / output
+    assert path.is_file(), f"voiga wrote no {output} in {folder}"
+    return path
+
+
+@pytest.fixture(scope="session")
+def stretch_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Result of the one-body slab stretch (VO layer, 2 steps, converged)."""
+    return run_case(voiga, tmp_path_factory.mktemp("stretch"), STRETCH, "stretch.h5")
+
+
+@pytest.fixture(scope="session")
+def two_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Result of the two-body case (die without layer, slab with one; 3 steps)."""
+    return run_case(voiga, tmp_path_factory.mktemp("two"), TWO_BODIES, "two.h5")
+
+
+@pytest.fixture(scope="session")
+def crush_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Result of a run that fails at step 2 (status 'failed: ...', 1 step)."""
+    return run_case(voiga, tmp_path_factory.mktemp("crush"), CRUSH, "crush.h5", expect=3)
+
+
+@pytest.fixture()
+def running_h5(two_h5: Path, tmp_path: Path) -> Path:
+    """The two-body result as a run still going after step 1 would leave it
+    (status 'running', steps 2 and 3 not written yet, n_steps_done = 1)."""
+    path = tmp_path / "running.h5"
+    shutil.copy(two_h5, path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["status"] = np.bytes_(b"running")
+        f.attrs["n_steps_done"] = np.int32(1)
+        del f["steps/000002"], f["steps/000003"]
+    return path
+
+
+def synthetic_body(name: str, disc: BodyDiscretization) -> Body:
+    """A :class:`Body` from a ``pre`` discretization, numbered as voiga does
+    (bulk rows xi fastest, the last row replaced by the layer when there is
+    one); no elements or edges."""
+    bulk, layer = disc.bulk, disc.layer
+    rows = bulk.shape[0] - (layer is not None)
+    cp = bulk.control_points[:rows].reshape(-1, 2)
+    w = bulk.weights[:rows].reshape(-1)
+    if layer is not None:
+        cp = np.concatenate([cp, layer.control_points])
+        w = np.concatenate([w, layer.weights])
+    return Body(name=name, material="linear", youngs_modulus=1.0, poisson_ratio=0.3,
+                dof_offset=0, control_points=cp, weights=w,
+                element_ptr=np.zeros(1, dtype=np.int64), element_conn=np.zeros(0, dtype=np.int64),
+                element_ranges=np.zeros((0, 4)), element_vo=np.zeros(0, dtype=bool), edges={},
+                bulk=bulk, layer=layer)
+
+
+SYNTHETIC_CASES = ["ironing/m1-NN2.2.nml", "ironing/m1-N2.nml", "ironing/m2-NN4.nml",
+                   "hertz/m1-NN3.2.nml", "hertz/m1-L1.nml", "rings/m1-NN2.1.nml"]
+"""Committed cases whose bodies the field tests use (layered and not)."""
+
+
+@pytest.fixture(scope="session")
+def synthetic_bodies() -> dict[str, Body]:
+    """``'<case>:<body>'`` -> synthetic body, for every body of SYNTHETIC_CASES."""
+    out = {}
+    for case in SYNTHETIC_CASES:
+        path = CASES / case
+        if not path.is_file():
+            pytest.skip(f"{path} missing: run `python -m pre cases`")
+        for name, b in discretize_case(path).bodies.items():
+            out[f"{case}:{name}"] = synthetic_body(name, b)
+    return out
