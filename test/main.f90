@@ -9,6 +9,7 @@ program voiga_tests
     use voiga_error, only: error_t
     use voiga_kinds, only: dp
     use test_sparse, only: collect_sparse
+    use test_contact, only: collect_contact
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -20,7 +21,8 @@ program voiga_tests
              new_testsuite('refine', collect_refine), &
              new_testsuite('discretization', collect_discretization), &
              new_testsuite('solid', collect_solid), &
-             new_testsuite('sparse', collect_sparse) &
+             new_testsuite('sparse', collect_sparse), &
+             new_testsuite('contact', collect_contact) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

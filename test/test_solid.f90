@@ -248,7 +248,7 @@ contains
     end subroutine test_global_tangent
 
     subroutine stiffness_of(model, u, k, r, stats, error)
-        type(model_t), intent(in) :: model
+        type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         type(csc_matrix_t), intent(out) :: k
         real(dp), intent(out) :: r(:)

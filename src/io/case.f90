@@ -10,7 +10,7 @@ module voiga_io_case
     implicit none
     private
 
-    public :: case_t, body_input_t, solver_input_t, dirichlet_input_t, pressure_input_t
+    public :: case_t, body_input_t, solver_input_t, dirichlet_input_t, pressure_input_t, contact_input_t
     public :: read_case, resolve_path, known_groups
 
     !> Most explicit knots one direction of one body may list.
@@ -22,8 +22,8 @@ module voiga_io_case
     !> Most load phases.
     integer, parameter :: max_phases = 64
     !> The namelist groups a case file may contain.
-    character(len=*), parameter :: known_groups(5) = [character(len=9) :: 'case', 'body', 'solver', &
-                                                      'dirichlet', 'pressure']
+    character(len=*), parameter :: known_groups(6) = [character(len=9) :: 'case', 'body', 'solver', &
+                                                      'dirichlet', 'pressure', 'contact']
 
     !> One body as the case describes it.
     type :: body_input_t
@@ -66,6 +66,17 @@ module voiga_io_case
         real(dp), allocatable :: values(:)
     end type pressure_input_t
 
+    !> A contact pair (`&contact`).
+    type :: contact_input_t
+        !> Slave body; master body, or 'rigid' for a fixed rigid line.
+        character(len=32) :: slave = '', master = ''
+        !> Rigid line: a point on it and its outward normal.
+        real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
+        real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
+        !> Gauss points per slave contact element (0: layer degree + 1).
+        integer :: n_gauss = 0
+    end type contact_input_t
+
     !> A case.
     type :: case_t
         !> The case file and its folder (with trailing '/', or '').
@@ -77,6 +88,7 @@ module voiga_io_case
         type(solver_input_t) :: solver
         type(dirichlet_input_t), allocatable :: dirichlet(:)
         type(pressure_input_t), allocatable :: pressure(:)
+        type(contact_input_t), allocatable :: contact(:)
     end type case_t
 
 contains
@@ -312,7 +324,8 @@ contains
         do i = 1, size(names)
             if (.not. any(known_groups == names(i))) then
                 call fatal_error(error, path//': unknown namelist group &'//trim(names(i))// &
-                                 ' (known: &case, &body, &solver, &dirichlet, &pressure)', error_code%input)
+                                 ' (known: &case, &body, &solver, &dirichlet, &pressure, &contact)', &
+                                 error_code%input)
                 return
             end if
         end do
@@ -365,6 +378,14 @@ contains
             rewind (u)
             do i = 1, size(self%pressure)
                 call read_pressure(u, path, i, nph, self, self%pressure(i), error)
+                if (allocated(error)) exit
+            end do
+        end if
+        if (.not. allocated(error)) then
+            allocate (self%contact(count(names == 'contact')))
+            rewind (u)
+            do i = 1, size(self%contact)
+                call read_contact(u, path, i, self, self%contact(i), error)
                 if (allocated(error)) exit
             end do
         end if
@@ -548,6 +569,102 @@ contains
             read (text, nml=pressure, iostat=ios, iomsg=msg)
         end subroutine try_pressure
     end subroutine read_pressure
+
+    subroutine read_contact(u, path, k, self, entry, error)
+        integer, intent(in) :: u, k
+        character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: self
+        type(contact_input_t), intent(out) :: entry
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32) :: slave, master
+        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction
+        integer :: n_gauss, ios, ib
+        character(len=512) :: msg
+        character(len=:), allocatable :: where
+        namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
+            friction, n_gauss
+
+        slave = ''
+        master = ''
+        rigid_point = 0.0_dp
+        rigid_normal = [0.0_dp, 1.0_dp]
+        penalty_normal = unset
+        penalty_tangent = unset
+        friction = 0.0_dp
+        n_gauss = 0
+        read (u, nml=contact, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call group_error(path, 'contact', k, ios, msg, try_contact, error)
+            return
+        end if
+        write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        where = path//trim(msg)
+        ib = body_index(self, slave)
+        if (ib == 0) then
+            call fatal_error(error, where//"slave = '"//trim(slave)//"' is not a body of the case", &
+                             error_code%input)
+            return
+        end if
+        if (len_trim(self%bodies(ib)%layout%contact_edge) == 0) then
+            call fatal_error(error, where//"slave = '"//trim(slave)//"' has no contact_edge in its &body", &
+                             error_code%input)
+            return
+        end if
+        if (trim(master) /= 'rigid') then
+            ib = body_index(self, master)
+            if (ib == 0) then
+                call fatal_error(error, where//"master = '"//trim(master)// &
+                                 "' is neither a body of the case nor 'rigid'", error_code%input)
+                return
+            end if
+            if (trim(master) == trim(slave)) then
+                call fatal_error(error, where//'master and slave must be different bodies', error_code%input)
+                return
+            end if
+            if (len_trim(self%bodies(ib)%layout%contact_edge) == 0) then
+                call fatal_error(error, where//"master = '"//trim(master)// &
+                                 "' has no contact_edge in its &body", error_code%input)
+                return
+            end if
+        else
+            if (.not. all(ieee_is_finite(rigid_point)) .or. .not. all(ieee_is_finite(rigid_normal)) .or. &
+                norm2(rigid_normal) <= 0.0_dp) then
+                call fatal_error(error, where//'rigid_point must be finite and rigid_normal finite and '// &
+                                 'nonzero', error_code%input)
+                return
+            end if
+        end if
+        if (penalty_normal == unset) then
+            call fatal_error(error, where//'penalty_normal is required', error_code%input)
+            return
+        end if
+        if (.not. (penalty_normal > 0.0_dp .and. ieee_is_finite(penalty_normal))) then
+            call fatal_error(error, where//'penalty_normal must be finite and > 0', error_code%input)
+            return
+        end if
+        if (.not. (friction >= 0.0_dp .and. ieee_is_finite(friction))) then
+            call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
+            return
+        end if
+        if (penalty_tangent == unset) penalty_tangent = penalty_normal
+        if (friction > 0.0_dp .and. .not. (penalty_tangent > 0.0_dp .and. ieee_is_finite(penalty_tangent))) then
+            call fatal_error(error, where//'penalty_tangent must be finite and > 0', error_code%input)
+            return
+        end if
+        if (n_gauss < 0 .or. n_gauss > 30) then
+            call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
+            return
+        end if
+        entry = contact_input_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
+                                friction, n_gauss)
+    contains
+        subroutine try_contact(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+            read (text, nml=contact, iostat=ios, iomsg=msg)
+        end subroutine try_contact
+    end subroutine read_contact
 
     !> Values at the end of each phase: exactly one per phase when given; all
     !> zero when the component is prescribed but no value is given.

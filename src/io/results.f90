@@ -2,6 +2,7 @@
 !> discretization first, then one group per converged step, written and flushed
 !> when the step converges, and a final status.
 module voiga_io_results
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_version, only: voiga_version_string
@@ -9,6 +10,7 @@ module voiga_io_results
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization
     use voiga_model, only: model_t
+    use voiga_contact_pair, only: contact_pair_t
     implicit none
     private
 
@@ -116,10 +118,12 @@ contains
     end subroutine results_open
 
     !> Write one converged step and the current displacement; flush.
-    subroutine results_write_step(self, rec, u, wall)
+    subroutine results_write_step(self, rec, u, wall, pairs)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
+        !> Contact pairs with the output of their last evaluation.
+        type(contact_pair_t), intent(in) :: pairs(:)
         !> Wall time so far (s).
         real(dp), intent(in) :: wall
         character(len=:), allocatable :: g
@@ -139,11 +143,57 @@ contains
         call self%h5%write(g//'/energy_norms', rec%energy_norms)
         if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
         call self%h5%write(g//'/displacement', u)
+        do k = 1, size(pairs)
+            call write_contact(self%h5, g, k, pairs(k))
+        end do
         self%n_written = self%n_written + 1
         call self%h5%write_attr('/', 'n_steps_done', self%n_written)
         call self%h5%write_attr('/', 'wall_time', wall)
         call self%h5%flush()
     end subroutine results_write_step
+
+    !> Per-slave-point contact output of pair `k` under step group `g`.
+    subroutine write_contact(h5, g, k, pair)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: g
+        integer, intent(in) :: k
+        type(contact_pair_t), intent(in) :: pair
+        character(len=:), allocatable :: c
+        character(len=8) :: buf
+        integer :: i, n
+        real(dp), allocatable :: a2(:, :), a1(:)
+        integer, allocatable :: st(:)
+
+        write (buf, '(i0)') k
+        c = g//'/contact/'//trim(buf)
+        n = size(pair%out)
+        call h5%create_group(c)
+        call h5%write_attr(c, 'slave', trim(pair%slave_name))
+        call h5%write_attr(c, 'master', trim(pair%master_name))
+        call h5%write(c//'/force', pair%force)
+        allocate (a2(2, n), a1(n), st(n))
+        do i = 1, n
+            a2(:, i) = pair%out(i)%x0
+        end do
+        call h5%write(c//'/x_ref', a2)
+        do i = 1, n
+            a2(:, i) = pair%out(i)%x
+        end do
+        call h5%write(c//'/x', a2)
+        a1 = pair%out%gap
+        ! no orthogonal projection onto the master: NaN
+        where (a1 > 1.0e300_dp) a1 = ieee_value(1.0_dp, ieee_quiet_nan)
+        call h5%write(c//'/gap', a1)
+        a1 = pair%out%pn
+        call h5%write(c//'/p_n', a1)
+        a1 = pair%out%pt
+        call h5%write(c//'/p_t', a1)
+        a1 = pair%out%xi_m
+        call h5%write(c//'/xi_master', a1)
+        st = pair%out%state
+        call h5%write(c//'/state', st)
+        call h5%write(c//'/xi_slave', pair%xi)
+    end subroutine write_contact
 
     !> Set the final status ('converged' or 'failed: <reason>') and close.
     subroutine results_finish(self, status, wall)

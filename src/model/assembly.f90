@@ -8,6 +8,7 @@ module voiga_model_assembly
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_point, reference_gradients
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    use voiga_contact_pair, only: pair_contribution
     implicit none
     private
 
@@ -17,6 +18,8 @@ module voiga_model_assembly
     type :: assembly_stats_t
         !> Quadrature points evaluated with a finite-strain / small-strain law.
         integer(i8) :: finite_strain_points = 0, small_strain_points = 0
+        !> Seconds spent in bulk assembly and in contact (search and assembly).
+        real(dp) :: seconds_bulk = 0.0_dp, seconds_contact = 0.0_dp
     end type assembly_stats_t
 
 contains
@@ -82,7 +85,7 @@ contains
         type(csc_matrix_t), intent(out) :: k
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: ptr(:), dofs(:)
-        integer :: ib, e, nel, n, pos
+        integer :: ib, e, nel, n, pos, ip
 
         nel = 0
         n = 0
@@ -91,6 +94,12 @@ contains
             do e = 1, model%bodies(ib)%disc%nel
                 n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
+        end do
+        ! a deformable master couples every slave edge DOF with every master edge DOF
+        do ip = 1, size(model%pairs)
+            if (.not. model%pairs(ip)%master%deformable) cycle
+            nel = nel + 1
+            n = n + size(model%pairs(ip)%slave%dofs) + size(model%pairs(ip)%master%all_dofs())
         end do
         allocate (ptr(nel + 1), dofs(n))
         ptr(1) = 1
@@ -103,13 +112,21 @@ contains
                 dofs(ptr(pos):ptr(pos + 1) - 1) = body_dofs(model%bodies(ib), e)
             end do
         end do
+        do ip = 1, size(model%pairs)
+            if (.not. model%pairs(ip)%master%deformable) cycle
+            pos = pos + 1
+            n = size(model%pairs(ip)%slave%dofs) + size(model%pairs(ip)%master%all_dofs())
+            ptr(pos + 1) = ptr(pos) + n
+            dofs(ptr(pos):ptr(pos + 1) - 1) = [reshape(model%pairs(ip)%slave%dofs, [size(model%pairs(ip)%slave%dofs)]), &
+                                               model%pairs(ip)%master%all_dofs()]
+        end do
         call new_csc_pattern(k, model%ndof, ptr, dofs, error)
     end subroutine stiffness_pattern
 
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
     subroutine assemble(model, u, t, r, stats, error, k)
-        type(model_t), intent(in) :: model
+        type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         !> Load time (for the external forces).
         real(dp), intent(in) :: t
@@ -119,10 +136,12 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
-        integer :: ib, e, n, npts
+        integer :: ib, e, n, npts, ip
         logical :: ok
         character(len=64) :: buf
+        integer(i8) :: c0, c1, rate
 
+        call system_clock(c0, rate)
         r = 0.0_dp
         if (present(k)) call k%zero()
         do ib = 1, size(model%bodies)
@@ -159,6 +178,24 @@ contains
             call external_forces(model, t, fext)
             r = r - fext
         end block
+        call system_clock(c1)
+        stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
+        do ip = 1, size(model%pairs)
+            if (present(k)) then
+                call pair_contribution(model%pairs(ip), u, r, error, add_to_k)
+            else
+                call pair_contribution(model%pairs(ip), u, r, error)
+            end if
+            if (allocated(error)) return
+        end do
+        call system_clock(c0)
+        stats%seconds_contact = stats%seconds_contact + real(c0 - c1, dp)/real(rate, dp)
+    contains
+        subroutine add_to_k(dofs, kl)
+            integer, intent(in) :: dofs(:)
+            real(dp), intent(in) :: kl(:, :)
+            call k%add_element(dofs, kl)
+        end subroutine add_to_k
     end subroutine assemble
 
     !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the

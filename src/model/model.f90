@@ -3,10 +3,14 @@
 module voiga_model
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_case, only: case_t
+    use voiga_io_case, only: case_t, contact_input_t
     use voiga_material, only: material_t
     use voiga_material_factory, only: new_material
     use voiga_discretization_patch, only: discretization_t, edge_cps
+    use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit
+    use voiga_contact_surface, only: new_contact_surface
+    use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
+    use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
     implicit none
     private
 
@@ -57,6 +61,8 @@ module voiga_model
         logical :: finite_strain = .false.
         !> fixed(dof): is the DOF prescribed? shape [ndof]
         logical, allocatable :: fixed(:)
+        !> Contact pairs (their friction history changes as steps converge).
+        type(contact_pair_t), allocatable :: pairs(:)
     end type model_t
 
 contains
@@ -140,7 +146,53 @@ contains
             self%pressure(k)%edge = ie
             self%pressure(k)%values = case%pressure(k)%values
         end do
+        allocate (self%pairs(size(case%contact)))
+        do k = 1, size(case%contact)
+            call new_pair(self, case%contact(k), self%pairs(k), error)
+            if (allocated(error)) return
+        end do
     end subroutine new_model
+
+    !> Build a contact pair; its history starts from the projections in the
+    !> reference configuration.
+    subroutine new_pair(self, inp, pair, error)
+        type(model_t), intent(in) :: self
+        type(contact_input_t), intent(in) :: inp
+        type(contact_pair_t), intent(out) :: pair
+        type(error_t), allocatable, intent(out) :: error
+        type(rigid_line_t) :: rigid
+        type(nurbs_master_t) :: master
+        real(dp), allocatable :: u0(:), r0(:)
+        integer :: ib
+
+        pair%slave_name = inp%slave
+        pair%master_name = inp%master
+        ib = find_body(self, inp%slave)
+        pair%slave_body = ib
+        call new_contact_surface(pair%slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
+        if (trim(inp%master) == 'rigid') then
+            call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
+            allocate (pair%master, source=rigid)
+        else
+            ib = find_body(self, inp%master)
+            pair%master_body = ib
+            call new_nurbs_master(master, self%bodies(ib)%disc, self%bodies(ib)%dof0)
+            allocate (pair%master, source=master)
+        end if
+        pair%law%eps_n = inp%penalty_normal
+        pair%law%eps_t = inp%penalty_tangent
+        pair%law%mu = inp%friction
+        pair%n_gauss = inp%n_gauss
+        call setup_points(pair)
+        allocate (u0(self%ndof), r0(self%ndof))
+        u0 = 0.0_dp
+        r0 = 0.0_dp
+        call pair_contribution(pair, u0, r0, error)
+        if (allocated(error)) return
+        call pair_commit(pair)
+        pair%n_evaluations = 0
+        pair%n_friction = 0
+    end subroutine new_pair
 
     pure integer function find_body(self, name) result(ib)
         type(model_t), intent(in) :: self

@@ -14,6 +14,7 @@ module voiga_solver_newton
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_io_results, only: results_t, step_record_t
+    use voiga_contact_pair, only: pair_commit, pair_reset_trial
     implicit none
     private
 
@@ -41,7 +42,7 @@ contains
     !> step to `results` (if present) and report progress unless `quiet`.
     !> `u` holds the last converged displacement on return (also on failure).
     subroutine solve_steps(model, u, stats, quiet, error, results, t0)
-        type(model_t), intent(in) :: model
+        type(model_t), intent(inout) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(solver_stats_t), intent(out) :: stats
         logical, intent(in) :: quiet
@@ -53,8 +54,8 @@ contains
         type(umfpack_t) :: lu
         type(step_record_t) :: rec
         real(dp), allocatable :: r(:), du(:), u_conv(:), norms(:), energies(:), rhs(:)
-        real(dp) :: t, r0, rn, e1, en, tic, start
-        integer :: step, it, nsteps, j, c
+        real(dp) :: t, r0, rn, e1, en, tic, start, bulk0, contact0
+        integer :: step, it, nsteps, j, c, ip
         logical :: converged
         character(len=160) :: msg
 
@@ -79,9 +80,11 @@ contains
             e1 = 0.0_dp
             en = huge(1.0_dp)
             do it = 0, model%max_iterations
-                tic = wall_seconds()
+                bulk0 = stats%assembly%seconds_bulk
+                contact0 = stats%assembly%seconds_contact
                 call assemble(model, u, t, r, stats%assembly, error, k)
-                rec%seconds(1) = rec%seconds(1) + wall_seconds() - tic
+                rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
+                rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
                 if (allocated(error)) exit
                 rn = norm2(merge(0.0_dp, r, model%fixed))
                 norms(it + 1) = rn
@@ -121,9 +124,15 @@ contains
                 write (msg, '(a,i0,a,es12.5,a)') 'step ', step, ' (load time ', t, '): '
                 error%message = trim(msg)//' '//error%message
                 u = u_conv
+                do ip = 1, size(model%pairs)
+                    call pair_reset_trial(model%pairs(ip))
+                end do
                 exit
             end if
             u_conv = u
+            do ip = 1, size(model%pairs)
+                call pair_commit(model%pairs(ip))
+            end do
             stats%steps = step
             rec%iterations = it
             rec%residual_norms = norms(1:it + 1)
@@ -137,7 +146,7 @@ contains
             stats%records = [stats%records, rec]
             if (present(results)) then
                 tic = wall_seconds()
-                call results%write_step(rec, u, wall_seconds() - start)
+                call results%write_step(rec, u, wall_seconds() - start, model%pairs)
                 rec%seconds(5) = wall_seconds() - tic
             end if
             if (.not. quiet) then

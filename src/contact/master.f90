@@ -1,0 +1,53 @@
+!> The master side of a contact pair: a deformable body's contact edge (NURBS)
+!> or a rigid straight line without DOFs. Both answer the closest-point projection
+!> of a slave point with a `master_point_t`.
+module voiga_contact_master
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: contact_master_t, master_point_t
+
+    !> The master at the projection of a slave point.
+    type :: master_point_t
+        !> Convective coordinate, point, tangent dx/dxi, second derivative.
+        real(dp) :: xi = 0.0_dp, x(2) = 0.0_dp, a(2) = 0.0_dp, a2(2) = 0.0_dp
+        !> Outward unit normal of the master body at the point.
+        real(dp) :: n(2) = 0.0_dp
+        !> Function values and derivatives at xi [nm] (empty for a rigid master).
+        real(dp), allocatable :: r(:), dr(:)
+        !> Global DOFs of those functions [2 nm], order 2(k-1) + i.
+        integer, allocatable :: dofs(:)
+    end type master_point_t
+
+    !> A master surface.
+    type, abstract :: contact_master_t
+        !> Does it carry DOFs?
+        logical :: deformable = .false.
+    contains
+        procedure(project_interface), deferred :: project
+        procedure(all_dofs_interface), deferred :: all_dofs
+    end type contact_master_t
+
+    abstract interface
+        !> Closest point on the master to `xs` in the configuration `u`; `found` is
+        !> false when the orthogonal projection falls beyond the master's ends.
+        pure subroutine project_interface(self, u, xs, mp, found, converged)
+            import :: contact_master_t, master_point_t, dp
+            class(contact_master_t), intent(in) :: self
+            real(dp), intent(in) :: u(:), xs(2)
+            type(master_point_t), intent(out) :: mp
+            logical, intent(out) :: found
+            !> False if the local Newton iteration did not converge.
+            logical, intent(out) :: converged
+        end subroutine project_interface
+
+        !> Every DOF the master may couple to (for the stiffness pattern).
+        pure function all_dofs_interface(self) result(dofs)
+            import :: contact_master_t
+            class(contact_master_t), intent(in) :: self
+            integer, allocatable :: dofs(:)
+        end function all_dofs_interface
+    end interface
+
+end module voiga_contact_master

@@ -1,0 +1,170 @@
+!> A deformable master: another body's contact edge, a NURBS curve (the VO layer
+!> when the body has one). Closest-point projection by a local Newton iteration
+!> started from the nearest sampled point and bracketed per knot span, so that it
+!> is correct across C0 knots and at the ends of the curve.
+module voiga_contact_master_nurbs
+    use voiga_kinds, only: dp
+    use voiga_discretization_patch, only: discretization_t
+    use voiga_discretization_element, only: element_basis, element_nfun
+    use voiga_contact_master, only: contact_master_t, master_point_t
+    use voiga_contact_surface, only: contact_surface_t, new_contact_surface, surface_point_t, &
+                                     surface_point
+    implicit none
+    private
+
+    public :: nurbs_master_t, new_nurbs_master, outward_sign
+
+    !> Newton iterations of the projection.
+    integer, parameter :: max_newton = 50
+
+    !> A body's contact edge acting as master.
+    type, extends(contact_master_t) :: nurbs_master_t
+        type(contact_surface_t) :: surf
+        !> Outward normal = sign * (a_y, -a_x)/|a|, fixed by the patch orientation.
+        real(dp) :: sign = 1.0_dp
+    contains
+        procedure :: project => nurbs_project
+        procedure :: all_dofs => nurbs_all_dofs
+    end type nurbs_master_t
+
+contains
+
+    !> The sign s such that s (a_y, -a_x) points out of the body at its eta = 1 edge
+    !> (from dX/deta there, in the reference configuration).
+    function outward_sign(disc) result(s)
+        type(discretization_t), intent(in) :: disc
+        real(dp) :: s
+        real(dp), allocatable :: r(:), dr(:, :), d2r(:, :)
+        real(dp) :: jac(2, 2)
+        integer :: e, n
+        e = disc%nel - disc%nel_xi/2
+        n = element_nfun(disc, e)
+        allocate (r(n), dr(2, n), d2r(3, n))
+        associate (el => disc%elements(e))
+            call element_basis(disc, e, 0.5_dp*sum(el%xi), el%eta(2), r, dr, d2r)
+            jac = matmul(disc%x(:, el%conn), transpose(dr))
+        end associate
+        ! dX/deta points outward at eta = 1
+        s = merge(1.0_dp, -1.0_dp, jac(2, 1)*jac(1, 2) - jac(1, 1)*jac(2, 2) > 0.0_dp)
+    end function outward_sign
+
+    !> The contact edge of `disc` (DOFs after `dof0`) as a master.
+    subroutine new_nurbs_master(self, disc, dof0)
+        type(nurbs_master_t), intent(out) :: self
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: dof0
+        self%deformable = .true.
+        call new_contact_surface(self%surf, disc, dof0)
+        self%sign = outward_sign(disc)
+    end subroutine new_nurbs_master
+
+    pure function nurbs_all_dofs(self) result(dofs)
+        class(nurbs_master_t), intent(in) :: self
+        integer, allocatable :: dofs(:)
+        dofs = reshape(self%surf%dofs, [size(self%surf%dofs)])
+    end function nurbs_all_dofs
+
+    pure subroutine nurbs_project(self, u, xs, mp, found, converged)
+        class(nurbs_master_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xs(2)
+        type(master_point_t), intent(out) :: mp
+        logical, intent(out) :: found, converged
+        type(surface_point_t) :: pt, best_pt
+        real(dp) :: d, best_d, xi, xi_s, a, b, lo, hi, best, f, df, step
+        integer :: nspan, k, j, m, it, span, best_span, s0, s1
+        logical :: ok, best_ok
+
+        associate (br => self%surf%breaks)
+            nspan = size(br) - 1
+            ! 1. nearest sample (2p + 3 points per span)
+            m = 2*self%surf%degree + 3
+            best_d = huge(1.0_dp)
+            best = br(1)
+            do k = 1, nspan
+                do j = 0, m - 1
+                    xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
+                    call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
+                    d = norm2(xs - pt%x)
+                    if (d < best_d) then
+                        best_d = d
+                        best = xi
+                        s0 = k
+                    end if
+                end do
+            end do
+            ! 2. Newton in the sample's span and its neighbours, clamped to each span
+            best_d = huge(1.0_dp)
+            best_ok = .false.
+            converged = .true.
+            do k = max(1, s0 - 1), min(nspan, s0 + 1)
+                a = br(k)
+                b = br(k + 1)
+                xi = min(max(best, a), b)
+                lo = a
+                hi = b
+                ok = .false.
+                do it = 1, max_newton
+                    call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
+                    f = dot_product(xs - pt%x, pt%a)
+                    df = -dot_product(pt%a, pt%a) + dot_product(xs - pt%x, pt%a2)
+                    ! keep a bracket of the minimum of the distance: f > 0 -> it lies to the right
+                    if (f > 0.0_dp) then
+                        lo = xi
+                    else if (f < 0.0_dp) then
+                        hi = xi
+                    end if
+                    if (df < 0.0_dp) then
+                        step = -f/df
+                    else
+                        step = merge(hi - xi, lo - xi, f > 0.0_dp)
+                    end if
+                    if (abs(step) <= 1.0e-15_dp*max(1.0_dp, abs(xi))) then
+                        ok = .true.
+                        exit
+                    end if
+                    if ((xi == a .and. f < 0.0_dp) .or. (xi == b .and. f > 0.0_dp)) then
+                        ! the minimum over this span is at its end
+                        ok = .true.
+                        exit
+                    end if
+                    xi_s = min(max(xi + step, a), b)
+                    ! a Newton step that leaves the bracket is replaced by bisection
+                    if (xi_s < lo .or. xi_s > hi) xi_s = 0.5_dp*(lo + hi)
+                    if (xi_s == xi) then
+                        ok = .true.
+                        exit
+                    end if
+                    xi = xi_s
+                end do
+                if (.not. ok) converged = .false.
+                call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
+                d = norm2(xs - pt%x)
+                if (d < best_d) then
+                    best_d = d
+                    best_pt = pt
+                    best_span = k
+                    best_ok = ok
+                end if
+            end do
+            if (.not. best_ok) converged = .false.
+            ! 3. beyond the curve's ends: no orthogonal projection
+            found = .true.
+            s1 = size(self%surf%knots)
+            f = dot_product(xs - best_pt%x, best_pt%a)
+            if (best_pt%xi <= br(1) .and. f < -1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) found = .false.
+            if (best_pt%xi >= br(nspan + 1) .and. f > 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) &
+                found = .false.
+        end associate
+        mp%xi = best_pt%xi
+        mp%x = best_pt%x
+        mp%a = best_pt%a
+        mp%a2 = best_pt%a2
+        mp%n = self%sign*[best_pt%a(2), -best_pt%a(1)]/norm2(best_pt%a)
+        mp%r = best_pt%r
+        mp%dr = best_pt%dr
+        mp%dofs = best_pt%dofs
+        if (best_span < 0 .or. s1 < 0) found = .false.
+
+    end subroutine nurbs_project
+
+end module voiga_contact_master_nurbs

@@ -1,0 +1,54 @@
+!> A rigid straight master line (an obstacle without DOFs): the points
+!> x = p0 + xi t with outward unit normal n; xi is the arc length along t = (n_y, -n_x).
+module voiga_contact_master_rigid
+    use voiga_kinds, only: dp
+    use voiga_contact_master, only: contact_master_t, master_point_t
+    implicit none
+    private
+
+    public :: rigid_line_t, new_rigid_line
+
+    !> A fixed rigid line.
+    type, extends(contact_master_t) :: rigid_line_t
+        real(dp) :: p0(2) = 0.0_dp, n(2) = [0.0_dp, 1.0_dp], t(2) = [1.0_dp, 0.0_dp]
+    contains
+        procedure :: project => rigid_project
+        procedure :: all_dofs => rigid_all_dofs
+    end type rigid_line_t
+
+contains
+
+    !> Line through `p0` with outward normal `normal` (normalized here).
+    pure subroutine new_rigid_line(self, p0, normal)
+        type(rigid_line_t), intent(out) :: self
+        real(dp), intent(in) :: p0(2), normal(2)
+        self%deformable = .false.
+        self%p0 = p0
+        self%n = normal/norm2(normal)
+        self%t = [self%n(2), -self%n(1)]
+    end subroutine new_rigid_line
+
+    pure subroutine rigid_project(self, u, xs, mp, found, converged)
+        class(rigid_line_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xs(2)
+        type(master_point_t), intent(out) :: mp
+        logical, intent(out) :: found, converged
+        if (size(u) < 0) return   ! u is not needed: the line has no DOFs
+        mp%xi = dot_product(xs - self%p0, self%t)
+        mp%x = self%p0 + mp%xi*self%t
+        mp%a = self%t
+        mp%a2 = 0.0_dp
+        mp%n = self%n
+        allocate (mp%r(0), mp%dr(0), mp%dofs(0))
+        found = .true.
+        converged = .true.
+    end subroutine rigid_project
+
+    pure function rigid_all_dofs(self) result(dofs)
+        class(rigid_line_t), intent(in) :: self
+        integer, allocatable :: dofs(:)
+        allocate (dofs(0))
+        if (self%deformable) dofs = [integer ::]
+    end function rigid_all_dofs
+
+end module voiga_contact_master_rigid

@@ -1,0 +1,194 @@
+!> A contact pair: the slave body's contact edge integrated with Gauss points
+!> (GPTS, full pass: forces on slave and master), a master (another body's
+!> contact edge or a rigid line), the penalty/friction law, and the friction
+!> history per slave point (only when mu > 0).
+module voiga_contact_pair
+    use voiga_kinds, only: dp, i8
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_element_quadrature, only: gauss_legendre
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
+    use voiga_contact_master, only: contact_master_t, master_point_t
+    use voiga_contact_gpts, only: contact_law_t, gpts_point, state_inactive, state_stick, state_slip
+    implicit none
+    private
+
+    public :: contact_pair_t, setup_points, pair_contribution, pair_commit, pair_reset_trial, &
+              contact_point_out_t
+
+    !> Per-slave-point output of the last evaluation.
+    type :: contact_point_out_t
+        !> Reference and current position of the slave point.
+        real(dp) :: x0(2) = 0.0_dp, x(2) = 0.0_dp
+        real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp
+        !> Master convective coordinate of the projection.
+        real(dp) :: xi_m = 0.0_dp
+        integer :: state = state_inactive
+    end type contact_point_out_t
+
+    !> A slave/master pair.
+    type :: contact_pair_t
+        character(len=32) :: slave_name = '', master_name = ''
+        integer :: slave_body = 0
+        !> Master body index, 0 for a rigid master.
+        integer :: master_body = 0
+        type(contact_surface_t) :: slave
+        class(contact_master_t), allocatable :: master
+        type(contact_law_t) :: law
+        !> Gauss points per slave element.
+        integer :: n_gauss = 0
+        !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts].
+        real(dp), allocatable :: xi(:), w(:)
+        integer, allocatable :: span(:)
+        !> Friction history (allocated only when mu > 0) [npts]: committed and trial
+        !> stick anchors (master convective coordinate); whether the point was in
+        !> contact at the last converged state; the projection there.
+        real(dp), allocatable :: anchor(:), trial_anchor(:), xi_last(:), trial_xi(:)
+        logical, allocatable :: active_last(:), trial_active(:)
+        !> Output of the last evaluation [npts].
+        type(contact_point_out_t), allocatable :: out(:)
+        !> Resultant contact force on the slave at the last evaluation.
+        real(dp) :: force(2) = 0.0_dp
+        !> Counters: active point evaluations, of which frictional.
+        integer(i8) :: n_evaluations = 0, n_friction = 0
+    end type contact_pair_t
+
+contains
+
+    !> Place the slave Gauss points (n_gauss per slave element; 0: degree + 1) and,
+    !> for a frictional pair, the history arrays.
+    pure subroutine setup_points(self)
+        type(contact_pair_t), intent(inout) :: self
+        real(dp), allocatable :: gx(:), gw(:)
+        integer :: ne, ng, e, i, k
+        real(dp) :: a, b
+
+        if (self%n_gauss <= 0) self%n_gauss = self%slave%degree + 1
+        ng = self%n_gauss
+        ne = size(self%slave%breaks) - 1
+        allocate (gx(ng), gw(ng), self%xi(ne*ng), self%w(ne*ng), self%span(ne*ng))
+        call gauss_legendre(ng, gx, gw)
+        k = 0
+        do e = 1, ne
+            a = self%slave%breaks(e)
+            b = self%slave%breaks(e + 1)
+            do i = 1, ng
+                k = k + 1
+                self%xi(k) = a + 0.5_dp*(b - a)*(gx(i) + 1.0_dp)
+                self%w(k) = 0.5_dp*(b - a)*gw(i)
+                self%span(k) = self%slave%spans(e)
+            end do
+        end do
+        allocate (self%out(ne*ng))
+        if (self%law%mu > 0.0_dp) then
+            allocate (self%anchor(ne*ng), self%trial_anchor(ne*ng), self%xi_last(ne*ng), &
+                      self%trial_xi(ne*ng), self%active_last(ne*ng), self%trial_active(ne*ng))
+            self%anchor = 0.0_dp
+            self%trial_anchor = 0.0_dp
+            self%xi_last = 0.0_dp
+            self%trial_xi = 0.0_dp
+            self%active_last = .false.
+            self%trial_active = .false.
+        end if
+    end subroutine setup_points
+
+    !> Contact residual and tangent of the pair at displacement `u`, added to `r`
+    !> (global) and handed point by point to `add` (global DOFs, local matrix).
+    !> Updates the trial history and the output. Fails if a projection does not
+    !> converge for a point that may be in contact.
+    subroutine pair_contribution(self, u, r, error, add)
+        type(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        type(error_t), allocatable, intent(out) :: error
+        interface
+            subroutine add(dofs, k)
+                import :: dp
+                integer, intent(in) :: dofs(:)
+                real(dp), intent(in) :: k(:, :)
+            end subroutine add
+        end interface
+        optional :: add
+        type(surface_point_t) :: sp
+        type(master_point_t) :: mp
+        real(dp), allocatable :: rl(:), kl(:, :)
+        integer, allocatable :: dofs(:)
+        real(dp) :: g, pn, pt, anchor, new_anchor
+        integer :: k, state, nd
+        logical :: found, converged
+        character(len=96) :: buf
+
+        self%force = 0.0_dp
+        do k = 1, size(self%xi)
+            call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
+            self%out(k)%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
+            self%out(k)%x = sp%x
+            self%out(k)%state = state_inactive
+            self%out(k)%pn = 0.0_dp
+            self%out(k)%pt = 0.0_dp
+            call self%master%project(u, sp%x, mp, found, converged)
+            self%out(k)%xi_m = mp%xi
+            self%out(k)%gap = huge(1.0_dp)
+            if (found) self%out(k)%gap = dot_product(sp%x - mp%x, mp%n)
+            if (allocated(self%anchor)) then
+                self%trial_xi(k) = mp%xi
+                self%trial_active(k) = .false.
+                self%trial_anchor(k) = mp%xi
+            end if
+            if (.not. found) cycle
+            if (self%out(k)%gap >= 0.0_dp) cycle
+            if (.not. converged) then
+                write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
+                call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
+                                 trim(self%master_name)//"': the closest-point projection of "// &
+                                 trim(buf)//' did not converge', error_code%numeric)
+                return
+            end if
+            ! a point that was not in contact at the last converged state sticks where
+            ! it projected then
+            anchor = mp%xi
+            if (allocated(self%anchor)) then
+                anchor = merge(self%anchor(k), self%xi_last(k), self%active_last(k))
+                self%n_friction = self%n_friction + 1
+            end if
+            nd = size(sp%dofs) + size(mp%dofs)
+            if (allocated(rl)) then
+                if (size(rl) /= nd) deallocate (rl, kl)
+            end if
+            if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
+            call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
+            self%n_evaluations = self%n_evaluations + 1
+            dofs = [sp%dofs, mp%dofs]
+            r(dofs) = r(dofs) + rl
+            ! partition of unity: the slave part sums to -da t
+            self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
+            self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+            if (present(add)) call add(dofs, kl)
+            self%out(k)%state = state
+            self%out(k)%pn = pn
+            self%out(k)%pt = pt
+            if (allocated(self%anchor)) then
+                self%trial_active(k) = .true.
+                self%trial_anchor(k) = new_anchor
+            end if
+        end do
+    end subroutine pair_contribution
+
+    !> The step converged: the trial history becomes the committed one.
+    pure subroutine pair_commit(self)
+        type(contact_pair_t), intent(inout) :: self
+        if (.not. allocated(self%anchor)) return
+        self%anchor = self%trial_anchor
+        self%active_last = self%trial_active
+        self%xi_last = self%trial_xi
+    end subroutine pair_commit
+
+    !> Forget the trial history (a step is retried).
+    pure subroutine pair_reset_trial(self)
+        type(contact_pair_t), intent(inout) :: self
+        if (.not. allocated(self%anchor)) return
+        self%trial_anchor = self%anchor
+        self%trial_active = self%active_last
+        self%trial_xi = self%xi_last
+    end subroutine pair_reset_trial
+
+end module voiga_contact_pair

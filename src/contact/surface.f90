@@ -1,0 +1,111 @@
+!> A body's contact edge as a univariate NURBS curve over its own control points:
+!> the VO layer (degree q) when the body has one, else the bulk's eta = 1 row. This
+!> is the trace of the element basis on eta = 1, so the contact integral uses the
+!> layer's degree-q functions (docs/theory.md, section 7).
+module voiga_contact_surface
+    use voiga_kinds, only: dp
+    use voiga_nurbs_basis, only: find_span, basis_ders, distinct_knots
+    use voiga_nurbs_rational, only: rationalize
+    use voiga_discretization_patch, only: discretization_t
+    implicit none
+    private
+
+    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point
+
+    !> The contact edge of one body.
+    type :: contact_surface_t
+        integer :: degree = 0
+        !> Knot vector [n + degree + 1] and weights [n].
+        real(dp), allocatable :: knots(:), w(:)
+        !> Body-local control point ids [n] and their global DOFs [2, n].
+        integer, allocatable :: cps(:), dofs(:, :)
+        !> Reference control points [2, n].
+        real(dp), allocatable :: x0(:, :)
+        !> Breakpoints (element boundaries along the edge) [nel + 1].
+        real(dp), allocatable :: breaks(:)
+        !> Knot-span index of each element along the edge [nel].
+        integer, allocatable :: spans(:)
+    end type contact_surface_t
+
+    !> The curve at one parameter value, in a given configuration.
+    type :: surface_point_t
+        real(dp) :: xi = 0.0_dp
+        !> Point, first and second parametric derivatives.
+        real(dp) :: x(2) = 0.0_dp, a(2) = 0.0_dp, a2(2) = 0.0_dp
+        !> Nonzero functions: values, first and second derivatives [p + 1].
+        real(dp), allocatable :: r(:), dr(:), d2r(:)
+        !> Global DOFs of those functions [2 (p + 1)], local order 2(k-1) + i.
+        integer, allocatable :: dofs(:)
+        !> Their positions in the surface's arrays [p + 1].
+        integer, allocatable :: local(:)
+    end type surface_point_t
+
+contains
+
+    !> The contact edge (eta = 1) of `disc`, whose DOFs start after `dof0`.
+    pure subroutine new_contact_surface(self, disc, dof0)
+        type(contact_surface_t), intent(out) :: self
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: dof0
+        integer :: ny, k
+        if (disc%has_layer) then
+            self%degree = disc%layer%degree
+            self%knots = disc%layer%knots
+            self%w = disc%layer%w
+            self%cps = disc%layer_id
+        else
+            ny = size(disc%bulk%w, 2)
+            self%degree = disc%bulk%degree(1)
+            self%knots = disc%bulk%knots_xi
+            self%w = disc%bulk%w(:, ny)
+            self%cps = disc%bulk_id(:, ny)
+        end if
+        allocate (self%dofs(2, size(self%cps)))
+        self%dofs(1, :) = dof0 + 2*self%cps - 1
+        self%dofs(2, :) = dof0 + 2*self%cps
+        self%x0 = disc%x(:, self%cps)
+        self%breaks = distinct_knots(self%knots)
+        allocate (self%spans(size(self%breaks) - 1))
+        do k = 1, size(self%spans)
+            self%spans(k) = find_span(self%knots, self%degree, 0.5_dp*(self%breaks(k) + self%breaks(k + 1)))
+        end do
+    end subroutine new_contact_surface
+
+    !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
+    !> forces the knot span (0: found from xi), so that a point on an element
+    !> boundary can be evaluated from either side.
+    pure subroutine surface_point(self, u, xi, pt, span)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(in) :: xi
+        type(surface_point_t), intent(out) :: pt
+        integer, intent(in), optional :: span
+        real(dp) :: ders(3, self%degree + 1), dr(1, self%degree + 1), d2r(1, self%degree + 1), x(2)
+        integer :: s, p, k, id
+
+        p = self%degree
+        s = find_span(self%knots, p, xi)
+        if (present(span)) then
+            if (span > 0) s = span
+        end if
+        ders = basis_ders(self%knots, p, s, xi, 2)
+        allocate (pt%r(p + 1), pt%dr(p + 1), pt%d2r(p + 1), pt%local(p + 1), pt%dofs(2*(p + 1)))
+        call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), pt%r, dr, d2r)
+        pt%dr = dr(1, :)
+        pt%d2r = d2r(1, :)
+        pt%xi = xi
+        pt%x = 0.0_dp
+        pt%a = 0.0_dp
+        pt%a2 = 0.0_dp
+        do k = 1, p + 1
+            id = s - p + k - 1
+            pt%local(k) = id
+            pt%dofs(2*k - 1:2*k) = self%dofs(:, id)
+            x = self%x0(:, id) + u(self%dofs(:, id))
+            pt%x = pt%x + pt%r(k)*x
+            pt%a = pt%a + pt%dr(k)*x
+            pt%a2 = pt%a2 + pt%d2r(k)*x
+        end do
+    end subroutine surface_point
+
+end module voiga_contact_surface
