@@ -54,7 +54,7 @@ contains
         c%bodies(1)%poisson_ratio = nu
         c%bodies(1)%layout = layout
         c%solver%n_steps = [1]
-        allocate (c%dirichlet(0), c%pressure(0))
+        allocate (c%dirichlet(0), c%pressure(0), c%contact(0))
     end function one_body_case
 
     !> Append a Dirichlet condition.

@@ -146,6 +146,10 @@ contains
             self%pressure(k)%edge = ie
             self%pressure(k)%values = case%pressure(k)%values
         end do
+        if (.not. allocated(case%contact)) then
+            allocate (self%pairs(0))
+            return
+        end if
         allocate (self%pairs(size(case%contact)))
         do k = 1, size(case%contact)
             call new_pair(self, case%contact(k), self%pairs(k), error)
