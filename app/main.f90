@@ -14,7 +14,7 @@ program voiga_main
     implicit none
 
     character(len=:), allocatable :: case_path, dump_path, arg
-    logical :: check, quiet
+    logical :: check, quiet, verbose
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error
@@ -28,6 +28,7 @@ program voiga_main
 
     check = .false.
     quiet = .false.
+    verbose = .false.
     n = command_argument_count()
     i = 0
     do while (i < n)
@@ -44,6 +45,8 @@ program voiga_main
             check = .true.
         case ('--quiet', '-q')
             quiet = .true.
+        case ('--verbose', '-v')
+            verbose = .true.
         case ('--dump')
             if (i == n) call fail_usage('--dump needs a file name')
             i = i + 1
@@ -93,7 +96,7 @@ program voiga_main
     if (allocated(error)) call fail(error)
     call results%open(case, model, error)
     if (allocated(error)) call fail(error)
-    call solve_steps(model, u, stats, quiet, error, results, t0)
+    call solve_steps(model, u, stats, quiet, error, results, t0, verbose)
     if (allocated(error)) then
         call results%finish('failed: '//error%message, wall_seconds() - t0)
         write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
@@ -115,11 +118,12 @@ contains
     end function get_arg
 
     subroutine usage()
-        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet]', &
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet] [--verbose]', &
             '  (no option)    solve the case and write the result file it names', &
             '  --check        validate the case, build the discretization, print DOF counts', &
             '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
-            '  --quiet        less output', &
+            '  --quiet        no line per step', &
+            '  --verbose      a line per Newton iteration (residual, energy, contact states)', &
             '  --version      print the version'
     end subroutine usage
 

@@ -6,16 +6,35 @@ module voiga_test_fixtures
     implicit none
     private
 
-    public :: annulus_sector, rectangle, lcg_t
+    public :: annulus_sector, rectangle, lcg_t, quadratic
 
     !> Park-Miller generator: same numbers on every compiler and run.
     type :: lcg_t
         integer(8) :: state = 12345_8
     contains
+
         procedure :: uniform => lcg_uniform
     end type lcg_t
 
 contains
+
+    !> Does a Newton residual sequence converge quadratically? In the asymptotic
+    !> range (r_k < 1e-3 r_0) and above round-off (r_k+1 > 1e-13 r_0) every
+    !> iteration must satisfy r_k+1/r_0 <= 100 (r_k/r_0)^2. A linearly converging
+    !> sequence with rate above 0.1 fails this as soon as r_k < 1e-3 r_0. At least
+    !> one such iteration is required.
+    logical function quadratic(r)
+        real(dp), intent(in) :: r(:)
+        integer :: k, n
+        quadratic = .true.
+        n = 0
+        do k = 2, size(r) - 1
+            if (r(k) >= 1.0e-3_dp*r(1) .or. r(k + 1) <= 1.0e-13_dp*r(1)) cycle
+            n = n + 1
+            if (r(k + 1)/r(1) > 100.0_dp*(r(k)/r(1))**2) quadratic = .false.
+        end do
+        if (n == 0) quadratic = .false.
+    end function quadratic
 
     !> Next number in [0, 1).
     real(dp) function lcg_uniform(self)

@@ -9,9 +9,11 @@ module test_contact
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_io_case, only: case_t, body_input_t, contact_input_t
     use voiga_model, only: model_t, new_model
+    use voiga_solver_newton, only: solve_steps, solver_stats_t
+    use voiga_io_case, only: dirichlet_input_t, pressure_input_t
     use voiga_contact_pair, only: contact_pair_t, pair_contribution
     use voiga_contact_gpts, only: state_inactive, state_stick, state_slip
-    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle
+    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle, quadratic
     implicit none
     private
 
@@ -27,7 +29,13 @@ contains
                     new_unittest('tangent_fd_frictionless', test_fd_frictionless), &
                     new_unittest('tangent_fd_stick', test_fd_stick), &
                     new_unittest('tangent_fd_slip', test_fd_slip), &
-                    new_unittest('tangent_fd_rigid_master', test_fd_rigid) &
+                    new_unittest('tangent_fd_rigid_master', test_fd_rigid), &
+                    new_unittest('contact_patch_test', test_patch), &
+                    new_unittest('friction_block_slip', test_block_slip), &
+                    new_unittest('friction_block_stick', test_block_stick), &
+                    new_unittest('frictionless_runs_no_friction_code', test_no_friction_code), &
+                    new_unittest('rigid_master_adds_no_dofs', test_rigid_no_dofs), &
+                    new_unittest('ironing_newton_quadratic', test_ironing_quadratic) &
                     ]
     end subroutine collect_contact
 
@@ -228,5 +236,242 @@ contains
         if (allocated(error)) return
         call run_fd([character(len=5) :: 'N4', 'NN2.2'], 0.3_dp, .true., 0.5_dp, state_slip, error)
     end subroutine test_fd_rigid
+
+    !> A body entry of a test case.
+    function body(name, material, e, layout) result(b)
+        character(len=*), intent(in) :: name, material
+        real(dp), intent(in) :: e
+        type(layout_t), intent(in) :: layout
+        type(body_input_t) :: b
+        b%name = name
+        b%material = material
+        b%youngs_modulus = e
+        b%poisson_ratio = 0.3_dp
+        b%layout = layout
+    end function body
+
+    function bc(b, edge, fix, values) result(d)
+        character(len=*), intent(in) :: b, edge
+        logical, intent(in) :: fix(2)
+        real(dp), intent(in) :: values(:, :)
+        type(dirichlet_input_t) :: d
+        d%body = b
+        d%edge = edge
+        d%fix = fix
+        d%values = values
+    end function bc
+
+    !> Build a model from a case and the coarse patches of its bodies.
+    subroutine build_model(c, coarse, model, error)
+        type(case_t), intent(inout) :: c
+        type(nurbs_surface_t), intent(in) :: coarse(:)
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        type(discretization_t), allocatable :: discs(:)
+        integer :: i
+        c%path = 'test'
+        c%dir = ''
+        if (.not. allocated(c%dirichlet)) allocate (c%dirichlet(0))
+        if (.not. allocated(c%pressure)) allocate (c%pressure(0))
+        if (.not. allocated(c%contact)) allocate (c%contact(0))
+        allocate (discs(size(coarse)))
+        do i = 1, size(coarse)
+            call new_discretization(discs(i), coarse(i), c%bodies(i)%layout, '', error)
+            if (allocated(error)) return
+        end do
+        call new_model(model, c, discs, error)
+    end subroutine build_model
+
+    !> Two stacked blocks under uniform pressure. Matching meshes: the contact
+    !> pressure is uniform to round-off. Non-matching meshes: its spread is the
+    !> quadrature error of GPTS (the master's functions integrated with the
+    !> slave's points) and falls as the slave points are refined. Measured spread
+    !> (max - min)/mean for 3, 9, 15, 21 points per slave element: 0.22, 5.1e-3,
+    !> 1.8e-3, 4.8e-4; matching meshes: 5e-11 (docs/verification.md).
+    subroutine test_patch(error)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: spread(4), prev
+        integer :: i
+        call patch_spread(5, 3, spread(1), error)
+        if (allocated(error)) return
+        ! the penalty (1000 x E) amplifies round-off of the displacements
+        call check(error, spread(1) <= 1.0e-9_dp, 'matching meshes: uniform contact pressure')
+        if (allocated(error)) return
+        prev = huge(1.0_dp)
+        do i = 1, 4
+            call patch_spread(3, 3 + 6*(i - 1), spread(i), error)
+            if (allocated(error)) return
+            call check(error, spread(i) < prev, 'non-matching: spread falls with more slave points')
+            if (allocated(error)) return
+            prev = spread(i)
+        end do
+        call check(error, spread(4) <= 1.0e-3_dp, 'non-matching, 21 points: spread below 0.1%')
+    end subroutine test_patch
+
+    !> Upper block (slave, `nel_upper` elements) on a lower one (master, 5
+    !> elements); spread of p_N over the slave points with `ngp` points each.
+    subroutine patch_spread(nel_upper, ngp, spread, error)
+        integer, intent(in) :: nel_upper, ngp
+        real(dp), intent(out) :: spread
+        type(error_t), allocatable, intent(out) :: error
+        type(case_t) :: c
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        real(dp), parameter :: p = 0.01_dp
+
+        c%bodies = [body('upper', 'linear', 1.0_dp, layout_named('N2', [nel_upper, 2], 'bottom')), &
+                    body('lower', 'linear', 1.0_dp, layout_named('N2', [5, 2], 'top'))]
+        c%solver%n_steps = [1]
+        c%dirichlet = [bc('lower', 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
+                       bc('lower', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
+                       bc('upper', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1]))]
+        c%pressure = [pressure_input_t(body='upper', edge='top', values=[p])]
+        allocate (c%contact(1))
+        c%contact(1) = contact_input_t(slave='upper', master='lower', penalty_normal=1000.0_dp, n_gauss=ngp)
+        call build_model(c, [rectangle(0.0_dp, 1.0_dp, 2.0_dp, 1.0_dp), &
+                             rectangle(0.0_dp, 0.0_dp, 2.0_dp, 1.0_dp)], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., error)
+        if (allocated(error)) return
+        associate (out => model%pairs(1)%out)
+            call check(error, all(out%state /= state_inactive), 'every slave point in contact')
+            if (allocated(error)) return
+            spread = (maxval(out%pn) - minval(out%pn))/(sum(out%pn)/size(out))
+        end associate
+        ! momentum: the contact force carries the applied load exactly
+        call check(error, model%pairs(1)%force(2), 2.0_dp*p, 'total contact force = applied load', &
+                   rel=1.0e-10_dp)
+    end subroutine patch_spread
+
+    !> A block on a rigid plane, pressed then pushed (or barely pushed).
+    subroutine block_on_plane(push, mu, model, u, error)
+        real(dp), intent(in) :: push, mu
+        type(model_t), intent(out) :: model
+        real(dp), allocatable, intent(out) :: u(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(case_t) :: c
+        type(solver_stats_t) :: stats
+        c%bodies = [body('block', 'linear', 1.0_dp, layout_named('NN2.2', [4, 2], 'bottom'))]
+        c%solver%n_steps = [2, 4]
+        c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
+        allocate (c%contact(1))
+        c%contact(1) = contact_input_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
+                                       rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1000.0_dp, &
+                                       penalty_tangent=1000.0_dp, friction=mu)
+        call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., error)
+    end subroutine block_on_plane
+
+    subroutine test_block_slip(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        call block_on_plane(0.1_dp, 0.3_dp, model, u, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1))
+            ! the leading corner may lift off under the friction moment
+            call check(error, all(pair%out%state == state_slip .or. pair%out%state == state_inactive) &
+                       .and. count(pair%out%state == state_slip) >= size(pair%out) - 2, &
+                       'every point in contact slips')
+            if (allocated(error)) return
+            call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), 'F_T = mu F_N', rel=1.0e-8_dp)
+            if (allocated(error)) return
+            call check(error, pair%force(1) < 0.0_dp, 'friction opposes the push')
+        end associate
+    end subroutine test_block_slip
+
+    subroutine test_block_stick(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        real(dp) :: limit
+        integer :: k
+        call block_on_plane(1.0e-4_dp, 1.0_dp, model, u, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1))
+            call check(error, all(pair%out%state == state_stick), 'every point sticks')
+            if (allocated(error)) return
+            call check(error, abs(pair%force(1)) < abs(pair%force(2)), '|F_T| < mu F_N')
+            if (allocated(error)) return
+            ! no sliding beyond the penalty's elastic compliance t_T / eps_T
+            do k = 1, size(pair%out)
+                limit = abs(pair%out(k)%pt)/1000.0_dp*(1.0_dp + 1.0e-8_dp) + 1.0e-15_dp
+                call check(error, abs(pair%out(k)%x(1) - pair%out(k)%x0(1) - &
+                                      (pair%out(k)%xi_m - pair%out(k)%x0(1))) <= 1.0e-15_dp, &
+                           'projection of a point below it on the plane')
+                if (allocated(error)) return
+                call check(error, abs(pair%out(k)%xi_m - pair%anchor(k)) <= limit, &
+                           'stick: no slip beyond the penalty compliance')
+                if (allocated(error)) return
+            end do
+        end associate
+    end subroutine test_block_stick
+
+    !> mu = 0: no friction history, no friction evaluation.
+    subroutine test_no_friction_code(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        call block_on_plane(0.0_dp, 0.0_dp, model, u, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1))
+            call check(error, .not. allocated(pair%anchor), 'no friction history stored')
+            if (allocated(error)) return
+            call check(error, pair%n_friction == 0, 'no friction evaluation')
+            if (allocated(error)) return
+            call check(error, pair%n_evaluations > 0, 'contact evaluated')
+            if (allocated(error)) return
+            call check(error, all(pair%out%pt == 0.0_dp), 'no tangential traction')
+        end associate
+    end subroutine test_no_friction_code
+
+    !> A rigid master has no DOFs: the model's DOFs are the bodies' only.
+    subroutine test_rigid_no_dofs(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        call block_on_plane(0.0_dp, 0.3_dp, model, u, error)
+        if (allocated(error)) return
+        call check(error, model%ndof, model%bodies(1)%disc%total_dofs, 'DOFs of the body only')
+        if (allocated(error)) return
+        call check(error, size(model%pairs(1)%master%all_dofs()), 0, 'rigid master couples no DOF')
+    end subroutine test_rigid_no_dofs
+
+    !> Frictional ironing (m1, NN2.2): press, then slide; Newton converges
+    !> quadratically in a sliding step.
+    subroutine test_ironing_quadratic(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(case_t) :: c
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        integer :: i
+
+        c%bodies = [body('die', 'neo-hookean', 10.0_dp, layout_named('NN2.2', [6, 1], 'outer')), &
+                    body('slab', 'neo-hookean', 1.0_dp, layout_named('NN2.2', [8, 2], 'top'))]
+        ! press 0.5 in 10 steps, then 5 of the 200 sliding steps of 0.02
+        c%solver%n_steps = [10, 5]
+        c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &
+                       bc('slab', 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))]
+        allocate (c%contact(1))
+        c%contact(1) = contact_input_t(slave='die', master='slab', penalty_normal=100.0_dp, &
+                                       penalty_tangent=100.0_dp, friction=0.3_dp)
+        call build_model(c, [annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
+                             rectangle(0.0_dp, -3.0_dp, 9.0_dp, 3.0_dp)], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., error)
+        if (allocated(error)) return
+        call check(error, count(model%pairs(1)%out%state == state_slip) > 0, 'points slip while ironing')
+        if (allocated(error)) return
+        do i = 11, 15
+            call check(error, quadratic(stats%records(i)%residual_norms), 'quadratic convergence, step 11-15')
+            if (allocated(error)) then
+                print '(a,*(es9.2))', '        residuals: ', stats%records(i)%residual_norms
+                return
+            end if
+        end do
+    end subroutine test_ironing_quadratic
 
 end module test_contact

@@ -46,6 +46,10 @@ module voiga_contact_pair
         logical, allocatable :: active_last(:), trial_active(:)
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
+        !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
+        !> round-off) carries penalty stiffness, so bodies that start in contact are
+        !> supported. 1e-12 of the slave surface's size.
+        real(dp) :: gap_tol = 0.0_dp
         !> Resultant contact force on the slave at the last evaluation.
         real(dp) :: force(2) = 0.0_dp
         !> Counters: active point evaluations, of which frictional.
@@ -79,6 +83,7 @@ contains
             end do
         end do
         allocate (self%out(ne*ng))
+        self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
         if (self%law%mu > 0.0_dp) then
             allocate (self%anchor(ne*ng), self%trial_anchor(ne*ng), self%xi_last(ne*ng), &
                       self%trial_xi(ne*ng), self%active_last(ne*ng), self%trial_active(ne*ng))
@@ -135,7 +140,7 @@ contains
                 self%trial_anchor(k) = mp%xi
             end if
             if (.not. found) cycle
-            if (self%out(k)%gap >= 0.0_dp) cycle
+            if (self%out(k)%gap >= self%gap_tol) cycle
             if (.not. converged) then
                 write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
                 call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &

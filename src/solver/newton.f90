@@ -20,11 +20,16 @@ module voiga_solver_newton
 
     public :: solve_steps, solver_stats_t, wall_seconds
 
+    !> Most halvings of one Newton step.
+    integer, parameter :: max_line_search = 8
+
     !> Counters of a run.
     type :: solver_stats_t
         type(assembly_stats_t) :: assembly
         integer :: steps = 0, iterations = 0
         integer :: symbolic_factorizations = 0, numeric_factorizations = 0
+        !> Residual evaluations spent on halving Newton steps.
+        integer :: line_search_steps = 0
         !> The record of every converged step (residual and energy norms, reactions, seconds).
         type(step_record_t), allocatable :: records(:)
     end type solver_stats_t
@@ -41,7 +46,7 @@ contains
     !> Run every load step of `model` from zero displacement; write each converged
     !> step to `results` (if present) and report progress unless `quiet`.
     !> `u` holds the last converged displacement on return (also on failure).
-    subroutine solve_steps(model, u, stats, quiet, error, results, t0)
+    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose)
         type(model_t), intent(inout) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(solver_stats_t), intent(out) :: stats
@@ -50,12 +55,15 @@ contains
         type(results_t), intent(inout), optional :: results
         !> Wall time origin of the run (for the time written to the results).
         real(dp), intent(in), optional :: t0
+        !> Print every Newton iteration (residual, energy, contact states).
+        logical, intent(in), optional :: verbose
         type(csc_matrix_t) :: k
         type(umfpack_t) :: lu
         type(step_record_t) :: rec
         real(dp), allocatable :: r(:), du(:), u_conv(:), norms(:), energies(:), rhs(:)
-        real(dp) :: t, r0, rn, e1, en, tic, start, bulk0, contact0
-        integer :: step, it, nsteps, j, c, ip
+        real(dp) :: t, r0, rn, e1, en, tic, start, bulk0, contact0, alpha, rn_prev
+        real(dp), allocatable :: u_prev(:)
+        integer :: step, it, nsteps, j, c, ip, nls
         logical :: converged
         character(len=160) :: msg
 
@@ -79,7 +87,11 @@ contains
             r0 = 0.0_dp
             e1 = 0.0_dp
             en = huge(1.0_dp)
-            do it = 0, model%max_iterations
+            it = 0
+            nls = 0
+            alpha = 1.0_dp
+            rn_prev = huge(1.0_dp)
+            do
                 bulk0 = stats%assembly%seconds_bulk
                 contact0 = stats%assembly%seconds_contact
                 call assemble(model, u, t, r, stats%assembly, error, k)
@@ -87,16 +99,29 @@ contains
                 rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
                 if (allocated(error)) exit
                 rn = norm2(merge(0.0_dp, r, model%fixed))
-                norms(it + 1) = rn
                 if (.not. ieee_is_finite(rn)) then
                     call fatal_error(error, 'the residual is not finite', error_code%numeric)
                     exit
                 end if
+                ! backtracking: a Newton step that increases the residual is halved
+                ! (contact stick/slip and active-set changes can make full steps cycle)
+                if (it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
+                    rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, norm2(r))) then
+                    nls = nls + 1
+                    stats%line_search_steps = stats%line_search_steps + 1
+                    alpha = 0.5_dp*alpha
+                    u = u_prev + alpha*du
+                    cycle
+                end if
+                norms(it + 1) = rn
                 if (it == 0) r0 = rn
+                if (present(verbose)) then
+                    if (verbose) call print_iteration(model, step, it, rn, en, alpha)
+                end if
                 if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp) converged = .true.
                 if (it > 1 .and. en <= model%tol_energy*e1) converged = .true.
                 ! round-off floor: nothing left to gain relative to the forces in play
-                if (rn <= 1.0e3_dp*epsilon(1.0_dp)*max(r0, norm2(r))) converged = .true.
+                if (rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, norm2(r))) converged = .true.
                 if (converged) exit
                 if (it == model%max_iterations) exit
                 tic = wall_seconds()
@@ -112,7 +137,12 @@ contains
                 en = abs(dot_product(du, rhs))
                 if (it == 0) e1 = en
                 energies(it + 1) = en
+                u_prev = u
+                rn_prev = rn
+                alpha = 1.0_dp
+                nls = 0
                 u = u + du
+                it = it + 1
             end do
             stats%iterations = stats%iterations + it
             if (.not. allocated(error) .and. .not. converged) then
@@ -157,6 +187,21 @@ contains
         stats%symbolic_factorizations = lu%n_symbolic
         stats%numeric_factorizations = lu%n_numeric
     end subroutine solve_steps
+
+    !> One line per Newton iteration: residual, energy norm, contact states.
+    subroutine print_iteration(model, step, it, rn, en, alpha)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: step, it
+        real(dp), intent(in) :: rn, en, alpha
+        integer :: ip
+        write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4)', advance='no') '  step ', step, ' it ', it, &
+            '  |r|=', rn, '  |du.r|=', merge(en, 0.0_dp, it > 0), '  step length ', alpha
+        do ip = 1, size(model%pairs)
+            write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', count(model%pairs(ip)%out%state == 1), &
+                ' slip=', count(model%pairs(ip)%out%state == 2), ' of ', size(model%pairs(ip)%out)
+        end do
+        write (*, '(a)') ''
+    end subroutine print_iteration
 
     !> Put the prescribed values at load time `t` into `u`.
     pure subroutine set_prescribed(model, t, u)
