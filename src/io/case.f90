@@ -495,7 +495,7 @@ contains
             return
         end if
         write (msg, '(a,i0,a)') ': &dirichlet (', k, '): '
-        where = path//trim(msg)
+        where = path//trim(msg)//' '
         if (body_index(self, body) == 0) then
             call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
                              error_code%input)
@@ -547,7 +547,7 @@ contains
             return
         end if
         write (msg, '(a,i0,a)') ': &pressure (', k, '): '
-        where = path//trim(msg)
+        where = path//trim(msg)//' '
         if (body_index(self, body) == 0) then
             call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
                              error_code%input)
@@ -598,7 +598,7 @@ contains
             return
         end if
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
-        where = path//trim(msg)
+        where = path//trim(msg)//' '
         ib = body_index(self, slave)
         if (ib == 0) then
             call fatal_error(error, where//"slave = '"//trim(slave)//"' is not a body of the case", &
