@@ -124,6 +124,36 @@ class Dirichlet:
 
 
 @dataclass
+class ContactOutput:
+    """Per-slave-point output of one contact pair at one step (``/steps/<k>/contact/<i>``)."""
+
+    slave: str
+    master: str
+    force: np.ndarray
+    """(2,) resultant contact force on the slave."""
+    xi_slave: np.ndarray
+    """(n,) slave points' parameters along the slave's contact edge."""
+    x_ref: np.ndarray
+    """(n, 2) reference position of each slave point."""
+    x: np.ndarray
+    """(n, 2) current position."""
+    gap: np.ndarray
+    """(n,) normal gap (negative: penetration), NaN where there is no projection."""
+    p_n: np.ndarray
+    """(n,) contact pressure (>= 0)."""
+    p_t: np.ndarray
+    """(n,) tangential traction along the master tangent."""
+    xi_master: np.ndarray
+    state: np.ndarray
+    """(n,) 0 inactive, 1 stick (or frictionless contact), 2 slip."""
+
+    @property
+    def active(self) -> np.ndarray:
+        """(n,) bool: in contact."""
+        return self.state > 0
+
+
+@dataclass
 class Step:
     """One converged load step."""
 
@@ -140,6 +170,8 @@ class Step:
     """stage (``STAGES``) -> wall-clock seconds."""
     displacement: np.ndarray
     """(n_dofs,) control point displacements, global numbering, x/y interleaved."""
+    contact: list[ContactOutput] = field(default_factory=list)
+    """One entry per contact pair, in case-file order."""
 
 
 @dataclass
@@ -315,7 +347,25 @@ def _read_step(name: str, g: h5py.Group, n_dirichlet: int) -> Step | None:
                 reactions=reactions,
                 seconds={k[len("seconds_"):]: float(v) for k, v in a.items()
                          if k.startswith("seconds_")},
-                displacement=np.asarray(g["displacement"][()], dtype=float).reshape(-1))
+                displacement=np.asarray(g["displacement"][()], dtype=float).reshape(-1),
+                contact=[_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
+                if "contact" in g else [])
+
+
+def _read_contact(g: h5py.Group) -> ContactOutput:
+    a = _attrs(g)
+
+    def vec(key: str) -> np.ndarray:
+        return np.asarray(g[key][()], dtype=float).reshape(-1)
+
+    def pts(key: str) -> np.ndarray:
+        return np.asarray(g[key][()], dtype=float).reshape(-1, 2)
+
+    return ContactOutput(slave=str(a.get("slave", "")), master=str(a.get("master", "")),
+                         force=vec("force"), xi_slave=vec("xi_slave"), x_ref=pts("x_ref"),
+                         x=pts("x"), gap=vec("gap"), p_n=vec("p_n"), p_t=vec("p_t"),
+                         xi_master=vec("xi_master"),
+                         state=np.asarray(g["state"][()], dtype=int).reshape(-1))
 
 
 def read_result(path: str | Path) -> Result:
