@@ -29,7 +29,7 @@ program voiga_tests
     if (trim(filter) == '--lame-table') then
         ! the convergence table of docs/verification.md
         block
-            real(dp) :: rates(5, 2)
+            real(dp) :: rates(5, 3)
             type(error_t), allocatable :: error
             call lame_table(rates, error, .true.)
             if (allocated(error)) error stop 1

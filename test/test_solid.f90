@@ -410,14 +410,14 @@ contains
     !> Print the Lame convergence table (docs/verification.md) and return the
     !> observed rates between successive meshes, shape [n_meshes - 1, 2] (p = 2, 3).
     subroutine lame_table(rates, error, verbose)
-        real(dp), intent(out) :: rates(5, 2)
+        real(dp), intent(out) :: rates(5, 3)
         type(error_t), allocatable, intent(out) :: error
         logical, intent(in) :: verbose
         integer, parameter :: meshes(6) = [2, 4, 8, 16, 32, 64]
         real(dp) :: err(6), rate
         integer :: p, m, ndof
         if (verbose) write (*, '(a)') '| p | elements | DOFs | rel. L2 error | rate |', '|---|---|---|---|---|'
-        do p = 2, 3
+        do p = 2, 4
             do m = 1, size(meshes)
                 call lame_error(p, meshes(m), err(m), ndof, error)
                 if (allocated(error)) return
@@ -433,21 +433,27 @@ contains
     end subroutine lame_table
 
     !> L2 displacement error converges at rate p + 1 under h-refinement.
-    !> p = 2 is asymptotic from 4 x 4 on (3.00-3.06). p = 3 approaches 4 from below
-    !> (3.77, 3.83, 3.91, 3.96 for 8 .. 64 elements per side): we assert that the
-    !> rate keeps rising and reaches 3.95 on the finest pair (docs/verification.md).
+    !> p = 2 reaches 3 from above (3.06, 3.03, 3.01, 3.00). p = 3 and 4 approach 4 and
+    !> 5 from below, the deficit halving with each refinement (p = 3: 3.77, 3.83, 3.91,
+    !> 3.96; p = 4: 4.28, 4.72, 4.91, 4.97): we assert that their rates keep rising and
+    !> are within 0.05 of p + 1 on the finest pair (docs/verification.md).
     subroutine test_lame(error)
         type(error_t), allocatable, intent(out) :: error
-        real(dp) :: rates(5, 2)
+        real(dp) :: rates(5, 3)
+        integer :: p
         call lame_table(rates, error, .false.)
         if (allocated(error)) return
         call check(error, rates(5, 1) >= 3.0_dp .and. rates(4, 1) >= 3.0_dp, &
                    'Lame p = 2: L2 rate >= 3 on the two finest pairs')
         if (allocated(error)) return
-        call check(error, rates(3, 2) < rates(4, 2) .and. rates(4, 2) < rates(5, 2), &
-                   'Lame p = 3: rate still rising towards 4')
-        if (allocated(error)) return
-        call check(error, rates(5, 2) >= 3.95_dp, 'Lame p = 3: L2 rate >= 3.95 on 32 -> 64')
+        do p = 3, 4
+            call check(error, rates(3, p - 1) < rates(4, p - 1) .and. rates(4, p - 1) < rates(5, p - 1), &
+                       'Lame p = 3, 4: rate still rising towards p + 1')
+            if (allocated(error)) return
+            call check(error, rates(5, p - 1) >= real(p + 1, dp) - 0.05_dp, &
+                       'Lame p = 3, 4: L2 rate within 0.05 of p + 1 on 32 -> 64')
+            if (allocated(error)) return
+        end do
     end subroutine test_lame
 
     !> Block compressed by 30 % (Neo-Hookean, bottom clamped): Newton converges
