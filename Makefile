@@ -6,7 +6,7 @@ CASE    ?= cases/ironing/m1-NN2.2.nml
 PYTHON  ?= python3
 PREFIX  := build/install
 VOIGA   := $(PREFIX)/bin/voiga
-APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev
+APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev libopenblas-dev
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: all deps build run test test-fortran test-python clean
@@ -20,6 +20,7 @@ deps:
 	command -v pkg-config >/dev/null 2>&1 || missing="yes"; \
 	pkg-config --exists hdf5 2>/dev/null || missing="yes"; \
 	pkg-config --exists lapack 2>/dev/null || missing="yes"; \
+	pkg-config --exists openblas 2>/dev/null || missing="yes"; \
 	[ -f /usr/include/suitesparse/umfpack.h ] || missing="yes"; \
 	if [ -n "$$missing" ]; then \
 	  echo "deps: installing Debian packages: $(APT_PKGS)"; \

@@ -13,6 +13,16 @@ module voiga_model_assembly
     private
 
     public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
+    public :: assembly_map_t, new_assembly_map
+
+    !> Where each element's stiffness entries go in the CSC values, computed once per
+    !> pattern so that assembly needs no search.
+    type :: assembly_map_t
+        !> Start of each element's entries in `pos`, over all bodies in order [nel_total + 1].
+        integer, allocatable :: ptr(:)
+        !> Index into the matrix values of entry (a, b) of each element, column-major.
+        integer, allocatable :: pos(:)
+    end type assembly_map_t
 
     !> What the assembly did (to show that a scene simulates only what it asks for).
     type :: assembly_stats_t
@@ -47,37 +57,70 @@ contains
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        real(dp) :: gx(body%n_gauss(1)), wx(body%n_gauss(1)), ge(body%n_gauss(2)), we(body%n_gauss(2))
-        real(dp), allocatable :: r(:), dr(:, :), d2r(:, :), dndx(:, :), x0(:, :), ue(:, :)
-        integer, allocatable :: dofs(:)
+        real(dp) :: r(size(fe)/2), dr(2, size(fe)/2), dndx(2, size(fe)/2), x0(2, size(fe)/2), &
+                    ue(2, size(fe)/2)
         real(dp) :: xi, eta, det, hx, he
-        integer :: nen, i, j
+        integer :: i, j, a
 
-        nen = element_nfun(body%disc, e)
-        allocate (r(nen), dr(2, nen), d2r(3, nen), dndx(2, nen))
-        dofs = body_dofs(body, e)
-        x0 = body%disc%x(:, body%disc%elements(e)%conn)
-        ue = reshape(u(dofs), [2, nen])
-        call gauss_legendre(body%n_gauss(1), gx, wx)
-        call gauss_legendre(body%n_gauss(2), ge, we)
+        associate (conn => body%disc%elements(e)%conn)
+            do a = 1, size(conn)
+                x0(:, a) = body%disc%x(:, conn(a))
+                ue(:, a) = u(body%dof0 + 2*conn(a) - 1:body%dof0 + 2*conn(a))
+            end do
+        end associate
         fe = 0.0_dp
         ke = 0.0_dp
         ok = .true.
         associate (el => body%disc%elements(e))
             hx = 0.5_dp*(el%xi(2) - el%xi(1))
             he = 0.5_dp*(el%eta(2) - el%eta(1))
-            do j = 1, size(ge)
-                eta = el%eta(1) + he*(ge(j) + 1.0_dp)
-                do i = 1, size(gx)
-                    xi = el%xi(1) + hx*(gx(i) + 1.0_dp)
-                    call element_basis(body%disc, e, xi, eta, r, dr, d2r)
+            do j = 1, size(body%ge)
+                eta = el%eta(1) + he*(body%ge(j) + 1.0_dp)
+                do i = 1, size(body%gx)
+                    xi = el%xi(1) + hx*(body%gx(i) + 1.0_dp)
+                    call element_basis(body%disc, e, xi, eta, r, dr)
                     call reference_gradients(x0, dr, dndx, det)
-                    call solid_point(body%mat, dndx, ue, wx(i)*we(j)*hx*he*abs(det), fe, ke, ok)
+                    call solid_point(body%mat, dndx, ue, body%wx(i)*body%we(j)*hx*he*abs(det), fe, ke, ok)
                     if (.not. ok) return
                 end do
             end do
         end associate
     end subroutine body_element
+
+    !> The positions of every bulk element's entries in `k` (built on its pattern).
+    subroutine new_assembly_map(model, k, map)
+        type(model_t), intent(in) :: model
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(out) :: map
+        integer, allocatable :: dofs(:), pos(:, :)
+        integer :: ib, e, nel, n, m, idx
+        nel = sum([(model%bodies(ib)%disc%nel, ib=1, size(model%bodies))])
+        allocate (map%ptr(nel + 1))
+        map%ptr(1) = 1
+        idx = 0
+        do ib = 1, size(model%bodies)
+            do e = 1, model%bodies(ib)%disc%nel
+                idx = idx + 1
+                n = 2*size(model%bodies(ib)%disc%elements(e)%conn)
+                map%ptr(idx + 1) = map%ptr(idx) + n*n
+            end do
+        end do
+        allocate (map%pos(map%ptr(nel + 1) - 1))
+        idx = 0
+        do ib = 1, size(model%bodies)
+            do e = 1, model%bodies(ib)%disc%nel
+                idx = idx + 1
+                dofs = body_dofs(model%bodies(ib), e)
+                m = size(dofs)
+                if (allocated(pos)) then
+                    if (size(pos, 1) /= m) deallocate (pos)
+                end if
+                if (.not. allocated(pos)) allocate (pos(m, m))
+                call k%element_positions(dofs, pos)
+                map%pos(map%ptr(idx):map%ptr(idx + 1) - 1) = reshape(pos, [m*m])
+            end do
+        end do
+    end subroutine new_assembly_map
 
     !> The stiffness pattern of all bodies (every element couples its DOFs).
     subroutine stiffness_pattern(model, k, error)
@@ -125,7 +168,7 @@ contains
 
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
-    subroutine assemble(model, u, t, r, stats, error, k)
+    subroutine assemble(model, u, t, r, stats, error, k, map)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         !> Load time (for the external forces).
@@ -134,9 +177,11 @@ contains
         type(assembly_stats_t), intent(inout) :: stats
         type(error_t), allocatable, intent(out) :: error
         type(csc_matrix_t), intent(inout), optional :: k
+        !> Element positions in `k` (from `new_assembly_map`): no search when given.
+        type(assembly_map_t), intent(in), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
-        integer :: ib, e, n, npts, ip
+        integer :: ib, e, n, npts, ip, idx
         logical :: ok
         character(len=64) :: buf
         integer(i8) :: c0, c1, rate
@@ -144,6 +189,7 @@ contains
         call system_clock(c0, rate)
         r = 0.0_dp
         if (present(k)) call k%zero()
+        idx = 0
         do ib = 1, size(model%bodies)
             associate (body => model%bodies(ib))
                 npts = product(body%n_gauss)
@@ -161,9 +207,18 @@ contains
                                          error_code%numeric)
                         return
                     end if
+                    idx = idx + 1
                     dofs = body_dofs(body, e)
                     r(dofs) = r(dofs) + fe
-                    if (present(k)) call k%add_element(dofs, ke)
+                    if (present(k)) then
+                        if (present(map)) then
+                            associate (pos => map%pos(map%ptr(idx):map%ptr(idx + 1) - 1))
+                                k%values(pos) = k%values(pos) + reshape(ke, [n*n])
+                            end associate
+                        else
+                            call k%add_element(dofs, ke)
+                        end if
+                    end if
                 end do
                 if (body%mat%finite_strain) then
                     stats%finite_strain_points = stats%finite_strain_points + int(npts, i8)*body%disc%nel

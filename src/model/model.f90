@@ -7,6 +7,7 @@ module voiga_model
     use voiga_material, only: material_t
     use voiga_material_factory, only: new_material
     use voiga_discretization_patch, only: discretization_t, edge_cps
+    use voiga_element_quadrature, only: gauss_legendre
     use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit
     use voiga_contact_surface, only: new_contact_surface
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
@@ -24,8 +25,10 @@ module voiga_model
         class(material_t), allocatable :: mat
         !> Global DOFs of this body are dof0 + 1 .. dof0 + 2 ncp (2(a-1)+i for point a, component i).
         integer :: dof0 = 0
-        !> Gauss points per direction used for this body [xi, eta].
+        !> Gauss points per direction used for this body [xi, eta], and the points
+        !> and weights on [-1, 1] along xi (gx, wx) and eta (ge, we).
         integer :: n_gauss(2) = 0
+        real(dp), allocatable :: gx(:), wx(:), ge(:), we(:)
     end type body_t
 
     !> Prescribed displacement on the control points of an edge.
@@ -96,6 +99,9 @@ contains
                     if (b%disc%has_layer) b%n_gauss(1) = max(b%n_gauss(1), b%disc%layer%degree + 1)
                     b%n_gauss(2) = b%disc%bulk%degree(2) + 1
                 end if
+                allocate (b%gx(b%n_gauss(1)), b%wx(b%n_gauss(1)), b%ge(b%n_gauss(2)), b%we(b%n_gauss(2)))
+                call gauss_legendre(b%n_gauss(1), b%gx, b%wx)
+                call gauss_legendre(b%n_gauss(2), b%ge, b%we)
                 self%finite_strain = self%finite_strain .or. b%mat%finite_strain
             end associate
         end do

@@ -10,7 +10,8 @@ module voiga_solver_newton
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, phase_value, step_time, n_total_steps
-    use voiga_model_assembly, only: assembly_stats_t, assemble, stiffness_pattern
+    use voiga_model_assembly, only: assembly_stats_t, assemble, stiffness_pattern, assembly_map_t, &
+                                    new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_io_results, only: results_t, step_record_t
@@ -58,6 +59,7 @@ contains
         !> Print every Newton iteration (residual, energy, contact states).
         logical, intent(in), optional :: verbose
         type(csc_matrix_t) :: k
+        type(assembly_map_t) :: map
         type(umfpack_t) :: lu
         type(step_record_t) :: rec
         real(dp), allocatable :: r(:), du(:), u_conv(:), norms(:), energies(:), rhs(:)
@@ -71,6 +73,7 @@ contains
         if (present(t0)) start = t0
         call stiffness_pattern(model, k, error)
         if (allocated(error)) return
+        call new_assembly_map(model, k, map)
         allocate (u(model%ndof), r(model%ndof), du(model%ndof), rhs(model%ndof))
         u = 0.0_dp
         u_conv = u
@@ -94,7 +97,7 @@ contains
             do
                 bulk0 = stats%assembly%seconds_bulk
                 contact0 = stats%assembly%seconds_contact
-                call assemble(model, u, t, r, stats%assembly, error, k)
+                call assemble(model, u, t, r, stats%assembly, error, k, map)
                 rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
                 rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
                 if (allocated(error)) exit
