@@ -4,6 +4,8 @@ Subcommands:
   plot-deformed  draw every body deformed, coloured by |u| (PNG)
   plot-contact   p_N and p_T along the contact (PNG)
   hertz          compare a hertz result with the analytic line contact
+  sweep          run committed cases in parallel and write a summary (CSV, markdown)
+  figures        validation figures and accuracy/cost tables from a sweep's results
 
 Steps (--step): N >= 1 is the step number, N < 0 counts converged steps from
 the end (-1: the last one), 0 is the reference configuration.
@@ -60,6 +62,43 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    import os
+    from pathlib import Path
+
+    from .sweep import default_binary, find_cases, summarize, sweep, write_summary
+
+    binary = Path(args.binary) if args.binary else default_binary()
+    if not binary.exists():
+        print(f"python -m post sweep: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
+        return 2
+    runs = find_cases(Path(args.cases), Path(args.out), args.scenes, args.meshes, args.layouts)
+    if not runs:
+        print("python -m post sweep: no case matches", file=sys.stderr)
+        return 2
+    failed = 0
+    if not args.summary_only:
+        outcome = sweep(runs, binary, args.jobs or os.cpu_count() or 1, args.timeout, args.force,
+                        progress=not args.no_progress)
+        for label, (code, message) in sorted(outcome.items()):
+            if code != 0:
+                failed += 1
+                print(f"{label}: exit {code}: {message}", file=sys.stderr)
+    csv_path, md_path = write_summary(summarize(runs), Path(args.out))
+    print(f"{len(runs)} cases, {failed} failed; summary in {csv_path} and {md_path}")
+    return 1 if failed else 0
+
+
+def _cmd_figures(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .figures import make_all
+
+    for path in make_all(Path(args.results), Path(args.out)):
+        print(path)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argparse parser with one subparser per subcommand."""
     p = argparse.ArgumentParser(prog="python -m post", description=__doc__,
@@ -84,6 +123,25 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--axis", type=int, default=0, help="0: plot against x, 1: against y")
     s.add_argument("-o", "--output", default=None, help="PNG file")
     s.set_defaults(func=_cmd_plot_contact)
+
+    s = sub.add_parser("sweep", help="run committed cases in parallel, summarize")
+    s.add_argument("--cases", default="cases", help="folder of committed cases (default: cases)")
+    s.add_argument("--out", default="results", help="work and summary folder (default: results)")
+    s.add_argument("--scenes", nargs="*", help="scenes to run (default: all)")
+    s.add_argument("--meshes", nargs="*", help="meshes to run, e.g. m1 m2 (default: all)")
+    s.add_argument("--layouts", nargs="*", help="layouts to run, e.g. N2 NN2.2 (default: all)")
+    s.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores)")
+    s.add_argument("--timeout", type=float, default=3600.0, help="seconds per case (default 3600)")
+    s.add_argument("--force", action="store_true", help="rerun up-to-date cases too")
+    s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.add_argument("--binary", default=None, help="voiga binary (default: $VOIGA_BIN or build/install)")
+    s.set_defaults(func=_cmd_sweep)
+
+    s = sub.add_parser("figures", help="validation figures and tables from a sweep")
+    s.add_argument("--results", default="results", help="the sweep's folder (default: results)")
+    s.add_argument("--out", default="docs/validation", help="where to write (default: docs/validation)")
+    s.set_defaults(func=_cmd_figures)
 
     s = sub.add_parser("hertz", help="hertz result against the analytic line contact")
     s.add_argument("result", help="result file (.h5) of a hertz case")

@@ -1,0 +1,201 @@
+"""The validation figures and tables (``python -m post figures``), from a sweep's results
+folder: die forces per step (paper Figs. 8-10), contact pressure against the reference
+(Figs. 18, 24), error against mesh (Figs. 19-20) and against time (Figs. 13, 21),
+deformed shapes (Figs. 7, 14, 23) and the accuracy/cost table."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from .reader import read_result
+
+LAYOUT_ORDER = ["L1", "N2", "N4", "N6", "NN4", "NN6", "NN2.1", "NN2.2", "NN2.3", "NN3.2"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def read_summary(results: Path) -> list[dict[str, str]]:
+    with (results / "summary.csv").open() as fh:
+        return list(csv.DictReader(fh))
+
+
+def _num(row: dict[str, str], key: str) -> float:
+    try:
+        return float(row.get(key, "") or "nan")
+    except ValueError:
+        return float("nan")
+
+
+def ironing_forces(results: Path, out: Path, scene: str = "ironing", mesh: str = "m1") -> Path | None:
+    """Px and Py against the load step for every layout on one mesh."""
+    from .ironing import die_forces
+
+    files = {lay: results / scene / f"{mesh}-{lay}.h5" for lay in LAYOUT_ORDER}
+    files = {k: v for k, v in files.items() if v.exists()}
+    if not files:
+        return None
+    plt = _plt()
+    fig, ax = plt.subplots(2, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
+    for lay, path in files.items():
+        res = read_result(path)
+        if not res.steps:
+            continue
+        steps, f = die_forces(res)
+        ax[0].plot(steps, f[:, 0], lw=1.2 if lay == "N2" else 0.9, label=lay)
+        ax[1].plot(steps, f[:, 1], lw=1.2 if lay == "N2" else 0.9, label=lay)
+    ax[0].set_ylabel("$P_x$ on the die")
+    ax[1].set_ylabel("$P_y$ on the die")
+    ax[1].set_xlabel("load step (1-10 press, 11-210 slide)")
+    ax[0].set_title(f"{scene}, mesh {mesh}: reaction on the die's driven edge")
+    ax[0].legend(ncol=4, fontsize=8)
+    path = out / f"{scene}-forces-{mesh}.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def hertz_pressure(results: Path, out: Path, mesh: str = "m3") -> Path | None:
+    """p/p0 against x/a for the layouts on one mesh, the analytic profile and N2 on m6."""
+    from .contact import hertz_comparison
+    from .measures import profile
+
+    ref_path = results / "hertz" / "m6-N2.h5"
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    s = np.linspace(0, 1, 400)
+    ax.plot(s, np.sqrt(1 - s**2), "k-", lw=2, label="analytic Hertz")
+    scale_a = None
+    if ref_path.exists():
+        ref = read_result(ref_path)
+        h = hertz_comparison(ref)
+        scale_a, p0 = h.a, h.p0
+        x, p = profile(ref)
+        ax.plot(x / h.a, p / p0, "k--", lw=1, label="N2 m6 (reference)")
+    for lay in LAYOUT_ORDER:
+        path = results / "hertz" / f"{mesh}-{lay}.h5"
+        if not path.exists():
+            continue
+        res = read_result(path)
+        if not res.converged:
+            continue
+        h = hertz_comparison(res)
+        x, p = profile(res)
+        ax.plot(x / h.a, p / h.p0, ".-", ms=3, lw=0.8, label=lay)
+    ax.set_xlim(0, 1.3)
+    ax.set_xlabel("x / a")
+    ax.set_ylabel("p / p0")
+    ax.set_title(f"hertz, mesh {mesh}: contact pressure")
+    ax.legend(fontsize=8)
+    path = out / f"hertz-pressure-{mesh}.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def error_plots(rows: list[dict[str, str]], out: Path, scene: str, error: str,
+                label: str) -> list[Path]:
+    """Error against mesh level and against normalised time, one line per layout."""
+    plt = _plt()
+    paths = []
+    sel = [r for r in rows if r["scene"] == scene and r.get("status") == "converged"
+           and np.isfinite(_num(r, error)) and r["mesh"].startswith("m")]
+    if not sel:
+        return paths
+    for xkey, xlabel, name in (("mesh", "mesh", "mesh"), ("time_norm", "time / most expensive run", "time")):
+        fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+        for lay in LAYOUT_ORDER:
+            pts = [r for r in sel if r["layout"] == lay]
+            if not pts:
+                continue
+            pts.sort(key=lambda r: r["mesh"])
+            xs = [int(r["mesh"][1:]) for r in pts] if xkey == "mesh" else [_num(r, "time_norm") for r in pts]
+            ax.plot(xs, [_num(r, error) for r in pts], "o-", ms=4, label=lay)
+        ax.set_yscale("log")
+        if xkey == "time_norm":
+            ax.set_xscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(label)
+        ax.set_title(f"{scene}: {label} against {name}")
+        ax.legend(fontsize=8)
+        path = out / f"{scene}-{error}-vs-{name}.png"
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def accuracy_cost(rows: list[dict[str, str]], scene: str, error: str,
+                  levels: tuple[float, ...] = (0.10, 0.03, 0.01)) -> str:
+    """Markdown table: for each error level, the cheapest run reaching it, its time, and
+    its time relative to the cheapest N2 run reaching it."""
+    sel = [r for r in rows if r["scene"] == scene and r.get("status") == "converged"
+           and np.isfinite(_num(r, error)) and r["mesh"].startswith("m")]
+    lines = [f"| {error} <= | cheapest run | its wall s | cheapest N2 | N2 wall s | time / N2's |",
+             "|---|---|---|---|---|---|"]
+    for level in levels:
+        ok = [r for r in sel if _num(r, error) <= level]
+        if not ok:
+            lines.append(f"| {level:g} | none reaches it | | | | |")
+            continue
+        best = min(ok, key=lambda r: _num(r, "wall_s"))
+        n2 = [r for r in ok if r["layout"] == "N2"]
+        n2b = min(n2, key=lambda r: _num(r, "wall_s")) if n2 else None
+        ratio = f"{_num(best, 'wall_s') / _num(n2b, 'wall_s'):.2f}" if n2b else "N2 does not reach it"
+        lines.append(f"| {level:g} | {best['mesh']}-{best['layout']} ({_num(best, error):.3g}) | "
+                     f"{_num(best, 'wall_s'):.3g} | "
+                     f"{(n2b['mesh'] + '-N2 (' + format(_num(n2b, error), '.3g') + ')') if n2b else '-'} | "
+                     f"{_num(n2b, 'wall_s'):.3g} | {ratio} |" if n2b else
+                     f"| {level:g} | {best['mesh']}-{best['layout']} ({_num(best, error):.3g}) | "
+                     f"{_num(best, 'wall_s'):.3g} | - | - | {ratio} |")
+    return "\n".join(lines) + "\n"
+
+
+def deformed(results: Path, out: Path) -> list[Path]:
+    """Deformed shapes of one run per scene."""
+    from .plot import plot_deformed
+
+    paths = []
+    for scene, stem, step in (("ironing", "m1-N2", 110), ("hertz", "m3-NN2.2", -1), ("rings", "m1-N2", -1)):
+        path = results / scene / f"{stem}.h5"
+        if not path.exists():
+            continue
+        res = read_result(path)
+        if not res.steps:
+            continue
+        if step > 0 and step > res.steps[-1].step:
+            step = -1
+        paths.append(plot_deformed(res, step=step, output=out / f"{scene}-{stem}-deformed.png"))
+    return paths
+
+
+def make_all(results: Path, out: Path) -> list[Path]:
+    """Every figure and the accuracy/cost tables (``accuracy-cost.md``) into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    rows = read_summary(results)
+    made: list[Path | None] = []
+    for scene in ("ironing", "ironing-deep"):
+        for mesh in ("m1", "m2"):
+            made.append(ironing_forces(results, out, scene, mesh))
+    made.append(hertz_pressure(results, out, "m3"))
+    made.append(hertz_pressure(results, out, "m1"))
+    made += error_plots(rows, out, "hertz", "l2_ref", "L2 error of p/p_max vs N2 m6")
+    made += error_plots(rows, out, "hertz", "l2_analytic", "L2 error of p/p_max vs analytic")
+    made += error_plots(rows, out, "rings", "l2_pn_ref", "L2 error of p_N vs reference")
+    made += error_plots(rows, out, "rings", "l2_pt_ref", "L2 error of p_T vs reference")
+    made += deformed(results, out)
+    text = ["# What accuracy costs (generated by `python -m post figures`)\n"]
+    for scene, error in (("hertz", "l2_ref"), ("hertz", "l2_analytic"), ("rings", "l2_pn_ref"),
+                         ("rings", "l2_pt_ref")):
+        text += [f"\n## {scene}: {error}\n\n", accuracy_cost(rows, scene, error)]
+    (out / "accuracy-cost.md").write_text("".join(text))
+    return [p for p in made if p is not None]

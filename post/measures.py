@@ -1,0 +1,108 @@
+"""Error and cost measures of the benchmark scenes (definitions in docs/validation.md).
+
+- ironing: oscillation amplitude of the die forces Px, Py over the second half of the
+  sliding steps, after removing a cubic trend (the slab's finite length makes the mean
+  force drift as the die approaches its end); reported as % of N2 on the same mesh.
+- hertz: half-width / peak against analytic Hertz, and the relative L2 error of the
+  normalised pressure p/p_max against analytic Hertz and against the reference run
+  (N2 on m6).
+- rings: relative L2 errors of p_N and p_T against the reference run (N2, finer mesh).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .contact import fit_hertz, hertz_comparison
+from .ironing import die_forces
+from .reader import Result
+
+PRESS_STEPS = 10
+"""Steps of the ironing press phase (cases/ironing: n_steps = 10, 200)."""
+
+
+def detrended_amplitude(t: np.ndarray, y: np.ndarray, degree: int = 3) -> float:
+    """max - min of y after subtracting a least-squares polynomial trend in t."""
+    t = np.asarray(t, dtype=float)
+    scaled = (t - t.mean()) / max(np.ptp(t), 1e-300)
+    return float(np.ptp(y - np.polyval(np.polyfit(scaled, y, degree), scaled)))
+
+
+def ironing_measures(res: Result) -> dict[str, float]:
+    """Detrended oscillation amplitudes and mean forces over the second half of sliding."""
+    steps, f = die_forces(res)
+    sliding = np.flatnonzero(steps > PRESS_STEPS)
+    if len(sliding) < 8:
+        return {}
+    w = sliding[len(sliding) // 2:]
+    return {"amp_px": detrended_amplitude(steps[w], f[w, 0]),
+            "amp_py": detrended_amplitude(steps[w], f[w, 1]),
+            "raw_amp_px": float(np.ptp(f[w, 0])), "raw_amp_py": float(np.ptp(f[w, 1])),
+            "mean_px": float(f[w, 0].mean()), "mean_py": float(f[w, 1].mean())}
+
+
+def profile(res: Result, pair: int = 0, which: str = "p_n") -> tuple[np.ndarray, np.ndarray]:
+    """Current x and a traction of the last step's slave points, sorted in x."""
+    c = res.steps[-1].contact[pair]
+    x = c.x[:, 0]
+    order = np.argsort(x)
+    return x[order], getattr(c, which)[order]
+
+
+def profile_error(x: np.ndarray, p: np.ndarray, xr: np.ndarray, pr: np.ndarray,
+                  extent: float, scale: float) -> float:
+    """Relative L2 distance of two traction profiles on [0, extent], both divided by
+    ``scale``; linear interpolation between points, zero outside the sampled range."""
+    s = np.linspace(0.0, extent, 4001)
+    a = np.interp(s, x, p, left=0.0, right=0.0) / scale
+    b = np.interp(s, xr, pr, left=0.0, right=0.0) / scale
+    norm = np.sqrt(np.trapezoid(b**2, s))
+    return float(np.sqrt(np.trapezoid((a - b) ** 2, s)) / norm) if norm > 0 else float("nan")
+
+
+def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
+    """Comparison with analytic Hertz, and with the reference run if given: profiles in
+    x/a on [0, 1.2], pressures divided by the reference's (resp. analytic) peak."""
+    h = hertz_comparison(res)
+    out = {"force": h.force, "a_err": h.a_error, "p0_err": h.p0_error, "pmax_err": h.p_max / h.p0 - 1.0,
+           "l2_analytic": h.l2_error}
+    if ref is not None:
+        x, p = profile(res)
+        xr, pr = profile(ref)
+        href = hertz_comparison(ref)
+        out["l2_ref"] = profile_error(x / href.a, p, xr / href.a, pr, 1.2, float(pr.max()))
+    return out
+
+
+def rings_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
+    """L2 errors of p_N and p_T against the reference run (profiles along current x)."""
+    if ref is None or not res.steps or not res.steps[-1].contact:
+        return {}
+    out = {}
+    for which, key in (("p_n", "l2_pn_ref"), ("p_t", "l2_pt_ref")):
+        x, p = profile(res, which=which)
+        xr, pr = profile(ref, which=which)
+        active = np.abs(pr) > 0
+        extent = 1.2 * float(xr[active].max()) if active.any() else float(xr.max())
+        out[key] = profile_error(x, p, xr, pr, extent, float(np.abs(pr).max()))
+    return out
+
+
+def measures_for(scene: str, res: Result, ref: Result | None = None) -> dict[str, float]:
+    """The measures of ``scene`` for one converged result (empty if it has no steps)."""
+    if not res.steps or not res.converged:
+        return {}
+    try:
+        if scene.startswith("ironing"):
+            return ironing_measures(res)
+        if scene == "hertz":
+            return hertz_measures(res, ref)
+        if scene == "rings":
+            return rings_measures(res, ref)
+    except (ValueError, IndexError) as err:
+        return {"measure_error": str(err)}
+    return {}
+
+
+__all__ = ["detrended_amplitude", "fit_hertz", "hertz_measures", "ironing_measures",
+           "measures_for", "profile_error", "rings_measures"]

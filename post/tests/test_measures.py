@@ -1,0 +1,67 @@
+"""Measures, the sweep runner and the accuracy/cost table."""
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from post.figures import accuracy_cost
+from post.measures import detrended_amplitude, profile_error
+from post.sweep import find_cases, summarize, sweep, up_to_date, write_summary
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_detrended_amplitude_ignores_a_cubic_trend() -> None:
+    t = np.linspace(0, 10, 201)
+    trend = 0.3 + 0.02 * t - 0.001 * t**3
+    assert detrended_amplitude(t, trend) < 1e-10
+    wiggle = 0.01 * np.sin(7 * t)
+    # a sine over a non-integer number of periods projects a little on the cubic: 0.0216
+    assert detrended_amplitude(t, trend + wiggle) == pytest.approx(0.02, rel=0.1)
+
+
+def test_profile_error() -> None:
+    x = np.linspace(0, 1, 50)
+    p = np.sqrt(1 - x**2)
+    assert profile_error(x, p, x, p, 1.2, 1.0) == 0.0
+    assert profile_error(x, 1.1 * p, x, p, 1.2, 1.0) == pytest.approx(0.1, rel=1e-3)
+
+
+def test_accuracy_cost_picks_cheapest() -> None:
+    rows = [
+        {"scene": "s", "mesh": "m1", "layout": "N2", "status": "converged", "err": "0.2", "wall_s": "1"},
+        {"scene": "s", "mesh": "m2", "layout": "N2", "status": "converged", "err": "0.05", "wall_s": "4"},
+        {"scene": "s", "mesh": "m3", "layout": "N2", "status": "converged", "err": "0.02", "wall_s": "16"},
+        {"scene": "s", "mesh": "m1", "layout": "NN2.2", "status": "converged", "err": "0.025", "wall_s": "2"},
+    ]
+    table = accuracy_cost(rows, "s", "err", (0.1, 0.03, 0.01))
+    lines = table.splitlines()
+    # 10%: m1-NN2.2 (2 s) is the cheapest run; the cheapest N2 reaching it is m2 (4 s)
+    assert lines[2].split("|")[2].strip().startswith("m1-NN2.2") and "m2-N2" in lines[2]
+    assert lines[3].split("|")[2].strip().startswith("m1-NN2.2") and "0.12" in lines[3]  # 2 / 16
+    assert "none reaches it" in lines[4]
+
+
+def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
+    binary = Path(os.environ.get("VOIGA_BIN", REPO / "build" / "install" / "bin" / "voiga"))
+    if not binary.exists():
+        if os.environ.get("CI"):
+            pytest.fail(f"no voiga binary at {binary}")
+        pytest.skip(f"no voiga binary at {binary}")
+    runs = find_cases(REPO / "cases", tmp_path, ["hertz"], ["m1"], ["L1", "N2"])
+    assert [r.label for r in runs] == ["hertz/m1-L1", "hertz/m1-N2"]
+    outcome = sweep(runs, binary, jobs=2, timeout=300, progress=False)
+    assert all(code == 0 for code, _ in outcome.values()), outcome
+    assert all(up_to_date(r, binary) for r in runs)
+    again = sweep(runs, binary, jobs=2, timeout=300, progress=False)
+    assert all(msg == "up to date" for _, msg in again.values())
+    csv_path, md_path = write_summary(summarize(runs), tmp_path)
+    rows = list(csv.DictReader(csv_path.open()))
+    assert [int(r["dofs"]) for r in rows] == [980, 1078]
+    assert all(r["status"] == "converged" for r in rows)
+    assert float(rows[1]["l2_analytic"]) < 0.1 and abs(float(rows[1]["a_err"])) < 0.02
+    assert "| hertz | m1 | N2 |" in md_path.read_text()
