@@ -49,13 +49,34 @@ def profile(res: Result, pair: int = 0, which: str = "p_n") -> tuple[np.ndarray,
     return x[order], getattr(c, which)[order]
 
 
+def edge_profile(x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The active part of a pressure profile (x increasing away from the centre) closed
+    by a zero at the contact edge estimated from the last two active points, where p^2
+    is close to linear in x (p ~ sqrt(a - x) at a smooth contact edge). Without this the
+    profile would fall to zero at the first inactive point, whose distance from the
+    edge depends on where the quadrature points happen to lie."""
+    act = np.flatnonzero(p > 0)
+    if len(act) < 2:
+        return x[act], p[act]
+    xa, pa = x[act], p[act]
+    (x1, x2), (q1, q2) = xa[-2:], pa[-2:] ** 2
+    edge = x2 + q2 * (x2 - x1) / (q1 - q2) if q1 > q2 else x2
+    nxt = x[act[-1] + 1] if act[-1] + 1 < len(x) else edge
+    edge = min(max(edge, x2), nxt)   # between the last active and the first inactive point
+    return np.append(xa, edge), np.append(pa, 0.0)
+
+
 def profile_error(x: np.ndarray, p: np.ndarray, xr: np.ndarray, pr: np.ndarray,
                   extent: float, scale: float) -> float:
     """Relative L2 distance of two traction profiles on [0, extent], both divided by
-    ``scale``; linear interpolation between points, zero outside the sampled range."""
+    ``scale``; linear interpolation between points, the first value down to x = 0 (a
+    symmetry line), zero beyond the last point (for contact pressures, close the
+    profiles with :func:`edge_profile` first)."""
     s = np.linspace(0.0, extent, 4001)
-    a = np.interp(s, x, p, left=0.0, right=0.0) / scale
-    b = np.interp(s, xr, pr, left=0.0, right=0.0) / scale
+    # both scenes' profiles start at the symmetry line x = 0: below the first point the
+    # profile keeps its first value
+    a = np.interp(s, x, p, left=p[0], right=0.0) / scale
+    b = np.interp(s, xr, pr, left=pr[0], right=0.0) / scale
     norm = np.sqrt(np.trapezoid(b**2, s))
     return float(np.sqrt(np.trapezoid((a - b) ** 2, s)) / norm) if norm > 0 else float("nan")
 
@@ -67,8 +88,8 @@ def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     out = {"force": h.force, "a_err": h.a_error, "p0_err": h.p0_error, "pmax_err": h.p_max / h.p0 - 1.0,
            "l2_analytic": h.l2_error}
     if ref is not None:
-        x, p = profile(res)
-        xr, pr = profile(ref)
+        x, p = edge_profile(*profile(res))
+        xr, pr = edge_profile(*profile(ref))
         href = hertz_comparison(ref)
         out["l2_ref"] = profile_error(x / href.a, p, xr / href.a, pr, 1.2, float(pr.max()))
     return out
@@ -82,6 +103,10 @@ def rings_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     for which, key in (("p_n", "l2_pn_ref"), ("p_t", "l2_pt_ref")):
         x, p = profile(res, which=which)
         xr, pr = profile(ref, which=which)
+        keep, keep_r = p != 0, pr != 0
+        x, p, xr, pr = x[keep], p[keep], xr[keep_r], pr[keep_r]
+        if len(x) == 0 or len(xr) == 0:
+            continue
         active = np.abs(pr) > 0
         extent = 1.2 * float(xr[active].max()) if active.any() else float(xr.max())
         out[key] = profile_error(x, p, xr, pr, extent, float(np.abs(pr).max()))
