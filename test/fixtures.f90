@@ -3,10 +3,11 @@
 module voiga_test_fixtures
     use voiga_kinds, only: dp
     use voiga_nurbs_surface, only: nurbs_surface_t
+    use voiga_discretization_layout, only: layout_t
     implicit none
     private
 
-    public :: annulus_sector, rectangle, lcg_t, quadratic
+    public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout
 
     !> Park-Miller generator: same numbers on every compiler and run.
     type :: lcg_t
@@ -17,6 +18,36 @@ module voiga_test_fixtures
     end type lcg_t
 
 contains
+
+    !> A layout in the paper's notation: 'L1', 'Np' (degree p along the contact edge,
+    !> 2 across), 'NNq' (bulk 2 x 2, layer of degree q), 'NNq.k' (k more elevations).
+    function paper_layout(name, nel, contact) result(layout)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: nel(2)
+        character(len=*), intent(in) :: contact
+        type(layout_t) :: layout
+        integer :: dot, ios
+        layout%nel = nel
+        layout%contact_edge = contact
+        ios = 0
+        if (name == 'L1') then
+            layout%basis = 'linear'
+            layout%degree = [1, 1]
+        else if (name(1:min(2, len(name))) == 'NN') then
+            dot = index(name, '.')
+            if (dot == 0) then
+                read (name(3:), *, iostat=ios) layout%layer_degree
+            else
+                read (name(3:dot - 1), *, iostat=ios) layout%layer_degree
+                if (ios == 0) read (name(dot + 1:), *, iostat=ios) layout%layer_elevations
+            end if
+        else if (name(1:1) == 'N') then
+            read (name(2:), *, iostat=ios) layout%degree(1)
+        else
+            ios = 1
+        end if
+        if (ios /= 0) error stop 'paper_layout: unknown layout name'
+    end function paper_layout
 
     !> Does a Newton residual sequence converge quadratically? In the asymptotic
     !> range (r_k < 1e-3 r_0) and above round-off (r_k+1 > 1e-13 r_0) every

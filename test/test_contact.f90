@@ -13,7 +13,7 @@ module test_contact
     use voiga_io_case, only: dirichlet_input_t, pressure_input_t
     use voiga_contact_pair, only: contact_pair_t, pair_contribution
     use voiga_contact_gpts, only: state_inactive, state_stick, state_slip
-    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle, quadratic
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
     implicit none
     private
 
@@ -39,22 +39,6 @@ contains
                     ]
     end subroutine collect_contact
 
-    function layout_named(name, nel, contact) result(layout)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: nel(2)
-        character(len=*), intent(in) :: contact
-        type(layout_t) :: layout
-        layout%nel = nel
-        layout%contact_edge = contact
-        select case (name)
-        case ('N2'); layout%degree = [2, 2]
-        case ('N3'); layout%degree = [3, 2]
-        case ('N4'); layout%degree = [4, 2]
-        case ('NN4'); layout%layer_degree = 4
-        case ('NN2.1'); layout%layer_degree = 2; layout%layer_elevations = 1
-        case ('NN2.2'); layout%layer_degree = 2; layout%layer_elevations = 2
-        end select
-    end function layout_named
 
     !> Die (half annulus, outer radius 3, lowest point (2.5, 0)) over a 9 x 3 slab,
     !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0).
@@ -78,8 +62,8 @@ contains
             c%bodies(i)%youngs_modulus = merge(10.0_dp, 1.0_dp, i == 1)
             c%bodies(i)%poisson_ratio = 0.3_dp
         end do
-        c%bodies(1)%layout = layout_named(layout, [12, 1], 'outer')
-        c%bodies(2)%layout = layout_named(layout, [8, 2], 'top')
+        c%bodies(1)%layout = paper_layout(layout, [12, 1], 'outer')
+        c%bodies(2)%layout = paper_layout(layout, [8, 2], 'top')
         c%solver%n_steps = [1]
         allocate (c%dirichlet(0), c%pressure(0), c%contact(1))
         c%contact(1)%slave = 'die'
@@ -320,8 +304,8 @@ contains
         real(dp), allocatable :: u(:)
         real(dp), parameter :: p = 0.01_dp
 
-        c%bodies = [body('upper', 'linear', 1.0_dp, layout_named('N2', [nel_upper, 2], 'bottom')), &
-                    body('lower', 'linear', 1.0_dp, layout_named('N2', [5, 2], 'top'))]
+        c%bodies = [body('upper', 'linear', 1.0_dp, paper_layout('N2', [nel_upper, 2], 'bottom')), &
+                    body('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
         c%solver%n_steps = [1]
         c%dirichlet = [bc('lower', 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
                        bc('lower', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
@@ -352,7 +336,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(case_t) :: c
         type(solver_stats_t) :: stats
-        c%bodies = [body('block', 'linear', 1.0_dp, layout_named('NN2.2', [4, 2], 'bottom'))]
+        c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
@@ -449,8 +433,8 @@ contains
         real(dp), allocatable :: u(:)
         integer :: i
 
-        c%bodies = [body('die', 'neo-hookean', 10.0_dp, layout_named('NN2.2', [6, 1], 'outer')), &
-                    body('slab', 'neo-hookean', 1.0_dp, layout_named('NN2.2', [8, 2], 'top'))]
+        c%bodies = [body('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
+                    body('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
         ! press 0.5 in 10 steps, then 5 of the 200 sliding steps of 0.02
         c%solver%n_steps = [10, 5]
         c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &

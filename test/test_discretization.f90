@@ -9,7 +9,7 @@ module test_discretization
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_element, only: element_basis, element_nfun
-    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle
     implicit none
     private
 
@@ -32,27 +32,6 @@ contains
                     ]
     end subroutine collect_discretization
 
-    !> The paper's layouts as bulk degree / layer degree / elevations.
-    function make_layout(name, nel, contact) result(layout)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: nel(2)
-        character(len=*), intent(in) :: contact
-        type(layout_t) :: layout
-        layout%nel = nel
-        layout%contact_edge = contact
-        select case (name)
-        case ('N2'); layout%degree = [2, 2]
-        case ('N4'); layout%degree = [4, 2]
-        case ('N6'); layout%degree = [6, 2]
-        case ('NN4'); layout%layer_degree = 4
-        case ('NN6'); layout%layer_degree = 6
-        case ('NN2.1'); layout%layer_degree = 2; layout%layer_elevations = 1
-        case ('NN2.2'); layout%layer_degree = 2; layout%layer_elevations = 2
-        case ('NN2.3'); layout%layer_degree = 2; layout%layer_elevations = 3
-        case ('NN3.2'); layout%layer_degree = 3; layout%layer_elevations = 2
-        case ('L1'); layout%basis = 'linear'; layout%degree = [1, 1]
-        end select
-    end function make_layout
 
     function die() result(s)
         type(nurbs_surface_t) :: s
@@ -82,9 +61,9 @@ contains
         integer :: k
 
         do k = 1, size(names)
-            call new_discretization(d, die(), make_layout(trim(names(k)), [6, 1], 'outer'), '', error)
+            call new_discretization(d, die(), paper_layout(trim(names(k)), [6, 1], 'outer'), '', error)
             if (allocated(error)) return
-            call new_discretization(s, slab(), make_layout(trim(names(k)), [8, 2], 'top'), '', error)
+            call new_discretization(s, slab(), paper_layout(trim(names(k)), [8, 2], 'top'), '', error)
             if (allocated(error)) return
             call check(error, d%interface_dofs, expected(1, k), trim(names(k))//' die interface')
             if (allocated(error)) return
@@ -164,10 +143,10 @@ contains
             case (3); exact = annulus_sector([0.0_dp, 0.0_dp], 0.05_dp, 1.0_dp, -pi/2, 1)
             end select
             do k = 1, size(names)
-                call new_discretization(d, exact, make_layout(trim(names(k)), [12, 3], 'outer'), &
+                call new_discretization(d, exact, paper_layout(trim(names(k)), [12, 3], 'outer'), &
                                         '', error)
                 if (ib == 2) then
-                    call new_discretization(d, exact, make_layout(trim(names(k)), [12, 3], 'top'), &
+                    call new_discretization(d, exact, paper_layout(trim(names(k)), [12, 3], 'top'), &
                                             '', error)
                 end if
                 if (allocated(error)) return
@@ -194,10 +173,10 @@ contains
         integer :: k, i, e
 
         s = slab()
-        call new_discretization(a, s, make_layout('NN2.2', [4, 4], 'top'), '', error)
+        call new_discretization(a, s, paper_layout('NN2.2', [4, 4], 'top'), '', error)
         if (allocated(error)) return
         do k = 1, 4
-            call new_discretization(b, s, make_layout('NN2.2', [4, 4], trim(edges(k))), '', error)
+            call new_discretization(b, s, paper_layout('NN2.2', [4, 4], trim(edges(k))), '', error)
             if (allocated(error)) return
             call check(error, b%interface_dofs, a%interface_dofs, 'interface DOFs with contact edge '// &
                        trim(edges(k)))
@@ -240,7 +219,7 @@ contains
         character(len=5), parameter :: names(4) = [character(len=5) :: 'NN4', 'NN2.2', 'NN3.2', 'N4']
 
         do il = 1, size(names)
-            call new_discretization(d, die(), make_layout(trim(names(il)), [6, 2], 'outer'), '', error)
+            call new_discretization(d, die(), paper_layout(trim(names(il)), [6, 2], 'outer'), '', error)
             if (allocated(error)) return
             do k = 1, 500
                 e = 1 + int(rng%uniform()*d%nel)
@@ -279,7 +258,7 @@ contains
         real(dp) :: xi, eta, off(2)
         integer :: k, e, n, dir
 
-        call new_discretization(d, die(), make_layout('NN2.2', [6, 2], 'outer'), '', error)
+        call new_discretization(d, die(), paper_layout('NN2.2', [6, 2], 'outer'), '', error)
         if (allocated(error)) return
         do k = 1, 200
             ! VO elements are the last row
@@ -318,7 +297,7 @@ contains
         real(dp) :: xi, eta, above, below, dabove, dbelow
         integer :: k, e_top, e_low, i
 
-        call new_discretization(d, die(), make_layout('NN2.3', [6, 3], 'outer'), '', error)
+        call new_discretization(d, die(), paper_layout('NN2.3', [6, 3], 'outer'), '', error)
         if (allocated(error)) return
         allocate (u(d%ncp))
         do i = 1, d%ncp
@@ -357,26 +336,26 @@ contains
         type(layout_t) :: layout
         type(error_t), allocatable :: err
 
-        layout = make_layout('NN4', [6, 1], 'outer')
+        layout = paper_layout('NN4', [6, 1], 'outer')
         layout%layer_degree = 1
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, 'layer_degree')
         if (allocated(error)) return
-        layout = make_layout('N2', [6, 1], 'nowhere')
+        layout = paper_layout('N2', [6, 1], 'nowhere')
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, "contact_edge = 'nowhere'")
         if (allocated(error)) return
-        layout = make_layout('N2', [6, 1], 'outer')
+        layout = paper_layout('N2', [6, 1], 'outer')
         layout%degree = [1, 2]
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, 'degree_xi')
         if (allocated(error)) return
-        layout = make_layout('N2', [6, 1], 'outer')
+        layout = paper_layout('N2', [6, 1], 'outer')
         layout%knots_xi = [0.5_dp, 0.25_dp]
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, 'knots_xi must be strictly increasing')
         if (allocated(error)) return
-        layout = make_layout('N2', [6, 1], '')
+        layout = paper_layout('N2', [6, 1], '')
         layout%layer_elevations = 1
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, 'layer_elevations')

@@ -16,7 +16,7 @@ module test_solid
     use voiga_element_solid, only: reference_gradients
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t
-    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle, quadratic
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
     implicit none
     private
 
@@ -71,21 +71,6 @@ contains
         c%dirichlet = [c%dirichlet, d]
     end subroutine add_dirichlet
 
-    function layout_of(name, nel, contact) result(layout)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: nel(2)
-        character(len=*), intent(in) :: contact
-        type(layout_t) :: layout
-        layout%nel = nel
-        layout%contact_edge = contact
-        select case (name)
-        case ('N2'); layout%degree = [2, 2]
-        case ('N3'); layout%degree = [3, 3]
-        case ('N4'); layout%degree = [4, 2]
-        case ('NN4'); layout%layer_degree = 4
-        case ('NN2.2'); layout%layer_degree = 2; layout%layer_elevations = 2
-        end select
-    end function layout_of
 
     !> Build model from a case and one coarse patch.
     subroutine build(c, coarse, model, error)
@@ -165,7 +150,7 @@ contains
 
         do im = 1, 2
             do il = 1, 3
-                call build(one_body_case(trim(mats(im)), layout_of(trim(names(il)), [4, 2], 'outer'), &
+                call build(one_body_case(trim(mats(im)), paper_layout(trim(names(il)), [4, 2], 'outer'), &
                                          10.0_dp, 0.3_dp), &
                            annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), model, error)
                 if (allocated(error)) return
@@ -219,7 +204,7 @@ contains
         real(dp) :: worst, scale
         integer :: j
 
-        c = one_body_case('neo-hookean', layout_of('NN2.2', [3, 2], 'outer'), 10.0_dp, 0.3_dp)
+        c = one_body_case('neo-hookean', paper_layout('NN2.2', [3, 2], 'outer'), 10.0_dp, 0.3_dp)
         call add_dirichlet(c, 'inner', [.true., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
         c%pressure = [pressure_input_t(body='block', edge='outer', values=[0.3_dp])]
         call build(c, annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), model, error)
@@ -311,7 +296,7 @@ contains
         ey = -0.3_dp/0.7_dp*ex
         sxx = 2.0_dp/(1.0_dp - 0.09_dp)*ex
         do il = 1, size(names)
-            c = one_body_case('linear', layout_of(trim(names(il)), [4, 3], 'top'), 2.0_dp, 0.3_dp)
+            c = one_body_case('linear', paper_layout(trim(names(il)), [4, 3], 'top'), 2.0_dp, 0.3_dp)
             call add_dirichlet(c, 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1]))
             call add_dirichlet(c, 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
             if (by_pressure) then
@@ -481,7 +466,7 @@ contains
 
     subroutine quadratic_model(c)
         type(case_t), intent(out) :: c
-        c = one_body_case('neo-hookean', layout_of('N2', [4, 4], 'top'), 1.0_dp, 0.3_dp)
+        c = one_body_case('neo-hookean', paper_layout('N2', [4, 4], 'top'), 1.0_dp, 0.3_dp)
         c%solver%n_steps = [3]
         call add_dirichlet(c, 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
         call add_dirichlet(c, 'top', [.true., .true.], reshape([0.0_dp, -0.3_dp], [2, 1]))
@@ -494,7 +479,7 @@ contains
         type(case_t) :: c
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
-        c = one_body_case('linear', layout_of('NN2.2', [4, 3], 'top'), 2.0_dp, 0.3_dp)
+        c = one_body_case('linear', paper_layout('NN2.2', [4, 3], 'top'), 2.0_dp, 0.3_dp)
         c%solver%n_steps = [4]
         call add_dirichlet(c, 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
         call add_dirichlet(c, 'top', [.true., .true.], reshape([0.01_dp, -0.02_dp], [2, 1]))
