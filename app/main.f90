@@ -9,7 +9,8 @@ program voiga_main
     use voiga_discretization_bodies, only: discretize_bodies
     use voiga_model, only: model_t, new_model
     use voiga_io_results, only: results_t
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds
+    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, stepping_t
+    use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_kinds, only: dp
     implicit none
 
@@ -96,15 +97,28 @@ program voiga_main
     if (allocated(error)) call fail(error)
     call results%open(case, model, error)
     if (allocated(error)) call fail(error)
-    call solve_steps(model, u, stats, quiet, error, results, t0, verbose)
+    ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
+    call catch_signals()
+    call solve_steps(model, u, stats, quiet, error, results, t0, verbose, &
+                     stepping_t(min_step_fraction=case%solver%min_step_fraction, &
+                                max_cuts=case%solver%max_cuts, &
+                                grow_iterations=case%solver%grow_iterations))
+    if (stats%signal /= 0) then
+        call results%finish('interrupted', wall_seconds() - t0, stats%cut_records)
+        write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
+            ' completed steps are in '//case%output
+        ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
+        call exit_code(128 + stats%signal)
+    end if
     if (allocated(error)) then
-        call results%finish('failed: '//error%message, wall_seconds() - t0)
+        call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records)
         write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
         call fail(error)
     end if
-    call results%finish('converged', wall_seconds() - t0)
-    write (*, '(a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps, ', stats%iterations, &
-        ' Newton iterations, ', wall_seconds() - t0, ' s; wrote '//case%output
+    call results%finish('converged', wall_seconds() - t0, stats%cut_records)
+    write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
+        ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
+        wall_seconds() - t0, ' s; wrote '//case%output
 
 contains
 
@@ -124,7 +138,9 @@ contains
             '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
             '  --quiet        no line per step', &
             '  --verbose      a line per Newton iteration (residual, energy, contact states)', &
-            '  --version      print the version'
+            '  --version      print the version', &
+            'exit codes: 0 converged, 1 other failure, 2 bad input, 3 numerical failure,', &
+            '  130/143 interrupted by SIGINT/SIGTERM (completed steps kept)'
     end subroutine usage
 
     subroutine fail_usage(message)
@@ -133,6 +149,12 @@ contains
         call usage()
         stop 2, quiet=.true.
     end subroutine fail_usage
+
+    !> Stop with exit code `code`.
+    subroutine exit_code(code)
+        integer, intent(in) :: code
+        stop code, quiet=.true.
+    end subroutine exit_code
 
     subroutine fail(err)
         type(error_t), intent(in) :: err

@@ -10,6 +10,7 @@ program voiga_tests
     use voiga_kinds, only: dp
     use test_sparse, only: collect_sparse
     use test_contact, only: collect_contact
+    use test_stepping, only: collect_stepping
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -22,7 +23,8 @@ program voiga_tests
              new_testsuite('discretization', collect_discretization), &
              new_testsuite('solid', collect_solid), &
              new_testsuite('sparse', collect_sparse), &
-             new_testsuite('contact', collect_contact) &
+             new_testsuite('contact', collect_contact), &
+             new_testsuite('stepping', collect_stepping) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -47,6 +47,14 @@ module voiga_io_case
         real(dp) :: tol_energy = 1.0e-20_dp
         !> Gauss points per direction (0: degree + 1 in each direction).
         integer :: n_gauss = 0
+        !> Adaptive load stepping (docs/robustness.md): a failed load increment is
+        !> halved down to min_step_fraction of the nominal step ...
+        real(dp) :: min_step_fraction = 1.0e-4_dp
+        !> ... at most max_cuts times per nominal step (0: no cutting, a failed step fails the run) ...
+        integer :: max_cuts = 30
+        !> ... and doubled (never beyond the nominal step) after a substep that
+        !> converged in at most grow_iterations Newton iterations.
+        integer :: grow_iterations = 5
     end type solver_input_t
 
     !> A prescribed displacement on a named edge (`&dirichlet`).
@@ -397,17 +405,21 @@ contains
         character(len=*), intent(in) :: path
         type(solver_input_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph
-        real(dp) :: tol_residual, tol_energy
+        integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph, max_cuts, grow_iterations
+        real(dp) :: tol_residual, tol_energy, min_step_fraction
         character(len=512) :: msg
         character(len=:), allocatable :: where
-        namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss
+        namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
+            min_step_fraction, max_cuts, grow_iterations
 
         n_steps = -1
         max_iterations = entry%max_iterations
         tol_residual = entry%tol_residual
         tol_energy = entry%tol_energy
         n_gauss = entry%n_gauss
+        min_step_fraction = entry%min_step_fraction
+        max_cuts = entry%max_cuts
+        grow_iterations = entry%grow_iterations
         rewind (u)
         read (u, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -444,7 +456,22 @@ contains
             call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
             return
         end if
+        if (.not. (min_step_fraction > 0.0_dp .and. min_step_fraction <= 1.0_dp)) then
+            call fatal_error(error, where//'min_step_fraction must lie in (0, 1]', error_code%input)
+            return
+        end if
+        if (max_cuts < 0) then
+            call fatal_error(error, where//'max_cuts must be >= 0', error_code%input)
+            return
+        end if
+        if (grow_iterations < 0) then
+            call fatal_error(error, where//'grow_iterations must be >= 0', error_code%input)
+            return
+        end if
         entry%n_steps = n_steps(1:nph)
+        entry%min_step_fraction = min_step_fraction
+        entry%max_cuts = max_cuts
+        entry%grow_iterations = grow_iterations
         entry%max_iterations = max_iterations
         entry%tol_residual = tol_residual
         entry%tol_energy = tol_energy
@@ -577,7 +604,7 @@ contains
         type(contact_input_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         character(len=32) :: slave, master
-        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction
+        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, e_max
         integer :: n_gauss, ios, ib
         character(len=512) :: msg
         character(len=:), allocatable :: where
@@ -653,6 +680,16 @@ contains
         end if
         if (n_gauss < 0 .or. n_gauss > 30) then
             call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
+            return
+        end if
+        ! conditioning: a penalty above 1e12 x E leaves the stiffness matrix with fewer
+        ! than 4 significant digits in double precision
+        e_max = self%bodies(body_index(self, slave))%youngs_modulus
+        if (trim(master) /= 'rigid') e_max = max(e_max, self%bodies(body_index(self, master))%youngs_modulus)
+        if (penalty_normal > 1.0e12_dp*e_max .or. (friction > 0.0_dp .and. penalty_tangent > 1.0e12_dp*e_max)) then
+            call fatal_error(error, where//'penalty_normal and penalty_tangent must not exceed 1e12 times '// &
+                             "the largest Young's modulus of the two bodies (the stiffness matrix would "// &
+                             'lose its significant digits)', error_code%input)
             return
         end if
         entry = contact_input_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &

@@ -1,6 +1,7 @@
 !> The result file of a run (schema in docs/hdf5.md): metadata and the
 !> discretization first, then one group per converged step, written and flushed
-!> when the step converges, and a final status.
+!> when the step converges, and a final status ('converged', 'failed: ...',
+!> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use voiga_kinds, only: dp
@@ -14,7 +15,7 @@ module voiga_io_results
     implicit none
     private
 
-    public :: results_t, step_record_t, stage_names
+    public :: results_t, step_record_t, cut_record_t, stage_names
 
     !> Stages whose seconds are recorded per step.
     character(len=*), parameter :: stage_names(5) = [character(len=13) :: 'assembly', 'contact', &
@@ -33,7 +34,25 @@ module voiga_io_results
         real(dp), allocatable :: reactions(:, :)
         !> Seconds per stage (order of `stage_names`).
         real(dp) :: seconds(5) = 0.0_dp
+        !> Converged substeps the nominal step took (1: no cut) and the cuts on the way.
+        integer :: substeps = 1, cuts = 0
+        !> Newton iterations of all substeps, failed attempts included (`iterations`,
+        !> `residual_norms` and `energy_norms` are those of the last substep).
+        integer :: iterations_total = 0
     end type step_record_t
+
+    !> One cut of the load increment (adaptive stepping, docs/robustness.md).
+    type :: cut_record_t
+        !> Nominal step being solved.
+        integer :: step = 0
+        !> Load time the failed attempt aimed at.
+        real(dp) :: time = 0.0_dp
+        !> Increment of the failed attempt and the new one, as fractions of the nominal step.
+        real(dp) :: fraction = 0.0_dp, new_fraction = 0.0_dp
+        !> Why the attempt failed (fixed length: gfortran 12 corrupts the heap when
+        !> arrays of a type with a deferred-length component grow by constructor).
+        character(len=256) :: reason = ''
+    end type cut_record_t
 
     !> An open result file.
     type :: results_t
@@ -71,6 +90,7 @@ contains
         call self%h5%write_attr('/', 'n_dofs', model%ndof)
         call self%h5%write_attr('/', 'n_steps_planned', sum(model%n_steps))
         call self%h5%write_attr('/', 'n_steps_done', 0)
+        call self%h5%write_attr('/', 'n_cuts', 0)
         call self%h5%write_attr('/', 'wall_time', 0.0_dp)
         do i = 1, size(model%bodies)
             associate (b => model%bodies(i))
@@ -118,7 +138,7 @@ contains
     end subroutine results_open
 
     !> Write one converged step and the current displacement; flush.
-    subroutine results_write_step(self, rec, u, wall, pairs)
+    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -126,6 +146,10 @@ contains
         type(contact_pair_t), intent(in) :: pairs(:)
         !> Wall time so far (s).
         real(dp), intent(in) :: wall
+        !> The cuts made while solving this step.
+        type(cut_record_t), intent(in), optional :: cuts(:)
+        !> Cuts of the run so far.
+        integer, intent(in), optional :: n_cuts
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -136,6 +160,12 @@ contains
         call self%h5%write_attr(g, 'step', rec%step)
         call self%h5%write_attr(g, 'time', rec%time)
         call self%h5%write_attr(g, 'iterations', rec%iterations)
+        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
+        call self%h5%write_attr(g, 'substeps', rec%substeps)
+        call self%h5%write_attr(g, 'cuts', rec%cuts)
+        if (present(cuts)) then
+            if (size(cuts) > 0) call write_cuts(self%h5, g, cuts)
+        end if
         do k = 1, size(stage_names)
             call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k))
         end do
@@ -147,6 +177,7 @@ contains
             call write_contact(self%h5, g, k, pairs(k))
         end do
         self%n_written = self%n_written + 1
+        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts)
         call self%h5%write_attr('/', 'n_steps_done', self%n_written)
         call self%h5%write_attr('/', 'wall_time', wall)
         call self%h5%flush()
@@ -195,12 +226,38 @@ contains
         call h5%write(c//'/xi_slave', pair%xi)
     end subroutine write_contact
 
-    !> Set the final status ('converged' or 'failed: <reason>') and close.
-    subroutine results_finish(self, status, wall)
+    !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,
+    !> fraction, new fraction), with their reasons as its attribute `reasons` (one line each).
+    subroutine write_cuts(h5, g, cuts)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: g
+        type(cut_record_t), intent(in) :: cuts(:)
+        real(dp), allocatable :: rows(:, :)
+        character(len=:), allocatable :: reasons
+        integer :: i
+        allocate (rows(4, size(cuts)))
+        reasons = ''
+        do i = 1, size(cuts)
+            rows(:, i) = [real(cuts(i)%step, dp), cuts(i)%time, cuts(i)%fraction, cuts(i)%new_fraction]
+            if (i > 1) reasons = reasons//new_line('a')
+            reasons = reasons//trim(cuts(i)%reason)
+        end do
+        call h5%write(g//'/cuts', rows)
+        call h5%write_attr(g//'/cuts', 'reasons', reasons)
+    end subroutine write_cuts
+
+    !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and close;
+    !> `cuts`: every cut of the run (written as /cuts when there is one).
+    subroutine results_finish(self, status, wall, cuts)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
         real(dp), intent(in) :: wall
+        type(cut_record_t), intent(in), optional :: cuts(:)
         if (.not. self%h5%is_open()) return
+        if (present(cuts)) then
+            call self%h5%write_attr('/', 'n_cuts', size(cuts))
+            if (size(cuts) > 0) call write_cuts(self%h5, '', cuts)
+        end if
         call self%h5%write_attr('/', 'status', status)
         call self%h5%write_attr('/', 'wall_time', wall)
         call self%h5%close()

@@ -1,10 +1,21 @@
-!> Quasi-static load stepping with Newton-Raphson.
+!> Quasi-static load stepping with Newton-Raphson and adaptive load increments.
 !>
-!> Per step: prescribed displacements are set to their values at the step's load
+!> Per (sub)step: prescribed displacements are set to their values at the load
 !> time, then Newton iterates K du = -r on the free DOFs (the prescribed DOFs are
 !> eliminated symmetrically, their corrections are zero) until
 !> ||r|| <= tol_residual ||r_0|| or |du.r| <= tol_energy |du_1.r_0|, with r_0 the
-!> step's first residual, or until max_iterations (then the run fails).
+!> substep's first residual.
+!>
+!> Adaptive stepping (docs/robustness.md): a substep that fails numerically (the
+!> iteration cap, a residual that is not finite or grows by `divergence_ratio`, an
+!> inverted element, a contact projection that does not converge, a singular
+!> matrix) is cut: the last converged state (u and the contact pairs' trial
+!> history) is restored and the increment halved, down to `min_step_fraction` of
+!> the nominal step; after a substep that converged in at most `grow_iterations`
+!> iterations the increment doubles again (never beyond the nominal step). Substeps
+!> subdivide a nominal step, so the case's steps are hit exactly and only their
+!> converged states are written. SIGINT/SIGTERM (voiga_solver_signals) are polled
+!> between iterations: the solve stops with the last converged state.
 module voiga_solver_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp, i8
@@ -14,25 +25,50 @@ module voiga_solver_newton
                                     new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
-    use voiga_io_results, only: results_t, step_record_t
+    use voiga_solver_signals, only: caught_signal, signal_name
+    use voiga_io_results, only: results_t, step_record_t, cut_record_t
     use voiga_contact_pair, only: pair_commit, pair_reset_trial
     implicit none
     private
 
-    public :: solve_steps, solver_stats_t, wall_seconds
+    public :: solve_steps, solver_stats_t, wall_seconds, stepping_t
 
     !> Most halvings of one Newton step.
     integer, parameter :: max_line_search = 8
 
+    !> A Newton iteration whose residual exceeds this multiple of the substep's
+    !> first residual has diverged (the substep is cut instead of iterated to the cap).
+    real(dp), parameter :: divergence_ratio = 1.0e10_dp
+
+    !> Adaptive load stepping settings (`&solver`: min_step_fraction, max_cuts,
+    !> grow_iterations; docs/robustness.md).
+    type :: stepping_t
+        !> Smallest load increment, as a fraction of the nominal step.
+        real(dp) :: min_step_fraction = 1.0e-4_dp
+        !> Most cuts per nominal step (0: a failed step fails the run).
+        integer :: max_cuts = 30
+        !> The increment doubles after a substep converged in at most this many iterations.
+        integer :: grow_iterations = 5
+    end type stepping_t
+
     !> Counters of a run.
     type :: solver_stats_t
         type(assembly_stats_t) :: assembly
+        !> Converged nominal steps; Newton iterations of all attempts.
         integer :: steps = 0, iterations = 0
         integer :: symbolic_factorizations = 0, numeric_factorizations = 0
         !> Residual evaluations spent on halving Newton steps.
         integer :: line_search_steps = 0
+        !> Largest first residual of a step so far: the force scale of the round-off floor.
+        real(dp) :: r0_max = 0.0_dp
+        !> Converged substeps and cuts of the load increment.
+        integer :: substeps = 0, cuts = 0
+        !> The signal that interrupted the run (0: none).
+        integer :: signal = 0
         !> The record of every converged step (residual and energy norms, reactions, seconds).
         type(step_record_t), allocatable :: records(:)
+        !> Every cut of the run.
+        type(cut_record_t), allocatable :: cut_records(:)
     end type solver_stats_t
 
 contains
@@ -45,9 +81,10 @@ contains
     end function wall_seconds
 
     !> Run every load step of `model` from zero displacement; write each converged
-    !> step to `results` (if present) and report progress unless `quiet`.
-    !> `u` holds the last converged displacement on return (also on failure).
-    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose)
+    !> nominal step to `results` (if present) and report progress (and every cut)
+    !> unless `quiet`. `u` holds the last converged displacement on return (also on
+    !> failure). An interrupt (stats%signal /= 0) returns an error too.
+    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose, stepping)
         type(model_t), intent(inout) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(solver_stats_t), intent(out) :: stats
@@ -58,138 +95,260 @@ contains
         real(dp), intent(in), optional :: t0
         !> Print every Newton iteration (residual, energy, contact states).
         logical, intent(in), optional :: verbose
+        !> Adaptive stepping settings (default: `stepping_t()`).
+        type(stepping_t), intent(in), optional :: stepping
+        type(stepping_t) :: set
         type(csc_matrix_t) :: k
         type(assembly_map_t) :: map
         type(umfpack_t) :: lu
         type(step_record_t) :: rec
-        real(dp), allocatable :: r(:), du(:), u_conv(:), norms(:), energies(:), rhs(:)
-        real(dp) :: t, r0, rn, e1, en, tic, start, bulk0, contact0, alpha, rn_prev
-        real(dp), allocatable :: u_prev(:)
-        integer :: step, it, nsteps, j, c, ip, nls
-        logical :: converged
-        character(len=160) :: msg
+        type(cut_record_t) :: cut
+        real(dp), allocatable :: r(:), u_conv(:)
+        real(dp) :: t, t_begin, t_end, tic, start, frac, s, ds, rn
+        integer :: step, nsteps, j, c, ip, it, first_cut
+        logical :: loud
+        character(len=200) :: msg
 
         start = wall_seconds()
         if (present(t0)) start = t0
+        if (present(stepping)) set = stepping
+        loud = .false.
+        if (present(verbose)) loud = verbose
         call stiffness_pattern(model, k, error)
         if (allocated(error)) return
         call new_assembly_map(model, k, map)
-        allocate (u(model%ndof), r(model%ndof), du(model%ndof), rhs(model%ndof))
+        allocate (u(model%ndof), r(model%ndof))
         u = 0.0_dp
         u_conv = u
         nsteps = n_total_steps(model)
-        allocate (norms(model%max_iterations + 1), energies(model%max_iterations))
-        allocate (stats%records(0))
-        do step = 1, nsteps
-            t = step_time(model, step)
+        allocate (stats%records(0), stats%cut_records(0))
+        ! the load increment as a fraction of the nominal step; carried over steps
+        frac = 1.0_dp
+        steps: do step = 1, nsteps
+            t_begin = step_time(model, step - 1)
+            t_end = step_time(model, step)
             rec = step_record_t()
             rec%step = step
-            rec%time = t
-            call set_prescribed(model, t, u)
-            converged = .false.
-            r0 = 0.0_dp
-            e1 = 0.0_dp
-            en = huge(1.0_dp)
-            it = 0
-            nls = 0
-            alpha = 1.0_dp
-            rn_prev = huge(1.0_dp)
-            do
-                bulk0 = stats%assembly%seconds_bulk
-                contact0 = stats%assembly%seconds_contact
-                call assemble(model, u, t, r, stats%assembly, error, k, map)
-                rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
-                rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
-                if (allocated(error)) exit
-                rn = norm2(merge(0.0_dp, r, model%fixed))
-                if (.not. ieee_is_finite(rn)) then
-                    call fatal_error(error, 'the residual is not finite', error_code%numeric)
-                    exit
-                end if
-                ! backtracking: a Newton step that increases the residual is halved
-                ! (contact stick/slip and active-set changes can make full steps cycle)
-                if (it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
-                    rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, norm2(r))) then
-                    nls = nls + 1
-                    stats%line_search_steps = stats%line_search_steps + 1
-                    alpha = 0.5_dp*alpha
-                    u = u_prev + alpha*du
+            rec%time = t_end
+            rec%substeps = 0
+            first_cut = size(stats%cut_records) + 1
+            ! s: converged part of the nominal step (sums of powers of 2: exact)
+            s = 0.0_dp
+            do while (s < 1.0_dp)
+                ds = min(frac, 1.0_dp - s)
+                t = t_end
+                if (s + ds < 1.0_dp) t = t_begin + (s + ds)*(t_end - t_begin)
+                call set_prescribed(model, t, u)
+                call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
+                if (.not. allocated(error)) then
+                    u_conv = u
+                    do ip = 1, size(model%pairs)
+                        call pair_commit(model%pairs(ip))
+                    end do
+                    s = s + ds
+                    rec%substeps = rec%substeps + 1
+                    stats%substeps = stats%substeps + 1
+                    if (it <= set%grow_iterations) frac = min(1.0_dp, 2.0_dp*frac)
                     cycle
                 end if
-                norms(it + 1) = rn
-                if (it == 0) r0 = rn
-                if (present(verbose)) then
-                    if (verbose) call print_iteration(model, step, it, rn, en, alpha)
-                end if
-                if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp) converged = .true.
-                if (it > 1 .and. en <= model%tol_energy*e1) converged = .true.
-                ! round-off floor: nothing left to gain relative to the forces in play
-                if (rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, norm2(r))) converged = .true.
-                if (converged) exit
-                if (it == model%max_iterations) exit
-                tic = wall_seconds()
-                call k%fix_dofs(model%fixed)
-                call lu%factorize(k, error)
-                rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
-                if (allocated(error)) exit
-                tic = wall_seconds()
-                rhs = -merge(0.0_dp, r, model%fixed)
-                call lu%solve(k, rhs, du, error)
-                rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
-                if (allocated(error)) exit
-                en = abs(dot_product(du, rhs))
-                if (it == 0) e1 = en
-                energies(it + 1) = en
-                u_prev = u
-                rn_prev = rn
-                alpha = 1.0_dp
-                nls = 0
-                u = u + du
-                it = it + 1
-            end do
-            stats%iterations = stats%iterations + it
-            if (.not. allocated(error) .and. .not. converged) then
-                write (msg, '(a,i0,a,i0,a,es9.2,a,es9.2)') 'step ', step, ': Newton did not converge in ', &
-                    model%max_iterations, ' iterations (residual ', rn, ', first ', r0
-                call fatal_error(error, trim(msg)//')', error_code%numeric)
-            end if
-            if (allocated(error)) then
-                write (msg, '(a,i0,a,es12.5,a)') 'step ', step, ' (load time ', t, '): '
-                error%message = trim(msg)//' '//error%message
+                ! failed: back to the last converged state, forget the contact trial history
                 u = u_conv
                 do ip = 1, size(model%pairs)
                     call pair_reset_trial(model%pairs(ip))
                 end do
-                exit
-            end if
-            u_conv = u
-            do ip = 1, size(model%pairs)
-                call pair_commit(model%pairs(ip))
+                if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
+                if (rec%cuts >= set%max_cuts .or. &
+                    0.5_dp*ds < set%min_step_fraction*(1.0_dp - 1.0e-12_dp)) then
+                    if (rec%cuts > 0 .or. set%max_cuts > 0) then
+                        write (msg, '(a,i0,a,es9.2,a,es9.2,a,i0,a)') ' (after ', rec%cuts, &
+                            ' cuts; increment ', ds, ' of the nominal step, minimum ', &
+                            set%min_step_fraction, ', max_cuts ', set%max_cuts, ')'
+                        error%message = error%message//trim(msg)
+                    end if
+                    exit steps
+                end if
+                cut = cut_record_t(step=step, time=t, fraction=ds, new_fraction=0.5_dp*ds, &
+                                   reason=error%message)
+                call append_cut(stats%cut_records, cut)
+                stats%cuts = stats%cuts + 1
+                rec%cuts = rec%cuts + 1
+                frac = 0.5_dp*ds
+                if (.not. quiet) then
+                    write (*, '(a,i0,a,f10.6,a,es9.2,a)') 'cut  step ', step, '  t=', t, &
+                        '  new increment ', frac, ' of the step: '//error%message
+                end if
+                deallocate (error)
             end do
+            u_conv = u
             stats%steps = step
-            rec%iterations = it
-            rec%residual_norms = norms(1:it + 1)
-            rec%energy_norms = energies(1:it)
             allocate (rec%reactions(2, size(model%dirichlet)))
             do j = 1, size(model%dirichlet)
                 do c = 1, 2
                     rec%reactions(c, j) = sum(r(model%dirichlet(j)%dofs(c, :)))
                 end do
             end do
-            stats%records = [stats%records, rec]
             if (present(results)) then
                 tic = wall_seconds()
-                call results%write_step(rec, u, wall_seconds() - start, model%pairs)
+                call results%write_step(rec, u, wall_seconds() - start, model%pairs, &
+                                        stats%cut_records(first_cut:), stats%cuts)
                 rec%seconds(5) = wall_seconds() - tic
             end if
+            stats%records = [stats%records, rec]
             if (.not. quiet) then
-                write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)') 'step ', step, '/', nsteps, &
-                    '  t=', t, '  it=', it, '  |r|=', rn, '  ', sum(rec%seconds), ' s'
+                write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)', advance='no') 'step ', step, '/', &
+                    nsteps, '  t=', t_end, '  it=', rec%iterations, '  |r|=', rn, '  ', sum(rec%seconds), ' s'
+                if (rec%substeps > 1 .or. rec%cuts > 0) then
+                    write (*, '(a,i0,a,i0)') '  substeps=', rec%substeps, ' cuts=', rec%cuts
+                else
+                    write (*, '(a)') ''
+                end if
             end if
-        end do
+            ! (a signal during the last step's output: the run is complete anyway)
+            if (caught_signal() /= 0 .and. step < nsteps) then
+                stats%signal = caught_signal()
+                call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
+                exit steps
+            end if
+        end do steps
+        if (allocated(error) .and. stats%signal == 0) then
+            write (msg, '(a,i0,a,es12.5,a)') 'step ', step, ' (load time ', t, '):'
+            error%message = trim(msg)//' '//error%message
+        end if
         stats%symbolic_factorizations = lu%n_symbolic
         stats%numeric_factorizations = lu%n_numeric
     end subroutine solve_steps
+
+    !> Append `cut` to `list`.
+    pure subroutine append_cut(list, cut)
+        type(cut_record_t), allocatable, intent(inout) :: list(:)
+        type(cut_record_t), intent(in) :: cut
+        type(cut_record_t), allocatable :: longer(:)
+        integer :: i
+        allocate (longer(size(list) + 1))
+        do i = 1, size(list)
+            longer(i) = list(i)
+        end do
+        longer(size(list) + 1) = cut
+        call move_alloc(longer, list)
+    end subroutine append_cut
+
+    !> Newton iterations at load time `t` from `u` (prescribed values set). On
+    !> success `rec` holds the iteration's norms; `it` the iterations, `rn` the final
+    !> residual norm. A numerical failure returns an error with code `numeric`; an
+    !> interrupt sets stats%signal and returns a generic error.
+    subroutine newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, verbose, error)
+        type(model_t), intent(inout) :: model
+        integer, intent(in) :: step
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: u(:)
+        !> Residual at the last evaluation, shape [ndof].
+        real(dp), intent(inout) :: r(:)
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(in) :: map
+        type(umfpack_t), intent(inout) :: lu
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        integer, intent(out) :: it
+        real(dp), intent(out) :: rn
+        logical, intent(in) :: verbose
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: du(:), norms(:), energies(:), rhs(:), u_prev(:)
+        real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev
+        integer :: nls
+        logical :: converged
+        character(len=160) :: msg
+
+        allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof))
+        allocate (norms(model%max_iterations + 1), energies(model%max_iterations))
+        converged = .false.
+        r0 = 0.0_dp
+        e1 = 0.0_dp
+        en = huge(1.0_dp)
+        rn = 0.0_dp
+        it = 0
+        nls = 0
+        alpha = 1.0_dp
+        rn_prev = huge(1.0_dp)
+        do
+            if (caught_signal() /= 0) then
+                stats%signal = caught_signal()
+                call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
+                exit
+            end if
+            bulk0 = stats%assembly%seconds_bulk
+            contact0 = stats%assembly%seconds_contact
+            call assemble(model, u, t, r, stats%assembly, error, k, map)
+            rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
+            rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+            if (allocated(error)) exit
+            rn = norm2(merge(0.0_dp, r, model%fixed))
+            if (.not. ieee_is_finite(rn)) then
+                call fatal_error(error, 'the residual is not finite', error_code%numeric)
+                exit
+            end if
+            ! backtracking: a Newton step that increases the residual is halved
+            ! (contact stick/slip and active-set changes can make full steps cycle)
+            if (it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
+                rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
+                nls = nls + 1
+                stats%line_search_steps = stats%line_search_steps + 1
+                alpha = 0.5_dp*alpha
+                u = u_prev + alpha*du
+                cycle
+            end if
+            norms(it + 1) = rn
+            if (it == 0) then
+                r0 = rn
+                stats%r0_max = max(stats%r0_max, r0)
+            end if
+            if (verbose) call print_iteration(model, step, it, rn, en, alpha)
+            if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp) converged = .true.
+            ! the energy criterion alone may not hide a stalled residual
+            if (it > 1 .and. en <= model%tol_energy*e1 .and. rn <= sqrt(model%tol_residual)*r0) &
+                converged = .true.
+            ! round-off floor: nothing left to gain relative to the largest first residual
+            ! of the run (not the reactions, which can be huge with stiff penalties)
+            if (rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) converged = .true.
+            if (converged) exit
+            if (it > 0 .and. rn > divergence_ratio*r0) then
+                write (msg, '(a,es9.2,a,es9.2,a,i0,a)') 'the residual grew from ', r0, ' to ', rn, &
+                    ' in ', it, ' iterations'
+                call fatal_error(error, trim(msg), error_code%numeric)
+                exit
+            end if
+            if (it == model%max_iterations) then
+                write (msg, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', &
+                    model%max_iterations, ' iterations (residual ', rn, ', first ', r0, ')'
+                call fatal_error(error, trim(msg), error_code%numeric)
+                exit
+            end if
+            tic = wall_seconds()
+            call k%fix_dofs(model%fixed)
+            call lu%factorize(k, error)
+            rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
+            if (allocated(error)) exit
+            tic = wall_seconds()
+            rhs = -merge(0.0_dp, r, model%fixed)
+            call lu%solve(k, rhs, du, error)
+            rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
+            if (allocated(error)) exit
+            en = abs(dot_product(du, rhs))
+            if (it == 0) e1 = en
+            energies(it + 1) = en
+            u_prev = u
+            rn_prev = rn
+            alpha = 1.0_dp
+            nls = 0
+            u = u + du
+            it = it + 1
+        end do
+        stats%iterations = stats%iterations + it
+        rec%iterations_total = rec%iterations_total + it
+        if (allocated(error)) return
+        rec%iterations = it
+        rec%residual_norms = norms(1:it + 1)
+        rec%energy_norms = energies(1:it)
+    end subroutine newton_solve
 
     !> One line per Newton iteration: residual, energy norm, contact states.
     subroutine print_iteration(model, step, it, rn, en, alpha)

@@ -1,0 +1,171 @@
+!> Adaptive load stepping (docs/robustness.md): a step that fails at full size is
+!> cut and converges to the same state as many small nominal steps; the
+!> increment grows back to the nominal step; the minimum increment ends the run
+!> with a numerical error; max_cuts = 0 is the old behaviour.
+module test_stepping
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t, error_code
+    use voiga_testdrive, only: unittest_t, new_unittest, check
+    use voiga_discretization_layout, only: layout_t
+    use voiga_discretization_patch, only: discretization_t, new_discretization
+    use voiga_io_case, only: case_t, dirichlet_input_t
+    use voiga_model, only: model_t, new_model
+    use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t
+    use voiga_test_fixtures, only: rectangle
+    implicit none
+    private
+
+    public :: collect_stepping
+
+contains
+
+    subroutine collect_stepping(testsuite)
+        type(unittest_t), allocatable, intent(out) :: testsuite(:)
+        testsuite = [ &
+                    new_unittest('cut_step_converges_to_fine_path', test_cut_converges), &
+                    new_unittest('increment_grows_back_to_nominal', test_growth), &
+                    new_unittest('minimum_increment_fails_cleanly', test_minimum), &
+                    new_unittest('no_cuts_fails_at_full_step', test_no_cuts) &
+                    ]
+    end subroutine collect_stepping
+
+    !> Unit Neo-Hookean block (N2, 4 x 4 elements), bottom clamped, top pushed down
+    !> by `squeeze` per phase (x held), `n` nominal steps per phase.
+    subroutine block_model(squeeze, n, model, error)
+        real(dp), intent(in) :: squeeze(:)
+        integer, intent(in) :: n(:)
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        type(case_t) :: c
+        type(discretization_t) :: discs(1)
+        type(layout_t) :: layout
+        real(dp), allocatable :: top(:, :)
+        c%path = 'test'
+        c%dir = ''
+        allocate (c%bodies(1))
+        c%bodies(1)%name = 'block'
+        c%bodies(1)%material = 'neo-hookean'
+        c%bodies(1)%youngs_modulus = 1.0_dp
+        c%bodies(1)%poisson_ratio = 0.3_dp
+        layout%nel = [4, 4]
+        layout%degree = [2, 2]
+        layout%contact_edge = 'top'
+        c%bodies(1)%layout = layout
+        c%solver%n_steps = n
+        allocate (c%pressure(0), c%contact(0), top(2, size(squeeze)))
+        top(1, :) = 0.0_dp
+        top(2, :) = -squeeze
+        c%dirichlet = [dirichlet_input_t(body='block', edge='bottom', fix=[.true., .true.], &
+                                         values=0.0_dp*top), &
+                       dirichlet_input_t(body='block', edge='top', fix=[.true., .true.], values=top)]
+        call new_discretization(discs(1), rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), layout, '', error)
+        if (allocated(error)) return
+        call new_model(model, c, discs, error)
+    end subroutine block_model
+
+    !> 60 % compression in one step fails at full size (max_cuts = 0 fails, see
+    !> test_no_cuts); the cut solve reaches the same equilibrium as 32 nominal steps.
+    subroutine test_cut_converges(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u1(:), u32(:)
+        call block_model([0.6_dp], [1], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u1, stats, .true., error)
+        if (allocated(error)) return
+        call check(error, stats%steps, 1, 'the one nominal step converged')
+        if (allocated(error)) return
+        call check(error, stats%cuts > 0, 'the step was cut')
+        if (allocated(error)) return
+        call check(error, size(stats%cut_records), stats%cuts, 'every cut recorded')
+        if (allocated(error)) return
+        call check(error, stats%records(1)%cuts, stats%cuts, 'the cuts counted on the step')
+        if (allocated(error)) return
+        call check(error, stats%records(1)%substeps > 1, 'substeps taken')
+        if (allocated(error)) return
+        call check(error, stats%cut_records(1)%new_fraction, 0.5_dp, 'the first cut halves the step')
+        if (allocated(error)) return
+        call check(error, stats%records(1)%time, 1.0_dp, 'the nominal step is hit exactly')
+        if (allocated(error)) return
+        call block_model([0.6_dp], [32], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u32, stats, .true., error)
+        if (allocated(error)) return
+        call check(error, stats%cuts, 0, '32 small steps need no cut')
+        if (allocated(error)) return
+        ! hyperelastic, no history: one equilibrium; both solves end at round-off
+        ! (|r| <= 1e-10 |r_0|), u is O(1)
+        call check(error, maxval(abs(u1 - u32)), 0.0_dp, 'same final state as 32 steps', abs=1.0e-8_dp)
+    end subroutine test_cut_converges
+
+    !> Phase 1 needs cuts; the easy steps of phase 2 are taken whole again.
+    subroutine test_growth(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        integer :: k
+        call block_model([0.6_dp, 0.62_dp], [1, 4], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., error)
+        if (allocated(error)) return
+        call check(error, stats%steps, 5, 'all steps converged')
+        if (allocated(error)) return
+        call check(error, stats%records(1)%cuts > 0, 'step 1 was cut')
+        if (allocated(error)) return
+        do k = 2, 5
+            call check(error, stats%records(k)%cuts, 0, 'no cut in phase 2')
+            if (allocated(error)) return
+        end do
+        call check(error, stats%records(5)%substeps, 1, 'the last step is taken whole')
+        if (allocated(error)) return
+        call check(error, stats%substeps, sum(stats%records%substeps), 'substeps add up')
+        if (allocated(error)) return
+        call check(error, stats%records(5)%time, 2.0_dp, 'the phase end is hit exactly')
+    end subroutine test_growth
+
+    !> With min_step_fraction = 0.5 one cut is allowed, the second would go below:
+    !> a numerical error naming the step, no step converged.
+    subroutine test_minimum(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        type(error_t), allocatable :: run_error
+        call block_model([0.6_dp], [1], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., run_error, stepping=stepping_t(min_step_fraction=0.5_dp))
+        call check(error, allocated(run_error), 'the run failed')
+        if (allocated(error)) return
+        call check(error, run_error%code, error_code%numeric, 'a numerical failure (exit code 3)')
+        if (allocated(error)) return
+        call check(error, index(run_error%message, 'step 1 ') == 1, 'message names the step: '//run_error%message)
+        if (allocated(error)) return
+        call check(error, index(run_error%message, 'minimum') > 0, 'message names the minimum: '//run_error%message)
+        if (allocated(error)) return
+        call check(error, stats%steps, 0, 'no step converged')
+        if (allocated(error)) return
+        call check(error, stats%cuts, 1, 'one cut, to the minimum')
+        if (allocated(error)) return
+        call check(error, maxval(abs(u)), 0.0_dp, 'u is the last converged state (zero)')
+    end subroutine test_minimum
+
+    !> max_cuts = 0: the first failure fails the run, as without adaptive stepping.
+    subroutine test_no_cuts(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        type(error_t), allocatable :: run_error
+        call block_model([0.6_dp], [1], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u, stats, .true., run_error, stepping=stepping_t(max_cuts=0))
+        call check(error, allocated(run_error), 'the run failed')
+        if (allocated(error)) return
+        call check(error, run_error%code, error_code%numeric, 'a numerical failure')
+        if (allocated(error)) return
+        call check(error, stats%cuts, 0, 'no cut')
+    end subroutine test_no_cuts
+
+end module test_stepping
