@@ -172,6 +172,10 @@ class Step:
     """(n_dofs,) control point displacements, global numbering, x/y interleaved."""
     contact: list[ContactOutput] = field(default_factory=list)
     """One entry per contact pair, in case-file order."""
+    substeps: int = 1
+    """Substeps the adaptive load stepping used for this step."""
+    cuts: int = 0
+    """Times the step was cut (halved) before it converged."""
 
 
 @dataclass
@@ -349,7 +353,8 @@ def _read_step(name: str, g: h5py.Group, n_dirichlet: int) -> Step | None:
                          if k.startswith("seconds_")},
                 displacement=np.asarray(g["displacement"][()], dtype=float).reshape(-1),
                 contact=[_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
-                if "contact" in g else [])
+                if "contact" in g else [],
+                substeps=int(a.get("substeps", 1)), cuts=int(a.get("cuts", 0)))
 
 
 def _read_contact(g: h5py.Group) -> ContactOutput:
