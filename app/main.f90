@@ -1,6 +1,6 @@
 !> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet]`.
 program voiga_main
-    use voiga_error, only: error_t, error_code
+    use voiga_error, only: error_t, error_code, fatal_error
     use voiga_version, only: voiga_version_string
     use voiga_io_case, only: case_t, read_case
     use voiga_io_hdf5, only: h5file_t
@@ -9,18 +9,19 @@ program voiga_main
     use voiga_discretization_bodies, only: discretize_bodies
     use voiga_model, only: model_t, new_model
     use voiga_io_results, only: results_t
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, stepping_t
+    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
     use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_kinds, only: dp
     implicit none
 
-    character(len=:), allocatable :: case_path, dump_path, arg
+    character(len=:), allocatable :: case_path, dump_path, arg, restart_path
     logical :: check, quiet, verbose
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error
     type(h5file_t) :: h5
     type(model_t) :: model
+    type(resume_t) :: resume
     type(results_t) :: results
     type(solver_stats_t) :: stats
     real(dp), allocatable :: u(:)
@@ -48,6 +49,10 @@ program voiga_main
             quiet = .true.
         case ('--verbose', '-v')
             verbose = .true.
+        case ('--restart')
+            if (i == n) call fail_usage('--restart needs a result file')
+            i = i + 1
+            restart_path = get_arg(i)
         case ('--dump')
             if (i == n) call fail_usage('--dump needs a file name')
             i = i + 1
@@ -59,6 +64,11 @@ program voiga_main
             case_path = arg
         end select
     end do
+    if (allocated(restart_path) .and. .not. allocated(case_path)) then
+        ! the case the interrupted run was started from
+        call restart_case(restart_path, case_path, error)
+        if (allocated(error)) call fail(error)
+    end if
     if (.not. allocated(case_path)) call fail_usage('no case file given')
 
     t0 = wall_seconds()
@@ -95,14 +105,23 @@ program voiga_main
 
     call new_model(model, case, discs, error)
     if (allocated(error)) call fail(error)
-    call results%open(case, model, error)
-    if (allocated(error)) call fail(error)
+    if (allocated(restart_path)) then
+        call load_restart(restart_path, model, resume, error)
+        if (allocated(error)) call fail(error)
+        case%output = restart_path
+        call results%reopen(restart_path, error)
+        if (allocated(error)) call fail(error)
+        if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
+    else
+        call results%open(case, model, error)
+        if (allocated(error)) call fail(error)
+    end if
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
     call catch_signals()
     call solve_steps(model, u, stats, quiet, error, results, t0, verbose, &
                      stepping_t(min_step_fraction=case%solver%min_step_fraction, &
                                 max_cuts=case%solver%max_cuts, &
-                                grow_iterations=case%solver%grow_iterations))
+                                grow_iterations=case%solver%grow_iterations), resume)
     if (stats%signal /= 0) then
         call results%finish('interrupted', wall_seconds() - t0, stats%cut_records)
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
@@ -122,6 +141,72 @@ program voiga_main
 
 contains
 
+    !> The case file recorded in a result file.
+    subroutine restart_case(path, case_file, error)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: case_file
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: f
+        call f%open(path, 'r', error)
+        if (allocated(error)) return
+        call f%read_attr_str('/', 'case_file', case_file, error)
+        call f%close()
+        if (allocated(error)) error%message = '--restart: '//error%message
+    end subroutine restart_case
+
+    !> The state after the last completed step of a result file: displacement, the
+    !> solver's substep fraction and force scale, the friction history of each pair.
+    subroutine load_restart(path, model, state, error)
+        character(len=*), intent(in) :: path
+        type(model_t), intent(inout) :: model
+        type(resume_t), intent(out) :: state
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: f
+        character(len=:), allocatable :: g, c
+        character(len=16) :: buf
+        integer :: done, ip
+        integer, allocatable :: active(:)
+
+        call f%open(path, 'r', error)
+        if (allocated(error)) return
+        call f%read_attr_int('/', 'n_steps_done', done, error)
+        if (allocated(error)) return
+        state%step = done
+        allocate (state%u(model%ndof))
+        state%u = 0.0_dp
+        if (done > 0) then
+            write (buf, '(i6.6)') done
+            g = '/steps/'//trim(buf)
+            call f%read(g//'/displacement', state%u, error)
+            if (allocated(error)) return
+            if (size(state%u) /= model%ndof) then
+                call fatal_error(error, path//': --restart: the result file does not belong to this case '// &
+                                 '(different number of DOFs)', error_code%input)
+                return
+            end if
+            if (f%has_attr(g, 'next_fraction')) call f%read_attr_real(g, 'next_fraction', state%fraction, error)
+            if (allocated(error)) return
+            if (f%has_attr(g, 'r0_max')) call f%read_attr_real(g, 'r0_max', state%r0_max, error)
+            if (allocated(error)) return
+            do ip = 1, size(model%pairs)
+                if (.not. allocated(model%pairs(ip)%anchor)) cycle
+                write (buf, '(i0)') ip
+                c = g//'/contact/'//trim(buf)//'/history'
+                call f%read(c//'/anchor', model%pairs(ip)%anchor, error)
+                if (allocated(error)) return
+                call f%read(c//'/xi_last', model%pairs(ip)%xi_last, error)
+                if (allocated(error)) return
+                call f%read(c//'/active_last', active, error)
+                if (allocated(error)) return
+                model%pairs(ip)%active_last = active /= 0
+                model%pairs(ip)%trial_anchor = model%pairs(ip)%anchor
+                model%pairs(ip)%trial_xi = model%pairs(ip)%xi_last
+                model%pairs(ip)%trial_active = model%pairs(ip)%active_last
+            end do
+        end if
+        call f%close()
+    end subroutine load_restart
+
     function get_arg(k) result(val)
         integer, intent(in) :: k
         character(len=:), allocatable :: val
@@ -132,9 +217,10 @@ contains
     end function get_arg
 
     subroutine usage()
-        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet] [--verbose]', &
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet] [--verbose] [--restart R.h5]', &
             '  (no option)    solve the case and write the result file it names', &
             '  --check        validate the case, build the discretization, print DOF counts', &
+            '  --restart R.h5 continue the interrupted or failed run whose result file is R.h5', &
             '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
             '  --quiet        no line per step', &
             '  --verbose      a line per Newton iteration (residual, energy, contact states)', &

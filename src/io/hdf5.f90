@@ -15,7 +15,7 @@ module voiga_io_hdf5
                     h5dvlen_reclaim_f, H5P_DEFAULT_F, &
                     h5screate_simple_f, h5screate_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
                     h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
-                    h5gcreate_f, h5gclose_f, h5lexists_f, &
+                    h5gcreate_f, h5gclose_f, h5lexists_f, h5ldelete_f, &
                     h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5aexists_f, &
                     h5aget_type_f, h5aget_space_f, h5adelete_f, &
                     h5tcopy_f, h5tclose_f, h5tset_size_f, h5tget_size_f, h5tis_variable_str_f, &
@@ -46,6 +46,7 @@ module voiga_io_hdf5
         procedure, private :: attr_write_str, attr_write_int, attr_write_real
         procedure :: read_attr_str => attr_read_str
         procedure :: read_attr_int => attr_read_int
+        procedure :: read_attr_real => attr_read_real
         procedure :: has_attr => attr_exists
         procedure :: shape => dataset_shape
         procedure :: create_group => group_create
@@ -176,6 +177,8 @@ contains
         integer(hid_t), intent(out) :: did, sid
         integer :: st
         if (len(parent_of(path)) > 0) call self%create_group(parent_of(path))
+        ! a dataset that exists is replaced (a restarted run rewrites run-wide records)
+        if (self%exists(path)) call h5ldelete_f(self%id, path, st)
         if (size(dims) == 0) then
             call h5screate_f(H5S_SCALAR_F, sid, st)
         else
@@ -575,5 +578,29 @@ contains
         if (st /= 0) call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
                                       "' is not an integer", error_code%input)
     end subroutine attr_read_int
+
+    !> Read a scalar real attribute.
+    subroutine attr_read_real(self, path, name, value, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path, name
+        real(dp), intent(out) :: value
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: oid, aid
+        integer(hsize_t) :: dims(1) = [1]
+        integer :: st
+        value = 0.0_dp
+        if (.not. self%has_attr(path, name)) then
+            call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
+                             "' is missing", error_code%input)
+            return
+        end if
+        call h5oopen_f(self%id, path, oid, st)
+        call h5aopen_f(oid, name, aid, st)
+        call h5aread_f(aid, H5T_NATIVE_DOUBLE, value, dims, st)
+        call h5aclose_f(aid, st)
+        call h5oclose_f(oid, st)
+        if (st /= 0) call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
+                                      "' is not an integer", error_code%input)
+    end subroutine attr_read_real
 
 end module voiga_io_hdf5

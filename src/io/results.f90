@@ -60,6 +60,7 @@ module voiga_io_results
         integer :: n_written = 0
     contains
         procedure :: open => results_open
+        procedure :: reopen => results_reopen
         procedure :: write_step => results_write_step
         procedure :: finish => results_finish
     end type results_t
@@ -137,8 +138,22 @@ contains
         call self%h5%flush()
     end subroutine results_open
 
+    !> Reopen the result file of an earlier run to continue it: status 'running',
+    !> the steps it holds counted as written.
+    subroutine results_reopen(self, path, error)
+        class(results_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
+        call self%h5%open(path, 'rw', error)
+        if (allocated(error)) return
+        call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'status', 'running')
+        call self%h5%flush()
+    end subroutine results_reopen
+
     !> Write one converged step and the current displacement; flush.
-    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts)
+    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -150,6 +165,9 @@ contains
         type(cut_record_t), intent(in), optional :: cuts(:)
         !> Cuts of the run so far.
         integer, intent(in), optional :: n_cuts
+        !> Solver state needed to restart after this step: the substep fraction carried
+        !> to the next step and the run's largest first residual.
+        real(dp), intent(in), optional :: next_fraction, r0_max
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -163,6 +181,8 @@ contains
         call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
         call self%h5%write_attr(g, 'substeps', rec%substeps)
         call self%h5%write_attr(g, 'cuts', rec%cuts)
+        if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction)
+        if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max)
         if (present(cuts)) then
             if (size(cuts) > 0) call write_cuts(self%h5, g, cuts)
         end if
@@ -224,6 +244,12 @@ contains
         st = pair%out%state
         call h5%write(c//'/state', st)
         call h5%write(c//'/xi_slave', pair%xi)
+        if (allocated(pair%anchor)) then
+            ! committed friction history: what a restart needs
+            call h5%write(c//'/history/anchor', pair%anchor)
+            call h5%write(c//'/history/xi_last', pair%xi_last)
+            call h5%write(c//'/history/active_last', merge(1, 0, pair%active_last))
+        end if
     end subroutine write_contact
 
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,

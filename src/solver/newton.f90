@@ -31,7 +31,16 @@ module voiga_solver_newton
     implicit none
     private
 
-    public :: solve_steps, solver_stats_t, wall_seconds, stepping_t
+    public :: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
+
+    !> Where a restarted run continues: after step `step`, from displacement `u`, with
+    !> the substep fraction and force scale the interrupted run had there (the contact
+    !> pairs' committed history is set on the model by the caller).
+    type :: resume_t
+        integer :: step = 0
+        real(dp), allocatable :: u(:)
+        real(dp) :: fraction = 1.0_dp, r0_max = 0.0_dp
+    end type resume_t
 
     !> Most halvings of one Newton step.
     integer, parameter :: max_line_search = 8
@@ -84,7 +93,7 @@ contains
     !> nominal step to `results` (if present) and report progress (and every cut)
     !> unless `quiet`. `u` holds the last converged displacement on return (also on
     !> failure). An interrupt (stats%signal /= 0) returns an error too.
-    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose, stepping)
+    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose, stepping, resume)
         type(model_t), intent(inout) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(solver_stats_t), intent(out) :: stats
@@ -97,6 +106,8 @@ contains
         logical, intent(in), optional :: verbose
         !> Adaptive stepping settings (default: `stepping_t()`).
         type(stepping_t), intent(in), optional :: stepping
+        !> Continue an interrupted run instead of starting from zero.
+        type(resume_t), intent(in), optional :: resume
         type(stepping_t) :: set
         type(csc_matrix_t) :: k
         type(assembly_map_t) :: map
@@ -105,7 +116,7 @@ contains
         type(cut_record_t) :: cut
         real(dp), allocatable :: r(:), u_conv(:)
         real(dp) :: t, t_begin, t_end, tic, start, frac, s, ds, rn
-        integer :: step, nsteps, j, c, ip, it, first_cut
+        integer :: step, nsteps, j, c, ip, it, first_cut, first
         logical :: loud
         character(len=200) :: msg
 
@@ -124,7 +135,17 @@ contains
         allocate (stats%records(0), stats%cut_records(0))
         ! the load increment as a fraction of the nominal step; carried over steps
         frac = 1.0_dp
-        steps: do step = 1, nsteps
+        first = 1
+        if (present(resume)) then
+            if (allocated(resume%u)) then
+                u = resume%u
+                u_conv = u
+                frac = resume%fraction
+                stats%r0_max = resume%r0_max
+                first = resume%step + 1
+            end if
+        end if
+        steps: do step = first, nsteps
             t_begin = step_time(model, step - 1)
             t_end = step_time(model, step)
             rec = step_record_t()
@@ -190,7 +211,7 @@ contains
             if (present(results)) then
                 tic = wall_seconds()
                 call results%write_step(rec, u, wall_seconds() - start, model%pairs, &
-                                        stats%cut_records(first_cut:), stats%cuts)
+                                        stats%cut_records(first_cut:), stats%cuts, frac, stats%r0_max)
                 rec%seconds(5) = wall_seconds() - tic
             end if
             stats%records = [stats%records, rec]

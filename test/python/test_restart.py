@@ -1,0 +1,122 @@
+"""--restart (issue 6): a run continued from its result file after an interruption
+reproduces the uninterrupted run to 1e-12, friction history included."""
+from __future__ import annotations
+
+import shutil
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import REPO
+
+CASE = """&case
+  title = 'restart block', geometry = 'geometry.h5', output = 'run.h5', n_bodies = 1
+/
+&body
+  name = 'slab', material = 'neo-hookean', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 4, nel_eta = 2, contact_edge = 'bottom',
+  layer_degree = 2, layer_elevations = 2
+/
+&solver
+  n_steps = 3, {slide}
+/
+&dirichlet
+  body = 'slab', edge = 'top', fix_x = .true., fix_y = .true., ux = 0.0, 0.6, uy = -0.06, -0.06
+/
+&contact
+  slave = 'slab', master = 'rigid', rigid_point = 0.0, -3.0, rigid_normal = 0.0, 1.0,
+  penalty_normal = 100.0, penalty_tangent = 100.0, friction = 0.3, n_gauss = 8
+/
+"""
+
+
+def setup(tmp: Path, slide: int) -> Path:
+    shutil.copy(REPO / "cases" / "ironing" / "geometry.h5", tmp / "geometry.h5")
+    case = tmp / "case.nml"
+    case.write_text(CASE.format(slide=slide))
+    return case
+
+
+def steps(path: Path) -> dict[str, dict[str, np.ndarray]]:
+    with h5py.File(path, "r") as f:
+        return {k: {"u": g["displacement"][()], "pn": g["contact/1/p_n"][()], "pt": g["contact/1/p_t"][()]}
+                for k, g in f["steps"].items()}
+
+
+def truncate(path: Path, keep: int) -> None:
+    """Make `path` look like a run killed after `keep` steps."""
+    with h5py.File(path, "r+") as f:
+        for k in list(f["steps"]):
+            if int(k) > keep:
+                del f["steps"][k]
+        f.attrs["n_steps_done"] = np.int32(keep)
+        f.attrs["status"] = np.bytes_("interrupted")
+
+
+def compare(a: Path, b: Path) -> None:
+    sa, sb = steps(a), steps(b)
+    assert sa.keys() == sb.keys()
+    for k in sa:
+        for key in ("u", "pn", "pt"):
+            np.testing.assert_allclose(sb[k][key], sa[k][key], rtol=0, atol=1e-12, err_msg=f"{k} {key}")
+
+
+@pytest.mark.parametrize("keep", [2, 5])
+def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int) -> None:
+    case = setup(tmp_path, 6)
+    res = run(case, "--quiet")
+    assert res.returncode == 0, res.stderr
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    partial = tmp_path / "partial.h5"
+    shutil.copy(full, partial)
+    truncate(partial, keep)           # steps 1..keep; keep = 5 is in the sliding phase
+    res = run("--restart", partial, "--quiet")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(partial) as f:
+        assert f.attrs["status"] == b"converged" and f.attrs["n_steps_done"] == 9
+    compare(full, partial)
+
+
+def test_restart_after_kill9(voiga_bin: Path, tmp_path: Path) -> None:
+    """kill -9 at a random point: the file opens with every completed step, and a
+    restart reproduces the uninterrupted results."""
+    case = setup(tmp_path, 400)
+    subprocess.run([str(voiga_bin), str(case), "--quiet"], check=True, capture_output=True, cwd=tmp_path)
+    full = tmp_path / "full.h5"
+    shutil.move(tmp_path / "run.h5", full)
+    proc = subprocess.Popen([str(voiga_bin), str(case), "--quiet"], cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 60
+    done = 0
+    while time.time() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+        try:
+            with h5py.File(tmp_path / "run.h5", "r", locking=False) as f:
+                done = int(f.attrs["n_steps_done"])
+        except (OSError, KeyError):
+            continue
+        if done >= 20:
+            break
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    if done < 20:
+        pytest.skip("the run finished before it could be killed")
+    with h5py.File(tmp_path / "run.h5", "r") as f:
+        kept = int(f.attrs["n_steps_done"])
+        assert f.attrs["status"] == b"running" and kept >= 20
+        assert all("displacement" in f["steps"][k] for k in f["steps"] if int(k) <= kept)
+        extra = [k for k in f["steps"] if int(k) > kept]
+    if extra:                          # a step group the kill interrupted half-written
+        with h5py.File(tmp_path / "run.h5", "r+") as f:
+            for k in extra:
+                del f["steps"][k]
+    res = subprocess.run([str(voiga_bin), "--restart", "run.h5", "--quiet"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    compare(full, tmp_path / "run.h5")
