@@ -9,7 +9,7 @@ VOIGA   := $(PREFIX)/bin/voiga
 APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev libopenblas-dev
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test test-fortran test-python clean
+.PHONY: all deps build run test test-fortran test-python clean bench paper
 
 all: build
 
@@ -52,3 +52,15 @@ test-python: build
 
 clean:
 	rm -rf build
+
+## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX)
+bench: build
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m bench $(BENCH_ARGS)
+
+## paper: run the paper's studies (PAPER_ARGS, e.g. --scenes hertz --meshes m1 m2) and
+## regenerate the figures and tables in docs/validation; fails if a case fails
+paper: build
+	@status=0; \
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post sweep --out results $(PAPER_ARGS) || status=$$?; \
+	$(PYTHON) -m post figures --results results --out docs/validation || status=$$?; \
+	exit $$status

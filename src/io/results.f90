@@ -4,7 +4,7 @@
 !> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use voiga_kinds, only: dp
+    use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t
     use voiga_version, only: voiga_version_string
     use voiga_io_hdf5, only: h5file_t
@@ -171,7 +171,9 @@ contains
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
+        integer(i8) :: c0, c1, rate
 
+        call system_clock(c0, rate)
         write (buf, '(i6.6)') rec%step
         g = '/steps/'//trim(buf)
         call self%h5%create_group(g)
@@ -198,6 +200,9 @@ contains
         end do
         self%n_written = self%n_written + 1
         if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts)
+        ! this step's own output time (the record was made before it was written)
+        call system_clock(c1)
+        call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp))
         call self%h5%write_attr('/', 'n_steps_done', self%n_written)
         call self%h5%write_attr('/', 'wall_time', wall)
         call self%h5%flush()

@@ -1,0 +1,196 @@
+"""``python3 -m bench``: voiga performance figures, all measured in this one run.
+
+Sections (``--only 1,2,...``):
+  1  time per Newton iteration by stage (hertz m3 N2 / NN2.2, ironing m1 NN2.2 short)
+  2  NNp against Np on the same mesh (wall time and time per iteration)
+  3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
+  4  scaling of assembly and factorization per iteration with the DOFs (hertz N2)
+  5  CalculiX (CPE8, penalty contact) on the same Hertz problem, if apt offers it
+
+Runs go to a scratch directory (default build/bench); every ratio compares runs made
+here, interleaved and best of --repeat, never against figures from another run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from .run import (IRONING_SHORT, ROOT, STAGES, VOIGA, Run, Workdir, best_of, fit_exponent,
+                  header, hertz_errors, interleaved)
+
+def ms(x: float) -> str:
+    return f"{1e3 * x:9.2f}"
+
+
+def section_stages(w: Workdir, repeat: int) -> dict:
+    header("1. Time per Newton iteration by stage (sums of the result files' seconds_<stage>)")
+    cases = [w.case("hertz", "m3-N2"), w.case("hertz", "m3-NN2.2"),
+             w.case("ironing", "m1-NN2.2", IRONING_SHORT, tag="-short")]
+    runs = interleaved(cases, repeat)
+    print(f"{'case':18s} {'dofs':>6s} {'steps':>5s} {'iters':>5s} {'wall s':>8s} | ms per iteration: "
+          + " ".join(f"{s:>9.9s}" for s in STAGES) + f" {'other':>9s}")
+    out = {}
+    for r in runs:
+        other = (r.wall - r.staged) / r.iterations
+        print(f"{r.case:18s} {r.n_dofs:6d} {r.steps:5d} {r.iterations:5d} {r.wall:8.3f} | {'':17s} "
+              + " ".join(ms(v) for v in r.per_iteration.values()) + ms(other))
+    print("\nfractions of the wall time (other = wall - sum of the stages: start-up, set-up, "
+          "writing steps, exit)")
+    print(f"{'case':18s} " + " ".join(f"{s:>13.13s}" for s in STAGES) + f" {'other':>13s}")
+    for r in runs:
+        fr = {s: r.seconds[s] / r.wall for s in STAGES}
+        fr["other"] = 1.0 - r.staged / r.wall
+        print(f"{r.case:18s} " + " ".join(f"{v:13.3f}" for v in fr.values()))
+        out[r.case] = {"dofs": r.n_dofs, "iterations": r.iterations, "wall": r.wall,
+                       "per_iteration": r.per_iteration, "fractions": fr}
+    print("\nfractions of the staged total (assembly + contact + factorization + solve + output)")
+    for r in runs:
+        print(f"{r.case:18s} " + " ".join(f"{r.seconds[s] / r.staged:13.3f}" for s in STAGES))
+    return out
+
+
+def ratio_line(a: Run, b: Run) -> str:
+    return (f"{a.case:18s} {b.case:18s} {a.n_dofs:6d} {b.n_dofs:6d} {a.iterations:5d} "
+            f"{b.iterations:5d} {a.wall:8.3f} {b.wall:8.3f} {a.wall / b.wall:8.3f} "
+            f"{a.wall_per_iteration / b.wall_per_iteration:8.3f} "
+            f"{(a.staged / a.iterations) / (b.staged / b.iterations):8.3f} "
+            f"{a.per_iteration['factorization'] / b.per_iteration['factorization']:8.3f}")
+
+
+RATIO_HEAD = (f"{'A':18s} {'B':18s} {'dofs A':>6s} {'dofs B':>6s} {'it A':>5s} {'it B':>5s} "
+              f"{'wall A':>8s} {'wall B':>8s} {'wall A/B':>8s} {'it A/B':>8s} {'stg A/B':>8s} "
+              f"{'fac A/B':>8s}")
+RATIO_NOTE = ("wall A/B: ratio of wall times; it A/B: ratio of wall time per Newton iteration; "
+              "stg A/B: ratio of the staged\nseconds per iteration; fac A/B: ratio of the "
+              "factorization seconds per iteration")
+
+
+def section_nn_vs_n(w: Workdir, repeat: int) -> dict:
+    header("2. NNp against Np on the same mesh (ironing: sliding phase shortened to 20 steps "
+           f"over 0.4); best of {max(repeat, 3)}, interleaved")
+    pairs = []
+    for mesh in ("m1", "m2"):
+        for p in ("4", "6"):
+            pairs.append((w.case("ironing", f"{mesh}-NN{p}", IRONING_SHORT, tag="-short"),
+                          w.case("ironing", f"{mesh}-N{p}", IRONING_SHORT, tag="-short")))
+    pairs.append((w.case("hertz", "m3-NN4"), w.case("hertz", "m3-N4")))
+    print(RATIO_HEAD, flush=True)
+    out = {}
+    for a_case, b_case in pairs:
+        a, b = interleaved([a_case, b_case], max(repeat, 3))
+        print(ratio_line(a, b), flush=True)
+        out[f"{a.case}/{b.case}"] = {"dofs": [a.n_dofs, b.n_dofs],
+                                      "iterations": [a.iterations, b.iterations],
+                                      "wall": [a.wall, b.wall],
+                                      "wall_ratio": a.wall / b.wall,
+                                      "per_iteration_ratio": a.wall_per_iteration / b.wall_per_iteration}
+    print(RATIO_NOTE)
+    return out
+
+
+def section_accuracy(w: Workdir, repeat: int) -> dict:
+    header("3. NN2.2 against N2 at comparable accuracy (hertz; errors from post.contact."
+           "hertz_comparison, last step)")
+    pairs = [("m3-NN2.2", "m3-N2"), ("m3-NN2.2", "m4-N2"), ("m4-NN2.2", "m5-N2")]
+    names = sorted({n for p in pairs for n in p})
+    runs = dict(zip(names, interleaved([w.case("hertz", n) for n in names], repeat)))
+    errs = {n: hertz_errors(r.result) for n, r in runs.items()}
+    print(f"{'case':10s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} {'L2(p/pmax)':>11s} "
+          f"{'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}")
+    for n in names:
+        r, e = runs[n], errs[n]
+        print(f"{n:10s} {r.n_dofs:6d} {r.iterations:5d} {r.wall:8.3f} {e['l2']:11.5f} "
+              f"{e['a_error']:+10.4f} {e['p0_error']:+12.4f}")
+    print(f"\n{'A':10s} {'B':10s} {'wall A/B':>8s} {'it A/B':>8s} {'L2 A':>9s} {'L2 B':>9s} {'L2 A/B':>8s}")
+    out = {"runs": {n: {"dofs": runs[n].n_dofs, "wall": runs[n].wall, **errs[n]} for n in names}}
+    for a, b in pairs:
+        ra, rb = runs[a], runs[b]
+        print(f"{a:10s} {b:10s} {ra.wall / rb.wall:8.3f} "
+              f"{ra.wall_per_iteration / rb.wall_per_iteration:8.3f} {errs[a]['l2']:9.5f} "
+              f"{errs[b]['l2']:9.5f} {errs[a]['l2'] / errs[b]['l2']:8.3f}")
+        out[f"{a}/{b}"] = {"wall_ratio": ra.wall / rb.wall}
+    return out
+
+
+def section_scaling(w: Workdir, repeat: int, levels: int) -> dict:
+    from .refine import refined_hertz_text
+    header(f"4. Scaling with the DOFs: hertz N2 m1..m{levels}, one load step (n_steps = 1) so "
+           "that the large meshes fit;\n   m7+ generated from m6 by knot-span midpoints in xi "
+           "and eta")
+    print(f"{'mesh':6s} {'dofs':>7s} {'iters':>5s} {'wall s':>8s} | s per iteration: "
+          f"{'assembly':>10s} {'contact':>10s} {'factoriz.':>10s} {'solve':>10s} {'wall':>10s}",
+          flush=True)
+    rows = []
+    for lev in range(1, levels + 1):
+        name = f"m{lev}-N2"
+        text = refined_hertz_text(lev) if lev > 6 else None
+        case = w.case("hertz", name, {"n_steps": "1"}, tag="-1step", text=text)
+        r = best_of(case, repeat if lev <= 5 else 1)
+        pi = r.per_iteration
+        print(f"m{lev:<5d} {r.n_dofs:7d} {r.iterations:5d} {r.wall:8.2f} | {'':16s} "
+              f"{pi['assembly']:10.4f} {pi['contact']:10.4f} {pi['factorization']:10.4f} "
+              f"{pi['solve']:10.4f} {r.wall_per_iteration:10.4f}", flush=True)
+        rows.append({"mesh": f"m{lev}", "dofs": r.n_dofs, "iterations": r.iterations,
+                     "wall": r.wall, **{f"{k}_per_iteration": v for k, v in pi.items()}})
+    print("\nexponent e in time per iteration ~ DOFs^e")
+    print(f"{'between':14s} {'assembly':>9s} {'factoriz.':>9s} {'solve':>9s} {'wall':>9s}")
+    fits = {}
+    spans = [(i, i + 1) for i in range(max(0, len(rows) - 3), len(rows) - 1)]
+    spans.append((max(0, len(rows) - 3), len(rows) - 1))
+    for i, j in spans:
+        sel = rows[i:j + 1]
+        n = [r["dofs"] for r in sel]
+        e = {k: fit_exponent(n, [r[f"{k}_per_iteration"] for r in sel])
+             for k in ("assembly", "factorization", "solve")}
+        e["wall"] = fit_exponent(n, [r["wall"] / r["iterations"] for r in sel])
+        label = f"{sel[0]['mesh']}..{sel[-1]['mesh']}" + (" (lsq)" if len(sel) > 2 else "")
+        print(f"{label:14s} " + " ".join(f"{v:9.2f}" for v in e.values()))
+        fits[label] = e
+    return {"rows": rows, "exponents": fits}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--only", default="1,2,3,4,5", help="comma-separated sections")
+    ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
+    ap.add_argument("--levels", type=int, default=7,
+                    help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
+    ap.add_argument("--work", type=Path, default=ROOT / "build" / "bench")
+    ap.add_argument("--ccx-meshes", default="m2,m3,m4", help="section 5 meshes")
+    ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
+    args = ap.parse_args(argv)
+    if not VOIGA.exists():
+        print(f"bench: {VOIGA} missing; run make build", file=sys.stderr)
+        return 1
+    only = {s.strip() for s in args.only.split(",")}
+    w = Workdir(args.work)
+    t0 = time.perf_counter()
+    print(f"bench: voiga {VOIGA}, work dir {w.path}, best of {args.repeat} "
+          f"(started {time.strftime('%Y-%m-%d %H:%M:%S %Z')})")
+    figures: dict = {}
+    if "1" in only:
+        figures["stages"] = section_stages(w, args.repeat)
+    if "2" in only:
+        figures["nn_vs_n"] = section_nn_vs_n(w, args.repeat)
+    if "3" in only:
+        figures["accuracy"] = section_accuracy(w, args.repeat)
+    if "4" in only:
+        figures["scaling"] = section_scaling(w, args.repeat, args.levels)
+    if "5" in only:
+        from .ccx import section_calculix
+        figures["calculix"] = section_calculix(w, args.ccx_meshes.split(","), args.repeat)
+    total = time.perf_counter() - t0
+    print(f"\nbench: done in {total:.0f} s")
+    path = args.json or (w.path / "bench.json")
+    path.write_text(json.dumps(figures, indent=1, default=float))
+    print(f"bench: figures written to {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,281 @@
+"""Section 5: CalculiX on the same Hertz problem, for a reference point on the cost of
+a classical FE code at a given contact-pressure accuracy.
+
+Quarter cylinder (R = 1, hole R = 0.05 as in the hertz scene, E = 1, nu = 0.3), CPE8
+plane strain, meshed on the same graded parameter grid as voiga's hertz mesh m<k> (the
+knot spans of the case file mapped through the exact NURBS geometry: one CPE8 per knot
+span, mid-side nodes on the exact arc). The flat is a block of CPE8 whose nodes are all
+fixed (rigid); contact is surface-to-surface with a linear pressure-overclosure law of slope
+1000 (voiga's penalty_normal). u_y = -0.01 on the top cut (y = 0), u_x = 0 on the
+symmetry cut (x = 0), five increments as voiga's five steps.
+
+The pressure is K * overclosure at 3 Gauss points of every quadratic slave edge (what
+the surface-to-surface penalty applies), from the printed nodal displacements; the force from the reaction on the top cut. The same
+post.contact functions as ``python -m post hertz`` give the errors.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .refine import read_knots
+from .run import ROOT, Workdir
+
+PENALTY = 1000.0
+UY = -0.01
+E, NU = 1.0, 0.3
+
+
+def ensure_ccx() -> str | None:
+    """Path of ccx; installs calculix-ccx with apt-get if apt offers it and it is missing."""
+    exe = shutil.which("ccx")
+    if exe:
+        return exe
+    pol = subprocess.run(["apt-cache", "policy", "calculix-ccx"], capture_output=True, text=True)
+    if "Candidate:" not in pol.stdout or "Candidate: (none)" in pol.stdout:
+        print("bench: apt-cache policy calculix-ccx offers no candidate; skipping CalculiX")
+        return None
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    print("bench: installing calculix-ccx with apt-get", flush=True)
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    install = sudo + ["apt-get", "install", "-y", "-qq", "calculix-ccx"]
+    if subprocess.run(install, env=env, capture_output=True).returncode != 0:
+        # stale package lists: update once and retry
+        subprocess.run(sudo + ["apt-get", "update", "-qq"], env=env, capture_output=True)
+        subprocess.run(install, env=env, capture_output=True)
+    exe = shutil.which("ccx")
+    if exe is None:
+        print("bench: installing calculix-ccx failed; skipping CalculiX")
+    return exe
+
+
+def breakpoints(mesh: str) -> tuple[np.ndarray, np.ndarray]:
+    text = (ROOT / "cases" / "hertz" / f"{mesh}-N2.nml").read_text()
+    kx, ke = read_knots(text, "knots_xi"), read_knots(text, "knots_eta")
+    return np.concatenate([[0.0], kx, [1.0]]), np.concatenate([[0.0], ke, [1.0]])
+
+
+def cylinder_mesh(mesh: str):
+    """Nodes (n, 2), CPE8 connectivity (nel, 8; 1-based), and node sets."""
+    from pre.nurbs import evaluate_patch
+    from pre.scenes import hertz
+    patch = hertz()["cylinder"]
+    bx, be = breakpoints(mesh)
+    # parameter grid with the span midpoints (quadratic serendipity nodes)
+    gx = np.empty(2 * len(bx) - 1)
+    gx[0::2], gx[1::2] = bx, 0.5 * (bx[:-1] + bx[1:])
+    ge = np.empty(2 * len(be) - 1)
+    ge[0::2], ge[1::2] = be, 0.5 * (be[:-1] + be[1:])
+    ids = -np.ones((len(gx), len(ge)), dtype=int)
+    pairs = []
+    for i in range(len(gx)):
+        for j in range(len(ge)):
+            if i % 2 and j % 2:
+                continue
+            ids[i, j] = len(pairs) + 1
+            pairs.append((gx[i], ge[j]))
+    pairs = np.array(pairs)
+    xy = evaluate_patch(patch, pairs[:, 0], pairs[:, 1])
+    # exact snapping of the cuts
+    xy[np.isclose(pairs[:, 0], 0.0), 0] = 0.0
+    xy[np.isclose(pairs[:, 0], 1.0), 1] = 0.0
+    elems = []
+    for a in range(len(bx) - 1):
+        for b in range(len(be) - 1):
+            i0, i1, j0, j1 = 2 * a, 2 * a + 2, 2 * b, 2 * b + 2
+            # (eta, xi) is right-handed in the plane: corners in that order
+            c = [ids[i0, j0], ids[i0, j1], ids[i1, j1], ids[i1, j0],
+                 ids[i0, j0 + 1], ids[i0 + 1, j1], ids[i1, j0 + 1], ids[i0 + 1, j0]]
+            elems.append(c)
+    elems = np.array(elems)
+    outer = ids[:, -1][ids[:, -1] > 0]
+    sets = {"NSYM": ids[0, :][ids[0, :] > 0], "NTOP": ids[-1, :][ids[-1, :] > 0],
+            "NOUTER": outer}
+    outer_elems = np.array([k + 1 for k, (a, b) in enumerate(
+        (a, b) for a in range(len(bx) - 1) for b in range(len(be) - 1)) if b == len(be) - 2])
+    return xy, elems, sets, outer_elems
+
+
+def signed_area(xy: np.ndarray, conn: np.ndarray) -> float:
+    p = xy[conn[:4] - 1]
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def block_mesh(first_node: int, first_elem: int, nx: int = 40, ny: int = 2,
+               x0: float = -0.0525, x1: float = 0.3475, y0: float = -1.1, y1: float = -1.0):
+    """Rigid flat: CPE8 block [x0, x1] x [y0, y1], top face at y = -1."""
+    gx, gy = np.linspace(x0, x1, 2 * nx + 1), np.linspace(y0, y1, 2 * ny + 1)
+    ids = -np.ones((len(gx), len(gy)), dtype=int)
+    nodes = []
+    for i in range(len(gx)):
+        for j in range(len(gy)):
+            if i % 2 and j % 2:
+                continue
+            ids[i, j] = first_node + len(nodes)
+            nodes.append((gx[i], gy[j]))
+    elems, top = [], []
+    for a in range(nx):
+        for b in range(ny):
+            i0, i1, j0, j1 = 2 * a, 2 * a + 2, 2 * b, 2 * b + 2
+            elems.append([ids[i0, j0], ids[i1, j0], ids[i1, j1], ids[i0, j1],
+                          ids[i0 + 1, j0], ids[i1, j0 + 1], ids[i0 + 1, j1], ids[i0, j0 + 1]])
+            if b == ny - 1:
+                top.append(first_elem + len(elems) - 1)
+    return np.array(nodes), np.array(elems), top
+
+
+def write_input(path: Path, mesh: str) -> dict:
+    xy, conn, sets, outer_elems = cylinder_mesh(mesh)
+    # orientation: counter-clockwise corners; the outer face of a cylinder element is
+    # between corners 2 and 3 (eta = 1) -> face S2, flipped to S4 if reordered
+    face = "S2"
+    if signed_area(xy, conn[0]) < 0:
+        conn = conn[:, [0, 3, 2, 1, 7, 6, 5, 4]]
+        face = "S3"  # corners 1 4 3 2: the old 2-3 edge is now 3-4
+    assert all(signed_area(xy, c) > 0 for c in conn[:5])
+    bxy, bconn, btop = block_mesh(len(xy) + 1, len(conn) + 1)
+    lines = ["*HEADING", f"hertz {mesh}: CPE8 quarter cylinder on a rigid flat", "*NODE"]
+    lines += [f"{k + 1}, {x:.15g}, {y:.15g}" for k, (x, y) in enumerate(xy)]
+    lines += [f"{len(xy) + k + 1}, {x:.15g}, {y:.15g}" for k, (x, y) in enumerate(bxy)]
+    lines.append("*ELEMENT, TYPE=CPE8, ELSET=ECYL")
+    lines += [f"{k + 1}, " + ", ".join(str(int(v)) for v in c) for k, c in enumerate(conn)]
+    lines.append("*ELEMENT, TYPE=CPE8, ELSET=EBLOCK")
+    lines += [f"{len(conn) + k + 1}, " + ", ".join(str(int(v)) for v in c)
+              for k, c in enumerate(bconn)]
+
+    def nset(name, ids):
+        out = [f"*NSET, NSET={name}"]
+        ids = [int(v) for v in ids]
+        out += [", ".join(str(v) for v in ids[i:i + 12]) for i in range(0, len(ids), 12)]
+        return out
+
+    for name, ids in sets.items():
+        lines += nset(name, ids)
+    lines += nset("NBLOCK", range(len(xy) + 1, len(xy) + len(bxy) + 1))
+    lines.append("*SURFACE, NAME=SSLAVE, TYPE=ELEMENT")
+    lines += [f"{e}, {face}" for e in outer_elems]
+    lines.append("*SURFACE, NAME=SMASTER, TYPE=ELEMENT")
+    lines += [f"{e}, S3" for e in btop]
+    lines += ["*MATERIAL, NAME=CYL", "*ELASTIC", f"{E}, {NU}",
+              "*MATERIAL, NAME=RIGID", "*ELASTIC", f"{1e6 * E}, {NU}",
+              "*SOLID SECTION, ELSET=ECYL, MATERIAL=CYL", "1.",
+              "*SOLID SECTION, ELSET=EBLOCK, MATERIAL=RIGID", "1.",
+              "*SURFACE INTERACTION, NAME=SI1",
+              "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{PENALTY}, 1e-9, 1e-3",
+              "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE", "SSLAVE, SMASTER",
+              "*BOUNDARY", "NBLOCK, 1, 2, 0.", "NSYM, 1, 1, 0.",
+              "*STEP, INC=1000", "*STATIC", "0.2, 1.0, 1e-6, 0.2",
+              "*BOUNDARY", f"NTOP, 2, 2, {UY}",
+              "*NODE PRINT, NSET=NOUTER", "U",
+              "*NODE PRINT, NSET=NTOP, TOTALS=ONLY", "RF",
+              "*END STEP"]
+    path.write_text("\n".join(lines) + "\n")
+    return {"nodes": len(xy) + len(bxy), "cyl_nodes": len(xy), "elements": len(conn),
+            "dofs": 2 * len(xy), "outer": sets["NOUTER"], "xy": xy}
+
+
+def parse_dat(path: Path, info: dict) -> tuple[np.ndarray, np.ndarray, float]:
+    """Last printed displacements of the outer nodes and the total reaction on the top."""
+    disp: dict[int, tuple[float, float]] = {}
+    rf = np.nan
+    mode = None
+    for line in path.read_text().splitlines():
+        s = line.strip()
+        if s.startswith("displacements"):
+            mode, disp = "u", {}
+            continue
+        if s.startswith("total force"):
+            mode = "rf"
+            continue
+        if not s:
+            continue
+        parts = s.split()
+        try:
+            vals = [float(v) for v in parts]
+        except ValueError:
+            mode = None if not s.startswith(("displacements", "total")) else mode
+            continue
+        if mode == "u" and len(vals) >= 3:
+            disp[int(vals[0])] = (vals[1], vals[2])
+        elif mode == "rf" and len(vals) >= 2:
+            rf = vals[1]
+    ids = [int(v) for v in info["outer"]]
+    u = np.array([disp[i] for i in ids])
+    x = info["xy"][np.array(ids) - 1] + u
+    return x, u, rf
+
+
+def edge_points(xn: np.ndarray, n_gauss: int = 3) -> np.ndarray:
+    """Deformed outer edge at ``n_gauss`` Gauss points of every quadratic element edge
+    (nodes corner, mid, corner, mid, ... in xi order): the points where the
+    surface-to-surface penalty evaluates the overclosure."""
+    g, _ = np.polynomial.legendre.leggauss(n_gauss)
+    n = np.stack([0.5 * g * (g - 1.0), 1.0 - g**2, 0.5 * g * (g + 1.0)], axis=1)
+    pts = [n @ xn[2 * k:2 * k + 3] for k in range((len(xn) - 1) // 2)]
+    return np.concatenate(pts)
+
+
+def run_ccx(exe: str, w: Workdir, mesh: str) -> dict:
+    from post.contact import fit_hertz, hertz_reference, normalized_l2_error
+    d = w.path / "calculix"
+    d.mkdir(exist_ok=True)
+    inp = d / f"hertz-{mesh}.inp"
+    info = write_input(inp, mesh)
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    t0 = time.perf_counter()
+    proc = subprocess.run([exe, "-i", inp.stem], cwd=d, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
+    (d / f"hertz-{mesh}.log").write_text(proc.stdout + proc.stderr)
+    if proc.returncode != 0 or "Job finished" not in proc.stdout:
+        raise RuntimeError(f"ccx {inp} failed; see {d / f'hertz-{mesh}.log'}")
+    xn, u, rf = parse_dat(d / f"hertz-{mesh}.dat", info)
+    x = edge_points(xn)
+    p = PENALTY * np.clip(-1.0 - x[:, 1], 0.0, None)
+    act = p > 0
+    force = 2.0 * abs(rf)
+    a, p0 = hertz_reference(force, E, NU, 1.0)
+    a_fit, p0_fit = fit_hertz(x[act, 0], p[act])
+    return {"mesh": mesh, "dofs": info["dofs"], "elements": info["elements"], "wall": wall,
+            "force": force, "a": a, "p0": p0, "a_error": a_fit / a - 1, "p0_error": p0_fit / p0 - 1,
+            "p_max": float(p.max()), "l2": normalized_l2_error(x[act, 0], p[act], a),
+            "active_points": int(act.sum())}
+
+
+def section_calculix(w: Workdir, meshes: list[str], repeat: int = 2) -> dict:
+    from .run import header, hertz_errors, interleaved
+    header("5. CalculiX (CPE8 plane strain, surface-to-surface linear penalty 1000, rigid "
+           "flat) against voiga N2 / NN2.2, same meshes")
+    exe = ensure_ccx()
+    if exe is None:
+        return {"available": False}
+    out = {"available": True, "runs": []}
+    print(f"{'code':11s} {'mesh':5s} {'dofs':>6s} {'wall s':>8s} {'P':>10s} {'a_fit/a-1':>10s} "
+          f"{'p0_fit/p0-1':>12s} {'L2(p/pmax)':>11s} {'wall/voiga N2':>14s}", flush=True)
+    for mesh in meshes:
+        runs = interleaved([w.case("hertz", f"{mesh}-{lay}", tag="-ccxcmp")
+                            for lay in ("N2", "NN2.2")], repeat)
+        voiga = {lay: (r, hertz_errors(r.result)) for lay, r in zip(("N2", "NN2.2"), runs)}
+        try:
+            c = run_ccx(exe, w, mesh)
+        except Exception as err:  # noqa: BLE001 - report and go on with the next mesh
+            print(f"ccx         {mesh:5s} failed: {err}")
+            continue
+        for lay, (r, e) in voiga.items():
+            print(f"voiga {lay:5s} {mesh:5s} {r.n_dofs:6d} {r.wall:8.3f} {'':>10s} "
+                  f"{e['a_error']:+10.4f} {e['p0_error']:+12.4f} {e['l2']:11.5f} "
+                  f"{r.wall / voiga['N2'][0].wall:14.3f}")
+        print(f"ccx         {mesh:5s} {c['dofs']:6d} {c['wall']:8.3f} {c['force']:10.6f} "
+              f"{c['a_error']:+10.4f} {c['p0_error']:+12.4f} {c['l2']:11.5f} "
+              f"{c['wall'] / voiga['N2'][0].wall:14.3f}", flush=True)
+        out["runs"].append({**c, "voiga": {k: {"wall": r.wall, "dofs": r.n_dofs, **e}
+                                           for k, (r, e) in voiga.items()}})
+    print(f"voiga: best of {repeat}; ccx: one run, OMP_NUM_THREADS=1; ccx dofs: 2 x nodes of the cylinder (the fixed block's are not counted); P is the "
+          "full cylinder's force per length")
+    return out

@@ -1,0 +1,42 @@
+"""Hertz meshes beyond the committed m6: copy m6-N2 and insert the midpoint of every
+knot span along xi and along eta (more radial knots), so each level has about 4x the
+DOFs of the one before (m7 ~ 1.1e5, m8 ~ 4.5e5 DOFs)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from .run import ROOT, set_variable
+
+
+def read_knots(text: str, name: str) -> np.ndarray:
+    m = re.search(rf"^\s*{name}\s*=(.*?)(?=^\s*[A-Za-z_]\w*\s*=|^\s*/)", text, re.M | re.S)
+    if m is None:
+        raise KeyError(name)
+    return np.array([float(v) for v in m.group(1).replace("\n", " ").split(",") if v.strip()])
+
+
+def midpoints(interior: np.ndarray) -> np.ndarray:
+    k = np.concatenate([[0.0], interior, [1.0]])
+    mids = 0.5 * (k[:-1] + k[1:])
+    return np.sort(np.concatenate([interior, mids]))
+
+
+def format_list(values: np.ndarray, per_line: int = 4) -> str:
+    items = [repr(float(v)) for v in values]
+    lines = [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+    return (",\n" + " " * 13).join(lines)
+
+
+def refined_hertz_text(level: int) -> str:
+    """Case text of hertz N2 at mesh ``m<level>`` (level >= 7), from m6-N2."""
+    text = (ROOT / "cases" / "hertz" / "m6-N2.nml").read_text()
+    kx, ke = read_knots(text, "knots_xi"), read_knots(text, "knots_eta")
+    for _ in range(level - 6):
+        kx, ke = midpoints(kx), midpoints(ke)
+    text = set_variable(text, "knots_xi", format_list(kx))
+    text = set_variable(text, "knots_eta", format_list(ke))
+    text = set_variable(text, "mesh", f"'m{level}'")
+    return set_variable(text, "title", f"'hertz m{level} N2'")
