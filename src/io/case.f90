@@ -523,15 +523,8 @@ contains
         end if
         write (msg, '(a,i0,a)') ': &dirichlet (', k, '): '
         where = path//trim(msg)//' '
-        if (body_index(self, body) == 0) then
-            call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
-                             error_code%input)
-            return
-        end if
-        if (len_trim(edge) == 0) then
-            call fatal_error(error, where//'edge is required', error_code%input)
-            return
-        end if
+        call check_body_edge(self, body, edge, where, error)
+        if (allocated(error)) return
         if (.not. (fix_x .or. fix_y)) then
             call fatal_error(error, where//'fix_x or fix_y must be .true.', error_code%input)
             return
@@ -575,15 +568,8 @@ contains
         end if
         write (msg, '(a,i0,a)') ': &pressure (', k, '): '
         where = path//trim(msg)//' '
-        if (body_index(self, body) == 0) then
-            call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
-                             error_code%input)
-            return
-        end if
-        if (len_trim(edge) == 0) then
-            call fatal_error(error, where//'edge is required', error_code%input)
-            return
-        end if
+        call check_body_edge(self, body, edge, where, error)
+        if (allocated(error)) return
         entry%body = body
         entry%edge = edge
         allocate (entry%values(nph))
@@ -702,6 +688,20 @@ contains
             read (text, nml=contact, iostat=ios, iomsg=msg)
         end subroutine try_contact
     end subroutine read_contact
+
+    !> A load group names a body of the case and an edge (checked against the
+    !> body's edges once it is discretized).
+    subroutine check_body_edge(self, body, edge, where, error)
+        type(case_t), intent(in) :: self
+        character(len=*), intent(in) :: body, edge, where
+        type(error_t), allocatable, intent(out) :: error
+        if (body_index(self, body) == 0) then
+            call fatal_error(error, where//"body = '"//trim(body)//"' is not a body of the case", &
+                             error_code%input)
+            return
+        end if
+        if (len_trim(edge) == 0) call fatal_error(error, where//'edge is required', error_code%input)
+    end subroutine check_body_edge
 
     !> Values at the end of each phase: exactly one per phase when given; all
     !> zero when the component is prescribed but no value is given.
