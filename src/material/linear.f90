@@ -2,7 +2,7 @@
 !> sigma = lambda tr(eps) I + 2 mu eps, eps = sym(grad u).
 module voiga_material_linear
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t
+    use voiga_material, only: material_t, delta
     implicit none
     private
 
@@ -40,9 +40,5 @@ contains
         ok = .true.
     end subroutine linear_stress
 
-    pure real(dp) function delta(i, j)
-        integer, intent(in) :: i, j
-        delta = merge(1.0_dp, 0.0_dp, i == j)
-    end function delta
 
 end module voiga_material_linear

@@ -10,7 +10,7 @@ module voiga_material
     implicit none
     private
 
-    public :: material_t, lame_from_young
+    public :: material_t, lame_from_young, delta
 
     !> A material law.
     type, abstract :: material_t
@@ -50,5 +50,11 @@ contains
         self%lambda = youngs_modulus*poisson_ratio/((1.0_dp + poisson_ratio)*(1.0_dp - 2.0_dp*poisson_ratio))
         self%kappa = youngs_modulus/(3.0_dp*(1.0_dp - 2.0_dp*poisson_ratio))
     end subroutine lame_from_young
+
+    !> Kronecker delta as a real, for building elasticity tensors.
+    pure elemental real(dp) function delta(i, j)
+        integer, intent(in) :: i, j
+        delta = merge(1.0_dp, 0.0_dp, i == j)
+    end function delta
 
 end module voiga_material

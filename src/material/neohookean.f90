@@ -7,7 +7,7 @@
 !>     + 2 mu/3 [ tr(bbar) (I_s + I(x)I/3) - bbar(x)I - I(x)bbar ].
 module voiga_material_neohookean
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t
+    use voiga_material, only: material_t, delta
     implicit none
     private
 
@@ -64,9 +64,5 @@ contains
         end do
     end subroutine neo_hookean_stress
 
-    pure real(dp) function delta(i, j)
-        integer, intent(in) :: i, j
-        delta = merge(1.0_dp, 0.0_dp, i == j)
-    end function delta
 
 end module voiga_material_neohookean
