@@ -10,7 +10,7 @@ module test_solid
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_io_case, only: case_t, body_input_t, dirichlet_input_t, pressure_input_t
-    use voiga_model, only: model_t, new_model
+    use voiga_model, only: model_t, new_model, body_points
     use voiga_model_assembly, only: body_element, body_dofs, assemble, assembly_stats_t
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: reference_gradients
@@ -265,6 +265,7 @@ contains
                                                                        rng%uniform() - 0.5_dp]
             end do
         end associate
+        call body_points(model%bodies(1))
     end subroutine distort_interior
 
     !> Uniaxial stretch by Dirichlet conditions: the exact field is linear.

@@ -27,6 +27,7 @@ module voiga_contact_master
     contains
         procedure(project_interface), deferred :: project
         procedure(all_dofs_interface), deferred :: all_dofs
+        procedure :: prepare => master_prepare
     end type contact_master_t
 
     abstract interface
@@ -49,5 +50,15 @@ module voiga_contact_master
             integer, allocatable :: dofs(:)
         end function all_dofs_interface
     end interface
+
+contains
+
+    !> Update whatever the master's search needs for the configuration `u` (called
+    !> once per evaluation of a pair, before its projections). Default: nothing.
+    pure subroutine master_prepare(self, u)
+        class(contact_master_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        ! a rigid master has nothing to update
+    end subroutine master_prepare
 
 end module voiga_contact_master

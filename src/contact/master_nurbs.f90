@@ -2,6 +2,11 @@
 !> when the body has one). Closest-point projection by a local Newton iteration
 !> started from the nearest sampled point and bracketed per knot span, so that it
 !> is correct across C0 knots and at the ends of the curve.
+!>
+!> Search: `prepare(u)` samples every knot span once per configuration and boxes
+!> each span's control points (a NURBS span with positive weights lies in the
+!> convex hull of its control points); a projection then only looks at the
+!> samples of spans whose box is closer than the nearest sample found so far.
 module voiga_contact_master_nurbs
     use voiga_kinds, only: dp
     use voiga_discretization_patch, only: discretization_t
@@ -22,9 +27,14 @@ module voiga_contact_master_nurbs
         type(contact_surface_t) :: surf
         !> Outward normal = sign * (a_y, -a_x)/|a|, fixed by the patch orientation.
         real(dp) :: sign = 1.0_dp
+        !> Search structure of the configuration of the last `prepare`: sample
+        !> points [2, n_samples, nspan] and control-point boxes [xmin, ymin, xmax,
+        !> ymax] [4, nspan].
+        real(dp), allocatable :: samples(:, :, :), boxes(:, :)
     contains
         procedure :: project => nurbs_project
         procedure :: all_dofs => nurbs_all_dofs
+        procedure :: prepare => nurbs_prepare
     end type nurbs_master_t
 
 contains
@@ -58,6 +68,48 @@ contains
         self%sign = outward_sign(disc)
     end subroutine new_nurbs_master
 
+    !> Samples per knot span (2p + 3, ends included).
+    pure integer function n_samples(self)
+        class(nurbs_master_t), intent(in) :: self
+        n_samples = 2*self%surf%degree + 3
+    end function n_samples
+
+    !> Sample every span and box its control points in the configuration `u`;
+    !> `project` must be called with the same `u`.
+    pure subroutine nurbs_prepare(self, u)
+        class(nurbs_master_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        type(surface_point_t) :: pt
+        real(dp) :: xc(2, self%surf%degree + 1), xi
+        integer :: nspan, m, k, j, s, p
+
+        associate (br => self%surf%breaks, surf => self%surf)
+            nspan = size(br) - 1
+            m = n_samples(self)
+            p = surf%degree
+            if (.not. allocated(self%samples)) allocate (self%samples(2, m, nspan), self%boxes(4, nspan))
+            do k = 1, nspan
+                do j = 0, m - 1
+                    xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
+                    call surface_point(surf, u, xi, pt, surf%spans(k))
+                    self%samples(:, j + 1, k) = pt%x
+                end do
+                s = surf%spans(k)
+                xc(1, :) = surf%x0(1, s - p:s) + u(surf%dofs(1, s - p:s))
+                xc(2, :) = surf%x0(2, s - p:s) + u(surf%dofs(2, s - p:s))
+                self%boxes(1:2, k) = minval(xc, dim=2)
+                self%boxes(3:4, k) = maxval(xc, dim=2)
+            end do
+        end associate
+    end subroutine nurbs_prepare
+
+    !> Distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).
+    pure real(dp) function box_distance(box, x)
+        real(dp), intent(in) :: box(4), x(2)
+        box_distance = norm2([max(box(1) - x(1), 0.0_dp, x(1) - box(3)), &
+                              max(box(2) - x(2), 0.0_dp, x(2) - box(4))])
+    end function box_distance
+
     pure function nurbs_all_dofs(self) result(dofs)
         class(nurbs_master_t), intent(in) :: self
         integer, allocatable :: dofs(:)
@@ -71,23 +123,31 @@ contains
         logical, intent(out) :: found, converged
         type(surface_point_t) :: pt, best_pt
         real(dp) :: d, best_d, xi, xi_s, a, b, lo, hi, best, f, df, step
-        integer :: nspan, k, j, m, it, span, best_span, s0, s1
+        real(dp) :: lb(size(self%surf%breaks) - 1)
+        integer :: nspan, k, j, m, it, best_span, s0, s1, k0, i
         logical :: ok, best_ok
 
         associate (br => self%surf%breaks)
             nspan = size(br) - 1
-            ! 1. nearest sample (2p + 3 points per span)
-            m = 2*self%surf%degree + 3
+            ! 1. nearest sample (2p + 3 points per span), visiting the span whose box
+            !    is nearest first and skipping spans whose box is farther than the
+            !    nearest sample so far
+            m = n_samples(self)
+            do k = 1, nspan
+                lb(k) = box_distance(self%boxes(:, k), xs)
+            end do
             best_d = huge(1.0_dp)
             best = br(1)
-            do k = 1, nspan
-                do j = 0, m - 1
-                    xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
-                    call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
-                    d = norm2(xs - pt%x)
+            s0 = 1
+            k0 = minloc(lb, dim=1)
+            do i = 0, nspan - 1
+                k = modulo(k0 - 1 + i, nspan) + 1
+                if (lb(k) >= best_d) cycle
+                do j = 1, m
+                    d = norm2(xs - self%samples(:, j, k))
                     if (d < best_d) then
                         best_d = d
-                        best = xi
+                        best = br(k) + (br(k + 1) - br(k))*real(j - 1, dp)/real(m - 1, dp)
                         s0 = k
                     end if
                 end do

@@ -123,6 +123,7 @@ contains
         character(len=96) :: buf
 
         self%force = 0.0_dp
+        call self%master%prepare(u)
         do k = 1, size(self%xi)
             call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
             self%out(k)%x0 = matmul(self%slave%x0(:, sp%local), sp%r)

@@ -1,14 +1,23 @@
-!> Plane-strain solid element kernels: internal force and tangent stiffness of one
-!> quadrature point, small strain or finite strain, on any NURBS or VO element.
+!> Plane-strain solid element kernel: internal force and tangent stiffness of one
+!> element from its quadrature points, small strain or finite strain, on any NURBS
+!> or VO element.
 !>
 !> Local DOF order: 2(a-1) + i for function a and component i.
 module voiga_element_solid
     use voiga_kinds, only: dp
     use voiga_material, only: material_t
+    use voiga_linalg_blas, only: gemm_tn
     implicit none
     private
 
-    public :: solid_point, reference_gradients
+    public :: solid_element, reference_gradients, element_points_t
+
+    !> The quadrature of one element in the reference configuration, computed once
+    !> per discretization: reference gradients dN/dX [2, nen, npts] and weights
+    !> times |det dX/dxi| (reference volume) [npts].
+    type :: element_points_t
+        real(dp), allocatable :: dndx(:, :, :), wdv(:)
+    end type element_points_t
 
 contains
 
@@ -32,57 +41,69 @@ contains
         dndx = matmul(transpose(inv), dr)
     end subroutine reference_gradients
 
-    !> Add one quadrature point's contribution to `fe` [2 nen] and `ke` [2 nen, 2 nen].
-    !> `dndx` [2, nen] reference gradients, `u` [2, nen] displacements, `wdv` the
-    !> point's weight times |det| (reference volume). Small strain: f = int B^T sigma,
-    !> K = int B^T c B. Finite strain (total Lagrangian, spatial form):
-    !> f_a = int tau g_a dV, K_ab = int (g_a . c . g_b + (g_a . tau g_b) I) dV,
-    !> g = dN/dx = F^-T dN/dX. `ok` is false if J <= 0 at the point.
-    pure subroutine solid_point(mat, dndx, u, wdv, fe, ke, ok)
+    !> Internal force `fe` [2 nen] and tangent `ke` [2 nen, 2 nen] of a whole element
+    !> from its quadrature points `pts`, with displacements `u` [2, nen]. Small
+    !> strain: f = int B^T sigma, K = int B^T c B. Finite strain (total Lagrangian,
+    !> spatial form): f_a = int tau g_a dV, K_ab = int (g_a . c . g_b + (g_a . tau g_b) I) dV,
+    !> g = dN/dx = F^-T dN/dX. Evaluated as matrix products over all points:
+    !> K = B^T D B (material part, Voigt form; the tangents of both laws have minor
+    !> symmetries) + G^T T G (geometric part, finite strain only) with B, D, G, T
+    !> stacked over the points. `ok` is false if J <= 0 at a point.
+    pure subroutine solid_element(mat, pts, u, fe, ke, ok)
         class(material_t), intent(in) :: mat
-        real(dp), intent(in) :: dndx(:, :), u(:, :)
-        real(dp), intent(in) :: wdv
-        real(dp), intent(inout) :: fe(:), ke(:, :)
+        type(element_points_t), intent(in) :: pts
+        real(dp), intent(in) :: u(:, :)
+        real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, geo
-        real(dp) :: g(2, size(dndx, 2)), sg(2), cg(2, 2, 2)
-        integer :: a, b, i, k, nen
+        real(dp) :: bm(3*size(pts%wdv), 2*size(u, 2)), db(3*size(pts%wdv), 2*size(u, 2))
+        real(dp), allocatable :: gm(:, :), tg(:, :), kg(:, :)
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3)
+        real(dp) :: g(2, size(u, 2))
+        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
+        integer :: q, nen, i, j, r
 
-        nen = size(dndx, 2)
-        grad_u = matmul(u, transpose(dndx))
-        call mat%stress(grad_u, s, c, ok)
-        if (.not. ok) return
-        if (mat%finite_strain) then
-            f = grad_u
-            f(1, 1) = f(1, 1) + 1.0_dp
-            f(2, 2) = f(2, 2) + 1.0_dp
-            det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-            finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
-            g = matmul(transpose(finv), dndx)
-        else
-            g = dndx
-        end if
-        do a = 1, nen
-            sg = matmul(s, g(:, a))
-            fe(2*a - 1:2*a) = fe(2*a - 1:2*a) + wdv*sg
-            ! cg(i, k, l) = sum_j g_a,j c(i, j, k, l)
-            do i = 1, 2
-                cg(i, :, :) = g(1, a)*c(i, 1, :, :) + g(2, a)*c(i, 2, :, :)
-            end do
-            do b = 1, nen
-                do k = 1, 2
-                    do i = 1, 2
-                        ke(2*a - 2 + i, 2*b - 2 + k) = ke(2*a - 2 + i, 2*b - 2 + k) + &
-                                                       wdv*(cg(i, k, 1)*g(1, b) + cg(i, k, 2)*g(2, b))
-                    end do
+        nen = size(u, 2)
+        fe = 0.0_dp
+        bm = 0.0_dp
+        if (mat%finite_strain) allocate (gm(2*size(pts%wdv), nen), tg(2*size(pts%wdv), nen))
+        do q = 1, size(pts%wdv)
+            grad_u = matmul(u, transpose(pts%dndx(:, :, q)))
+            call mat%stress(grad_u, s, c, ok)
+            if (.not. ok) return
+            if (mat%finite_strain) then
+                f = grad_u
+                f(1, 1) = f(1, 1) + 1.0_dp
+                f(2, 2) = f(2, 2) + 1.0_dp
+                det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
+                finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
+                g = matmul(transpose(finv), pts%dndx(:, :, q))
+                gm(2*q - 1:2*q, :) = g
+                tg(2*q - 1:2*q, :) = pts%wdv(q)*matmul(s, g)
+            else
+                g = pts%dndx(:, :, q)
+            end if
+            do j = 1, 3
+                do i = 1, 3
+                    d(i, j) = pts%wdv(q)*c(vi(i), vj(i), vi(j), vj(j))
                 end do
-                if (mat%finite_strain) then
-                    geo = wdv*dot_product(g(:, a), matmul(s, g(:, b)))
-                    ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + geo
-                    ke(2*a, 2*b) = ke(2*a, 2*b) + geo
-                end if
             end do
+            sv = pts%wdv(q)*[s(1, 1), s(2, 2), s(1, 2)]
+            r = 3*q - 3
+            ! rows of B: [g1 0], [0 g2], [g2 g1] per function
+            bm(r + 1, 1::2) = g(1, :)
+            bm(r + 2, 2::2) = g(2, :)
+            bm(r + 3, 1::2) = g(2, :)
+            bm(r + 3, 2::2) = g(1, :)
+            db(r + 1:r + 3, :) = matmul(d, bm(r + 1:r + 3, :))
+            fe = fe + sv(1)*bm(r + 1, :) + sv(2)*bm(r + 2, :) + sv(3)*bm(r + 3, :)
         end do
-    end subroutine solid_point
+        call gemm_tn(bm, db, ke, 0.0_dp)
+        if (mat%finite_strain) then
+            allocate (kg(nen, nen))
+            call gemm_tn(gm, tg, kg, 0.0_dp)
+            ke(1::2, 1::2) = ke(1::2, 1::2) + kg
+            ke(2::2, 2::2) = ke(2::2, 2::2) + kg
+        end if
+    end subroutine solid_element
 
 end module voiga_element_solid

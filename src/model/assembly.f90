@@ -6,7 +6,7 @@ module voiga_model_assembly
     use voiga_model, only: model_t, body_t, phase_value
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: solid_point, reference_gradients
+    use voiga_element_solid, only: solid_element
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
     use voiga_contact_pair, only: pair_contribution
     implicit none
@@ -57,34 +57,15 @@ contains
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        real(dp) :: r(size(fe)/2), dr(2, size(fe)/2), dndx(2, size(fe)/2), x0(2, size(fe)/2), &
-                    ue(2, size(fe)/2)
-        real(dp) :: xi, eta, det, hx, he
-        integer :: i, j, a
+        real(dp) :: ue(2, size(fe)/2)
+        integer :: a
 
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                x0(:, a) = body%disc%x(:, conn(a))
                 ue(:, a) = u(body%dof0 + 2*conn(a) - 1:body%dof0 + 2*conn(a))
             end do
         end associate
-        fe = 0.0_dp
-        ke = 0.0_dp
-        ok = .true.
-        associate (el => body%disc%elements(e))
-            hx = 0.5_dp*(el%xi(2) - el%xi(1))
-            he = 0.5_dp*(el%eta(2) - el%eta(1))
-            do j = 1, size(body%ge)
-                eta = el%eta(1) + he*(body%ge(j) + 1.0_dp)
-                do i = 1, size(body%gx)
-                    xi = el%xi(1) + hx*(body%gx(i) + 1.0_dp)
-                    call element_basis(body%disc, e, xi, eta, r, dr)
-                    call reference_gradients(x0, dr, dndx, det)
-                    call solid_point(body%mat, dndx, ue, body%wx(i)*body%we(j)*hx*he*abs(det), fe, ke, ok)
-                    if (.not. ok) return
-                end do
-            end do
-        end associate
+        call solid_element(body%mat, body%points(e), ue, fe, ke, ok)
     end subroutine body_element
 
     !> The positions of every bulk element's entries in `k` (built on its pattern).

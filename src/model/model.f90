@@ -8,6 +8,8 @@ module voiga_model
     use voiga_material_factory, only: new_material
     use voiga_discretization_patch, only: discretization_t, edge_cps
     use voiga_element_quadrature, only: gauss_legendre
+    use voiga_element_solid, only: element_points_t, reference_gradients
+    use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit
     use voiga_contact_surface, only: new_contact_surface
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
@@ -16,7 +18,7 @@ module voiga_model
     private
 
     public :: model_t, body_t, dirichlet_t, pressure_t, new_model, phase_value, n_total_steps, &
-              step_time
+              step_time, body_points
 
     !> A deformable body.
     type :: body_t
@@ -29,6 +31,8 @@ module voiga_model
         !> and weights on [-1, 1] along xi (gx, wx) and eta (ge, we).
         integer :: n_gauss(2) = 0
         real(dp), allocatable :: gx(:), wx(:), ge(:), we(:)
+        !> Every element's quadrature points (reference gradients, weights) [nel].
+        type(element_points_t), allocatable :: points(:)
     end type body_t
 
     !> Prescribed displacement on the control points of an edge.
@@ -102,6 +106,7 @@ contains
                 allocate (b%gx(b%n_gauss(1)), b%wx(b%n_gauss(1)), b%ge(b%n_gauss(2)), b%we(b%n_gauss(2)))
                 call gauss_legendre(b%n_gauss(1), b%gx, b%wx)
                 call gauss_legendre(b%n_gauss(2), b%ge, b%we)
+                call body_points(b)
                 self%finite_strain = self%finite_strain .or. b%mat%finite_strain
             end associate
         end do
@@ -203,6 +208,41 @@ contains
         pair%n_evaluations = 0
         pair%n_friction = 0
     end subroutine new_pair
+
+    !> The quadrature points of every element of `body` (reference gradients and
+    !> weights x |det|), from its discretization and Gauss rule. `new_model` calls
+    !> it; call it again after changing the body's reference control points.
+    pure subroutine body_points(body)
+        type(body_t), intent(inout) :: body
+        real(dp), allocatable :: r(:), dr(:, :), x0(:, :)
+        real(dp) :: xi, eta, det, hx, he
+        integer :: e, i, j, q, nen
+
+        if (allocated(body%points)) deallocate (body%points)
+        allocate (body%points(body%disc%nel))
+        do e = 1, body%disc%nel
+            associate (el => body%disc%elements(e), pts => body%points(e))
+                nen = element_nfun(body%disc, e)
+                allocate (r(nen), dr(2, nen))
+                x0 = body%disc%x(:, el%conn)
+                allocate (pts%dndx(2, nen, size(body%gx)*size(body%ge)), pts%wdv(size(body%gx)*size(body%ge)))
+                hx = 0.5_dp*(el%xi(2) - el%xi(1))
+                he = 0.5_dp*(el%eta(2) - el%eta(1))
+                q = 0
+                do j = 1, size(body%ge)
+                    eta = el%eta(1) + he*(body%ge(j) + 1.0_dp)
+                    do i = 1, size(body%gx)
+                        xi = el%xi(1) + hx*(body%gx(i) + 1.0_dp)
+                        q = q + 1
+                        call element_basis(body%disc, e, xi, eta, r, dr)
+                        call reference_gradients(x0, dr, pts%dndx(:, :, q), det)
+                        pts%wdv(q) = body%wx(i)*body%we(j)*hx*he*abs(det)
+                    end do
+                end do
+                deallocate (r, dr)
+            end associate
+        end do
+    end subroutine body_points
 
     pure integer function find_body(self, name) result(ib)
         type(model_t), intent(in) :: self

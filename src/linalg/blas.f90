@@ -1,0 +1,35 @@
+!> The BLAS routines voiga calls, behind explicit interfaces (reference BLAS or
+!> OpenBLAS, whichever `libblas` the system provides).
+!>
+!> `dgemm` only writes its output argument; its interface is declared `pure` so
+!> that pure kernels may use it.
+module voiga_linalg_blas
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: gemm_tn
+
+    interface
+        pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: dp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            real(dp), intent(in) :: alpha, beta
+            real(dp), intent(in) :: a(lda, *), b(ldb, *)
+            real(dp), intent(inout) :: c(ldc, *)
+        end subroutine dgemm
+    end interface
+
+contains
+
+    !> c = beta c + a^T b, with a [k, m], b [k, n], c [m, n] (contiguous arrays).
+    pure subroutine gemm_tn(a, b, c, beta)
+        real(dp), intent(in) :: a(:, :), b(:, :)
+        real(dp), intent(inout) :: c(:, :)
+        real(dp), intent(in) :: beta
+        call dgemm('T', 'N', size(a, 2), size(b, 2), size(a, 1), 1.0_dp, a, size(a, 1), &
+                   b, size(b, 1), beta, c, size(c, 1))
+    end subroutine gemm_tn
+
+end module voiga_linalg_blas
