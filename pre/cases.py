@@ -11,6 +11,7 @@ insertion order.
 from __future__ import annotations
 
 import io
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -20,8 +21,9 @@ import numpy as np
 
 from .h5io import write_geometry
 from .layouts import parse_layout
-from .meshes import (hertz_eta_knots, hertz_radial_elements, hertz_xi_knots, mesh_level)
-from .scenes import scene_bodies
+from .meshes import (arc_parameter_exact, hertz_eta_knots, hertz_radial_elements, hertz_xi_knots,
+                     mesh_level, nest)
+from .scenes import RINGS_LOWER, RINGS_UPPER, scene_bodies
 
 Groups = dict[str, Any]
 
@@ -47,7 +49,14 @@ CONTACT_EDGES: dict[str, dict[str, str]] = {
 IRONING_M1 = {"die": (6, 1), "slab": (8, 2)}
 """(nel_xi, nel_eta) at m1; m<k> multiplies both by 2^(k-1)."""
 RINGS_M1 = {"upper": (12, 2), "lower": (16, 2)}
-"""(nel_xi, nel_eta) at m1; m<k> multiplies the arc direction by 2^(k-1)."""
+"""(nel_xi, nel_eta) at m1; m<k> splits every m1 arc span into 2^(k-1) (graded arc
+knots, :func:`rings_xi_knots`; the 2 radial elements are uniform on every mesh)."""
+RINGS_A_EXP = 0.06
+"""Expected contact half-width of the rings at the last step (c), used for the arc
+grading: on the uniform x8 mesh (N2, 96 x 2 / 128 x 2 elements) the last slave point in
+contact lies at x = 0.059, a quarter of one uniform m1 element of the upper ring."""
+RINGS_CONTACT_XI = {"upper": 0.0, "lower": 1.0}
+"""End of each ring's arc (xi) at the touching point (0, 0)."""
 
 # ------------------------------------------------------------ studies
 STUDIES: dict[str, list[tuple[str, str]]] = {}
@@ -181,12 +190,63 @@ def hertz_case(mesh: str, layout: str) -> Groups:
     return {"case": _case_group("hertz", mesh, mesh, layout, 1), "body": bodies, **hertz_loads()}
 
 
+def rings_m1_angles(r_out: float, n_el: int, a_exp: float = RINGS_A_EXP) -> list[float]:
+    """Interior breakpoint angles (rad) of a half ring's m1 arc mesh, measured along the
+    arc from the touching point (0 .. pi), as the hertz grading: half of the ``n_el``
+    elements uniform in angle over [0, theta_c], theta_c = asin(1.5 a_exp / r_out), the
+    other half uniform in angle on either side of the coarse C0 knot at pi / 2 (half over
+    [theta_c, pi/2], half over [pi/2, pi]; pi/2 is a breakpoint)."""
+    tc = math.asin(1.5 * a_exp / r_out)
+    n_fine = n_el // 2
+    n_near = (n_el - n_fine) // 2
+    n_far = n_el - n_fine - n_near
+    if n_near < 1 or n_far < 1:
+        raise ValueError("rings grading needs at least 4 arc elements")
+    fine = [tc * i / n_fine for i in range(1, n_fine + 1)]
+    near = [tc + (math.pi / 2 - tc) * j / n_near for j in range(1, n_near)]
+    far = [math.pi / 2 + (math.pi / 2) * j / n_far for j in range(0, n_far)]
+    return fine + near + far
+
+
+def rings_m1_breaks(body: str, a_exp: float = RINGS_A_EXP) -> np.ndarray:
+    """Interior arc parameters (increasing, including the coarse knot 0.5) of ``body``'s
+    m1 mesh: :func:`rings_m1_angles` mapped exactly onto the two rational quadratic
+    quarter arcs (each quarter spans half of [0, 1]), mirrored for the lower ring whose
+    touching point is at xi = 1."""
+    r_out = {"upper": RINGS_UPPER, "lower": RINGS_LOWER}[body]["r_out"]
+    ts = []
+    for phi in rings_m1_angles(r_out, RINGS_M1[body][0], a_exp):
+        if phi == math.pi / 2:
+            t = 0.5
+        elif phi < math.pi / 2:
+            t = 0.5 * arc_parameter_exact(phi)
+        else:
+            t = 0.5 + 0.5 * arc_parameter_exact(phi - math.pi / 2)
+        ts.append(t if RINGS_CONTACT_XI[body] == 0.0 else 1.0 - t)
+    return np.array(sorted(ts))
+
+
+def rings_xi_knots(body: str, level: int, a_exp: float = RINGS_A_EXP) -> np.ndarray:
+    """Interior arc knots of ``body`` on rings mesh m<level>: every m1 parameter span
+    split into 2^(level-1) equal spans (exactly nested); the coarse knot 0.5 is left out
+    (it is a knot of the geometry already)."""
+    knots = nest(rings_m1_breaks(body, a_exp), 2 ** (level - 1))
+    return knots[knots != 0.5]
+
+
+def rings_eta_knots(n_el: int) -> np.ndarray:
+    """Uniform interior radial knots (``n_el`` elements)."""
+    return np.array([i / n_el for i in range(1, n_el)])
+
+
 def rings_case(mesh: str, layout: str) -> Groups:
-    """rings: arc direction x 2^(k-1), radial fixed; ``mesh='ref'`` is m4."""
+    """rings: arc knots graded toward the touching point (:func:`rings_xi_knots`, nested
+    from m1), 2 uniform radial elements; ``mesh='ref'`` is m4."""
     real = RINGS_REF_MESH if mesh == "ref" else mesh
-    f = 2 ** (mesh_level(real) - 1)
-    bodies = [_body_group("rings", name, layout, nel=(nx * f, ne))
-              for name, (nx, ne) in RINGS_M1.items()]
+    level = mesh_level(real)
+    bodies = [_body_group("rings", name, layout,
+                          knots=(rings_xi_knots(name, level), rings_eta_knots(ne)))
+              for name, (_, ne) in RINGS_M1.items()]
     return {"case": _case_group("rings", mesh, real, layout, len(bodies)), "body": bodies,
             **rings_loads()}
 

@@ -84,13 +84,25 @@ def test_namelists(generated: Path) -> None:
     ("ironing/m1-N2.nml", {"die": (6, 1, 10.0), "slab": (8, 2, 1.0)}),
     ("ironing/m3-NN2.2.nml", {"die": (24, 4, 10.0), "slab": (32, 8, 1.0)}),
     ("ironing-deep/m4-N6.nml", {"die": (48, 8, 1000.0), "slab": (64, 16, 1.0)}),
-    ("rings/m2-NN4.nml", {"upper": (24, 2, 1.0), "lower": (32, 2, 2.0)}),
-    ("rings/ref-N2.nml", {"upper": (96, 2, 1.0), "lower": (128, 2, 2.0)}),
 ])
 def test_uniform_meshes(generated: Path, rel: str, bodies: dict) -> None:
     got = {b["name"]: (b["nel_xi"], b["nel_eta"], b["youngs_modulus"])
            for b in case_bodies(f90nml.read(str(generated / rel)))}
     assert got == bodies
+
+
+@pytest.mark.parametrize("rel, level", [("rings/m1-N2.nml", 1), ("rings/m2-NN4.nml", 2),
+                                        ("rings/m3-NN2.1.nml", 3), ("rings/ref-N2.nml", 4)])
+def test_rings_meshes(generated: Path, rel: str, level: int) -> None:
+    """Graded arc knots (12 / 16 elements at m1, x 2^(level-1)), 2 radial elements; the
+    coarse knot 0.5 is not listed (it is a knot of the geometry)."""
+    bodies = {b["name"]: b for b in case_bodies(f90nml.read(str(generated / rel)))}
+    for name, n_m1, e in (("upper", 12, 1.0), ("lower", 16, 2.0)):
+        b = bodies[name]
+        kx = np.atleast_1d(b["knots_xi"])
+        assert len(kx) == n_m1 * 2 ** (level - 1) - 2 and 0.5 not in kx
+        np.testing.assert_array_equal(np.atleast_1d(b["knots_eta"]), [0.5])
+        assert (b["material"], b["youngs_modulus"], b["poisson_ratio"]) == ("neo-hookean", e, 0.3)
 
 
 def test_hertz_knot_counts(generated: Path) -> None:

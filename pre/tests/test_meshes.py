@@ -7,11 +7,12 @@ import math
 import numpy as np
 import pytest
 
+from pre.cases import RINGS_A_EXP, rings_m1_angles, rings_m1_breaks, rings_xi_knots
 from pre.layouts import parse_layout
 from pre.meshes import (HERTZ_A_EXP, arc_angle, arc_parameter, hertz_eta_knots, hertz_m1_angles,
                         hertz_theta_c, hertz_xi_knots, nest, uniform_interior)
 from pre.nurbs import evaluate_patch
-from pre.scenes import scene_bodies
+from pre.scenes import RINGS_LOWER, RINGS_UPPER, scene_bodies
 
 
 @pytest.mark.parametrize("name, expect", [
@@ -95,3 +96,46 @@ def test_hertz_radial(n_el: int) -> None:
 def test_uniform_and_nest() -> None:
     np.testing.assert_array_equal(uniform_interior(4), [0.25, 0.5, 0.75])
     np.testing.assert_allclose(nest(np.array([0.5]), 2), [0.25, 0.5, 0.75])
+
+
+# ------------------------------------------------------------------ rings grading
+
+def _rings_angles_from_contact(body: str, knots: np.ndarray) -> np.ndarray:
+    """Angle along the half ring from the touching point of each arc knot, through the
+    geometry itself (splipy evaluation of the coarse outer arc)."""
+    ring = scene_bodies("rings")[body]
+    c = (RINGS_UPPER if body == "upper" else RINGS_LOWER)["centre"]
+    p = evaluate_patch(ring, knots, np.ones_like(knots)) - np.asarray(c)
+    from_bottom = np.arctan2(p[:, 0], -p[:, 1])  # 0 at the lowest point, pi at the top
+    return from_bottom if body == "upper" else math.pi - from_bottom
+
+
+@pytest.mark.parametrize("body, n_el, r_out", [("upper", 12, 1.0), ("lower", 16, 1.5)])
+def test_rings_m1_grading(body: str, n_el: int, r_out: float) -> None:
+    """Half of the m1 arc elements uniform in angle within 1.5 x RINGS_A_EXP of the
+    touching point, the rest uniform on either side of the coarse C0 knot (pi / 2)."""
+    tc = math.asin(1.5 * RINGS_A_EXP / r_out)
+    ang = np.concatenate([[0.0], rings_m1_angles(r_out, n_el), [math.pi]])
+    assert len(ang) == n_el + 1
+    d = np.diff(ang)
+    half, quarter = n_el // 2, n_el // 4
+    np.testing.assert_allclose(d[:half], tc / half, rtol=1e-13)
+    np.testing.assert_allclose(d[half:half + quarter], (math.pi / 2 - tc) / quarter, rtol=1e-13)
+    np.testing.assert_allclose(d[half + quarter:], math.pi / 2 / quarter, rtol=1e-13)
+    breaks = rings_m1_breaks(body)
+    assert 0.5 in breaks and np.all(np.diff(breaks) > 0)
+    got = np.sort(_rings_angles_from_contact(body, breaks))
+    np.testing.assert_allclose(got, ang[1:-1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("body, n_el", [("upper", 12), ("lower", 16)])
+@pytest.mark.parametrize("level", range(1, 5))
+def test_rings_nested(body: str, n_el: int, level: int) -> None:
+    k = rings_xi_knots(body, level)
+    assert len(k) == n_el * 2 ** (level - 1) - 2 and 0.5 not in k
+    assert np.all(np.diff(k) > 0) and k[0] > 0 and k[-1] < 1
+    if level > 1:
+        assert np.all(np.isin(rings_xi_knots(body, level - 1), k))  # exact nesting
+    full = np.concatenate([[0.0], np.sort(np.append(k, 0.5)), [1.0]])
+    spans = np.diff(full).reshape(n_el, -1)  # each m1 span split into equal spans
+    np.testing.assert_allclose(spans, spans[:, :1].repeat(spans.shape[1], axis=1), rtol=1e-12)
