@@ -9,6 +9,9 @@ module test_contact
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_io_case, only: case_t, body_input_t, contact_input_t
     use voiga_model, only: model_t, new_model
+    use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
+                                    new_assembly_map, update_contact_pattern
+    use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t
     use voiga_io_case, only: dirichlet_input_t, pressure_input_t
     use voiga_contact_pair, only: contact_pair_t, pair_contribution
@@ -35,7 +38,8 @@ contains
                     new_unittest('friction_block_stick', test_block_stick), &
                     new_unittest('frictionless_runs_no_friction_code', test_no_friction_code), &
                     new_unittest('rigid_master_adds_no_dofs', test_rigid_no_dofs), &
-                    new_unittest('ironing_newton_quadratic', test_ironing_quadratic) &
+                    new_unittest('ironing_newton_quadratic', test_ironing_quadratic), &
+                    new_unittest('fitted_pattern_keeps_couplings', test_fitted_pattern) &
                     ]
     end subroutine collect_contact
 
@@ -457,5 +461,65 @@ contains
             end if
         end do
     end subroutine test_ironing_quadratic
+
+    !> The contact part of the stiffness pattern fitted to the configuration
+    !> (update_contact_pattern) is smaller than the whole-master coupling but loses
+    !> no entry: the tangent assembled on it equals the one on the full pattern.
+    subroutine test_fitted_pattern(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=5), parameter :: layouts(3) = [character(len=5) :: 'N2', 'NN4', 'NN2.2']
+        type(model_t) :: model
+        type(csc_matrix_t) :: k
+        type(assembly_map_t) :: map
+        type(assembly_stats_t) :: stats
+        real(dp), allocatable :: u(:), r(:), k_full(:, :), k_fit(:, :)
+        integer :: il, nnz_full
+
+        do il = 1, size(layouts)
+            call two_body_model(trim(layouts(il)), 0.3_dp, .false., model, error)
+            if (allocated(error)) return
+            call penetrating_state(model, u)
+            allocate (r(size(u)))
+            call stiffness_pattern(model, k, error)
+            if (allocated(error)) return
+            call new_assembly_map(model, k, map)
+            nnz_full = k%nnz()
+            call assemble(model, u, 1.0_dp, r, stats, error, k, map)
+            if (allocated(error)) return
+            k_full = dense(k)
+            call update_contact_pattern(model, u, k, map, stats, error)
+            if (allocated(error)) return
+            call check(error, stats%pattern_rebuilds, 1, trim(layouts(il))//': pattern rebuilds')
+            if (allocated(error)) return
+            call assemble(model, u, 1.0_dp, r, stats, error, k, map)
+            if (allocated(error)) return
+            call check(error, stats%pattern_rebuilds, 1, trim(layouts(il))//': rebuilds after assembly '// &
+                       '(a miss would rebuild again)')
+            if (allocated(error)) return
+            call check(error, k%nnz() < nnz_full, trim(layouts(il))//': fitted pattern is smaller')
+            if (allocated(error)) return
+            call check(error, k%missed, 0, trim(layouts(il))//': entries missed')
+            if (allocated(error)) return
+            k_fit = dense(k)
+            call check(error, maxval(abs(k_fit - k_full))/maxval(abs(k_full)), 0.0_dp, &
+                       trim(layouts(il))//': tangent on the fitted pattern vs the full one', abs=1.0e-14_dp)
+            if (allocated(error)) return
+            deallocate (r)
+            stats = assembly_stats_t()
+        end do
+    contains
+        function dense(a) result(d)
+            type(csc_matrix_t), intent(in) :: a
+            real(dp), allocatable :: d(:, :)
+            integer :: j, p
+            allocate (d(a%n, a%n))
+            d = 0.0_dp
+            do j = 1, a%n
+                do p = a%colptr(j) + 1, a%colptr(j + 1)
+                    d(a%rowind(p) + 1, j) = a%values(p)
+                end do
+            end do
+        end function dense
+    end subroutine test_fitted_pattern
 
 end module test_contact

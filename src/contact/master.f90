@@ -18,6 +18,9 @@ module voiga_contact_master
         real(dp), allocatable :: r(:), dr(:)
         !> Global DOFs of those functions [2 nm], order 2(k-1) + i.
         integer, allocatable :: dofs(:)
+        !> Range of the master's control points (positions in `all_dofs` / 2) that
+        !> those functions belong to; empty (first > last) for a rigid master.
+        integer :: first = 1, last = 0
     end type master_point_t
 
     !> A master surface.

@@ -223,6 +223,8 @@ contains
         mp%r = best_pt%r
         mp%dr = best_pt%dr
         mp%dofs = best_pt%dofs
+        mp%first = minval(best_pt%local)
+        mp%last = maxval(best_pt%local)
         if (best_span < 0 .or. s1 < 0) found = .false.
 
     end subroutine nurbs_project

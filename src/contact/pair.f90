@@ -13,15 +13,17 @@ module voiga_contact_pair
     private
 
     public :: contact_pair_t, setup_points, pair_contribution, pair_commit, pair_reset_trial, &
-              contact_point_out_t
+              contact_point_out_t, pair_wanted_ranges, pair_element_dofs
 
     !> Per-slave-point output of the last evaluation.
     type :: contact_point_out_t
         !> Reference and current position of the slave point.
         real(dp) :: x0(2) = 0.0_dp, x(2) = 0.0_dp
         real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp
-        !> Master convective coordinate of the projection.
+        !> Master convective coordinate of the projection, and the range of master
+        !> control points its functions belong to (empty for a rigid master).
         real(dp) :: xi_m = 0.0_dp
+        integer :: first = 1, last = 0
         integer :: state = state_inactive
     end type contact_point_out_t
 
@@ -54,12 +56,21 @@ module voiga_contact_pair
         real(dp) :: force(2) = 0.0_dp
         !> Counters: active point evaluations, of which frictional.
         integer(i8) :: n_evaluations = 0, n_friction = 0
+        !> Deformable master: the master control points [mlo(e), mhi(e)] each slave
+        !> element e is coupled with in the stiffness pattern (empty: lo > hi;
+        !> initially the whole master).
+        integer, allocatable :: mlo(:), mhi(:)
+        !> Set by an evaluation with a stiffness in which an active point projected
+        !> outside its element's range (the range was widened, the point's
+        !> stiffness not added: the pattern must be rebuilt and the tangent
+        !> assembled again).
+        logical :: pattern_miss = .false.
     end type contact_pair_t
 
 contains
 
     !> Place the slave Gauss points (n_gauss per slave element; 0: degree + 1) and,
-    !> for a frictional pair, the history arrays.
+    !> for a frictional pair, the history arrays. Set the master first.
     pure subroutine setup_points(self)
         type(contact_pair_t), intent(inout) :: self
         real(dp), allocatable :: gx(:), gw(:)
@@ -83,6 +94,12 @@ contains
             end do
         end do
         allocate (self%out(ne*ng))
+        ! until a caller fits them (update_contact_pattern), every slave element is
+        ! coupled with the whole master
+        allocate (self%mlo(ne), self%mhi(ne))
+        self%mlo = 1
+        self%mhi = 0
+        if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/2
         self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
         if (self%law%mu > 0.0_dp) then
             allocate (self%anchor(ne*ng), self%trial_anchor(ne*ng), self%xi_last(ne*ng), &
@@ -118,7 +135,7 @@ contains
         real(dp), allocatable :: rl(:), kl(:, :)
         integer, allocatable :: dofs(:)
         real(dp) :: g, pn, pt, anchor, new_anchor
-        integer :: k, state, nd
+        integer :: k, state, nd, e
         logical :: found, converged
         character(len=96) :: buf
 
@@ -133,6 +150,8 @@ contains
             self%out(k)%pt = 0.0_dp
             call self%master%project(u, sp%x, mp, found, converged)
             self%out(k)%xi_m = mp%xi
+            self%out(k)%first = mp%first
+            self%out(k)%last = mp%last
             self%out(k)%gap = huge(1.0_dp)
             if (found) self%out(k)%gap = dot_product(sp%x - mp%x, mp%n)
             if (allocated(self%anchor)) then
@@ -168,7 +187,22 @@ contains
             ! partition of unity: the slave part sums to -da t
             self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
             self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
-            if (present(add)) call add(dofs, kl)
+            if (present(add)) then
+                e = (k - 1)/self%n_gauss + 1
+                if (mp%first < self%mlo(e) .or. mp%last > self%mhi(e)) then
+                    ! outside the pattern: widen it, the caller rebuilds and reassembles
+                    if (self%mlo(e) > self%mhi(e)) then
+                        self%mlo(e) = mp%first
+                        self%mhi(e) = mp%last
+                    else
+                        self%mlo(e) = min(self%mlo(e), mp%first)
+                        self%mhi(e) = max(self%mhi(e), mp%last)
+                    end if
+                    self%pattern_miss = .true.
+                else
+                    call add(dofs, kl)
+                end if
+            end if
             self%out(k)%state = state
             self%out(k)%pn = pn
             self%out(k)%pt = pt
@@ -178,6 +212,54 @@ contains
             end if
         end do
     end subroutine pair_contribution
+
+    !> Global DOFs of slave element `e`'s control points on the contact edge.
+    pure function pair_element_dofs(self, e) result(dofs)
+        type(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: e
+        integer, allocatable :: dofs(:)
+        integer :: s, p
+        p = self%slave%degree
+        s = self%slave%spans(e)
+        dofs = reshape(self%slave%dofs(:, s - p:s), [2*(p + 1)])
+    end function pair_element_dofs
+
+    !> The master ranges each slave element should be coupled with, from the last
+    !> evaluation: the control points of the projections of its points that are
+    !> closer than the element's size (gap < diameter of its points' box),
+    !> widened by one span on each side and rounded outward to blocks of
+    !> `block` control points (so that the pattern changes seldom while the
+    !> bodies slide). `n_master` is the master's number of control points.
+    pure subroutine pair_wanted_ranges(self, n_master, block, lo, hi)
+        type(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: n_master, block
+        integer, intent(out) :: lo(:), hi(:)
+        real(dp) :: h
+        integer :: e, k, ng, w
+        ng = self%n_gauss
+        lo = 1
+        hi = 0
+        do e = 1, size(lo)
+            associate (pts => self%out((e - 1)*ng + 1:e*ng))
+                h = norm2(maxval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2) - &
+                          minval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2))
+                do k = 1, ng
+                    if (pts(k)%first > pts(k)%last .or. pts(k)%gap >= h) cycle
+                    w = pts(k)%last - pts(k)%first
+                    if (lo(e) > hi(e)) then
+                        lo(e) = pts(k)%first - w
+                        hi(e) = pts(k)%last + w
+                    else
+                        lo(e) = min(lo(e), pts(k)%first - w)
+                        hi(e) = max(hi(e), pts(k)%last + w)
+                    end if
+                end do
+            end associate
+            if (lo(e) > hi(e)) cycle
+            lo(e) = max(1, ((lo(e) - 1)/block)*block + 1)
+            hi(e) = min(n_master, ((hi(e) + block - 1)/block)*block)
+        end do
+    end subroutine pair_wanted_ranges
 
     !> The step converged: the trial history becomes the committed one.
     pure subroutine pair_commit(self)

@@ -8,12 +8,12 @@ module voiga_model_assembly
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
-    use voiga_contact_pair, only: pair_contribution
+    use voiga_contact_pair, only: pair_contribution, pair_wanted_ranges, pair_element_dofs
     implicit none
     private
 
     public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
-    public :: assembly_map_t, new_assembly_map
+    public :: assembly_map_t, new_assembly_map, update_contact_pattern
 
     !> Where each element's stiffness entries go in the CSC values, computed once per
     !> pattern so that assembly needs no search.
@@ -30,6 +30,8 @@ module voiga_model_assembly
         integer(i8) :: finite_strain_points = 0, small_strain_points = 0
         !> Seconds spent in bulk assembly and in contact (search and assembly).
         real(dp) :: seconds_bulk = 0.0_dp, seconds_contact = 0.0_dp
+        !> Times the stiffness pattern was rebuilt for the contact couplings.
+        integer :: pattern_rebuilds = 0
     end type assembly_stats_t
 
 contains
@@ -108,7 +110,7 @@ contains
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(out) :: k
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: ptr(:), dofs(:)
+        integer, allocatable :: ptr(:), dofs(:), mdofs(:)
         integer :: ib, e, nel, n, pos, ip
 
         nel = 0
@@ -119,11 +121,17 @@ contains
                 n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
         end do
-        ! a deformable master couples every slave edge DOF with every master edge DOF
+        ! a deformable master: each slave element's edge DOFs with the master's control
+        ! points in its range (contact_pair_t%mlo, mhi)
         do ip = 1, size(model%pairs)
-            if (.not. model%pairs(ip)%master%deformable) cycle
-            nel = nel + 1
-            n = n + size(model%pairs(ip)%slave%dofs) + size(model%pairs(ip)%master%all_dofs())
+            associate (pair => model%pairs(ip))
+                if (.not. pair%master%deformable) cycle
+                do e = 1, size(pair%mlo)
+                    if (pair%mlo(e) > pair%mhi(e)) cycle
+                    nel = nel + 1
+                    n = n + size(pair_element_dofs(pair, e)) + 2*(pair%mhi(e) - pair%mlo(e) + 1)
+                end do
+            end associate
         end do
         allocate (ptr(nel + 1), dofs(n))
         ptr(1) = 1
@@ -137,18 +145,26 @@ contains
             end do
         end do
         do ip = 1, size(model%pairs)
-            if (.not. model%pairs(ip)%master%deformable) cycle
-            pos = pos + 1
-            n = size(model%pairs(ip)%slave%dofs) + size(model%pairs(ip)%master%all_dofs())
-            ptr(pos + 1) = ptr(pos) + n
-            dofs(ptr(pos):ptr(pos + 1) - 1) = [reshape(model%pairs(ip)%slave%dofs, [size(model%pairs(ip)%slave%dofs)]), &
-                                               model%pairs(ip)%master%all_dofs()]
+            associate (pair => model%pairs(ip))
+                if (.not. pair%master%deformable) cycle
+                mdofs = pair%master%all_dofs()
+                do e = 1, size(pair%mlo)
+                    if (pair%mlo(e) > pair%mhi(e)) cycle
+                    pos = pos + 1
+                    n = size(pair_element_dofs(pair, e)) + 2*(pair%mhi(e) - pair%mlo(e) + 1)
+                    ptr(pos + 1) = ptr(pos) + n
+                    dofs(ptr(pos):ptr(pos + 1) - 1) = [pair_element_dofs(pair, e), &
+                                                       mdofs(2*pair%mlo(e) - 1:2*pair%mhi(e))]
+                end do
+            end associate
         end do
         call new_csc_pattern(k, model%ndof, ptr, dofs, error)
     end subroutine stiffness_pattern
 
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
+    !> When a contact point falls outside the stiffness pattern, the pattern (and
+    !> `map`) is rebuilt and the whole assembly done again.
     subroutine assemble(model, u, t, r, stats, error, k, map)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
@@ -159,6 +175,91 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(csc_matrix_t), intent(inout), optional :: k
         !> Element positions in `k` (from `new_assembly_map`): no search when given.
+        type(assembly_map_t), intent(inout), optional :: map
+        integer :: pass, ip
+        do pass = 1, 3
+            call assemble_once(model, u, t, r, stats, error, k, map)
+            if (allocated(error) .or. .not. present(k)) return
+            if (.not. any([(model%pairs(ip)%pattern_miss, ip=1, size(model%pairs))])) return
+            do ip = 1, size(model%pairs)
+                model%pairs(ip)%pattern_miss = .false.
+            end do
+            call rebuild_pattern(model, k, error, map)
+            if (allocated(error)) return
+            stats%pattern_rebuilds = stats%pattern_rebuilds + 1
+        end do
+        call fatal_error(error, 'contact: the stiffness pattern still misses contact couplings '// &
+                         'after two rebuilds', error_code%numeric)
+    end subroutine assemble
+
+    !> Rebuild the stiffness pattern `k` (values lost) and, if given, `map`.
+    subroutine rebuild_pattern(model, k, error, map)
+        type(model_t), intent(in) :: model
+        type(csc_matrix_t), intent(inout) :: k
+        type(error_t), allocatable, intent(out) :: error
+        type(assembly_map_t), intent(inout), optional :: map
+        call stiffness_pattern(model, k, error)
+        if (allocated(error)) return
+        if (present(map)) call new_assembly_map(model, k, map)
+    end subroutine rebuild_pattern
+
+    !> Fit the contact part of the stiffness pattern to the configuration `u` (the
+    !> start of a load step): each slave element coupled with the master control
+    !> points near its points (`pair_wanted_ranges`). Rebuilds `k` and `map` only
+    !> if a range changed; the result depends on `u` only, so a restarted run
+    !> gets the same patterns as an uninterrupted one.
+    subroutine update_contact_pattern(model, u, k, map, stats, error)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: u(:)
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(inout) :: map
+        type(assembly_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: r(:)
+        integer, allocatable :: lo(:), hi(:)
+        integer :: ip, nm
+        logical :: changed
+        integer(i8) :: c0, c1, rate
+
+        call system_clock(c0, rate)
+        changed = .false.
+        allocate (r(size(u)))
+        do ip = 1, size(model%pairs)
+            associate (pair => model%pairs(ip))
+                if (.not. pair%master%deformable) cycle
+                r = 0.0_dp
+                call pair_contribution(pair, u, r, error)
+                ! a projection failure here is not this step's: the step's own
+                ! evaluations report it
+                if (allocated(error)) deallocate (error)
+                nm = size(pair%master%all_dofs())/2
+                allocate (lo(size(pair%mlo)), hi(size(pair%mhi)))
+                call pair_wanted_ranges(pair, nm, 8, lo, hi)
+                if (any(lo /= pair%mlo) .or. any(hi /= pair%mhi)) then
+                    changed = .true.
+                    pair%mlo = lo
+                    pair%mhi = hi
+                end if
+                deallocate (lo, hi)
+            end associate
+        end do
+        if (changed) then
+            call rebuild_pattern(model, k, error, map)
+            stats%pattern_rebuilds = stats%pattern_rebuilds + 1
+        end if
+        call system_clock(c1)
+        stats%seconds_contact = stats%seconds_contact + real(c1 - c0, dp)/real(rate, dp)
+    end subroutine update_contact_pattern
+
+    !> One pass of `assemble`.
+    subroutine assemble_once(model, u, t, r, stats, error, k, map)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(in) :: t
+        real(dp), intent(out) :: r(:)
+        type(assembly_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout), optional :: k
         type(assembly_map_t), intent(in), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
@@ -232,7 +333,7 @@ contains
             real(dp), intent(in) :: kl(:, :)
             call k%add_element(dofs, kl)
         end subroutine add_to_k
-    end subroutine assemble
+    end subroutine assemble_once
 
     !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the
     !> reference edge, N the outward unit normal.

@@ -22,7 +22,7 @@ module voiga_solver_newton
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, phase_value, step_time, n_total_steps
     use voiga_model_assembly, only: assembly_stats_t, assemble, stiffness_pattern, assembly_map_t, &
-                                    new_assembly_map
+                                    new_assembly_map, update_contact_pattern
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_signals, only: caught_signal, signal_name
@@ -160,7 +160,9 @@ contains
                 t = t_end
                 if (s + ds < 1.0_dp) t = t_begin + (s + ds)*(t_end - t_begin)
                 call set_prescribed(model, t, u)
-                call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
+                call update_contact_pattern(model, u, k, map, stats%assembly, error)
+                if (.not. allocated(error)) &
+                    call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
                 if (.not. allocated(error)) then
                     u_conv = u
                     do ip = 1, size(model%pairs)
@@ -265,7 +267,7 @@ contains
         !> Residual at the last evaluation, shape [ndof].
         real(dp), intent(inout) :: r(:)
         type(csc_matrix_t), intent(inout) :: k
-        type(assembly_map_t), intent(in) :: map
+        type(assembly_map_t), intent(inout) :: map
         type(umfpack_t), intent(inout) :: lu
         type(solver_stats_t), intent(inout) :: stats
         type(step_record_t), intent(inout) :: rec
