@@ -8,6 +8,10 @@ PREFIX  := build/install
 VOIGA   := $(PREFIX)/bin/voiga
 APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev libopenblas-dev
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# One BLAS thread per run unless the caller sets it: on this 2-core machine the sweep
+# runs one case per core, and OpenBLAS threads that wait by spinning made hertz m3
+# 3x slower while anything else ran (docs/performance.md).
+export OPENBLAS_NUM_THREADS ?= 1
 
 .PHONY: all deps build run test test-fortran test-python clean bench paper
 
@@ -57,10 +61,11 @@ clean:
 bench: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m bench $(BENCH_ARGS)
 
-## paper: run the paper's studies (PAPER_ARGS, e.g. --scenes hertz --meshes m1 m2) and
-## regenerate the figures and tables in docs/validation; fails if a case fails
+## paper: run the paper's studies (PAPER_ARGS, e.g. --scenes hertz --meshes m1 m2) into
+## PAPER_OUT and regenerate the figures and tables in docs/validation; fails if a case fails
+PAPER_OUT ?= results
 paper: build
 	@status=0; \
-	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post sweep --out results $(PAPER_ARGS) || status=$$?; \
-	$(PYTHON) -m post figures --results results --out docs/validation || status=$$?; \
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post sweep --out $(PAPER_OUT) $(PAPER_ARGS) || status=$$?; \
+	$(PYTHON) -m post figures --results $(PAPER_OUT) --out docs/validation || status=$$?; \
 	exit $$status

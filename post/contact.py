@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .reader import ContactOutput, Result
+from pre.nurbs import Curve, curve_to_splipy
+
+from .reader import Body, ContactOutput, Result
 
 
 @dataclass
@@ -88,6 +90,51 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0, radius: floa
     a_fit, p0_fit = fit_hertz(x, p)
     return HertzComparison(force=force, a=a, p0=p0, a_fit=a_fit, p0_fit=p0_fit,
                            p_max=float(p.max()), l2_error=normalized_l2_error(x, p, a))
+
+
+def slave_edge_curve(body: Body) -> tuple[Curve, np.ndarray]:
+    """The slave body's contact edge as a curve in the reference configuration (the
+    VO layer, else the bulk's eta = 1 row) and its control points' 0-based body ids
+    (the edge in ``body.edges`` that lists them)."""
+    if body.layer is not None:
+        curve = body.layer
+    else:
+        b = body.bulk
+        curve = Curve(degree=b.degree[0], knots=b.knots_xi, control_points=b.control_points[-1],
+                      weights=b.weights[-1])
+    for ids in body.edges.values():
+        if len(ids) == len(curve.weights) and np.allclose(body.control_points[ids],
+                                                          curve.control_points, atol=1e-12):
+            return curve, ids
+    raise ValueError(f"body {body.name!r}: no edge lists the contact edge's control points")
+
+
+def pressure_field(result: Result, step: int = -1, pair: int = 0, per_span: int = 64,
+                   params: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The penalty contact pressure as the continuous field it is along the slave
+    curve, p = eps_N <-g>, g = (x - p0) . n, for a pair with a rigid master line:
+    current points ``(m, 2)`` and pressures ``(m,)`` at ``per_span`` parameters per
+    knot span of the slave's contact edge (ends included). Unlike the per-Gauss-point
+    output, this does not depend on where the quadrature points lie. ``params``:
+    evaluate at these parameters of the edge instead."""
+    st = result.steps[step] if step != 0 else None
+    if st is None:
+        raise ValueError("pressure_field needs a converged step")
+    c = st.contact[pair]
+    if c.rigid_point is None or c.rigid_normal is None:
+        raise ValueError("pressure_field: only for a rigid master line")
+    eps = float(c.attrs["penalty_normal"])
+    body = result.bodies[c.slave]
+    curve, ids = slave_edge_curve(body)
+    u = np.asarray(st.displacement[body.dofs]).reshape(-1, 2)
+    moved = Curve(degree=curve.degree, knots=curve.knots,
+                  control_points=curve.control_points + u[ids], weights=curve.weights)
+    breaks = np.unique(curve.knots)
+    t = np.unique(np.concatenate([np.linspace(a, b, per_span) for a, b in zip(breaks[:-1], breaks[1:])])) \
+        if params is None else np.asarray(params, dtype=float)
+    x = np.asarray(curve_to_splipy(moved)(t), dtype=float).reshape(-1, 2)
+    gap = (x - c.rigid_point) @ c.rigid_normal
+    return x, eps * np.maximum(0.0, -gap)
 
 
 def contact_profile(c: ContactOutput, axis: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

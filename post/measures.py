@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact import fit_hertz, hertz_comparison
+from .contact import fit_hertz, hertz_comparison, pressure_field
 from .ironing import die_forces
 from .reader import Result
 
@@ -35,10 +35,15 @@ def ironing_measures(res: Result) -> dict[str, float]:
     if len(sliding) < 8:
         return {}
     w = sliding[len(sliding) // 2:]
-    return {"amp_px": detrended_amplitude(steps[w], f[w, 0]),
-            "amp_py": detrended_amplitude(steps[w], f[w, 1]),
-            "raw_amp_px": float(np.ptp(f[w, 0])), "raw_amp_py": float(np.ptp(f[w, 1])),
-            "mean_px": float(f[w, 0].mean()), "mean_py": float(f[w, 1].mean())}
+    out = {"amp_px": detrended_amplitude(steps[w], f[w, 0]),
+           "amp_py": detrended_amplitude(steps[w], f[w, 1]),
+           "raw_amp_px": float(np.ptp(f[w, 0])), "raw_amp_py": float(np.ptp(f[w, 1])),
+           "mean_px": float(f[w, 0].mean()), "mean_py": float(f[w, 1].mean())}
+    # the oscillation relative to the mean force: an error measure (the continuum
+    # solution of steady sliding has none), comparable across meshes
+    out["osc_px"] = out["amp_px"] / abs(out["mean_px"]) if out["mean_px"] else float("nan")
+    out["osc_py"] = out["amp_py"] / abs(out["mean_py"]) if out["mean_py"] else float("nan")
+    return out
 
 
 def profile(res: Result, pair: int = 0, which: str = "p_n") -> tuple[np.ndarray, np.ndarray]:
@@ -92,6 +97,12 @@ def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
         xr, pr = edge_profile(*profile(ref))
         href = hertz_comparison(ref)
         out["l2_ref"] = profile_error(x / href.a, p, xr / href.a, pr, 1.2, float(pr.max()))
+        # the same distance between the continuous penalty pressure fields
+        xf, pf = pressure_field(res)
+        xfr, pfr = pressure_field(ref)
+        o, orr = np.argsort(xf[:, 0]), np.argsort(xfr[:, 0])
+        out["l2_ref_field"] = profile_error(xf[o, 0] / href.a, pf[o], xfr[orr, 0] / href.a, pfr[orr],
+                                            1.2, float(pfr.max()))
     return out
 
 

@@ -146,6 +146,12 @@ class ContactOutput:
     xi_master: np.ndarray
     state: np.ndarray
     """(n,) 0 inactive, 1 stick (or frictionless contact), 2 slip."""
+    attrs: dict[str, Any] = field(default_factory=dict)
+    """Every attribute of the group (penalty_normal, penalty_tangent, friction, ...)."""
+    rigid_point: np.ndarray | None = None
+    """(2,) a point of a rigid master line (None for a deformable master)."""
+    rigid_normal: np.ndarray | None = None
+    """(2,) the rigid master line's unit outward normal."""
 
     @property
     def active(self) -> np.ndarray:
@@ -370,7 +376,9 @@ def _read_contact(g: h5py.Group) -> ContactOutput:
                          force=vec("force"), xi_slave=vec("xi_slave"), x_ref=pts("x_ref"),
                          x=pts("x"), gap=vec("gap"), p_n=vec("p_n"), p_t=vec("p_t"),
                          xi_master=vec("xi_master"),
-                         state=np.asarray(g["state"][()], dtype=int).reshape(-1))
+                         state=np.asarray(g["state"][()], dtype=int).reshape(-1), attrs=a,
+                         rigid_point=vec("rigid_point") if "rigid_point" in g else None,
+                         rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None)
 
 
 def read_result(path: str | Path) -> Result:

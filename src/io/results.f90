@@ -11,6 +11,7 @@ module voiga_io_results
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization
     use voiga_model, only: model_t
+    use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_pair, only: contact_pair_t
     implicit none
     private
@@ -226,6 +227,14 @@ contains
         call h5%create_group(c)
         call h5%write_attr(c, 'slave', trim(pair%slave_name))
         call h5%write_attr(c, 'master', trim(pair%master_name))
+        call h5%write_attr(c, 'penalty_normal', pair%law%eps_n)
+        call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t)
+        call h5%write_attr(c, 'friction', pair%law%mu)
+        select type (m => pair%master)
+        type is (rigid_line_t)
+            call h5%write(c//'/rigid_point', m%p0)
+            call h5%write(c//'/rigid_normal', m%n)
+        end select
         call h5%write(c//'/force', pair%force)
         allocate (a2(2, n), a1(n), st(n))
         do i = 1, n

@@ -8,7 +8,9 @@ from pathlib import Path
 import pytest
 
 from conftest import REPO
-from post.contact import hertz_comparison
+import numpy as np
+
+from post.contact import hertz_comparison, pressure_field
 from post.reader import read_result
 
 
@@ -25,3 +27,20 @@ def test_hertz_m3(run, tmp_path: Path, layout: str) -> None:
     assert abs(h.a_error) <= 0.02, h
     assert abs(h.p_max / h.p0 - 1.0) <= 0.02, h
     assert abs(h.p0_error) <= 0.02, h
+
+
+def test_pressure_field_matches_gauss_points(run, tmp_path: Path) -> None:
+    """The continuous penalty pressure (post, splipy) at the slave points equals the
+    solver's per-point output, and it is zero where the points are not in contact."""
+    src = REPO / "cases" / "hertz"
+    shutil.copy(src / "geometry.h5", tmp_path)
+    for layout in ("N2", "NN2.2"):
+        case = tmp_path / f"m1-{layout}.nml"
+        shutil.copy(src / case.name, case)
+        assert run(case, "--quiet").returncode == 0
+        res = read_result(tmp_path / f"m1-{layout}.h5")
+        c = res.steps[-1].contact[0]
+        x, p = pressure_field(res, params=c.xi_slave)
+        assert np.allclose(x, c.x, rtol=0, atol=1e-12)
+        assert np.allclose(p, c.p_n, rtol=1e-9, atol=1e-12 * c.p_n.max())
+        assert c.p_n.max() > 0 and (p[c.state == 0] == 0).all()
