@@ -137,9 +137,18 @@ def pressure_field(result: Result, step: int = -1, pair: int = 0, per_span: int 
     return x, eps * np.maximum(0.0, -gap)
 
 
-def contact_profile(c: ContactOutput, axis: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Current position along ``axis`` (sorted), p_N and p_T of one pair's slave points."""
-    order = np.argsort(c.x[:, axis])
+def contact_profile(c: ContactOutput, axis: int = 0,
+                    margin: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Current position along ``axis`` (sorted), p_N and p_T of one pair's slave points
+    around the contact zone: in the slave parameter's order, from ``margin`` points
+    before the first point in contact to ``margin`` points after the last (all points
+    when none is in contact). Points elsewhere on the slave edge (e.g. the far side
+    of a ring, at the same x) would otherwise interleave with the zone's."""
+    along = np.argsort(c.xi_slave, kind="stable")
+    act = np.flatnonzero(c.active[along])
+    if act.size:
+        along = along[max(0, act[0] - margin):act[-1] + margin + 1]
+    order = along[np.argsort(c.x[along, axis], kind="stable")]
     return c.x[order, axis], c.p_n[order], c.p_t[order]
 
 

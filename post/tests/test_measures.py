@@ -65,3 +65,23 @@ def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
     assert all(r["status"] == "converged" for r in rows)
     assert float(rows[1]["l2_analytic"]) < 0.1 and abs(float(rows[1]["a_err"])) < 0.02
     assert "| hertz | m1 | N2 |" in md_path.read_text()
+
+
+def test_contact_profile_keeps_the_contact_zone() -> None:
+    """A ring-like slave edge: its far end comes back to small x with no contact; the
+    profile keeps the contact zone and its neighbours only, in x order."""
+    from post.contact import contact_profile
+    from post.reader import ContactOutput
+
+    theta = np.linspace(-np.pi / 2, np.pi / 2, 41)          # bottom to top of a half ring
+    x = np.c_[np.cos(theta), np.sin(theta)]
+    pn = np.where(theta < -np.pi / 2 + 0.2, 1.0 - (theta + np.pi / 2) / 0.2, 0.0)
+    state = (pn > 0).astype(int)
+    n = len(theta)
+    c = ContactOutput(slave="upper", master="lower", force=np.zeros(2), xi_slave=np.linspace(0, 1, n),
+                      x_ref=x, x=x, gap=-pn, p_n=pn, p_t=np.zeros(n), xi_master=np.zeros(n), state=state)
+    xs, p, _ = contact_profile(c, margin=2)
+    last = np.flatnonzero(state)[-1]
+    assert len(xs) == last + 1 + 2                      # the zone and 2 points after it
+    assert np.all(np.diff(xs) >= 0)
+    assert np.array_equal(p[: last + 1], pn[: last + 1])
