@@ -39,4 +39,30 @@ def refined_hertz_text(level: int) -> str:
     text = set_variable(text, "knots_xi", format_list(kx))
     text = set_variable(text, "knots_eta", format_list(ke))
     text = set_variable(text, "mesh", f"'m{level}'")
+    text = set_variable(text, "output", f"'m{level}-N2.h5'")
     return set_variable(text, "title", f"'hertz m{level} N2'")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m bench.refine LEVEL [OUT.nml]``: write the hertz N2 case of mesh
+    m<LEVEL> (next to cases/hertz/geometry.h5's copy, which the case names)."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(prog="python -m bench.refine", description=main.__doc__)
+    ap.add_argument("level", type=int, help="mesh level, >= 7")
+    ap.add_argument("out", nargs="?", help="case file to write (default: m<level>-N2.nml)")
+    args = ap.parse_args(argv)
+    if args.level < 7:
+        print("bench.refine: level must be >= 7 (m1..m6 are committed in cases/hertz)",
+              file=sys.stderr)
+        return 2
+    out = args.out or f"m{args.level}-N2.nml"
+    with open(out, "w") as fh:
+        fh.write(refined_hertz_text(args.level))
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
