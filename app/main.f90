@@ -121,7 +121,8 @@ program voiga_main
     call solve_steps(model, u, stats, quiet, error, results, t0, verbose, &
                      stepping_t(min_step_fraction=case%solver%min_step_fraction, &
                                 max_cuts=case%solver%max_cuts, &
-                                grow_iterations=case%solver%grow_iterations), resume)
+                                grow_iterations=case%solver%grow_iterations, &
+                                predictor=case%solver%predictor), resume)
     if (stats%signal /= 0) then
         call results%finish('interrupted', wall_seconds() - t0, stats%cut_records)
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
@@ -179,6 +180,14 @@ contains
             g = '/steps/'//trim(buf)
             call f%read(g//'/displacement', state%u, error)
             if (allocated(error)) return
+            ! the step before (the predictor extrapolates the last step's increment)
+            allocate (state%u_before(size(state%u)))
+            state%u_before = 0.0_dp
+            if (done > 1) then
+                write (buf, '(i6.6)') done - 1
+                call f%read('/steps/'//trim(buf)//'/displacement', state%u_before, error)
+                if (allocated(error)) return
+            end if
             if (size(state%u) /= model%ndof) then
                 call fatal_error(error, path//': --restart: the result file does not belong to this case '// &
                                  '(different number of DOFs)', error_code%input)

@@ -25,7 +25,8 @@ contains
                     new_unittest('cut_step_converges_to_fine_path', test_cut_converges), &
                     new_unittest('increment_grows_back_to_nominal', test_growth), &
                     new_unittest('minimum_increment_fails_cleanly', test_minimum), &
-                    new_unittest('no_cuts_fails_at_full_step', test_no_cuts) &
+                    new_unittest('no_cuts_fails_at_full_step', test_no_cuts), &
+                    new_unittest('predictor_same_states_fewer_iterations', test_predictor) &
                     ]
     end subroutine collect_stepping
 
@@ -167,5 +168,35 @@ contains
         if (allocated(error)) return
         call check(error, stats%cuts, 0, 'no cut')
     end subroutine test_no_cuts
+
+    !> The predictor (last step's increment, extrapolated within a phase) reaches
+    !> the same states as starting each step from the last one, in fewer Newton
+    !> iterations; it is not used across a phase change.
+    subroutine test_predictor(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: on, off
+        real(dp), allocatable :: u_on(:), u_off(:)
+        integer :: k
+        call block_model([0.3_dp, 0.0_dp], [10, 10], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u_off, off, .true., error, stepping=stepping_t(predictor=.false.))
+        if (allocated(error)) return
+        call block_model([0.3_dp, 0.0_dp], [10, 10], model, error)
+        if (allocated(error)) return
+        call solve_steps(model, u_on, on, .true., error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(u_on - u_off)), 0.0_dp, 'same final state', abs=1.0e-8_dp)
+        if (allocated(error)) return
+        call check(error, sum(on%records%iterations) < sum(off%records%iterations), &
+                   'fewer iterations with the predictor')
+        if (allocated(error)) return
+        ! steps 1 and 11 start a phase: no increment to extrapolate, same first residual
+        do k = 1, 11, 10
+            call check(error, on%records(k)%iterations, off%records(k)%iterations, &
+                       'phase start: no prediction')
+            if (allocated(error)) return
+        end do
+    end subroutine test_predictor
 
 end module test_stepping

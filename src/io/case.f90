@@ -55,6 +55,9 @@ module voiga_io_case
         !> ... and doubled (never beyond the nominal step) after a substep that
         !> converged in at most grow_iterations Newton iterations.
         integer :: grow_iterations = 5
+        !> Start each substep from the last step's increment, extrapolated (within a
+        !> load phase; docs/robustness.md).
+        logical :: predictor = .true.
     end type solver_input_t
 
     !> A prescribed displacement on a named edge (`&dirichlet`).
@@ -407,10 +410,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph, max_cuts, grow_iterations
         real(dp) :: tol_residual, tol_energy, min_step_fraction
+        logical :: predictor
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
-            min_step_fraction, max_cuts, grow_iterations
+            min_step_fraction, max_cuts, grow_iterations, predictor
 
         n_steps = -1
         max_iterations = entry%max_iterations
@@ -420,6 +424,7 @@ contains
         min_step_fraction = entry%min_step_fraction
         max_cuts = entry%max_cuts
         grow_iterations = entry%grow_iterations
+        predictor = entry%predictor
         rewind (u)
         read (u, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -472,6 +477,7 @@ contains
         entry%min_step_fraction = min_step_fraction
         entry%max_cuts = max_cuts
         entry%grow_iterations = grow_iterations
+        entry%predictor = predictor
         entry%max_iterations = max_iterations
         entry%tol_residual = tol_residual
         entry%tol_energy = tol_energy

@@ -38,7 +38,8 @@ module voiga_solver_newton
     !> pairs' committed history is set on the model by the caller).
     type :: resume_t
         integer :: step = 0
-        real(dp), allocatable :: u(:)
+        !> Displacement after `step` and after the step before it.
+        real(dp), allocatable :: u(:), u_before(:)
         real(dp) :: fraction = 1.0_dp, r0_max = 0.0_dp
     end type resume_t
 
@@ -58,6 +59,9 @@ module voiga_solver_newton
         integer :: max_cuts = 30
         !> The increment doubles after a substep converged in at most this many iterations.
         integer :: grow_iterations = 5
+        !> Start a substep from u_conv + (substep fraction) x (the last nominal step's
+        !> increment) when that step is in the same load phase.
+        logical :: predictor = .true.
     end type stepping_t
 
     !> Counters of a run.
@@ -114,7 +118,7 @@ contains
         type(umfpack_t) :: lu
         type(step_record_t) :: rec
         type(cut_record_t) :: cut
-        real(dp), allocatable :: r(:), u_conv(:)
+        real(dp), allocatable :: r(:), u_conv(:), u_step(:), u_step_before(:)
         real(dp) :: t, t_begin, t_end, tic, start, frac, s, ds, rn
         integer :: step, nsteps, j, c, ip, it, first_cut, first
         logical :: loud
@@ -131,6 +135,8 @@ contains
         allocate (u(model%ndof), r(model%ndof))
         u = 0.0_dp
         u_conv = u
+        ! converged states at the ends of the last two nominal steps (step 0: zero)
+        u_step = u
         nsteps = n_total_steps(model)
         allocate (stats%records(0), stats%cut_records(0))
         ! the load increment as a fraction of the nominal step; carried over steps
@@ -140,6 +146,8 @@ contains
             if (allocated(resume%u)) then
                 u = resume%u
                 u_conv = u
+                u_step = u
+                if (allocated(resume%u_before)) u_step_before = resume%u_before
                 frac = resume%fraction
                 stats%r0_max = resume%r0_max
                 first = resume%step + 1
@@ -159,6 +167,10 @@ contains
                 ds = min(frac, 1.0_dp - s)
                 t = t_end
                 if (s + ds < 1.0_dp) t = t_begin + (s + ds)*(t_end - t_begin)
+                if (set%predictor .and. allocated(u_step_before) .and. step >= 2) then
+                    if (phase_of_step(model, step - 1) == phase_of_step(model, step)) &
+                        u = u + ds*(u_step - u_step_before)
+                end if
                 call set_prescribed(model, t, u)
                 call update_contact_pattern(model, u, k, map, stats%assembly, error)
                 if (.not. allocated(error)) &
@@ -203,6 +215,8 @@ contains
                 deallocate (error)
             end do
             u_conv = u
+            u_step_before = u_step
+            u_step = u
             stats%steps = step
             allocate (rec%reactions(2, size(model%dirichlet)))
             do j = 1, size(model%dirichlet)
@@ -254,6 +268,19 @@ contains
         longer(size(list) + 1) = cut
         call move_alloc(longer, list)
     end subroutine append_cut
+
+    !> Load phase (1-based) that nominal step `step` belongs to.
+    pure integer function phase_of_step(model, step) result(ph)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: step
+        integer :: total
+        total = 0
+        do ph = 1, size(model%n_steps)
+            total = total + model%n_steps(ph)
+            if (step <= total) return
+        end do
+        ph = size(model%n_steps)
+    end function phase_of_step
 
     !> Newton iterations at load time `t` from `u` (prescribed values set). On
     !> success `rec` holds the iteration's norms; `it` the iterations, `rn` the final
