@@ -195,12 +195,28 @@ def suite() -> list[HardCase]:
         for layout in LAYOUTS:
             cases.append(HardCase(f"deep-{mesh}-{layout}", "ironing-deep", f"{mesh}-{layout}",
                                   "ironing-deep as committed"))
-    # penalties 1e1 .. 1e6 x E (the committed cases use 1e2)
+    # penalties 1e1 .. 1e6 x E (the committed cases use 1e2); from 1e4 on, Newton cycles
+    # between stick and slip of a point on the stick/slip limit (docs/robustness.md)
     for exponent in range(1, 7):
         eps = 10.0**exponent * E_SLAB
+        stiff = exponent >= 4
         cases.append(HardCase(f"penalty-1e{exponent}", "ironing", "m1-NN2.2",
                               f"penalty_normal = penalty_tangent = 1e{exponent} x E",
-                              (contact(penalty_normal=eps, penalty_tangent=eps),)))
+                              (contact(penalty_normal=eps, penalty_tangent=eps),),
+                              expect="fails" if stiff else "converges",
+                              words=("stick/slip",) if stiff else ()))
+    # which of the two penalties: the normal one alone stiff (tangential 1e2 x E), and
+    # no friction at all
+    # (1e6: the slip limit mu p_N is as stiff as a tangential penalty of 3e5 x E)
+    for exponent in (4, 6):
+        eps = 10.0**exponent * E_SLAB
+        cases.append(HardCase(f"penalty-n1e{exponent}-t1e2", "ironing", "m1-NN2.2",
+                              f"penalty_normal 1e{exponent} x E, penalty_tangent 1e2 x E",
+                              (contact(penalty_normal=eps, penalty_tangent=100.0 * E_SLAB),),
+                              expect="fails" if exponent == 6 else "converges",
+                              words=("stick/slip",) if exponent == 6 else ()))
+    cases.append(HardCase("penalty-1e6-mu0", "ironing", "m1-NN2.2", "penalty 1e6 x E, frictionless",
+                          (contact(penalty_normal=1e6 * E_SLAB, friction=0.0),)))
     # the same on the hertz cylinder (E = 1, rigid plane): 1e9 x E converges on the
     # round-off floor, 1e12 x E (the largest accepted) fails: the floor lies above the
     # first residual at every increment (cuts down to 1/16 of a step show it as well
@@ -223,8 +239,10 @@ def suite() -> list[HardCase]:
     for mu in (0.5, 1.0):
         cases.append(HardCase(f"mu-{mu}", "ironing", "m1-NN2.2", f"friction mu = {mu}",
                               (contact(friction=mu),)))
+    # (with mu = 1 the deep die drags the slab until its first element inverts, at
+    # load time 1.69, whatever the increment)
     cases.append(HardCase("mu-1.0-deep", "ironing-deep", "m1-NN4", "ironing-deep with mu = 1.0",
-                          (contact(friction=1.0),)))
+                          (contact(friction=1.0),), expect="fails", words=("inverted",)))
     # nearly incompressible
     cases.append(HardCase("nu-0.49", "ironing", "m1-NN2.2", "Poisson ratio 0.49, both bodies",
                           (bodies(poisson_ratio=0.49),)))
@@ -241,7 +259,7 @@ def suite() -> list[HardCase]:
                               (dirichlet("die", "inner", ux=[0.0, ux], uy=[-0.02, -0.02]),
                                solver(n_steps=[2, 50])), reduced=tag == "end",
                               checks=(reaches_master_end(0),) if tag == "end"
-                              else (reaches_master_end(-1, 0.999), in_contact(0, False))))
+                              else (reaches_master_end(-1, 0.99), in_contact(0, False))))
     # bodies that start apart: the die lifted by 0.2, then pressed 0.7 (contact starts at
     # load time 0.29) and slid; the hertz cylinder 0.005 above the plane, pressed 0.01
     cases.append(HardCase("apart-ironing", "ironing", "m1-NN2.2",
