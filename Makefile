@@ -13,7 +13,7 @@ SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # 3x slower while anything else ran (docs/performance.md).
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: all deps build run test test-fortran test-python clean bench paper
+.PHONY: all deps build run test test-fortran test-python clean bench paper stress
 
 all: build
 
@@ -56,6 +56,14 @@ test-python: build
 
 clean:
 	rm -rf build
+
+## stress: the full hard-case suite of issue 6 (docs/robustness.md), one case at a time;
+## prints the table (case, outcome, steps, cuts, Newton iterations, wall s) and writes it
+## to build/stress/table.md; fails if a case does not end as expected.
+## STRESS_ARGS e.g. --only 'deep-m1-*' 'penalty-*', or --list
+stress: build
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/hard_cases.py --out build/stress \
+	  --markdown build/stress/table.md $(STRESS_ARGS)
 
 ## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX)
 bench: build
