@@ -87,6 +87,9 @@ module voiga_solver_newton
         !> Converged nominal steps; Newton iterations of all attempts.
         integer :: steps = 0, iterations = 0
         integer :: symbolic_factorizations = 0, numeric_factorizations = 0
+        !> Substeps whose predicted start failed and that were retried from the last
+        !> converged state.
+        integer :: predictor_retries = 0
         !> Residual evaluations spent on halving Newton steps.
         integer :: line_search_steps = 0
         !> Largest first residual of a step so far: the force scale of the round-off floor.
@@ -138,7 +141,7 @@ contains
         real(dp), allocatable :: r(:), u_conv(:), u_step(:), u_step_before(:)
         real(dp) :: t, t_begin, t_end, tic, start, frac, s, ds, rn
         integer :: step, nsteps, j, c, ip, it, first_cut, first
-        logical :: loud
+        logical :: loud, predicted, unpredicted_retry
         character(len=200) :: msg
 
         start = wall_seconds()
@@ -158,6 +161,7 @@ contains
         allocate (stats%records(0), stats%cut_records(0))
         ! the load increment as a fraction of the nominal step; carried over steps
         frac = 1.0_dp
+        unpredicted_retry = .false.
         first = 1
         if (present(resume)) then
             if (allocated(resume%u)) then
@@ -184,10 +188,15 @@ contains
                 ds = min(frac, 1.0_dp - s)
                 t = t_end
                 if (s + ds < 1.0_dp) t = t_begin + (s + ds)*(t_end - t_begin)
-                if (set%predictor .and. allocated(u_step_before) .and. step >= 2) then
-                    if (phase_of_step(model, step - 1) == phase_of_step(model, step)) &
+                predicted = .false.
+                if (set%predictor .and. .not. unpredicted_retry .and. allocated(u_step_before) &
+                    .and. step >= 2) then
+                    if (phase_of_step(model, step - 1) == phase_of_step(model, step)) then
                         u = u + ds*(u_step - u_step_before)
+                        predicted = .true.
+                    end if
                 end if
+                unpredicted_retry = .false.
                 call set_prescribed(model, t, u)
                 call update_contact_pattern(model, u, k, map, stats%assembly, error)
                 if (.not. allocated(error)) &
@@ -209,6 +218,16 @@ contains
                     call pair_reset_trial(model%pairs(ip))
                 end do
                 if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
+                if (predicted) then
+                    ! a predicted start that fails is retried once from the last converged
+                    ! state, at the same increment, before the increment is cut
+                    unpredicted_retry = .true.
+                    stats%predictor_retries = stats%predictor_retries + 1
+                    if (.not. quiet) write (*, '(a,i0,a,f10.6,a)') 'retry step ', step, '  t=', t, &
+                        ' from the last converged state (the predicted start failed: '//error%message//')'
+                    deallocate (error)
+                    cycle
+                end if
                 if (rec%cuts >= set%max_cuts .or. &
                     0.5_dp*ds < set%min_step_fraction*(1.0_dp - 1.0e-12_dp)) then
                     if (rec%cuts > 0 .or. set%max_cuts > 0) then
