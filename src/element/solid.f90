@@ -56,7 +56,10 @@ contains
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
         real(dp) :: bm(3*size(pts%wdv), 2*size(u, 2)), db(3*size(pts%wdv), 2*size(u, 2))
-        real(dp), allocatable :: gm(:, :), tg(:, :), kg(:, :)
+        ! automatic (stack) arrays: no heap allocation per element; gm, tg, kg are used
+        ! by the finite-strain law only
+        real(dp) :: gm(2*size(pts%wdv), size(u, 2)), tg(2*size(pts%wdv), size(u, 2)), &
+                    kg(size(u, 2), size(u, 2))
         real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3)
         real(dp) :: g(2, size(u, 2))
         integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
@@ -65,7 +68,6 @@ contains
         nen = size(u, 2)
         fe = 0.0_dp
         bm = 0.0_dp
-        if (mat%finite_strain) allocate (gm(2*size(pts%wdv), nen), tg(2*size(pts%wdv), nen))
         do q = 1, size(pts%wdv)
             grad_u = matmul(u, transpose(pts%dndx(:, :, q)))
             call mat%stress(grad_u, s, c, ok)
@@ -99,7 +101,6 @@ contains
         end do
         call gemm_tn(bm, db, ke, 0.0_dp)
         if (mat%finite_strain) then
-            allocate (kg(nen, nen))
             call gemm_tn(gm, tg, kg, 0.0_dp)
             ke(1::2, 1::2) = ke(1::2, 1::2) + kg
             ke(2::2, 2::2) = ke(2::2, 2::2) + kg
