@@ -195,11 +195,13 @@ def suite() -> list[HardCase]:
         for layout in LAYOUTS:
             cases.append(HardCase(f"deep-{mesh}-{layout}", "ironing-deep", f"{mesh}-{layout}",
                                   "ironing-deep as committed"))
-    # penalties 1e1 .. 1e6 x E (the committed cases use 1e2); from 1e4 on, Newton cycles
-    # between stick and slip of a point on the stick/slip limit (docs/robustness.md)
+    # penalties 1e1 .. 1e6 x E (the committed cases use 1e2); at 1e6, Newton cycles
+    # between stick and slip of a point on the stick/slip limit (docs/robustness.md);
+    # 1e4 and 1e5 failed the same way until the predictor and the retry of a failed
+    # predicted start from the last state (measured since: 11 and 450 cuts)
     for exponent in range(1, 7):
         eps = 10.0**exponent * E_SLAB
-        stiff = exponent >= 4
+        stiff = exponent >= 6
         cases.append(HardCase(f"penalty-1e{exponent}", "ironing", "m1-NN2.2",
                               f"penalty_normal = penalty_tangent = 1e{exponent} x E",
                               (contact(penalty_normal=eps, penalty_tangent=eps),),
