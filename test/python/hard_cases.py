@@ -241,10 +241,13 @@ def suite() -> list[HardCase]:
     for mu in (0.5, 1.0):
         cases.append(HardCase(f"mu-{mu}", "ironing", "m1-NN2.2", f"friction mu = {mu}",
                               (contact(friction=mu),)))
-    # (with mu = 1 the deep die drags the slab until its first element inverts, at
-    # load time 1.69, whatever the increment)
+    # (with mu = 1 the deep die drags the slab's top until the corner element at the
+    # clamped bottom edge inverts: with the slide of 4.0 at load time 1.69; with the
+    # committed slide 3.0 at 1.921, where every predicted start inverts slab element 1
+    # and the retries from the last state stall with contact states switching, down to
+    # the smallest increment; an open problem of issue 6, not a refusal)
     cases.append(HardCase("mu-1.0-deep", "ironing-deep", "m1-NN4", "ironing-deep with mu = 1.0",
-                          (contact(friction=1.0),), expect="fails", words=("inverted",)))
+                          (contact(friction=1.0),), expect="fails", words=("Newton did not converge",)))
     # nearly incompressible
     cases.append(HardCase("nu-0.49", "ironing", "m1-NN2.2", "Poisson ratio 0.49, both bodies",
                           (bodies(poisson_ratio=0.49),)))
