@@ -10,7 +10,7 @@ module test_contact
     use voiga_io_case, only: case_t, body_input_t, contact_input_t
     use voiga_model, only: model_t, new_model
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
-                                    new_assembly_map, update_contact_pattern
+                                    new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t
     use voiga_io_case, only: dirichlet_input_t, pressure_input_t
@@ -464,7 +464,7 @@ contains
     end subroutine test_ironing_quadratic
 
     !> The contact part of the stiffness pattern fitted to the configuration
-    !> (update_contact_pattern) is smaller than the whole-master coupling but loses
+    !> (assemble with refit) is smaller than the whole-master coupling but loses
     !> no entry: the tangent assembled on it equals the one on the full pattern.
     subroutine test_fitted_pattern(error)
         type(error_t), allocatable, intent(out) :: error
@@ -488,7 +488,8 @@ contains
             call assemble(model, u, 1.0_dp, r, stats, error, k, map)
             if (allocated(error)) return
             k_full = dense(k)
-            call update_contact_pattern(model, u, k, map, stats, error)
+            ! the first assembly of a substep fits the pattern to its configuration
+            call assemble(model, u, 1.0_dp, r, stats, error, k, map, refit=.true.)
             if (allocated(error)) return
             call check(error, stats%pattern_rebuilds, 1, trim(layouts(il))//': pattern rebuilds')
             if (allocated(error)) return

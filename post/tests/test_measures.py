@@ -85,3 +85,31 @@ def test_contact_profile_keeps_the_contact_zone() -> None:
     assert len(xs) == last + 1 + 2                      # the zone and 2 points after it
     assert np.all(np.diff(xs) >= 0)
     assert np.array_equal(p[: last + 1], pn[: last + 1])
+
+
+def test_accuracy_cost_skips_the_reference_run() -> None:
+    """The reference (hertz N2 m6) has error 0 by definition and is no candidate."""
+    rows = [
+        {"scene": "hertz", "mesh": "m5", "layout": "N2", "status": "converged", "l2_ref_field": "0.002",
+         "wall_s": "8"},
+        {"scene": "hertz", "mesh": "m6", "layout": "N2", "status": "converged", "l2_ref_field": "0",
+         "wall_s": "15"},
+    ]
+    lines = accuracy_cost(rows, "hertz", "l2_ref_field", (0.003, 0.001)).splitlines()
+    assert "m5-N2" in lines[2]
+    assert "none reaches it" in lines[3] and "m6-N2" not in "".join(lines)
+
+
+def test_ironing_relative_oscillation(monkeypatch: pytest.MonkeyPatch) -> None:
+    """osc_px / osc_py: the detrended amplitude over the second half of sliding,
+    divided by |mean force| there."""
+    import post.measures as measures
+
+    steps = np.arange(1, 211)
+    fx = np.where(steps > 10, 2.0 + 0.01 * np.sin(steps), 0.0)
+    fy = np.where(steps > 10, -4.0 + 0.04 * np.cos(steps), 0.0)
+    monkeypatch.setattr(measures, "die_forces", lambda res: (steps, np.c_[fx, fy]))
+    m = measures.ironing_measures(None)  # type: ignore[arg-type]
+    assert m["osc_px"] == pytest.approx(m["amp_px"] / abs(m["mean_px"]))
+    assert m["osc_py"] == pytest.approx(m["amp_py"] / abs(m["mean_py"]))
+    assert 0.005 < m["osc_px"] < 0.011 and 0.01 < m["osc_py"] < 0.021

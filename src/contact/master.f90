@@ -36,6 +36,7 @@ module voiga_contact_master
     abstract interface
         !> Closest point on the master to `xs` in the configuration `u`; `found` is
         !> false when the orthogonal projection falls beyond the master's ends.
+        !> `prepare(u)` must have been called with the same `u` first.
         pure subroutine project_interface(self, u, xs, mp, found, converged)
             import :: contact_master_t, master_point_t, dp
             class(contact_master_t), intent(in) :: self

@@ -94,7 +94,7 @@ contains
             end do
         end do
         allocate (self%out(ne*ng))
-        ! until a caller fits them (update_contact_pattern), every slave element is
+        ! until the assembly fits them (assemble with refit), every slave element is
         ! coupled with the whole master
         allocate (self%mlo(ne), self%mhi(ne))
         self%mlo = 1

@@ -13,7 +13,7 @@ module voiga_model_assembly
     private
 
     public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
-    public :: assembly_map_t, new_assembly_map, update_contact_pattern
+    public :: assembly_map_t, new_assembly_map
 
     !> Where each element's stiffness entries go in the CSC values, computed once per
     !> pattern so that assembly needs no search.
@@ -165,7 +165,7 @@ contains
     !> Fails with a numeric error if J <= 0 at a quadrature point.
     !> When a contact point falls outside the stiffness pattern, the pattern (and
     !> `map`) is rebuilt and the whole assembly done again.
-    subroutine assemble(model, u, t, r, stats, error, k, map)
+    subroutine assemble(model, u, t, r, stats, error, k, map, refit)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         !> Load time (for the external forces).
@@ -176,10 +176,27 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         !> Element positions in `k` (from `new_assembly_map`): no search when given.
         type(assembly_map_t), intent(inout), optional :: map
+        !> Fit the contact part of the pattern to `u` (the start of a substep): each
+        !> slave element coupled with the master control points near its points
+        !> (`pair_wanted_ranges`), rebuilt only if a range changed. The pattern then
+        !> depends on `u` only, so a restarted run gets the same patterns.
+        logical, intent(in), optional :: refit
         integer :: pass, ip
+        logical :: fit
+        fit = .false.
+        if (present(refit)) fit = refit .and. present(k)
         do pass = 1, 3
             call assemble_once(model, u, t, r, stats, error, k, map)
             if (allocated(error) .or. .not. present(k)) return
+            if (fit) then
+                fit = .false.
+                if (refit_contact_ranges(model)) then
+                    ! the ranges now hold every projection of this evaluation
+                    do ip = 1, size(model%pairs)
+                        model%pairs(ip)%pattern_miss = .true.
+                    end do
+                end if
+            end if
             if (.not. any([(model%pairs(ip)%pattern_miss, ip=1, size(model%pairs))])) return
             do ip = 1, size(model%pairs)
                 model%pairs(ip)%pattern_miss = .false.
@@ -203,38 +220,19 @@ contains
         if (present(map)) call new_assembly_map(model, k, map)
     end subroutine rebuild_pattern
 
-    !> Fit the contact part of the stiffness pattern to the configuration `u` (the
-    !> start of a load step): each slave element coupled with the master control
-    !> points near its points (`pair_wanted_ranges`). Rebuilds `k` and `map` only
-    !> if a range changed; the result depends on `u` only, so a restarted run
-    !> gets the same patterns as an uninterrupted one.
-    subroutine update_contact_pattern(model, u, k, map, stats, error)
+    !> Fit the contact ranges of every deformable-master pair to its last evaluation
+    !> (`pair_wanted_ranges`); true if a range changed (the pattern must be rebuilt).
+    function refit_contact_ranges(model) result(changed)
         type(model_t), intent(inout) :: model
-        real(dp), intent(in) :: u(:)
-        type(csc_matrix_t), intent(inout) :: k
-        type(assembly_map_t), intent(inout) :: map
-        type(assembly_stats_t), intent(inout) :: stats
-        type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: r(:)
-        integer, allocatable :: lo(:), hi(:)
-        integer :: ip, nm
         logical :: changed
-        integer(i8) :: c0, c1, rate
-
-        call system_clock(c0, rate)
+        integer, allocatable :: lo(:), hi(:)
+        integer :: ip
         changed = .false.
-        allocate (r(size(u)))
         do ip = 1, size(model%pairs)
             associate (pair => model%pairs(ip))
                 if (.not. pair%master%deformable) cycle
-                r = 0.0_dp
-                call pair_contribution(pair, u, r, error)
-                ! a projection failure here is not this step's: the step's own
-                ! evaluations report it
-                if (allocated(error)) deallocate (error)
-                nm = size(pair%master%all_dofs())/2
                 allocate (lo(size(pair%mlo)), hi(size(pair%mhi)))
-                call pair_wanted_ranges(pair, nm, 8, lo, hi)
+                call pair_wanted_ranges(pair, size(pair%master%all_dofs())/2, 8, lo, hi)
                 if (any(lo /= pair%mlo) .or. any(hi /= pair%mhi)) then
                     changed = .true.
                     pair%mlo = lo
@@ -243,13 +241,7 @@ contains
                 deallocate (lo, hi)
             end associate
         end do
-        if (changed) then
-            call rebuild_pattern(model, k, error, map)
-            stats%pattern_rebuilds = stats%pattern_rebuilds + 1
-        end if
-        call system_clock(c1)
-        stats%seconds_contact = stats%seconds_contact + real(c1 - c0, dp)/real(rate, dp)
-    end subroutine update_contact_pattern
+    end function refit_contact_ranges
 
     !> One pass of `assemble`.
     subroutine assemble_once(model, u, t, r, stats, error, k, map)

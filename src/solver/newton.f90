@@ -24,7 +24,7 @@ module voiga_solver_newton
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, phase_value, step_time, n_total_steps
     use voiga_model_assembly, only: assembly_stats_t, assemble, stiffness_pattern, assembly_map_t, &
-                                    new_assembly_map, update_contact_pattern
+                                    new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_signals, only: caught_signal, signal_name
@@ -198,9 +198,7 @@ contains
                 end if
                 unpredicted_retry = .false.
                 call set_prescribed(model, t, u)
-                call update_contact_pattern(model, u, k, map, stats%assembly, error)
-                if (.not. allocated(error)) &
-                    call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
+                call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
                 if (.not. allocated(error)) then
                     u_conv = u
                     do ip = 1, size(model%pairs)
@@ -368,7 +366,8 @@ contains
             end if
             bulk0 = stats%assembly%seconds_bulk
             contact0 = stats%assembly%seconds_contact
-            call assemble(model, u, t, r, stats%assembly, error, k, map)
+            ! the substep's first assembly also fits the contact pattern to its start
+            call assemble(model, u, t, r, stats%assembly, error, k, map, refit=(it == 0 .and. nls == 0))
             rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
             rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
             if (allocated(error)) exit
