@@ -29,6 +29,7 @@ contains
                     new_unittest('umfpack_symbolic_reuse', test_reuse), &
                     new_unittest('umfpack_pattern_change', test_pattern_change), &
                     new_unittest('umfpack_singular', test_singular), &
+                    new_unittest('umfpack_determinant', test_determinant), &
                     new_unittest('umfpack_misuse', test_misuse) &
                     ]
     end subroutine collect_sparse
@@ -451,6 +452,50 @@ contains
         call lu%release()
         call check(error, lu%n_symbolic, 1, 'counters survive release')
     end subroutine test_reuse
+
+    !> det of 200 2x2 diagonal blocks [2 1; 1 3] (det 5), one of them replaced by
+    !> [1 2; 2 1] (det -3): sign and log10 |det| = 199 log10 5 + log10 3 (5^199 would
+    !> overflow as a double: UMFPACK's mantissa/exponent form must not).
+    subroutine test_determinant(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t) :: a
+        type(umfpack_t) :: lu
+        type(error_t), allocatable :: misuse
+        integer :: e, sgn
+        real(dp) :: log_det
+
+        call lu%determinant(sgn, log_det, misuse)
+        call check(error, allocated(misuse), 'determinant without a factorization is an error')
+        if (allocated(error)) return
+        call new_csc_pattern(a, 400, [(2*e - 1, e=1, 200), 401], [(e, e=1, 400)], error)
+        if (allocated(error)) return
+        do e = 1, 200
+            call a%add_element([2*e - 1, 2*e], reshape([2.0_dp, 1.0_dp, 1.0_dp, 3.0_dp], [2, 2]))
+        end do
+        call lu%factorize(a, error)
+        if (allocated(error)) return
+        call lu%determinant(sgn, log_det, error)
+        if (allocated(error)) return
+        call check(error, sgn, 1, 'sign of det, all blocks positive')
+        if (allocated(error)) return
+        call check(error, log_det, 200*log10(5.0_dp), 'log10 det', rel=1.0e-12_dp)
+        if (allocated(error)) return
+        a%values = 0.0_dp
+        do e = 1, 200
+            if (e == 77) then
+                call a%add_element([2*e - 1, 2*e], reshape([1.0_dp, 2.0_dp, 2.0_dp, 1.0_dp], [2, 2]))
+            else
+                call a%add_element([2*e - 1, 2*e], reshape([2.0_dp, 1.0_dp, 1.0_dp, 3.0_dp], [2, 2]))
+            end if
+        end do
+        call lu%factorize(a, error)
+        if (allocated(error)) return
+        call lu%determinant(sgn, log_det, error)
+        if (allocated(error)) return
+        call check(error, sgn, -1, 'sign of det, one indefinite block')
+        if (allocated(error)) return
+        call check(error, log_det, 199*log10(5.0_dp) + log10(3.0_dp), 'log10 |det|', rel=1.0e-12_dp)
+    end subroutine test_determinant
 
     subroutine test_pattern_change(error)
         type(error_t), allocatable, intent(out) :: error

@@ -40,6 +40,9 @@ module voiga_io_results
         !> Newton iterations of all substeps, failed attempts included (`iterations`,
         !> `residual_norms` and `energy_norms` are those of the last substep).
         integer :: iterations_total = 0
+        !> Sign of det(K) (free DOFs) of the last tangent factorized up to this step
+        !> (0: singular, or no factorization yet).
+        integer :: det_sign = 0
     end type step_record_t
 
     !> One cut of the load increment (adaptive stepping, docs/robustness.md).
@@ -182,6 +185,7 @@ contains
         call self%h5%write_attr(g, 'time', rec%time)
         call self%h5%write_attr(g, 'iterations', rec%iterations)
         call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
+        call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign)
         call self%h5%write_attr(g, 'substeps', rec%substeps)
         call self%h5%write_attr(g, 'cuts', rec%cuts)
         if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction)

@@ -92,6 +92,9 @@ module voiga_solver_newton
         integer :: predictor_retries = 0
         !> Residual evaluations spent on halving Newton steps.
         integer :: line_search_steps = 0
+        !> Sign of det(K) of the last factorization (free DOFs), and the iterations of
+        !> the last Newton attempt whose tangent had det(K) <= 0 (`newton_solve`).
+        integer :: det_sign = 0, attempt_nonpositive_det = 0
         !> Largest first residual of a step so far: the force scale of the round-off floor.
         real(dp) :: r0_max = 0.0_dp
         !> Converged substeps and cuts of the load increment.
@@ -143,6 +146,9 @@ contains
         integer :: step, nsteps, j, c, ip, it, first_cut, first
         logical :: loud, predicted, unpredicted_retry
         character(len=200) :: msg
+        ! sign of det(K) at the last converged substep; det(K) <= 0 iterations and all
+        ! iterations of the last failed attempt started from the converged state
+        integer :: conv_det_sign, fold_iterations, fold_total
 
         start = wall_seconds()
         if (present(t0)) start = t0
@@ -163,6 +169,7 @@ contains
         frac = 1.0_dp
         unpredicted_retry = .false.
         first = 1
+        conv_det_sign = 0
         if (present(resume)) then
             if (allocated(resume%u)) then
                 u = resume%u
@@ -182,6 +189,8 @@ contains
             rec%time = t_end
             rec%substeps = 0
             first_cut = size(stats%cut_records) + 1
+            fold_iterations = 0
+            fold_total = 0
             ! s: converged part of the nominal step (sums of powers of 2: exact)
             s = 0.0_dp
             do while (s < 1.0_dp)
@@ -200,6 +209,7 @@ contains
                 call set_prescribed(model, t, u)
                 call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
                 if (.not. allocated(error)) then
+                    if (it > 0) conv_det_sign = stats%det_sign
                     u_conv = u
                     do ip = 1, size(model%pairs)
                         call pair_commit(model%pairs(ip))
@@ -216,6 +226,10 @@ contains
                     call pair_reset_trial(model%pairs(ip))
                 end do
                 if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
+                if (.not. predicted) then
+                    fold_iterations = stats%attempt_nonpositive_det
+                    fold_total = it
+                end if
                 if (predicted) then
                     ! a predicted start that fails is retried once from the last converged
                     ! state, at the same increment, before the increment is cut
@@ -234,6 +248,8 @@ contains
                             set%min_step_fraction, ', max_cuts ', set%max_cuts, ')'
                         error%message = error%message//trim(msg)
                     end if
+                    if (fold_iterations > 0 .and. (fold_iterations < fold_total .or. conv_det_sign > 0)) &
+                        error%message = error%message//fold_diagnosis(model, fold_iterations, fold_total)
                     exit steps
                 end if
                 cut = cut_record_t(step=step, time=t, fraction=ds, new_fraction=0.5_dp*ds, &
@@ -252,6 +268,7 @@ contains
             u_step_before = u_step
             u_step = u
             stats%steps = step
+            rec%det_sign = conv_det_sign
             allocate (rec%reactions(2, size(model%dirichlet)))
             do j = 1, size(model%dirichlet)
                 do c = 1, 2
@@ -288,6 +305,39 @@ contains
         stats%symbolic_factorizations = lu%n_symbolic
         stats%numeric_factorizations = lu%n_numeric
     end subroutine solve_steps
+
+    !> Why a step that cut down to its limit failed, when the tangent's determinant
+    !> changed sign near the last converged state: det K <= 0 in `nonpositive` of
+    !> the `total` iterations of the last attempt started there, det K > 0 in the
+    !> others or at the converged state. Pieces of the (piecewise smooth)
+    !> incremental problem with opposite orientation meet there, so the incremental
+    !> map folds (it is not coherently oriented): for some increments it has no
+    !> solution nearby. The message does not decide between a limit point of the
+    !> path and a passage narrower than the smallest increment (docs/robustness.md,
+    !> "Folds of the incremental problem").
+    pure function fold_diagnosis(model, nonpositive, total) result(text)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: nonpositive, total
+        character(len=:), allocatable :: text
+        character(len=300) :: buf
+        integer :: ip
+        write (buf, '(a,i0,a,i0,a)') '; the determinant of the tangent stiffness changes sign near '// &
+            'the last converged state (det K <= 0 in ', nonpositive, ' of the ', total, &
+            ' iterations of the last attempt, > 0 in the others or at that state)'
+        text = trim(buf)//': pieces of the incremental problem with opposite orientation meet '// &
+               'there, so it folds (for some increments it has no nearby solution): either the '// &
+               'quasi-static path ends here (a limit point; the physical system would move '// &
+               'dynamically) or it goes on only through increments below min_step_fraction'
+        do ip = 1, size(model%pairs)
+            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
+            write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', model%pairs(ip)%law%mu, &
+                ', penalty_normal = ', model%pairs(ip)%law%eps_n, '): slipping points couple the '
+            text = text//trim(buf)//' normal penalty into the tangential direction (mu x penalty_normal) '// &
+                   'and can turn the tangent so (the friction-induced instability); a smaller '// &
+                   'penalty_normal or mu keeps the path stable longer'
+            exit
+        end do
+    end function fold_diagnosis
 
     !> Append `cut` to `list`.
     pure subroutine append_cut(list, cut)
@@ -339,7 +389,7 @@ contains
         real(dp), allocatable :: du(:), norms(:), energies(:), rhs(:), u_prev(:), x0(:)
         ! contact state of every slave point after each iteration; shape: [npoints, 0:max_iterations]
         integer, allocatable :: states(:, :)
-        real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor
+        real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor, log_det
         integer :: nls, ip, flips
         logical :: converged
         character(len=400) :: msg
@@ -358,6 +408,7 @@ contains
         nls = 0
         alpha = 1.0_dp
         rn_prev = huge(1.0_dp)
+        stats%attempt_nonpositive_det = 0
         do
             if (caught_signal() /= 0) then
                 stats%signal = caught_signal()
@@ -451,6 +502,12 @@ contains
             tic = wall_seconds()
             call k%fix_dofs(model%fixed)
             call lu%factorize(k, error)
+            if (.not. allocated(error)) then
+                ! the orientation of the tangent (O(n) from the factors): a sign
+                ! change marks a fold of the incremental problem (solve_steps)
+                call lu%determinant(stats%det_sign, log_det, error)
+                if (stats%det_sign <= 0) stats%attempt_nonpositive_det = stats%attempt_nonpositive_det + 1
+            end if
             rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
             if (allocated(error)) exit
             tic = wall_seconds()

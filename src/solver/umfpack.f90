@@ -64,6 +64,8 @@ module voiga_solver_umfpack
         procedure :: factorize => umfpack_factorize
         !> Solve A x = b with the current factorization.
         procedure :: solve => umfpack_solve
+        !> Sign and log10 magnitude of det(A) of the current factorization.
+        procedure :: determinant => umfpack_determinant
         !> Free the Symbolic and Numeric objects; safe to call any number of times.
         procedure :: release => umfpack_release
         procedure, private :: assign => umfpack_assign
@@ -114,6 +116,15 @@ module voiga_solver_umfpack
             real(c_double), intent(out) :: info(*)
             integer(c_int) :: status
         end function umfpack_di_solve
+
+        function umfpack_di_get_determinant(mx, ex, numeric, info) result(status) &
+            bind(c, name='umfpack_di_get_determinant')
+            import :: c_int, c_double, c_ptr
+            real(c_double), intent(out) :: mx, ex
+            type(c_ptr), value :: numeric
+            real(c_double), intent(out) :: info(*)
+            integer(c_int) :: status
+        end function umfpack_di_get_determinant
 
         subroutine umfpack_di_free_symbolic(symbolic) bind(c, name='umfpack_di_free_symbolic')
             import :: c_ptr
@@ -220,6 +231,32 @@ contains
             return
         end if
     end subroutine umfpack_solve
+
+    !> det(A) = sign x 10**log10_abs of the current numeric factorization (UMFPACK
+    !> returns it as mantissa and base-10 exponent, so it neither over- nor
+    !> underflows). sign = 0 for a singular factorization.
+    subroutine umfpack_determinant(self, sign, log10_abs, error)
+        class(umfpack_t), intent(in) :: self
+        integer, intent(out) :: sign
+        real(dp), intent(out) :: log10_abs
+        type(error_t), allocatable, intent(out) :: error
+        real(c_double) :: mx, ex, info(umfpack_info)
+        integer(c_int) :: status
+        sign = 0
+        log10_abs = -huge(1.0_dp)
+        if (.not. c_associated(self%numeric)) then
+            call fatal_error(error, 'umfpack determinant: no numeric factorization')
+            return
+        end if
+        status = umfpack_di_get_determinant(mx, ex, self%numeric, info)
+        if (status < umfpack_ok) then
+            call status_error(error, 'umfpack_di_get_determinant', status)
+            return
+        end if
+        if (mx > 0.0_c_double) sign = 1
+        if (mx < 0.0_c_double) sign = -1
+        if (mx /= 0.0_c_double) log10_abs = log10(abs(mx)) + ex
+    end subroutine umfpack_determinant
 
     !> Free both UMFPACK objects and forget the pattern; the counters are kept.
     subroutine umfpack_release(self)

@@ -55,6 +55,9 @@ def test_stretch_result_file(run, tmp_path: Path) -> None:
         assert f["steps/000001"].attrs["iterations"] == 1
         step = f["steps/000002"]
         assert step.attrs["iterations"] == 0
+        # a stable (positive definite) tangent; step 2 factorized nothing and keeps step 1's sign
+        assert f["steps/000001"].attrs["tangent_det_sign"] == 1
+        assert step.attrs["tangent_det_sign"] == 1
         for stage in ("assembly", "contact", "factorization", "solve", "output"):
             assert step.attrs[f"seconds_{stage}"] >= 0.0
         # plane strain, sigma_yy = 0: reaction = E/(1-nu^2) * 0.01 * height 3 on the right edge
