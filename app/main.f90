@@ -11,6 +11,7 @@ program voiga_main
     use voiga_io_results, only: results_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
     use voiga_solver_signals, only: catch_signals, signal_name
+    use voiga_solver_heap, only: keep_freed_memory
     use voiga_kinds, only: dp
     implicit none
 
@@ -27,7 +28,10 @@ program voiga_main
     real(dp), allocatable :: u(:)
     real(dp) :: t0
     integer :: i, n, total
+    logical :: heap_ok
 
+    ! reuse freed memory across factorizations (glibc; without it, only slower)
+    call keep_freed_memory(heap_ok)
     check = .false.
     quiet = .false.
     verbose = .false.

@@ -66,7 +66,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     import os
     from pathlib import Path
 
-    from .sweep import default_binary, find_cases, summarize, sweep, write_summary
+    from .sweep import default_binary, find_cases, previous_times, summarize, sweep, write_summary
 
     binary = Path(args.binary) if args.binary else default_binary()
     if not binary.exists():
@@ -78,8 +78,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         return 2
     failed = 0
     if not args.summary_only:
+        # the previous sweep's wall times order the runs longest first
         outcome = sweep(runs, binary, args.jobs or os.cpu_count() or 1, args.timeout, args.force,
-                        progress=not args.no_progress)
+                        progress=not args.no_progress,
+                        times=previous_times(Path(args.out) / "summary.csv"))
         for label, (code, message) in sorted(outcome.items()):
             if code != 0:
                 failed += 1

@@ -47,7 +47,7 @@ def ironing_forces(results: Path, out: Path, scene: str = "ironing", mesh: str =
     plt = _plt()
     fig, ax = plt.subplots(2, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
     for lay, path in files.items():
-        res = read_result(path)
+        res = read_result(path, lazy=True)
         if not res.steps:
             continue
         steps, f = die_forces(res)
@@ -76,7 +76,7 @@ def hertz_pressure(results: Path, out: Path, mesh: str = "m3") -> Path | None:
     ax.plot(s, np.sqrt(1 - s**2), "k-", lw=2, label="analytic Hertz")
     scale_a = None
     if ref_path.exists():
-        ref = read_result(ref_path)
+        ref = read_result(ref_path, lazy=True)
         h = hertz_comparison(ref)
         scale_a, p0 = h.a, h.p0
         x, p = profile(ref)
@@ -85,7 +85,7 @@ def hertz_pressure(results: Path, out: Path, mesh: str = "m3") -> Path | None:
         path = results / "hertz" / f"{mesh}-{lay}.h5"
         if not path.exists():
             continue
-        res = read_result(path)
+        res = read_result(path, lazy=True)
         if not res.converged:
             continue
         h = hertz_comparison(res)
@@ -174,7 +174,7 @@ def deformed(results: Path, out: Path) -> list[Path]:
         path = results / scene / f"{stem}.h5"
         if not path.exists():
             continue
-        res = read_result(path)
+        res = read_result(path, lazy=True)
         if not res.steps:
             continue
         if step > 0 and step > res.steps[-1].step:

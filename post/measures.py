@@ -11,6 +11,8 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .contact import fit_hertz, hertz_comparison, pressure_field
@@ -86,6 +88,19 @@ def profile_error(x: np.ndarray, p: np.ndarray, xr: np.ndarray, pr: np.ndarray,
     return float(np.sqrt(np.trapezoid((a - b) ** 2, s)) / norm) if norm > 0 else float("nan")
 
 
+@lru_cache(maxsize=4)
+def _hertz_reference(ref: Result) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`hertz_measures` needs of the reference run, computed once per
+    reference (a sweep compares every hertz run with the same one): the fitted
+    half-width a, the closed point profile (x, p) and the pressure field (x, p)
+    sorted in x."""
+    href = hertz_comparison(ref)
+    xr, pr = edge_profile(*profile(ref))
+    xfr, pfr = pressure_field(ref)
+    order = np.argsort(xfr[:, 0])
+    return href.a, xr, pr, xfr[order, 0], pfr[order]
+
+
 def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     """Comparison with analytic Hertz, and with the reference run if given: profiles in
     x/a on [0, 1.2], pressures divided by the reference's (resp. analytic) peak."""
@@ -93,16 +108,14 @@ def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     out = {"force": h.force, "a_err": h.a_error, "p0_err": h.p0_error, "pmax_err": h.p_max / h.p0 - 1.0,
            "l2_analytic": h.l2_error}
     if ref is not None:
+        a_ref, xr, pr, xfr, pfr = _hertz_reference(ref)
         x, p = edge_profile(*profile(res))
-        xr, pr = edge_profile(*profile(ref))
-        href = hertz_comparison(ref)
-        out["l2_ref"] = profile_error(x / href.a, p, xr / href.a, pr, 1.2, float(pr.max()))
+        out["l2_ref"] = profile_error(x / a_ref, p, xr / a_ref, pr, 1.2, float(pr.max()))
         # the same distance between the continuous penalty pressure fields
         xf, pf = pressure_field(res)
-        xfr, pfr = pressure_field(ref)
-        o, orr = np.argsort(xf[:, 0]), np.argsort(xfr[:, 0])
-        out["l2_ref_field"] = profile_error(xf[o, 0] / href.a, pf[o], xfr[orr, 0] / href.a, pfr[orr],
-                                            1.2, float(pfr.max()))
+        o = np.argsort(xf[:, 0])
+        out["l2_ref_field"] = profile_error(xf[o, 0] / a_ref, pf[o], xfr / a_ref, pfr, 1.2,
+                                            float(pfr.max()))
     return out
 
 

@@ -5,7 +5,7 @@ module test_sparse
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, error_code
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
     use voiga_solver_umfpack, only: umfpack_t, dp_is_c_double
     use voiga_test_fixtures, only: lcg_t
     implicit none
@@ -21,6 +21,7 @@ contains
                     new_unittest('kinds_match_c', test_kinds), &
                     new_unittest('chain_pattern', test_chain_pattern), &
                     new_unittest('bad_pattern_input', test_bad_pattern), &
+                    new_unittest('pattern_positions', test_pattern_positions), &
                     new_unittest('assembly_matvec_dense', test_assembly), &
                     new_unittest('missed_entries_counted', test_missed), &
                     new_unittest('fix_dofs', test_fix_dofs), &
@@ -80,6 +81,34 @@ contains
         if (allocated(error)) return
         call check(error, a%index_of(6, 6), 14, 'isolated DOF keeps its diagonal')
     end subroutine test_chain_pattern
+
+    !> Entries of one pattern found in another (a contact coupling added and one
+    !> removed, as when the contact pattern is rebuilt): every entry of the old
+    !> pattern maps to the same (row, column) of the new one, or to 0 when the new
+    !> one lacks it.
+    subroutine test_pattern_positions(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t) :: old, new
+        integer, allocatable :: old2new(:)
+        integer :: j, p, i
+
+        ! chain (1,2), (2,3), (3,4) plus a coupling (1,4); then the chain plus (2,5)
+        call new_csc_pattern(old, 5, [1, 3, 5, 7, 9], [1, 2, 2, 3, 3, 4, 1, 4], error)
+        if (allocated(error)) return
+        call new_csc_pattern(new, 5, [1, 3, 5, 7, 9], [1, 2, 2, 3, 3, 4, 2, 5], error)
+        if (allocated(error)) return
+        call pattern_positions(old, new, old2new)
+        call check(error, size(old2new), old%nnz(), 'one position per old entry')
+        if (allocated(error)) return
+        do j = 1, old%n
+            do p = old%colptr(j) + 1, old%colptr(j + 1)
+                i = old%rowind(p) + 1
+                call check(error, old2new(p), new%index_of(i, j), 'position of an old entry')
+                if (allocated(error)) return
+            end do
+        end do
+        call check(error, count(old2new == 0), 2, 'the removed coupling (1,4), (4,1) has no position')
+    end subroutine test_pattern_positions
 
     subroutine test_bad_pattern(error)
         type(error_t), allocatable, intent(out) :: error

@@ -10,7 +10,8 @@ import pytest
 
 from post.figures import accuracy_cost
 from post.measures import detrended_amplitude, profile_error
-from post.sweep import find_cases, summarize, sweep, up_to_date, write_summary
+from post.sweep import (estimated_cost, find_cases, longest_first, previous_times, summarize, sweep,
+                        up_to_date, write_summary)
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -113,3 +114,30 @@ def test_ironing_relative_oscillation(monkeypatch: pytest.MonkeyPatch) -> None:
     assert m["osc_px"] == pytest.approx(m["amp_px"] / abs(m["mean_px"]))
     assert m["osc_py"] == pytest.approx(m["amp_py"] / abs(m["mean_py"]))
     assert 0.005 < m["osc_px"] < 0.011 and 0.01 < m["osc_py"] < 0.021
+
+
+def test_longest_first_from_previous_times_and_estimates(tmp_path: Path) -> None:
+    """Runs are started longest first: by the wall times of a previous summary where
+    it has them, else by the estimate from the case file scaled to those times."""
+    runs = find_cases(REPO / "cases", tmp_path, ["ironing", "hertz"], ["m1", "m4"], ["N2", "N6"])
+    labels = {r.label for r in runs}
+    assert {"ironing/m4-N6", "ironing/m4-N2", "ironing/m1-N2", "hertz/m1-N2", "hertz/m4-N2"} <= labels
+    cost = {r.label: estimated_cost(r.case) for r in runs}
+    # more elements, higher degree and more steps cost more
+    assert cost["ironing/m4-N6"] > cost["ironing/m4-N2"] > cost["ironing/m1-N2"] > cost["hertz/m1-N2"]
+    assert cost["hertz/m4-N2"] > cost["hertz/m1-N2"]
+    assert longest_first(runs)[0].label == "ironing/m4-N6"
+    # measured times override the estimate; the others are scaled by the median ratio
+    summary = tmp_path / "summary.csv"
+    with summary.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["scene", "mesh", "layout", "wall_s", "status"])
+        w.writeheader()
+        w.writerow({"scene": "hertz", "mesh": "m1", "layout": "N2", "wall_s": "100", "status": "converged"})
+        w.writerow({"scene": "ironing", "mesh": "m1", "layout": "N2", "wall_s": "1", "status": "converged"})
+        w.writerow({"scene": "hertz", "mesh": "m4", "layout": "N2", "wall_s": "5", "status": "failed: x"})
+    times = previous_times(summary)
+    assert times == {"hertz/m1-N2": 100.0, "ironing/m1-N2": 1.0}
+    order = [r.label for r in longest_first(runs, times)]
+    assert order.index("hertz/m1-N2") < order.index("ironing/m1-N2")
+    assert order.index("ironing/m4-N6") < order.index("ironing/m4-N2")
+    assert previous_times(tmp_path / "none.csv") == {}

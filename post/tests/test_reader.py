@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -13,7 +14,7 @@ import pytest
 
 from post.reader import STAGES, body_displacement, decode, reaction_history, read_result
 
-from .conftest import DIE_SHIFT, NU, STRAIN, exact_stretch
+from .conftest import CASES, DIE_SHIFT, NU, STRAIN, exact_stretch
 
 TOL = 1e-12
 
@@ -202,3 +203,60 @@ def test_incomplete_step_is_skipped(running_h5: Path) -> None:
 def test_missing_file(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         read_result(tmp_path / "nothing.h5")
+
+
+@pytest.fixture(scope="module")
+def hertz_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Result of the committed case hertz m1 N2 (rigid flat, 5 steps, contact output)."""
+    folder = tmp_path_factory.mktemp("hertz")
+    for name in ("geometry.h5", "m1-N2.nml"):
+        shutil.copy(CASES / "hertz" / name, folder / name)
+    subprocess.run([str(voiga), "m1-N2.nml", "--quiet"], cwd=folder, check=True, timeout=120,
+                   capture_output=True, stdin=subprocess.DEVNULL)
+    return folder / "m1-N2.h5"
+
+
+@pytest.mark.parametrize("which", ["two", "hertz"])
+def test_lazy_read_gives_the_same_values(which: str, request: pytest.FixtureRequest) -> None:
+    """read_result(lazy=True) reads the summary's scalars and the reactions of every
+    step at once and the rest of a step on first use; every value equals the eager read."""
+    path = request.getfixturevalue(f"{which}_h5")
+    eager, lazy = read_result(path), read_result(path, lazy=True)
+    assert lazy.attrs == eager.attrs and list(lazy.bodies) == list(eager.bodies)
+    assert [s.step for s in lazy.steps] == [s.step for s in eager.steps]
+    assert len(eager.steps) == {"two": 3, "hertz": 5}[which]
+    for a, b in zip(lazy.steps, eager.steps):
+        assert (a.iterations, a.cuts, a.seconds) == (b.iterations, b.cuts, b.seconds)
+        np.testing.assert_array_equal(a.reactions, b.reactions)
+        assert not a._data  # nothing else read yet
+    for a, b in zip(lazy.steps, eager.steps):
+        np.testing.assert_array_equal(a.displacement, b.displacement)
+        assert (a.time, a.substeps) == (b.time, b.substeps)
+        np.testing.assert_array_equal(a.residual_norms, b.residual_norms)
+        np.testing.assert_array_equal(a.energy_norms, b.energy_norms)
+        assert len(a.contact) == len(b.contact) == {"two": 0, "hertz": 1}[which]
+        for ca, cb in zip(a.contact, b.contact):
+            assert (ca.slave, ca.master, ca.attrs) == (cb.slave, cb.master, cb.attrs)
+            for key in ("force", "xi_slave", "x_ref", "x", "gap", "p_n", "p_t", "xi_master", "state"):
+                np.testing.assert_array_equal(getattr(ca, key), getattr(cb, key))
+    for name in eager.bodies:
+        np.testing.assert_array_equal(body_displacement(lazy, name), body_displacement(eager, name))
+    for k in range(len(eager.dirichlet)):
+        for x, y in zip(reaction_history(lazy, k), reaction_history(eager, k)):
+            np.testing.assert_array_equal(x, y)
+
+
+def test_lazy_read_checks_the_displacement_when_used(two_h5: Path, tmp_path: Path) -> None:
+    """A lazy read defers the displacement-length check of a step to its first use."""
+    path = tmp_path / "short.h5"
+    shutil.copy(two_h5, path)
+    with h5py.File(path, "r+") as f:
+        d = f["steps/000002/displacement"][()]
+        del f["steps/000002/displacement"]
+        f["steps/000002/displacement"] = d[:-2]
+    with pytest.raises(ValueError, match="displacement has"):
+        read_result(path)
+    res = read_result(path, lazy=True)
+    assert len(res.steps[0].displacement) == res.n_dofs
+    with pytest.raises(ValueError, match="displacement has"):
+        res.steps[1].displacement

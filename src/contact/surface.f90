@@ -73,12 +73,15 @@ contains
 
     !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
     !> forces the knot span (0: found from xi), so that a point on an element
-    !> boundary can be evaluated from either side.
+    !> boundary can be evaluated from either side. Every component of `pt` is set;
+    !> its arrays are reused when they have the right size (a projection evaluates
+    !> the curve some ten times per slave point: allocating them afresh each time
+    !> was a third of the contact time).
     pure subroutine surface_point(self, u, xi, pt, span)
         type(contact_surface_t), intent(in) :: self
         real(dp), intent(in) :: u(:)
         real(dp), intent(in) :: xi
-        type(surface_point_t), intent(out) :: pt
+        type(surface_point_t), intent(inout) :: pt
         integer, intent(in), optional :: span
         real(dp) :: ders(3, self%degree + 1), dr(1, self%degree + 1), d2r(1, self%degree + 1), x(2)
         integer :: s, p, k, id
@@ -89,7 +92,11 @@ contains
             if (span > 0) s = span
         end if
         ders = basis_ders(self%knots, p, s, xi, 2)
-        allocate (pt%r(p + 1), pt%dr(p + 1), pt%d2r(p + 1), pt%local(p + 1), pt%dofs(2*(p + 1)))
+        call reuse(pt%r, p + 1)
+        call reuse(pt%dr, p + 1)
+        call reuse(pt%d2r, p + 1)
+        call reuse_int(pt%local, p + 1)
+        call reuse_int(pt%dofs, 2*(p + 1))
         call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), pt%r, dr, d2r)
         pt%dr = dr(1, :)
         pt%d2r = d2r(1, :)
@@ -106,6 +113,26 @@ contains
             pt%a = pt%a + pt%dr(k)*x
             pt%a2 = pt%a2 + pt%d2r(k)*x
         end do
+    contains
+        pure subroutine reuse(a, n)
+            real(dp), allocatable, intent(inout) :: a(:)
+            integer, intent(in) :: n
+            if (allocated(a)) then
+                if (size(a) == n) return
+                deallocate (a)
+            end if
+            allocate (a(n))
+        end subroutine reuse
+
+        pure subroutine reuse_int(a, n)
+            integer, allocatable, intent(inout) :: a(:)
+            integer, intent(in) :: n
+            if (allocated(a)) then
+                if (size(a) == n) return
+                deallocate (a)
+            end if
+            allocate (a(n))
+        end subroutine reuse_int
     end subroutine surface_point
 
 end module voiga_contact_surface

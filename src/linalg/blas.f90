@@ -8,7 +8,7 @@ module voiga_linalg_blas
     implicit none
     private
 
-    public :: gemm_tn
+    public :: gemm_tn, gemm_nt
 
     interface
         pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
@@ -31,5 +31,14 @@ contains
         call dgemm('T', 'N', size(a, 2), size(b, 2), size(a, 1), 1.0_dp, a, size(a, 1), &
                    b, size(b, 1), beta, c, size(c, 1))
     end subroutine gemm_tn
+
+    !> c = beta c + a b^T, with a [m, k], b [n, k], c [m, n] (contiguous arrays).
+    pure subroutine gemm_nt(a, b, c, beta)
+        real(dp), intent(in) :: a(:, :), b(:, :)
+        real(dp), intent(inout) :: c(:, :)
+        real(dp), intent(in) :: beta
+        call dgemm('N', 'T', size(a, 1), size(b, 1), size(a, 2), 1.0_dp, a, size(a, 1), &
+                   b, size(b, 1), beta, c, size(c, 1))
+    end subroutine gemm_nt
 
 end module voiga_linalg_blas

@@ -2,7 +2,7 @@
 !> sigma = lambda tr(eps) I + 2 mu eps, eps = sym(grad u).
 module voiga_material_linear
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, delta
+    use voiga_material, only: material_t, identity2
     implicit none
     private
 
@@ -31,8 +31,8 @@ contains
             do k = 1, 2
                 do j = 1, 2
                     do i = 1, 2
-                        c(i, j, k, l) = self%lambda*delta(i, j)*delta(k, l) + &
-                                        self%mu*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+                        c(i, j, k, l) = self%lambda*identity2(i, j)*identity2(k, l) + &
+                                        self%mu*(identity2(i, k)*identity2(j, l) + identity2(i, l)*identity2(j, k))
                     end do
                 end do
             end do

@@ -10,7 +10,11 @@ module voiga_material
     implicit none
     private
 
-    public :: material_t, lame_from_young, delta
+    public :: material_t, lame_from_young, delta, identity2
+
+    !> The 2 x 2 identity: delta(i, j) as a constant array, for the inner loops of
+    !> the laws (a lookup instead of a call; same values as `delta`).
+    real(dp), parameter :: identity2(2, 2) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2])
 
     !> A material law.
     type, abstract :: material_t

@@ -7,7 +7,7 @@
 !>     + 2 mu/3 [ tr(bbar) (I_s + I(x)I/3) - bbar(x)I - I(x)bbar ].
 module voiga_material_neohookean
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, delta
+    use voiga_material, only: material_t, identity2
     implicit none
     private
 
@@ -53,11 +53,11 @@ contains
             do k = 1, 2
                 do j = 1, 2
                     do i = 1, 2
-                        isym = 0.5_dp*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
-                        c(i, j, k, l) = self%kappa*jac**2*delta(i, j)*delta(k, l) &
+                        isym = 0.5_dp*(identity2(i, k)*identity2(j, l) + identity2(i, l)*identity2(j, k))
+                        c(i, j, k, l) = self%kappa*jac**2*identity2(i, j)*identity2(k, l) &
                                         - self%kappa*(jac**2 - 1.0_dp)*isym &
-                                        + 2.0_dp*self%mu/3.0_dp*(trbbar*(isym + delta(i, j)*delta(k, l)/3.0_dp) &
-                                                                 - bbar(i, j)*delta(k, l) - delta(i, j)*bbar(k, l))
+                                        + 2.0_dp*self%mu/3.0_dp*(trbbar*(isym + identity2(i, j)*identity2(k, l)/3.0_dp) &
+                                                                 - bbar(i, j)*identity2(k, l) - identity2(i, j)*bbar(k, l))
                     end do
                 end do
             end do

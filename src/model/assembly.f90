@@ -7,7 +7,7 @@ module voiga_model_assembly
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
     use voiga_contact_pair, only: pair_contribution, pair_wanted_ranges, pair_element_dofs
     implicit none
     private
@@ -164,7 +164,10 @@ contains
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
     !> When a contact point falls outside the stiffness pattern, the pattern (and
-    !> `map`) is rebuilt and the whole assembly done again.
+    !> `map`) is rebuilt and the contact part evaluated again. With `k` and `map`
+    !> and a deformable master, the bulk part (elements and external forces) is kept
+    !> from before the contact part and carried into the new pattern instead of being
+    !> assembled again (the same numbers: the bulk part does not depend on the pattern).
     subroutine assemble(model, u, t, r, stats, error, k, map, refit)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
@@ -181,12 +184,23 @@ contains
         !> (`pair_wanted_ranges`), rebuilt only if a range changed. The pattern then
         !> depends on `u` only, so a restarted run gets the same patterns.
         logical, intent(in), optional :: refit
+        ! bulk residual [ndof] and stiffness values [nnz], kept for a rebuild
+        real(dp), allocatable :: r_bulk(:), k_bulk(:)
         integer :: pass, ip
-        logical :: fit
+        logical :: fit, keep
         fit = .false.
         if (present(refit)) fit = refit .and. present(k)
+        keep = .false.
+        if (present(k) .and. present(map)) &
+            keep = any([(model%pairs(ip)%master%deformable, ip=1, size(model%pairs))])
+        call assemble_bulk(model, u, t, r, stats, error, k, map)
+        if (allocated(error)) return
+        if (keep) then
+            r_bulk = r
+            k_bulk = k%values
+        end if
         do pass = 1, 3
-            call assemble_once(model, u, t, r, stats, error, k, map)
+            call assemble_contact(model, u, r, stats, error, k)
             if (allocated(error) .or. .not. present(k)) return
             if (fit) then
                 fit = .false.
@@ -201,23 +215,69 @@ contains
             do ip = 1, size(model%pairs)
                 model%pairs(ip)%pattern_miss = .false.
             end do
-            call rebuild_pattern(model, k, error, map)
+            if (keep) then
+                call rebuild_pattern(model, k, error, map, k_bulk)
+            else
+                call rebuild_pattern(model, k, error, map)
+            end if
             if (allocated(error)) return
             stats%pattern_rebuilds = stats%pattern_rebuilds + 1
+            if (keep) then
+                r = r_bulk
+                k%values = k_bulk
+            else
+                call assemble_bulk(model, u, t, r, stats, error, k, map)
+                if (allocated(error)) return
+            end if
         end do
         call fatal_error(error, 'contact: the stiffness pattern still misses contact couplings '// &
                          'after two rebuilds', error_code%numeric)
     end subroutine assemble
 
-    !> Rebuild the stiffness pattern `k` (values lost) and, if given, `map`.
-    subroutine rebuild_pattern(model, k, error, map)
+    !> Rebuild the stiffness pattern `k` (values lost) and, if given, `map`. The
+    !> map's positions are translated from the old pattern to the new one (every
+    !> bulk entry is in both); `k_bulk` [nnz of the old pattern], if given, is carried
+    !> into the new pattern (entries the new one lacks must be zero: bulk values
+    !> before any contact part).
+    subroutine rebuild_pattern(model, k, error, map, k_bulk)
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(inout) :: k
         type(error_t), allocatable, intent(out) :: error
         type(assembly_map_t), intent(inout), optional :: map
+        real(dp), allocatable, intent(inout), optional :: k_bulk(:)
+        type(csc_matrix_t) :: old
+        integer, allocatable :: old2new(:)
+        real(dp), allocatable :: moved(:)
+        integer :: p
+
+        if (.not. present(map)) then
+            call stiffness_pattern(model, k, error)
+            return
+        end if
+        old%n = k%n
+        call move_alloc(k%colptr, old%colptr)
+        call move_alloc(k%rowind, old%rowind)
         call stiffness_pattern(model, k, error)
         if (allocated(error)) return
-        if (present(map)) call new_assembly_map(model, k, map)
+        call pattern_positions(old, k, old2new)
+        if (all(old2new(map%pos) > 0)) then
+            map%pos = old2new(map%pos)
+        else
+            call new_assembly_map(model, k, map)
+        end if
+        if (present(k_bulk)) then
+            allocate (moved(k%nnz()), source=0.0_dp)
+            do p = 1, size(old2new)
+                if (old2new(p) > 0) then
+                    moved(old2new(p)) = k_bulk(p)
+                else if (k_bulk(p) /= 0.0_dp) then
+                    call fatal_error(error, 'rebuild_pattern: the new stiffness pattern lacks a '// &
+                                     'bulk entry')
+                    return
+                end if
+            end do
+            call move_alloc(moved, k_bulk)
+        end if
     end subroutine rebuild_pattern
 
     !> Fit the contact ranges of every deformable-master pair to its last evaluation
@@ -243,8 +303,9 @@ contains
         end do
     end function refit_contact_ranges
 
-    !> One pass of `assemble`.
-    subroutine assemble_once(model, u, t, r, stats, error, k, map)
+    !> The bulk part of `assemble`: every element's internal force and tangent, and
+    !> the external forces (r = f_int - f_ext; `k` zeroed first).
+    subroutine assemble_bulk(model, u, t, r, stats, error, k, map)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         real(dp), intent(in) :: t
@@ -255,7 +316,7 @@ contains
         type(assembly_map_t), intent(in), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
-        integer :: ib, e, n, npts, ip, idx
+        integer :: ib, e, n, npts, idx
         logical :: ok
         character(len=64) :: buf
         integer(i8) :: c0, c1, rate
@@ -286,9 +347,7 @@ contains
                     r(dofs) = r(dofs) + fe
                     if (present(k)) then
                         if (present(map)) then
-                            associate (pos => map%pos(map%ptr(idx):map%ptr(idx + 1) - 1))
-                                k%values(pos) = k%values(pos) + reshape(ke, [n*n])
-                            end associate
+                            call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ke)
                         else
                             call k%add_element(dofs, ke)
                         end if
@@ -309,23 +368,54 @@ contains
         end block
         call system_clock(c1)
         stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
+    end subroutine assemble_bulk
+
+    !> values(pos(i)) += ke(i) for the entries of an element matrix in column-major
+    !> order (positions from `new_assembly_map`).
+    pure subroutine add_mapped(values, pos, ke)
+        real(dp), intent(inout) :: values(:)
+        integer, intent(in) :: pos(:)
+        real(dp), intent(in) :: ke(:, :)
+        integer :: a, b, i
+        i = 0
+        do b = 1, size(ke, 2)
+            do a = 1, size(ke, 1)
+                i = i + 1
+                values(pos(i)) = values(pos(i)) + ke(a, b)
+            end do
+        end do
+    end subroutine add_mapped
+
+    !> The contact part of `assemble`: every pair's residual and tangent, added to
+    !> `r` and `k`.
+    subroutine assemble_contact(model, u, r, stats, error, k)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        type(assembly_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout), optional :: k
+        integer :: ip
+        integer(i8) :: c0, c1, rate
+
+        call system_clock(c0, rate)
         do ip = 1, size(model%pairs)
             if (present(k)) then
                 call pair_contribution(model%pairs(ip), u, r, error, add_to_k)
             else
                 call pair_contribution(model%pairs(ip), u, r, error)
             end if
-            if (allocated(error)) return
+            if (allocated(error)) exit
         end do
-        call system_clock(c0)
-        stats%seconds_contact = stats%seconds_contact + real(c0 - c1, dp)/real(rate, dp)
+        call system_clock(c1)
+        stats%seconds_contact = stats%seconds_contact + real(c1 - c0, dp)/real(rate, dp)
     contains
         subroutine add_to_k(dofs, kl)
             integer, intent(in) :: dofs(:)
             real(dp), intent(in) :: kl(:, :)
             call k%add_element(dofs, kl)
         end subroutine add_to_k
-    end subroutine assemble_once
+    end subroutine assemble_contact
 
     !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the
     !> reference edge, N the outward unit normal.

@@ -33,7 +33,8 @@ contains
         real(dp), intent(out) :: dr(:, :)
         !> NURBS second derivatives, shape [npar*(npar+1)/2, nfun].
         real(dp), intent(out) :: d2r(:, :)
-        real(dp) :: ww, dw(size(db, 1)), d2w(size(d2b, 1))
+        ! fixed sizes (npar <= 2): no heap allocation per call
+        real(dp) :: ww, dw(2), d2w(3)
         integer :: a, npar, i, j, k
 
         npar = size(db, 1)

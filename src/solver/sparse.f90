@@ -13,7 +13,7 @@ module voiga_solver_sparse
     implicit none
     private
 
-    public :: csc_matrix_t, new_csc_pattern
+    public :: csc_matrix_t, new_csc_pattern, pattern_positions
 
     !> A square n x n matrix in compressed-sparse-column form (0-based indices).
     type :: csc_matrix_t
@@ -213,6 +213,32 @@ contains
         self%n = n
         self%missed = 0
     end subroutine new_csc_pattern
+
+    !> Where each stored entry of `old` is in `new` (same n, both patterns from
+    !> `new_csc_pattern`): `old2new(p)` is the index into `new%values` of the entry
+    !> `old` stores at index p, 0 when `new` does not store it; shape: [nnz of old].
+    !> One merge of the sorted rows of each column, O(nnz(old) + nnz(new)): values
+    !> and cached element positions move to a rebuilt pattern without any search.
+    pure subroutine pattern_positions(old, new, old2new)
+        type(csc_matrix_t), intent(in) :: old, new
+        integer, allocatable, intent(out) :: old2new(:)
+        integer :: j, p, q, qend
+
+        allocate (old2new(old%nnz()))
+        old2new = 0
+        do j = 1, min(old%n, new%n)
+            q = new%colptr(j) + 1
+            qend = new%colptr(j + 1)
+            do p = old%colptr(j) + 1, old%colptr(j + 1)
+                do while (q <= qend)
+                    if (new%rowind(q) >= old%rowind(p)) exit
+                    q = q + 1
+                end do
+                if (q > qend) exit
+                if (new%rowind(q) == old%rowind(p)) old2new(p) = q
+            end do
+        end do
+    end subroutine pattern_positions
 
     !> Set every stored value to zero (the pattern and `missed` are kept).
     pure subroutine csc_zero(self)

@@ -21,6 +21,17 @@ module voiga_solver_umfpack
     integer, parameter :: umfpack_control = 20, umfpack_info = 90
     !> `sys` argument of umfpack_di_solve: solve A x = b.
     integer(c_int), parameter :: umfpack_a = 0
+    !> Control(UMFPACK_IRSTEP) (0-based in C): most iterative refinement steps of a solve.
+    integer, parameter :: umfpack_irstep = 7
+    !> A solve refines its solution iteratively (UMFPACK's default, at most 2 steps)
+    !> only when the reciprocal condition estimate of the factorization is below this.
+    !> A refinement step costs a residual and a second solve (solve with refinement
+    !> 8 ms, without 2 ms on ironing m4 N6); in a Newton iteration the next residual
+    !> corrects a direction that is off by rounding anyway, so only a badly
+    !> conditioned matrix needs it. Measured rcond: hertz 6e-3..2e-2, ironing and
+    !> ironing-deep 1.4e-3..8e-2 (not refined); rings 4e-4..1.3e-3 and stiff penalties
+    !> (ironing with 1e4 x E: 6e-7..8e-2, median 2e-4) keep the refinement.
+    real(dp), parameter :: refine_below_rcond = 1.0e-3_dp
     !> Info(UMFPACK_RCOND) (0-based in C): reciprocal condition estimate.
     integer, parameter :: umfpack_rcond = 67
 
@@ -191,7 +202,8 @@ contains
 
     !> Solve A x = b with the current numeric factorization. `a` must be the
     !> matrix last passed to `factorize` (UMFPACK uses it for iterative
-    !> refinement); its pattern is checked, its values are not.
+    !> refinement, done only when rcond < `refine_below_rcond`); its pattern is
+    !> checked, its values are not.
     subroutine umfpack_solve(self, a, b, x, error)
         class(umfpack_t), intent(in) :: self
         !> The factorized matrix.
@@ -224,6 +236,7 @@ contains
             return
         end if
         call umfpack_di_defaults(control)
+        if (self%rcond >= refine_below_rcond) control(umfpack_irstep + 1) = 0.0_c_double
         status = umfpack_di_solve(umfpack_a, a%colptr, a%rowind, a%values, x, b, &
                                   self%numeric, control, info)
         if (status /= umfpack_ok) then
