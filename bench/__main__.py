@@ -141,6 +141,10 @@ def section_scaling(w: Workdir, repeat: int, levels: int) -> dict:
     fits = {}
     spans = [(i, i + 1) for i in range(max(0, len(rows) - 3), len(rows) - 1)]
     spans.append((max(0, len(rows) - 3), len(rows) - 1))
+    # issue 7's range: every mesh from 1e4 DOFs on (lsq), when there are at least three
+    big = [i for i, r in enumerate(rows) if r["dofs"] >= 1e4]
+    if len(big) >= 3 and (big[0], big[-1]) not in spans:
+        spans.append((big[0], big[-1]))
     for i, j in spans:
         sel = rows[i:j + 1]
         n = [r["dofs"] for r in sel]

@@ -344,7 +344,9 @@ contains
         end if
     end subroutine check_matrix
 
-    !> Error naming the routine and the meaning of a non-OK status.
+    !> Error naming the routine and the meaning of a non-OK status; code `numeric`
+    !> (the load step may be cut) except for running out of memory (generic: the run
+    !> ends, a smaller increment needs as much memory).
     subroutine status_error(error, routine, status)
         type(error_t), allocatable, intent(out) :: error
         character(len=*), intent(in) :: routine
@@ -352,8 +354,16 @@ contains
         character(len=16) :: num
 
         write (num, '(i0)') status
-        call fatal_error(error, routine//' failed: '//status_meaning(status)// &
-                         ' (UMFPACK status '//trim(num)//')', error_code%numeric)
+        if (status == umfpack_error_out_of_memory) then
+            ! not a numerical failure: a smaller increment would not need less memory
+            call fatal_error(error, routine//' failed: '//status_meaning(status)// &
+                             ' (UMFPACK status '//trim(num)//'): the LU factors of the '// &
+                             'stiffness matrix need more memory than UMFPACK (32-bit integer '// &
+                             'version) could allocate; a coarser mesh or a lower degree needs less')
+        else
+            call fatal_error(error, routine//' failed: '//status_meaning(status)// &
+                             ' (UMFPACK status '//trim(num)//')', error_code%numeric)
+        end if
     end subroutine status_error
 
     !> Meaning of an UMFPACK status code (umfpack.h names).
