@@ -31,6 +31,7 @@ contains
                     new_unittest('umfpack_pattern_change', test_pattern_change), &
                     new_unittest('umfpack_singular', test_singular), &
                     new_unittest('umfpack_determinant', test_determinant), &
+                    new_unittest('umfpack_64bit_indices', test_wide), &
                     new_unittest('umfpack_misuse', test_misuse) &
                     ]
     end subroutine collect_sparse
@@ -525,6 +526,35 @@ contains
         if (allocated(error)) return
         call check(error, log_det, 199*log10(5.0_dp) + log10(3.0_dp), 'log10 |det|', rel=1.0e-12_dp)
     end subroutine test_determinant
+
+    !> The 64-bit-index version (used after the 32-bit one ran out of memory):
+    !> same solution, determinant sign, refactorization with the symbolic reused.
+    subroutine test_wide(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: m = 30
+        type(csc_matrix_t) :: a
+        type(umfpack_t) :: lu
+        type(lcg_t) :: rng
+        integer :: sgn
+        real(dp) :: log_det
+
+        call laplacian(m, a, reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]), error)
+        if (allocated(error)) return
+        lu%wide = .true.
+        call lu%factorize(a, error)
+        if (allocated(error)) return
+        call solve_and_check(lu, a, random_vector(rng, m*m), 'laplacian, 64-bit', error)
+        if (allocated(error)) return
+        call lu%determinant(sgn, log_det, error)
+        if (allocated(error)) return
+        call check(error, sgn, 1, 'det of an SPD matrix, 64-bit')
+        if (allocated(error)) return
+        call lu%factorize(a, error)
+        if (allocated(error)) return
+        call check(error, lu%n_symbolic, 1, 'symbolic analysis reused, 64-bit')
+        if (allocated(error)) return
+        call check(error, lu%wide, 'still 64-bit')
+    end subroutine test_wide
 
     subroutine test_pattern_change(error)
         type(error_t), allocatable, intent(out) :: error

@@ -1,14 +1,17 @@
-!> Direct sparse LU solves with UMFPACK (SuiteSparse), `int`/`double` version.
+!> Direct sparse LU solves with UMFPACK (SuiteSparse), `double` values with `int` or, for large matrices, `long` indices.
 !>
 !> `umfpack_t` owns the opaque Symbolic and Numeric objects of UMFPACK. The
 !> symbolic analysis (fill-reducing ordering) depends only on the sparsity
 !> pattern, which stays fixed over a simulation, so `factorize` redoes it only
 !> when the pattern changes; every call redoes the numeric LU. Every UMFPACK
 !> status other than `UMFPACK_OK` becomes an `error_t` naming the routine and
-!> the status, and no handle is leaked on any path. The raw C interfaces are
+!> the status, and no handle is leaked on any path. The 32-bit-index version
+!> (umfpack_di_*) is used until it runs out of memory (it cannot index the
+!> factors of about 1.7e6 DOFs); the factorization is then redone, and every
+!> later one done, with the 64-bit version (umfpack_dl_*). The raw C interfaces are
 !> private to this module.
 module voiga_solver_umfpack
-    use, intrinsic :: iso_c_binding, only: c_int, c_double, c_ptr, c_null_ptr, c_associated
+    use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr, c_null_ptr, c_associated
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_solver_sparse, only: csc_matrix_t
@@ -65,11 +68,18 @@ module voiga_solver_umfpack
         !> UMFPACK's reciprocal condition estimate of the last numeric
         !> factorization (read only; 0 when there is none).
         real(dp) :: rcond = 0.0_dp
+        !> Use UMFPACK's 64-bit-index version (umfpack_dl_*). Set by `factorize`
+        !> when the 32-bit version runs out of memory (its factors are indexed by
+        !> 32-bit integers: about 1.7e6 DOFs of a 2D p = 2 mesh are too many) and
+        !> kept from then on; may be set before the first factorization.
+        logical :: wide = .false.
         type(c_ptr), private :: symbolic = c_null_ptr
         type(c_ptr), private :: numeric = c_null_ptr
         !> Pattern the symbolic analysis was computed for; shapes: [n+1], [nnz].
         integer, private :: n = 0
         integer(c_int), allocatable, private :: colptr(:), rowind(:)
+        !> The same pattern with 64-bit indices (only when `wide`).
+        integer(c_long), allocatable, private :: colptr_l(:), rowind_l(:)
     contains
         !> Symbolic analysis (when needed) and numeric LU of a matrix.
         procedure :: factorize => umfpack_factorize
@@ -137,6 +147,63 @@ module voiga_solver_umfpack
             integer(c_int) :: status
         end function umfpack_di_get_determinant
 
+        function umfpack_dl_symbolic(n_row, n_col, ap, ai, ax, symbolic, control, info) &
+            result(status) bind(c, name='umfpack_dl_symbolic')
+            import :: c_long, c_double, c_ptr
+            integer(c_long), value :: n_row, n_col
+            integer(c_long), intent(in) :: ap(*), ai(*)
+            real(c_double), intent(in) :: ax(*)
+            type(c_ptr), intent(out) :: symbolic
+            real(c_double), intent(in) :: control(*)
+            real(c_double), intent(out) :: info(*)
+            integer(c_long) :: status
+        end function umfpack_dl_symbolic
+
+        function umfpack_dl_numeric(ap, ai, ax, symbolic, numeric, control, info) &
+            result(status) bind(c, name='umfpack_dl_numeric')
+            import :: c_long, c_double, c_ptr
+            integer(c_long), intent(in) :: ap(*), ai(*)
+            real(c_double), intent(in) :: ax(*)
+            type(c_ptr), value :: symbolic
+            type(c_ptr), intent(out) :: numeric
+            real(c_double), intent(in) :: control(*)
+            real(c_double), intent(out) :: info(*)
+            integer(c_long) :: status
+        end function umfpack_dl_numeric
+
+        function umfpack_dl_solve(sys, ap, ai, ax, x, b, numeric, control, info) &
+            result(status) bind(c, name='umfpack_dl_solve')
+            import :: c_long, c_double, c_ptr
+            integer(c_long), value :: sys
+            integer(c_long), intent(in) :: ap(*), ai(*)
+            real(c_double), intent(in) :: ax(*)
+            real(c_double), intent(out) :: x(*)
+            real(c_double), intent(in) :: b(*)
+            type(c_ptr), value :: numeric
+            real(c_double), intent(in) :: control(*)
+            real(c_double), intent(out) :: info(*)
+            integer(c_long) :: status
+        end function umfpack_dl_solve
+
+        function umfpack_dl_get_determinant(mx, ex, numeric, info) result(status) &
+            bind(c, name='umfpack_dl_get_determinant')
+            import :: c_long, c_double, c_ptr
+            real(c_double), intent(out) :: mx, ex
+            type(c_ptr), value :: numeric
+            real(c_double), intent(out) :: info(*)
+            integer(c_long) :: status
+        end function umfpack_dl_get_determinant
+
+        subroutine umfpack_dl_free_symbolic(symbolic) bind(c, name='umfpack_dl_free_symbolic')
+            import :: c_ptr
+            type(c_ptr), intent(inout) :: symbolic
+        end subroutine umfpack_dl_free_symbolic
+
+        subroutine umfpack_dl_free_numeric(numeric) bind(c, name='umfpack_dl_free_numeric')
+            import :: c_ptr
+            type(c_ptr), intent(inout) :: numeric
+        end subroutine umfpack_dl_free_numeric
+
         subroutine umfpack_di_free_symbolic(symbolic) bind(c, name='umfpack_di_free_symbolic')
             import :: c_ptr
             type(c_ptr), intent(inout) :: symbolic
@@ -174,26 +241,48 @@ contains
         call umfpack_di_defaults(control)
 
         call free_numeric(self)
-        if (.not. c_associated(self%symbolic) .or. .not. same_pattern(self, a)) then
-            call free_symbolic(self)
-            status = umfpack_di_symbolic(int(a%n, c_int), int(a%n, c_int), a%colptr, &
-                                         a%rowind, a%values, self%symbolic, control, info)
-            if (status /= umfpack_ok) then
+        do
+            if (.not. c_associated(self%symbolic) .or. .not. same_pattern(self, a)) then
                 call free_symbolic(self)
-                call status_error(error, 'umfpack_di_symbolic', status)
-                return
+                if (self%wide) then
+                    self%colptr_l = int(a%colptr, c_long)
+                    self%rowind_l = int(a%rowind, c_long)
+                    status = int(umfpack_dl_symbolic(int(a%n, c_long), int(a%n, c_long), self%colptr_l, &
+                                                     self%rowind_l, a%values, self%symbolic, control, info), c_int)
+                else
+                    status = umfpack_di_symbolic(int(a%n, c_int), int(a%n, c_int), a%colptr, &
+                                                 a%rowind, a%values, self%symbolic, control, info)
+                end if
+                if (status /= umfpack_ok) then
+                    call free_symbolic(self)
+                    call status_error(error, merge('umfpack_dl_symbolic', 'umfpack_di_symbolic', self%wide), &
+                                      status)
+                    return
+                end if
+                self%n = a%n
+                self%colptr = a%colptr
+                self%rowind = a%rowind
+                self%n_symbolic = self%n_symbolic + 1
             end if
-            self%n = a%n
-            self%colptr = a%colptr
-            self%rowind = a%rowind
-            self%n_symbolic = self%n_symbolic + 1
-        end if
-
-        status = umfpack_di_numeric(a%colptr, a%rowind, a%values, self%symbolic, &
-                                    self%numeric, control, info)
+            if (self%wide) then
+                status = int(umfpack_dl_numeric(self%colptr_l, self%rowind_l, a%values, self%symbolic, &
+                                                self%numeric, control, info), c_int)
+            else
+                status = umfpack_di_numeric(a%colptr, a%rowind, a%values, self%symbolic, &
+                                            self%numeric, control, info)
+            end if
+            if (status == umfpack_error_out_of_memory .and. .not. self%wide) then
+                ! the 32-bit version cannot index factors this large: once more, 64-bit
+                call free_numeric(self)
+                call free_symbolic(self)
+                self%wide = .true.
+                cycle
+            end if
+            exit
+        end do
         if (status /= umfpack_ok) then
             call free_numeric(self)
-            call status_error(error, 'umfpack_di_numeric', status)
+            call status_error(error, merge('umfpack_dl_numeric', 'umfpack_di_numeric', self%wide), status)
             return
         end if
         self%n_numeric = self%n_numeric + 1
@@ -237,10 +326,15 @@ contains
         end if
         call umfpack_di_defaults(control)
         if (self%rcond >= refine_below_rcond) control(umfpack_irstep + 1) = 0.0_c_double
-        status = umfpack_di_solve(umfpack_a, a%colptr, a%rowind, a%values, x, b, &
-                                  self%numeric, control, info)
+        if (self%wide) then
+            status = int(umfpack_dl_solve(int(umfpack_a, c_long), self%colptr_l, self%rowind_l, a%values, &
+                                          x, b, self%numeric, control, info), c_int)
+        else
+            status = umfpack_di_solve(umfpack_a, a%colptr, a%rowind, a%values, x, b, &
+                                      self%numeric, control, info)
+        end if
         if (status /= umfpack_ok) then
-            call status_error(error, 'umfpack_di_solve', status)
+            call status_error(error, merge('umfpack_dl_solve', 'umfpack_di_solve', self%wide), status)
             return
         end if
     end subroutine umfpack_solve
@@ -261,7 +355,11 @@ contains
             call fatal_error(error, 'umfpack determinant: no numeric factorization')
             return
         end if
-        status = umfpack_di_get_determinant(mx, ex, self%numeric, info)
+        if (self%wide) then
+            status = int(umfpack_dl_get_determinant(mx, ex, self%numeric, info), c_int)
+        else
+            status = umfpack_di_get_determinant(mx, ex, self%numeric, info)
+        end if
         if (status < umfpack_ok) then
             call status_error(error, 'umfpack_di_get_determinant', status)
             return
@@ -299,18 +397,32 @@ contains
 
     subroutine free_numeric(self)
         class(umfpack_t), intent(inout) :: self
-        if (c_associated(self%numeric)) call umfpack_di_free_numeric(self%numeric)
+        if (c_associated(self%numeric)) then
+            if (self%wide) then
+                call umfpack_dl_free_numeric(self%numeric)
+            else
+                call umfpack_di_free_numeric(self%numeric)
+            end if
+        end if
         self%numeric = c_null_ptr
         self%rcond = 0.0_dp
     end subroutine free_numeric
 
     subroutine free_symbolic(self)
         class(umfpack_t), intent(inout) :: self
-        if (c_associated(self%symbolic)) call umfpack_di_free_symbolic(self%symbolic)
+        if (c_associated(self%symbolic)) then
+            if (self%wide) then
+                call umfpack_dl_free_symbolic(self%symbolic)
+            else
+                call umfpack_di_free_symbolic(self%symbolic)
+            end if
+        end if
         self%symbolic = c_null_ptr
         self%n = 0
         if (allocated(self%colptr)) deallocate (self%colptr)
         if (allocated(self%rowind)) deallocate (self%rowind)
+        if (allocated(self%colptr_l)) deallocate (self%colptr_l)
+        if (allocated(self%rowind_l)) deallocate (self%rowind_l)
     end subroutine free_symbolic
 
     !> Whether `a` has the pattern the symbolic analysis was computed for.
@@ -358,8 +470,8 @@ contains
             ! not a numerical failure: a smaller increment would not need less memory
             call fatal_error(error, routine//' failed: '//status_meaning(status)// &
                              ' (UMFPACK status '//trim(num)//'): the LU factors of the '// &
-                             'stiffness matrix need more memory than UMFPACK (32-bit integer '// &
-                             'version) could allocate; a coarser mesh or a lower degree needs less')
+                             'stiffness matrix need more memory than the machine gave UMFPACK; '// &
+                             'a coarser mesh or a lower degree needs less')
         else
             call fatal_error(error, routine//' failed: '//status_meaning(status)// &
                              ' (UMFPACK status '//trim(num)//')', error_code%numeric)
