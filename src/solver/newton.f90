@@ -333,7 +333,7 @@ contains
             write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', model%pairs(ip)%law%mu, &
                 ', penalty_normal = ', model%pairs(ip)%law%eps_n, '): slipping points couple the '
             text = text//trim(buf)//' normal penalty into the tangential direction (mu x penalty_normal) '// &
-                   'and can turn the tangent so (the friction-induced instability); a smaller '// &
+                   'which can make the tangent indefinite (the friction-induced instability); a smaller '// &
                    'penalty_normal or mu keeps the path stable longer'
             exit
         end do
