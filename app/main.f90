@@ -201,6 +201,8 @@ contains
             if (allocated(error)) return
             if (f%has_attr(g, 'r0_max')) call f%read_attr_real(g, 'r0_max', state%r0_max, error)
             if (allocated(error)) return
+            if (f%has_attr(g, 'tangent_det_sign')) call f%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
+            if (allocated(error)) return
             do ip = 1, size(model%pairs)
                 if (.not. allocated(model%pairs(ip)%anchor)) cycle
                 write (buf, '(i0)') ip

@@ -44,6 +44,8 @@ module voiga_solver_newton
         !> Displacement after `step` and after the step before it.
         real(dp), allocatable :: u(:), u_before(:)
         real(dp) :: fraction = 1.0_dp, r0_max = 0.0_dp
+        !> Sign of det K of the last tangent factorized before `step` was written.
+        integer :: det_sign = 0
     end type resume_t
 
     !> Most halvings of one Newton step.
@@ -178,6 +180,7 @@ contains
                 if (allocated(resume%u_before)) u_step_before = resume%u_before
                 frac = resume%fraction
                 stats%r0_max = resume%r0_max
+                conv_det_sign = resume%det_sign
                 first = resume%step + 1
             end if
         end if

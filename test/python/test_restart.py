@@ -44,7 +44,8 @@ def setup(tmp: Path, slide: int) -> Path:
 
 def steps(path: Path) -> dict[str, dict[str, np.ndarray]]:
     with h5py.File(path, "r") as f:
-        return {k: {"u": g["displacement"][()], "pn": g["contact/1/p_n"][()], "pt": g["contact/1/p_t"][()]}
+        return {k: {"u": g["displacement"][()], "pn": g["contact/1/p_n"][()], "pt": g["contact/1/p_t"][()],
+                    "det": g.attrs["tangent_det_sign"]}
                 for k, g in f["steps"].items()}
 
 
@@ -64,6 +65,7 @@ def compare(a: Path, b: Path) -> None:
     for k in sa:
         for key in ("u", "pn", "pt"):
             np.testing.assert_allclose(sb[k][key], sa[k][key], rtol=0, atol=1e-12, err_msg=f"{k} {key}")
+        assert sb[k]["det"] == sa[k]["det"], k
 
 
 @pytest.mark.parametrize("keep", [2, 5])
