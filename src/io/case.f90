@@ -58,6 +58,10 @@ module voiga_io_case
         !> Start each substep from the last step's increment, extrapolated (within a
         !> load phase; docs/robustness.md).
         logical :: predictor = .true.
+        !> Linear solver of each Newton iteration: 'direct' (UMFPACK LU) or
+        !> 'multigrid' (GMRES preconditioned by geometric multigrid over the
+        !> nested spline spaces; docs/performance.md).
+        character(len=16) :: linear_solver = 'direct'
     end type solver_input_t
 
     !> A prescribed displacement on a named edge (`&dirichlet`).
@@ -411,10 +415,11 @@ contains
         integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph, max_cuts, grow_iterations
         real(dp) :: tol_residual, tol_energy, min_step_fraction
         logical :: predictor
+        character(len=16) :: linear_solver
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
-            min_step_fraction, max_cuts, grow_iterations, predictor
+            min_step_fraction, max_cuts, grow_iterations, predictor, linear_solver
 
         n_steps = -1
         max_iterations = entry%max_iterations
@@ -425,6 +430,7 @@ contains
         max_cuts = entry%max_cuts
         grow_iterations = entry%grow_iterations
         predictor = entry%predictor
+        linear_solver = entry%linear_solver
         rewind (u)
         read (u, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -473,6 +479,12 @@ contains
             call fatal_error(error, where//'grow_iterations must be >= 0', error_code%input)
             return
         end if
+        if (trim(linear_solver) /= 'direct' .and. trim(linear_solver) /= 'multigrid') then
+            call fatal_error(error, where//"linear_solver = '"//trim(linear_solver)// &
+                             "': must be 'direct' or 'multigrid'", error_code%input)
+            return
+        end if
+        entry%linear_solver = linear_solver
         entry%n_steps = n_steps(1:nph)
         entry%min_step_fraction = min_step_fraction
         entry%max_cuts = max_cuts

@@ -43,6 +43,9 @@ module voiga_io_results
         !> Sign of det(K) (free DOFs) of the last tangent factorized up to this step
         !> (0: singular, or no factorization yet).
         integer :: det_sign = 0
+        !> GMRES iterations of all Newton iterations of the step (multigrid; 0 with
+        !> the direct solver).
+        integer :: linear_iterations = 0
     end type step_record_t
 
     !> One cut of the load increment (adaptive stepping, docs/robustness.md).
@@ -93,6 +96,7 @@ contains
         call self%h5%write_attr('/', 'case_file', case%path)
         call self%h5%write_attr('/', 'status', 'running')
         call self%h5%write_attr('/', 'n_dofs', model%ndof)
+        call self%h5%write_attr('/', 'linear_solver', trim(model%linear_solver))
         call self%h5%write_attr('/', 'n_steps_planned', sum(model%n_steps))
         call self%h5%write_attr('/', 'n_steps_done', 0)
         call self%h5%write_attr('/', 'n_cuts', 0)
@@ -186,6 +190,7 @@ contains
         call self%h5%write_attr(g, 'iterations', rec%iterations)
         call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
         call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign)
+        call self%h5%write_attr(g, 'linear_iterations', rec%linear_iterations)
         call self%h5%write_attr(g, 'substeps', rec%substeps)
         call self%h5%write_attr(g, 'cuts', rec%cuts)
         if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction)

@@ -64,6 +64,8 @@ module voiga_model
         integer, allocatable :: n_steps(:)
         integer :: max_iterations = 25
         real(dp) :: tol_residual = 1.0e-10_dp, tol_energy = 1.0e-20_dp
+        !> Linear solver: 'direct' or 'multigrid' (`&solver linear_solver`).
+        character(len=16) :: linear_solver = 'direct'
         !> Is any body finite-strain?
         logical :: finite_strain = .false.
         !> fixed(dof): is the DOF prescribed? shape [ndof]
@@ -114,6 +116,7 @@ contains
         self%max_iterations = case%solver%max_iterations
         self%tol_residual = case%solver%tol_residual
         self%tol_energy = case%solver%tol_energy
+        self%linear_solver = case%solver%linear_solver
 
         allocate (self%fixed(self%ndof))
         self%fixed = .false.

@@ -10,7 +10,7 @@ module voiga_nurbs_refine
     implicit none
     private
 
-    public :: insert_knot, insert_knots, elevate_degree
+    public :: insert_knot, insert_knots, elevate_degree, insertion_matrix
 
 contains
 
@@ -45,6 +45,43 @@ contains
         call move_alloc(kn, knots)
         call move_alloc(qw, pw)
     end subroutine insert_knot
+
+    !> Knot-insertion matrix from the B-splines of degree `p` on `coarse` to those on
+    !> `fine` (which must contain `coarse` as a multiset, same end knots):
+    !> `B_coarse(k) = sum_i t(i, k) B_fine(i)`, i.e. control points refine as
+    !> `P_fine = t P_coarse`. Shape [n_fine, n_coarse]; dense (1D, small).
+    pure function insertion_matrix(p, coarse, fine) result(t)
+        integer, intent(in) :: p
+        real(dp), intent(in) :: coarse(:), fine(:)
+        real(dp), allocatable :: t(:, :)
+        real(dp), allocatable :: knots(:), pw(:, :), values(:)
+        integer :: n, i, j, m
+
+        n = size(coarse) - p - 1
+        ! the fine knots not in the coarse vector (multiset difference; both sorted)
+        allocate (values(size(fine)))
+        m = 0
+        j = 1
+        do i = 1, size(fine)
+            if (j <= size(coarse)) then
+                if (coarse(j) == fine(i)) then
+                    j = j + 1
+                    cycle
+                end if
+            end if
+            m = m + 1
+            values(m) = fine(i)
+        end do
+        ! refine the identity: column k of the result is coarse function k
+        allocate (pw(n, n))
+        pw = 0.0_dp
+        do i = 1, n
+            pw(i, i) = 1.0_dp
+        end do
+        knots = coarse
+        call insert_knots(p, knots, pw, values(1:m))
+        t = transpose(pw)
+    end function insertion_matrix
 
     !> Insert each value of `values` once (values may repeat to insert several times).
     pure subroutine insert_knots(p, knots, pw, values)

@@ -27,6 +27,7 @@ module voiga_solver_newton
                                     new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
+    use voiga_solver_multigrid, only: multigrid_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
     use voiga_contact_pair, only: pair_commit, pair_reset_trial
@@ -97,6 +98,8 @@ module voiga_solver_newton
         !> Sign of det(K) of the last factorization (free DOFs), and the iterations of
         !> the last Newton attempt whose tangent had det(K) <= 0 (`newton_solve`).
         integer :: det_sign = 0, attempt_nonpositive_det = 0
+        !> DOFs of each multigrid level (empty with the direct solver).
+        integer, allocatable :: multigrid_levels(:)
         !> Largest first residual of a step so far: the force scale of the round-off floor.
         real(dp) :: r0_max = 0.0_dp
         !> Converged substeps and cuts of the load increment.
@@ -141,6 +144,7 @@ contains
         type(csc_matrix_t) :: k
         type(assembly_map_t) :: map
         type(umfpack_t) :: lu
+        type(multigrid_t) :: mg
         type(step_record_t) :: rec
         type(cut_record_t) :: cut
         real(dp), allocatable :: r(:), u_conv(:), u_step(:), u_step_before(:)
@@ -160,6 +164,11 @@ contains
         call stiffness_pattern(model, k, error)
         if (allocated(error)) return
         call new_assembly_map(model, k, map)
+        if (model%linear_solver == 'multigrid') then
+            call mg%build(model%bodies(:)%disc, model%bodies(:)%dof0, model%ndof, model%fixed, error)
+            if (allocated(error)) return
+            stats%multigrid_levels = mg%level_dofs()
+        end if
         allocate (u(model%ndof), r(model%ndof))
         u = 0.0_dp
         u_conv = u
@@ -210,7 +219,7 @@ contains
                 end if
                 unpredicted_retry = .false.
                 call set_prescribed(model, t, u)
-                call newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, loud, error)
+                call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, loud, error)
                 if (.not. allocated(error)) then
                     if (it > 0) conv_det_sign = stats%det_sign
                     u_conv = u
@@ -373,7 +382,7 @@ contains
     !> success `rec` holds the iteration's norms; `it` the iterations, `rn` the final
     !> residual norm. A numerical failure returns an error with code `numeric`; an
     !> interrupt sets stats%signal and returns a generic error.
-    subroutine newton_solve(model, step, t, u, r, k, map, lu, stats, rec, it, rn, verbose, error)
+    subroutine newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, error)
         type(model_t), intent(inout) :: model
         integer, intent(in) :: step
         real(dp), intent(in) :: t
@@ -383,6 +392,8 @@ contains
         type(csc_matrix_t), intent(inout) :: k
         type(assembly_map_t), intent(inout) :: map
         type(umfpack_t), intent(inout) :: lu
+        !> The multigrid solver (used when model%linear_solver is 'multigrid').
+        type(multigrid_t), intent(inout) :: mg
         type(solver_stats_t), intent(inout) :: stats
         type(step_record_t), intent(inout) :: rec
         integer, intent(out) :: it
@@ -394,9 +405,10 @@ contains
         integer, allocatable :: states(:, :)
         real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor, log_det
         integer :: nls, ip, flips
-        logical :: converged
+        logical :: converged, multigrid
         character(len=400) :: msg
 
+        multigrid = model%linear_solver == 'multigrid'
         allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof))
         x0 = reference_coordinates(model)
         allocate (states(sum([(size(model%pairs(ip)%out), ip=1, size(model%pairs))]), &
@@ -504,18 +516,28 @@ contains
             end if
             tic = wall_seconds()
             call k%fix_dofs(model%fixed)
-            call lu%factorize(k, error)
-            if (.not. allocated(error)) then
-                ! the orientation of the tangent (O(n) from the factors): a sign
-                ! change marks a fold of the incremental problem (solve_steps)
-                call lu%determinant(stats%det_sign, log_det, error)
-                if (stats%det_sign <= 0) stats%attempt_nonpositive_det = stats%attempt_nonpositive_det + 1
+            if (multigrid) then
+                ! no factors, no determinant: det_sign stays 0 (unknown)
+                call mg%setup(k, error)
+            else
+                call lu%factorize(k, error)
+                if (.not. allocated(error)) then
+                    ! the orientation of the tangent (O(n) from the factors): a sign
+                    ! change marks a fold of the incremental problem (solve_steps)
+                    call lu%determinant(stats%det_sign, log_det, error)
+                    if (stats%det_sign <= 0) stats%attempt_nonpositive_det = stats%attempt_nonpositive_det + 1
+                end if
             end if
             rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
             if (allocated(error)) exit
             tic = wall_seconds()
             rhs = -merge(0.0_dp, r, model%fixed)
-            call lu%solve(k, rhs, du, error)
+            if (multigrid) then
+                call mg%solve(rhs, du, forcing(rn, r0, model%tol_residual), error)
+                rec%linear_iterations = rec%linear_iterations + mg%last_iterations
+            else
+                call lu%solve(k, rhs, du, error)
+            end if
             rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
             if (allocated(error)) exit
             en = abs(dot_product(du, rhs))
@@ -535,6 +557,21 @@ contains
         rec%residual_norms = norms(1:it + 1)
         rec%energy_norms = energies(1:it)
     end subroutine newton_solve
+
+    !> Relative residual to which an iterative linear solve is taken at a Newton
+    !> iteration with residual `rn` (first residual `r0`): eta = 1e-3 min(1, rn/r0),
+    !> so that the linear error, eta rn <= 1e-3 rn^2/r0, does not spoil the quadratic
+    !> convergence; never tighter than needed for the Newton tolerance (0.1 tol r0)
+    !> nor than 1e-12 (the attainable level in double precision).
+    pure real(dp) function forcing(rn, r0, tol) result(eta)
+        real(dp), intent(in) :: rn, r0, tol
+        eta = 1.0e-3_dp
+        if (r0 > 0.0_dp .and. rn > 0.0_dp) then
+            eta = 1.0e-3_dp*min(1.0_dp, rn/r0)
+            eta = max(eta, 0.1_dp*tol*r0/rn)
+        end if
+        eta = min(1.0e-3_dp, max(eta, 1.0e-12_dp))
+    end function forcing
 
     !> One line per Newton iteration: residual, energy norm, contact states.
     subroutine print_iteration(model, step, it, rn, en, alpha, floor)

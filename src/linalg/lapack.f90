@@ -1,0 +1,70 @@
+!> The LAPACK routines voiga calls, behind explicit interfaces.
+module voiga_linalg_lapack
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: solve_spd, band_factor, band_solve
+
+    interface
+        pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, nrhs, lda, ldb
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dposv
+        pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, kl, ku, ldab
+            real(dp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgbtrf
+        pure subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: trans
+            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb
+            real(dp), intent(in) :: ab(ldab, *)
+            integer, intent(in) :: ipiv(*)
+            real(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgbtrs
+    end interface
+
+contains
+
+    !> Solve a x = b for a symmetric positive definite `a` (Cholesky, LAPACK dposv).
+    !> On exit `b` holds x; `a` is overwritten by its factor. `info` /= 0: `a` is
+    !> not positive definite (or an argument is wrong), `b` is then undefined.
+    pure subroutine solve_spd(a, b, info)
+        !> shape: [n, n]
+        real(dp), intent(inout) :: a(:, :)
+        !> shape: [n, nrhs]
+        real(dp), intent(inout) :: b(:, :)
+        integer, intent(out) :: info
+        call dposv('L', size(a, 1), size(b, 2), a, size(a, 1), b, size(b, 1), info)
+    end subroutine solve_spd
+
+    !> LU factorization with partial pivoting of an n x n band matrix with `kl`
+    !> sub- and `ku` superdiagonals (LAPACK dgbtrf). `ab` has shape [2 kl + ku + 1, n]
+    !> (explicit shape: a section of a longer array may be passed by its first element):
+    !> entry (i, j) of the matrix in ab(kl + ku + 1 + i - j, j); rows 1..kl are
+    !> workspace. `info` > 0: the matrix is singular.
+    pure subroutine band_factor(n, kl, ku, ab, ipiv, info)
+        integer, intent(in) :: n, kl, ku
+        real(dp), intent(inout) :: ab(2*kl + ku + 1, n)
+        integer, intent(out) :: ipiv(n), info
+        call dgbtrf(n, n, kl, ku, ab, 2*kl + ku + 1, ipiv, info)
+    end subroutine band_factor
+
+    !> Solve with the factors of `band_factor`; `b` [n] is overwritten by x.
+    pure subroutine band_solve(n, kl, ku, ab, ipiv, b, info)
+        integer, intent(in) :: n, kl, ku
+        real(dp), intent(in) :: ab(2*kl + ku + 1, n)
+        integer, intent(in) :: ipiv(n)
+        real(dp), intent(inout) :: b(n)
+        integer, intent(out) :: info
+        call dgbtrs('N', n, kl, ku, 1, ab, 2*kl + ku + 1, ipiv, b, n, info)
+    end subroutine band_solve
+
+end module voiga_linalg_lapack
