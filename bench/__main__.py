@@ -4,7 +4,7 @@ Sections (``--only 1,2,...``):
   1  time per Newton iteration by stage (hertz m3 N2 / NN2.2, ironing m1 NN2.2 short)
   2  NNp against Np on the same mesh (wall time and time per iteration)
   3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
-  4  scaling of assembly and factorization per iteration with the DOFs (hertz N2)
+  4  scaling of the time per iteration with the DOFs (hertz N2), direct and multigrid
   5  CalculiX (CPE8, penalty contact) on the same Hertz problem, if apt offers it
 
 Runs go to a scratch directory (default build/bench); every ratio compares runs made
@@ -116,44 +116,56 @@ def section_accuracy(w: Workdir, repeat: int) -> dict:
     return out
 
 
-def section_scaling(w: Workdir, repeat: int, levels: int) -> dict:
+def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str]) -> dict:
     from .refine import refined_hertz_text
     header(f"4. Scaling with the DOFs: hertz N2 m1..m{levels}, one load step (n_steps = 1) so "
            "that the large meshes fit;\n   m7+ generated from m6 by knot-span midpoints in xi "
-           "and eta")
-    print(f"{'mesh':6s} {'dofs':>7s} {'iters':>5s} {'wall s':>8s} | s per iteration: "
-          f"{'assembly':>10s} {'contact':>10s} {'factoriz.':>10s} {'solve':>10s} {'wall':>10s}",
-          flush=True)
-    rows = []
+           f"and eta; linear solvers: {', '.join(solvers)}")
+    print(f"{'solver':9s} {'mesh':5s} {'dofs':>7s} {'iters':>5s} {'gmres/it':>8s} {'wall s':>8s} | "
+          f"s per iteration: {'assembly':>9s} {'contact':>9s} {'setup':>9s} {'solve':>9s} "
+          f"{'wall':>9s}", flush=True)
+    print("(setup: the factorization stage, i.e. UMFPACK's LU or the multigrid set-up)")
+    rows: dict[str, list[dict]] = {s: [] for s in solvers}
     for lev in range(1, levels + 1):
         name = f"m{lev}-N2"
         text = refined_hertz_text(lev) if lev > 6 else None
-        case = w.case("hertz", name, {"n_steps": "1"}, tag="-1step", text=text)
-        r = best_of(case, repeat if lev <= 5 else 1)
-        pi = r.per_iteration
-        print(f"m{lev:<5d} {r.n_dofs:7d} {r.iterations:5d} {r.wall:8.2f} | {'':16s} "
-              f"{pi['assembly']:10.4f} {pi['contact']:10.4f} {pi['factorization']:10.4f} "
-              f"{pi['solve']:10.4f} {r.wall_per_iteration:10.4f}", flush=True)
-        rows.append({"mesh": f"m{lev}", "dofs": r.n_dofs, "iterations": r.iterations,
-                     "wall": r.wall, **{f"{k}_per_iteration": v for k, v in pi.items()}})
+        for solver in solvers:
+            case = w.case("hertz", name, {"n_steps": "1"}, tag=f"-1step-{solver}", text=text,
+                          linear_solver=solver)
+            r = best_of(case, repeat if lev <= 5 else 1)
+            pi = r.per_iteration
+            print(f"{solver:9s} m{lev:<4d} {r.n_dofs:7d} {r.iterations:5d} "
+                  f"{r.linear_iterations / r.iterations:8.1f} {r.wall:8.2f} | {'':16s} "
+                  f"{pi['assembly']:9.4f} {pi['contact']:9.4f} {pi['factorization']:9.4f} "
+                  f"{pi['solve']:9.4f} {r.wall_per_iteration:9.4f}", flush=True)
+            rows[solver].append({"mesh": f"m{lev}", "dofs": r.n_dofs, "iterations": r.iterations,
+                                 "linear_iterations": r.linear_iterations, "wall": r.wall,
+                                 **{f"{k}_per_iteration": v for k, v in pi.items()}})
     print("\nexponent e in time per iteration ~ DOFs^e")
-    print(f"{'between':14s} {'assembly':>9s} {'factoriz.':>9s} {'solve':>9s} {'wall':>9s}")
-    fits = {}
-    spans = [(i, i + 1) for i in range(max(0, len(rows) - 3), len(rows) - 1)]
-    spans.append((max(0, len(rows) - 3), len(rows) - 1))
-    # issue 7's range: every mesh from 1e4 DOFs on (lsq), when there are at least three
-    big = [i for i, r in enumerate(rows) if r["dofs"] >= 1e4]
-    if len(big) >= 3 and (big[0], big[-1]) not in spans:
-        spans.append((big[0], big[-1]))
-    for i, j in spans:
-        sel = rows[i:j + 1]
-        n = [r["dofs"] for r in sel]
-        e = {k: fit_exponent(n, [r[f"{k}_per_iteration"] for r in sel])
-             for k in ("assembly", "factorization", "solve")}
-        e["wall"] = fit_exponent(n, [r["wall"] / r["iterations"] for r in sel])
-        label = f"{sel[0]['mesh']}..{sel[-1]['mesh']}" + (" (lsq)" if len(sel) > 2 else "")
-        print(f"{label:14s} " + " ".join(f"{v:9.2f}" for v in e.values()))
-        fits[label] = e
+    print(f"{'solver':9s} {'between':14s} {'assembly':>9s} {'setup':>9s} {'solve':>9s} {'wall':>9s}")
+    fits: dict[str, dict] = {}
+    for solver in solvers:
+        srows = rows[solver]
+        fits[solver] = {}
+        spans = [(i, i + 1) for i in range(max(0, len(srows) - 3), len(srows) - 1)]
+        spans.append((max(0, len(srows) - 3), len(srows) - 1))
+        # issue 7's range: every mesh from 1e4 DOFs on (lsq), when there are at least three
+        big = [i for i, r in enumerate(srows) if r["dofs"] >= 1e4]
+        if len(big) >= 3 and (big[0], big[-1]) not in spans:
+            spans.append((big[0], big[-1]))
+        for i, j in spans:
+            sel = srows[i:j + 1]
+            n = [r["dofs"] for r in sel]
+            e = {k: fit_exponent(n, [r[f"{k}_per_iteration"] for r in sel])
+                 for k in ("assembly", "factorization", "solve")}
+            e["wall"] = fit_exponent(n, [r["wall"] / r["iterations"] for r in sel])
+            label = f"{sel[0]['mesh']}..{sel[-1]['mesh']}" + (" (lsq)" if len(sel) > 2 else "")
+            print(f"{solver:9s} {label:14s} " + " ".join(f"{v:9.2f}" for v in e.values()))
+            fits[solver][label] = e
+    if "direct" in rows and "multigrid" in rows:
+        print("\nwall time per iteration, direct / multigrid:")
+        print("  ".join(f"{a['mesh']} {a['wall'] / a['iterations'] / (b['wall'] / b['iterations']):.2f}"
+                        for a, b in zip(rows["direct"], rows["multigrid"])))
     return {"rows": rows, "exponents": fits}
 
 
@@ -164,6 +176,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
+    ap.add_argument("--solvers", default="direct,multigrid",
+                    help="section 4: linear solvers to scale (direct, multigrid)")
     ap.add_argument("--work", type=Path, default=ROOT / "build" / "bench")
     ap.add_argument("--ccx-meshes", default="m2,m3,m4", help="section 5 meshes")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
@@ -184,7 +198,8 @@ def main(argv: list[str] | None = None) -> int:
     if "3" in only:
         figures["accuracy"] = section_accuracy(w, args.repeat)
     if "4" in only:
-        figures["scaling"] = section_scaling(w, args.repeat, args.levels)
+        figures["scaling"] = section_scaling(w, args.repeat, args.levels,
+                                              [x.strip() for x in args.solvers.split(",")])
     if "5" in only:
         from .ccx import section_calculix
         figures["calculix"] = section_calculix(w, args.ccx_meshes.split(","), args.repeat)

@@ -34,6 +34,8 @@ class Run:
     iterations: int
     seconds: dict[str, float] = field(default_factory=dict)
     result: Path | None = None
+    #: GMRES iterations summed over the steps (multigrid; 0 with the direct solver)
+    linear_iterations: int = 0
 
     @property
     def per_iteration(self) -> dict[str, float]:
@@ -56,6 +58,18 @@ def set_variable(text: str, name: str, value: str) -> str:
     return pat.sub(lambda m: f"{m.group(1)}{name} = {value}\n", text, count=1)
 
 
+def add_to_group(text: str, group: str, name: str, value: str) -> str:
+    """Set ``name = value`` in namelist group ``&group``: replaced if present, else added."""
+    try:
+        head, sep, rest = text.partition(f"&{group}")
+        if not sep:
+            raise KeyError(group)
+        end = rest.index("\n/")
+        return head + sep + set_variable(rest[:end + 1], name, value) + rest[end + 1:]
+    except KeyError:
+        return re.sub(rf"^&{group}\b", f"&{group}\n  {name} = {value}", text, count=1, flags=re.M)
+
+
 class Workdir:
     """A scratch directory holding copies of the scenes' case files and geometry."""
 
@@ -71,8 +85,9 @@ class Workdir:
         marker.touch()
 
     def case(self, scene: str, name: str, changes: dict[str, str] | None = None,
-             tag: str = "", text: str | None = None) -> Path:
-        """Copy cases/<scene>/<name>.nml (edited by ``changes``) into <work>/<scene>/."""
+             tag: str = "", text: str | None = None, linear_solver: str | None = None) -> Path:
+        """Copy cases/<scene>/<name>.nml (edited by ``changes``, and with ``&solver
+        linear_solver`` when given) into <work>/<scene>/."""
         src = ROOT / "cases" / scene
         dst = self.path / scene
         if not dst.exists():
@@ -84,6 +99,8 @@ class Workdir:
         for k, v in (changes or {}).items():
             text = set_variable(text, k, v)
         text = set_variable(text, "output", f"'{out_name}.h5'")
+        if linear_solver is not None:
+            text = add_to_group(text, "solver", "linear_solver", f"'{linear_solver}'")
         path = dst / f"{out_name}.nml"
         path.write_text(text)
         return path
@@ -107,6 +124,7 @@ def solve(case: Path) -> Run:
         n_dofs = int(f.attrs["n_dofs"])
         secs = {s: 0.0 for s in STAGES}
         iters = 0
+        linear = 0
         steps = f["steps"]
         for name in steps:
             a = steps[name].attrs
@@ -116,9 +134,10 @@ def solve(case: Path) -> Run:
             iters += int(a["iterations_total"] if "iterations_total" in a else a["iterations"])
             for s in STAGES:
                 secs[s] += float(a[f"seconds_{s}"])
+            linear += int(a.get("linear_iterations", 0))
         n_steps = len(steps)
     return Run(case=case.stem, wall=wall, n_dofs=n_dofs, steps=n_steps, iterations=iters,
-               seconds=secs, result=out)
+               seconds=secs, result=out, linear_iterations=linear)
 
 
 def best_of(case: Path, repeat: int) -> Run:

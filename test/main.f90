@@ -11,6 +11,7 @@ program voiga_tests
     use test_sparse, only: collect_sparse
     use test_contact, only: collect_contact
     use test_stepping, only: collect_stepping
+    use test_multigrid, only: collect_multigrid
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -24,7 +25,8 @@ program voiga_tests
              new_testsuite('solid', collect_solid), &
              new_testsuite('sparse', collect_sparse), &
              new_testsuite('contact', collect_contact), &
-             new_testsuite('stepping', collect_stepping) &
+             new_testsuite('stepping', collect_stepping), &
+             new_testsuite('multigrid', collect_multigrid) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -296,7 +296,8 @@ contains
         m = 0.0_dp
         proj = 0.0_dp
         call gauss_legendre(q + 1, gp, gw)
-        breaks = distinct_knots([disc%layer%knots, disc%bulk%knots_xi])
+        ! the layer has the bulk breakpoints along xi (docs/theory.md)
+        breaks = distinct_knots(disc%layer%knots)
         do e = 1, size(breaks) - 1
             do g = 1, q + 1
                 u = 0.5_dp*(breaks(e) + breaks(e + 1)) + 0.5_dp*(breaks(e + 1) - breaks(e))*gp(g)

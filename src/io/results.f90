@@ -70,6 +70,8 @@ module voiga_io_results
         procedure :: reopen => results_reopen
         procedure :: write_step => results_write_step
         procedure :: finish => results_finish
+        !> Record the DOFs of each multigrid level (/multigrid_level_dofs).
+        procedure :: write_multigrid => results_write_multigrid
     end type results_t
 
 contains
@@ -311,5 +313,15 @@ contains
         call self%h5%write_attr('/', 'wall_time', wall)
         call self%h5%close()
     end subroutine results_finish
+
+    !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
+    subroutine results_write_multigrid(self, level_dofs)
+        class(results_t), intent(inout) :: self
+        integer, intent(in) :: level_dofs(:)
+        if (.not. self%h5%is_open()) return
+        if (self%h5%exists('/multigrid_level_dofs')) return
+        call self%h5%write('/multigrid_level_dofs', level_dofs)
+        call self%h5%flush()
+    end subroutine results_write_multigrid
 
 end module voiga_io_results

@@ -12,7 +12,7 @@ module voiga_solver_csr
     private
 
     public :: csr_t, csr_from_csc, csr_from_triplets, csr_transpose, csr_matmul, csr_to_csc, &
-              csr_matvec, csr_diagonal_positions
+              csr_matvec, csr_diagonal_positions, csr_matmul_numeric
 
     !> An nrow x ncol matrix; row i holds entries ptr(i) .. ptr(i+1)-1.
     type :: csr_t
@@ -228,6 +228,32 @@ contains
             end if
         end if
     end subroutine csr_matmul
+
+    !> The values of c = a b into the existing pattern of `c`, which must hold every
+    !> entry of the product (a pattern from `csr_matmul` of matrices with the same
+    !> patterns as a and b, possibly with more entries, which come out 0).
+    pure subroutine csr_matmul_numeric(a, b, c)
+        type(csr_t), intent(in) :: a, b
+        type(csr_t), intent(inout) :: c
+        integer, allocatable :: at(:)
+        integer :: i, k, kb, q
+        real(dp) :: aik
+
+        allocate (at(c%ncol))
+        do i = 1, a%nrow
+            do q = c%ptr(i), c%ptr(i + 1) - 1
+                at(c%col(q)) = q
+                c%val(q) = 0.0_dp
+            end do
+            do k = a%ptr(i), a%ptr(i + 1) - 1
+                aik = a%val(k)
+                do kb = b%ptr(a%col(k)), b%ptr(a%col(k) + 1) - 1
+                    q = at(b%col(kb))
+                    c%val(q) = c%val(q) + aik*b%val(kb)
+                end do
+            end do
+        end do
+    end subroutine csr_matmul_numeric
 
     !> y = a x.
     pure subroutine csr_matvec(a, x, y)

@@ -23,7 +23,7 @@ module voiga_solver_multigrid
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_csr, only: csr_t, csr_from_csc, csr_from_triplets, csr_transpose, csr_matmul, &
-                                csr_to_csc, csr_matvec, csr_diagonal_positions
+                                csr_to_csc, csr_matvec, csr_diagonal_positions, csr_matmul_numeric
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_smoother, only: line_set_t, new_line_set
     use voiga_discretization_patch, only: discretization_t
@@ -40,14 +40,16 @@ module voiga_solver_multigrid
         type(csr_t) :: a
         !> Prolongation from level + 1 [n, n_coarser] and its transpose (not on the coarsest).
         type(csr_t) :: p, r
+        !> a p (kept for its pattern: later set-ups only recompute values).
+        type(csr_t) :: ap
         !> Position of each row's diagonal in a%val.
         integer, allocatable :: diag(:)
         !> Smoother lines: rows of control points along xi (1) and along eta (2).
         type(line_set_t) :: lines(2)
         !> DOFs outside the multigrid space (Dirichlet and what they constrain).
         logical, allocatable :: fixed(:)
-        !> Work vectors: right-hand side, solution, residual [n].
-        real(dp), allocatable :: b(:), x(:), res(:)
+        !> Work vectors: right-hand side, solution, residual [n]; line solves.
+        real(dp), allocatable :: b(:), x(:), res(:), work(:)
     end type mg_level_t
 
     !> Control points of a body at one level, as the smoother's lines see them:
@@ -70,8 +72,13 @@ module voiga_solver_multigrid
         !> Relative residual reached by the last solve (read only).
         real(dp) :: last_residual = 0.0_dp
         type(mg_level_t), allocatable :: levels(:)
+        !> The tangent's CSC pattern the operators were built for, and the position
+        !> in the tangent's values of each fine CSR entry.
+        integer, allocatable, private :: colptr(:), rowind(:), perm(:)
         type(csc_matrix_t), private :: coarse
         type(umfpack_t), private :: lu
+        !> GMRES work arrays, kept between solves (no page faults per solve).
+        real(dp), allocatable, private :: v(:, :), w(:), r(:)
     contains
         !> Build the hierarchy of spaces and prolongations (once per run).
         procedure :: build => mg_build
@@ -162,6 +169,7 @@ contains
         do lev = 1, size(self%levels)
             associate (l => self%levels(lev))
                 allocate (l%b(l%n), l%x(l%n), l%res(l%n))
+                allocate (l%work(max(1, l%lines(1)%longest(), l%lines(2)%longest())))
             end associate
         end do
     end subroutine mg_build
@@ -301,19 +309,51 @@ contains
         class(multigrid_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: k
         type(error_t), allocatable, intent(out) :: error
-        type(csr_t) :: ap
         integer :: l, nl
+        logical :: same
 
         if (.not. allocated(self%levels)) then
             call fatal_error(error, 'multigrid: setup before build')
             return
         end if
         nl = size(self%levels)
-        call csr_from_csc(k, self%levels(1)%a)
-        do l = 1, nl - 1
-            call csr_matmul(self%levels(l)%a, self%levels(l)%p, ap)
-            call csr_matmul(self%levels(l)%r, ap, self%levels(l + 1)%a, sorted=.true.)
-            call unit_diagonal(self%levels(l + 1)%a, self%levels(l + 1)%fixed)
+        same = .false.
+        if (allocated(self%colptr)) then
+            if (size(self%colptr) == size(k%colptr) .and. size(self%rowind) == size(k%rowind)) &
+                same = all(self%colptr == k%colptr) .and. all(self%rowind == k%rowind)
+        end if
+        if (same) then
+            ! the patterns are those of the last set-up: values only
+            self%levels(1)%a%val = k%values(self%perm)
+            do l = 1, nl - 1
+                call csr_matmul_numeric(self%levels(l)%a, self%levels(l)%p, self%levels(l)%ap)
+                call csr_matmul_numeric(self%levels(l)%r, self%levels(l)%ap, self%levels(l + 1)%a)
+                associate (c => self%levels(l + 1))
+                    where (c%fixed) c%a%val(c%diag) = 1.0_dp
+                end associate
+            end do
+        else
+            call fine_operator(self, k)
+            do l = 1, nl - 1
+                call csr_matmul(self%levels(l)%a, self%levels(l)%p, self%levels(l)%ap)
+                call csr_matmul(self%levels(l)%r, self%levels(l)%ap, self%levels(l + 1)%a, sorted=.true.)
+                call unit_diagonal(self%levels(l + 1)%a, self%levels(l + 1)%fixed)
+            end do
+            do l = 1, nl
+                self%levels(l)%diag = csr_diagonal_positions(self%levels(l)%a)
+                if (any(self%levels(l)%diag == 0)) then
+                    call fatal_error(error, 'multigrid: a level operator has no diagonal entry', &
+                                     error_code%numeric)
+                    return
+                end if
+            end do
+        end if
+        do l = 1, nl
+            if (any(self%levels(l)%a%val(self%levels(l)%diag) == 0.0_dp)) then
+                call fatal_error(error, 'multigrid: a zero on the diagonal of a level operator', &
+                                 error_code%numeric)
+                return
+            end if
         end do
         do l = 1, nl - 1
             call self%levels(l)%lines(1)%factor(self%levels(l)%a, error)
@@ -321,19 +361,12 @@ contains
             call self%levels(l)%lines(2)%factor(self%levels(l)%a, error)
             if (allocated(error)) return
         end do
-        do l = 1, nl
-            self%levels(l)%diag = csr_diagonal_positions(self%levels(l)%a)
-            if (any(self%levels(l)%diag == 0)) then
-                call fatal_error(error, 'multigrid: a level operator has no diagonal entry', error_code%numeric)
-                return
-            end if
-            if (any(self%levels(l)%a%val(self%levels(l)%diag) == 0.0_dp)) then
-                call fatal_error(error, 'multigrid: a zero on the diagonal (Gauss-Seidel cannot smooth)', &
-                                 error_code%numeric)
-                return
-            end if
-        end do
-        call csr_to_csc(self%levels(nl)%a, self%coarse)
+        if (same) then
+            self%coarse%values = 0.0_dp
+            call coarse_values(self%levels(nl)%a, self%coarse)
+        else
+            call csr_to_csc(self%levels(nl)%a, self%coarse)
+        end if
         call self%lu%factorize(self%coarse, error)
         if (allocated(error)) then
             error%message = 'multigrid coarsest level: '//error%message
@@ -341,6 +374,46 @@ contains
         end if
         self%n_setups = self%n_setups + 1
     end subroutine mg_setup
+
+    !> The fine operator in CSR, and the map from its entries to the tangent's
+    !> values (kept for later set-ups with the same pattern).
+    subroutine fine_operator(self, k)
+        class(multigrid_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: k
+        type(csc_matrix_t) :: index
+        type(csr_t) :: t
+        integer :: q
+
+        ! the transpose of the entry numbers gives each CSR entry's CSC position
+        index%n = k%n
+        index%colptr = k%colptr
+        index%rowind = k%rowind
+        index%values = [(real(q, dp), q=1, size(k%values))]
+        call csr_from_csc(index, t)
+        self%perm = nint(t%val)
+        call csr_from_csc(k, self%levels(1)%a)
+        self%colptr = k%colptr
+        self%rowind = k%rowind
+    end subroutine fine_operator
+
+    !> Copy the values of a square CSR matrix into a CSC matrix of the same pattern.
+    pure subroutine coarse_values(a, c)
+        type(csr_t), intent(in) :: a
+        type(csc_matrix_t), intent(inout) :: c
+        integer :: i, q, j, p
+        do i = 1, a%nrow
+            do q = a%ptr(i), a%ptr(i + 1) - 1
+                j = a%col(q)
+                ! row i of column j: rows ascend within the column
+                do p = c%colptr(j) + 1, c%colptr(j + 1)
+                    if (c%rowind(p) + 1 == i) then
+                        c%values(p) = a%val(q)
+                        exit
+                    end if
+                end do
+            end do
+        end do
+    end subroutine coarse_values
 
     !> Put 1 on the (missing) diagonal of the rows of `fixed` DOFs, which the
     !> Galerkin product leaves empty.
@@ -388,8 +461,8 @@ contains
             end if
             lv%x = 0.0_dp
             do s = 1, self%sweeps
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, forward=.true.)
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, forward=.true.)
+                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
+                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
             end do
             call csr_matvec(lv%a, lv%x, lv%res)
             lv%res = lv%b - lv%res
@@ -399,8 +472,8 @@ contains
             call csr_matvec(lv%p, self%levels(l + 1)%x, lv%res)
             lv%x = lv%x + lv%res
             do s = 1, self%sweeps
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, forward=.false.)
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, forward=.false.)
+                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
+                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
             end do
         end associate
     end subroutine vcycle
@@ -425,7 +498,7 @@ contains
         real(dp), intent(out) :: x(:)
         real(dp), intent(in) :: rtol
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: v(:, :), h(:, :), g(:), cs(:), sn(:), y(:), w(:), r(:)
+        real(dp), allocatable :: h(:, :), g(:), cs(:), sn(:), y(:)
         real(dp) :: bnorm, beta, target, temp
         integer :: n, m, j, i, total
         character(len=200) :: msg
@@ -439,7 +512,9 @@ contains
         self%last_residual = 0.0_dp
         if (bnorm == 0.0_dp) return
         target = rtol*bnorm
-        allocate (v(n, m + 1), h(m + 1, m), g(m + 1), cs(m), sn(m), y(m), w(n), r(n))
+        allocate (h(m + 1, m), g(m + 1), cs(m), sn(m), y(m))
+        if (.not. allocated(self%v)) allocate (self%v(n, m + 1), self%w(n), self%r(n))
+        associate (v => self%v, w => self%w, r => self%r)
         r = b
         beta = bnorm
         total = 0
@@ -485,7 +560,10 @@ contains
             do i = j, 1, -1
                 y(i) = (g(i) - dot_product(h(i, i + 1:j), y(i + 1:j)))/h(i, i)
             end do
-            w = matmul(v(:, 1:j), y(1:j))
+            w = 0.0_dp
+            do i = 1, j
+                w = w + y(i)*v(:, i)
+            end do
             call precondition(self, w, r, error)
             if (allocated(error)) return
             x = x + r
@@ -501,6 +579,7 @@ contains
                 exit
             end if
         end do
+        end associate
         self%last_iterations = total
         self%n_iterations = self%n_iterations + total
     end subroutine mg_solve

@@ -2,7 +2,7 @@
 !>
 !> A line is the set of DOFs of one row of control points of a patch (along xi,
 !> or along eta). A sweep visits the lines in order and solves each line's block
-!> exactly (band LU, LAPACK dgbtrf/dgbtrs) with the latest values of all other
+!> exactly (band LU: LAPACK dgbtrf, and its solve inline) with the latest values of all other
 !> DOFs: block Gauss-Seidel. Point Gauss-Seidel smooths only errors that vary on
 !> the scale of the elements in every direction; on stretched elements (the thin
 !> inner elements of the Hertz annulus, the penalty-stiffened contact row) the
@@ -12,7 +12,7 @@ module voiga_solver_smoother
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_solver_csr, only: csr_t
-    use voiga_linalg_lapack, only: band_factor, band_solve
+    use voiga_linalg_lapack, only: band_factor
     implicit none
     private
 
@@ -36,6 +36,8 @@ module voiga_solver_smoother
         procedure :: factor => lines_factor
         !> One block Gauss-Seidel sweep over the lines.
         procedure :: sweep => lines_sweep
+        !> Length of the longest line.
+        procedure :: longest
     end type line_set_t
 
 contains
@@ -128,21 +130,17 @@ contains
 
     !> One block Gauss-Seidel sweep for a x = b over the lines (in increasing
     !> order, or decreasing when not `forward`); DOFs in no line keep their values.
-    pure subroutine lines_sweep(self, a, b, x, forward)
+    !> `work` needs the length of the longest line.
+    pure subroutine lines_sweep(self, a, b, x, forward, work)
         class(line_set_t), intent(in) :: self
         type(csr_t), intent(in) :: a
         real(dp), intent(in) :: b(:)
         real(dp), intent(inout) :: x(:)
         logical, intent(in) :: forward
-        real(dp), allocatable :: res(:)
-        integer :: l, k, q, i, m, first, last, step, info
+        real(dp), intent(inout) :: work(:)
+        integer :: l, k, q, i, m, first, last, step
         real(dp) :: s
 
-        m = 0
-        do l = 1, self%n
-            m = max(m, self%ptr(l + 1) - self%ptr(l))
-        end do
-        allocate (res(m))
         if (forward) then
             first = 1
             last = self%n
@@ -160,14 +158,59 @@ contains
                 do q = a%ptr(i), a%ptr(i + 1) - 1
                     s = s - a%val(q)*x(a%col(q))
                 end do
-                res(k - self%ptr(l) + 1) = s
+                work(k - self%ptr(l) + 1) = s
             end do
-            call band_solve(m, self%kl(l), self%ku(l), self%band(self%band_start(l)), &
-                            self%ipiv(self%piv_start(l)), res(1:m), info)
+            call band_lu_solve(m, self%kl(l), self%ku(l), self%band(self%band_start(l)), &
+                               self%ipiv(self%piv_start(l)), work)
             do k = self%ptr(l), self%ptr(l + 1) - 1
-                x(self%dofs(k)) = x(self%dofs(k)) + res(k - self%ptr(l) + 1)
+                x(self%dofs(k)) = x(self%dofs(k)) + work(k - self%ptr(l) + 1)
             end do
         end do
     end subroutine lines_sweep
+
+    !> Longest line (the length of `lines_sweep`'s work array).
+    pure integer function longest(self)
+        class(line_set_t), intent(in) :: self
+        integer :: l
+        longest = 0
+        do l = 1, self%n
+            longest = max(longest, self%ptr(l + 1) - self%ptr(l))
+        end do
+    end function longest
+
+    !> Solve with the band LU factors of LAPACK's dgbtrf (the steps of dgbtrs,
+    !> 'N', one right-hand side), inline: the lines are short and narrow (bandwidth
+    !> 5 for quadratic splines), where the library's per-call overhead dominates.
+    pure subroutine band_lu_solve(n, kl, ku, ab, ipiv, b)
+        integer, intent(in) :: n, kl, ku
+        real(dp), intent(in) :: ab(2*kl + ku + 1, n)
+        integer, intent(in) :: ipiv(n)
+        real(dp), intent(inout) :: b(:)
+        integer :: j, i, lm, p, kd
+        real(dp) :: t
+
+        kd = kl + ku + 1
+        ! L: row interchanges and the multipliers below the diagonal
+        do j = 1, n - 1
+            lm = min(kl, n - j)
+            p = ipiv(j)
+            t = b(p)
+            if (p /= j) then
+                b(p) = b(j)
+                b(j) = t
+            end if
+            do i = 1, lm
+                b(j + i) = b(j + i) - t*ab(kd + i, j)
+            end do
+        end do
+        ! U: kl + ku superdiagonals, diagonal in row kd
+        do j = n, 1, -1
+            b(j) = b(j)/ab(kd, j)
+            t = b(j)
+            do i = max(1, j - kl - ku), j - 1
+                b(i) = b(i) - t*ab(kd + i - j, j)
+            end do
+        end do
+    end subroutine band_lu_solve
 
 end module voiga_solver_smoother
