@@ -26,6 +26,7 @@ module voiga_solver_multigrid
                                 csr_to_csc, csr_matvec, csr_diagonal_positions, csr_matmul_numeric
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_smoother, only: line_set_t, new_line_set
+    use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_discretization_patch, only: discretization_t
     use voiga_discretization_hierarchy, only: coarse_space_t, cp_map_t, coarsen_discretization, &
                                               coarsen_space
@@ -527,6 +528,12 @@ contains
             do while (j < m)
                 j = j + 1
                 total = total + 1
+                ! a long solve must not delay SIGINT/SIGTERM (generic error: not a
+                ! numerical failure, the caller reads the signal)
+                if (caught_signal() /= 0) then
+                    call fatal_error(error, 'interrupted by '//signal_name(caught_signal()))
+                    return
+                end if
                 call precondition(self, v(:, j), w, error)
                 if (allocated(error)) return
                 call csr_matvec(self%levels(1)%a, w, v(:, j + 1))

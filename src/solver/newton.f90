@@ -76,7 +76,7 @@ module voiga_solver_newton
     !> active set. Hertz N2 m8, one load step: 1e-2 takes the same 10 Newton
     !> iterations as the exact solve with 31 GMRES iterations instead of 82; 1e-1
     !> takes 11 with 16 (docs/performance.md).
-    real(dp), parameter :: active_set_forcing = 1.0e-2_dp
+    real(dp), parameter :: active_set_forcing = 1.0e-1_dp
 
     !> Adaptive load stepping settings (`&solver`: min_step_fraction, max_cuts,
     !> grow_iterations; docs/robustness.md).
@@ -553,6 +553,7 @@ contains
                     if (any(states(:, it) /= states(:, it - 1))) eta = max(eta, active_set_forcing)
                 end if
                 call mg%solve(rhs, du, eta, error)
+                if (caught_signal() /= 0) stats%signal = caught_signal()
                 rec%linear_iterations = rec%linear_iterations + mg%last_iterations
                 if (verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', mg%last_iterations, &
                     ' iterations, relative residual ', mg%last_residual, ' (asked ', eta, ')'
