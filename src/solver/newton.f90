@@ -242,12 +242,12 @@ contains
                 if (allocated(error) .and. .not. predicted .and. .not. set%tresca_always) then
                     fold_iterations = stats%attempt_nonpositive_det
                     fold_total = it
-                    ! a fold in a frictional case (contact states switching, det K <= 0 in
-                    ! some iterations and > 0 in others or at the converged state): retry
-                    ! the same increment with the Tresca fixed point before cutting
+                    ! contact states still switching in a frictional case (a period-2 cycle
+                    ! or the cap with switches; at a fold det K also changes sign, but the
+                    ! stick/slip switch of a stiff penalty stalls Newton with det K > 0 as
+                    ! well): retry the same increment with the Tresca fixed point before cutting
                     if (error%code == error_code%numeric .and. stats%signal == 0 .and. &
-                        stats%attempt_switching .and. frictional(model) .and. fold_iterations > 0 .and. &
-                        (fold_iterations < fold_total .or. conv_det_sign > 0)) then
+                        stats%attempt_switching .and. frictional(model)) then
                         u = u_conv
                         do ip = 1, size(model%pairs)
                             call pair_reset_trial(model%pairs(ip))
@@ -627,10 +627,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: inner
         real(dp), allocatable :: bound(:), new_bound(:), x0(:)
-        real(dp) :: r0, floor, change, last_change, gmax, log_det
+        real(dp) :: r0, floor, change, last_change, gmax, log_det, growth
         integer :: fp, it_inner, growing
         logical :: accepted
-        character(len=300) :: msg
+        character(len=600) :: msg
 
         it = 0
         rn = 0.0_dp
@@ -648,6 +648,7 @@ contains
         r0 = norm2(merge(0.0_dp, r, model%fixed))
         last_change = huge(1.0_dp)
         growing = 0
+        growth = 0.0_dp
         accepted = .false.
         do fp = 1, max_fixed_point
             stats%fixed_point_iterations = stats%fixed_point_iterations + 1
@@ -684,6 +685,8 @@ contains
             end if
             if (.not. ieee_is_finite(rn)) exit
             growing = merge(growing + 1, 0, change > last_change)
+            if (growing > 0) growth = max(growth, change/last_change)
+            if (growing == 0) growth = 0.0_dp
             if (growing >= 3) exit
             last_change = change
             bound = new_bound
@@ -692,9 +695,18 @@ contains
             write (msg, '(a,i0,a,es9.2,a,es9.2,a,es9.2,a,es9.2,a)') 'the fixed point did not converge in ', &
                 fp - merge(1, 0, fp > max_fixed_point), ' iterations (Coulomb residual ', rn, ', reference ', r0, &
                 '; last bound change ', change, ' of max bound ', gmax, ')'
-            if (growing >= 3) msg = trim(msg)//': the bound changes grew in 3 iterations in a row'
-            call fatal_error(error, trim(msg)//': the Coulomb incremental problem may have no solution '// &
-                             'near this state (not unique or not existing for this mu)', error_code%numeric)
+            if (growing >= 3) then
+                write (msg, '(a,f0.2,a)') trim(msg)//': the successive approximations diverge (the bound '// &
+                    'change grew in 3 iterations in a row, by up to ', growth, ' per iteration): the map g -> '// &
+                    'mu p_N(g) is not a contraction here'
+                call fatal_error(error, trim(msg)//', the condition under which the existence theory of '// &
+                                 'quasi-static Coulomb friction guarantees a unique incremental solution '// &
+                                 '(small mu); a Coulomb solution may not exist near this state', &
+                                 error_code%numeric)
+            else
+                call fatal_error(error, trim(msg)//': the Coulomb incremental problem may have no '// &
+                                 'solution near this state', error_code%numeric)
+            end if
             return
         end if
         ! the orientation of the Coulomb tangent at the accepted state
@@ -704,10 +716,11 @@ contains
         call lu%determinant(stats%det_sign, log_det, error)
         if (allocated(error)) return
         stats%tresca_accepted = stats%tresca_accepted + 1
-        if (.not. quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,es9.2,a,es9.2,a,es9.2,a,i0)') 'tresca step ', &
+        if (.not. quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,6(es9.2,a),i0)') 'tresca step ', &
             step, '  t=', t, ': the Tresca fixed point converged in ', fp, ' iterations (', it, &
-            ' Newton iterations); Coulomb residual ', rn, ' (reference ', r0, '); last bound change ', &
-            change, '; det K sign ', stats%det_sign
+            ' Newton iterations); Coulomb residual ', rn, ' (reference ', r0, ', round-off floor ', floor, &
+            ', force scale ', max(r0, stats%r0_max), '); last bound change ', change, ' of max bound ', gmax, &
+            '; det K sign ', stats%det_sign
     end subroutine tresca_fixed_point
 
     !> Whether any contact pair has friction.
