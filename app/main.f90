@@ -143,6 +143,9 @@ program voiga_main
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output
+    if (stats%tresca_retries > 0) write (*, '(a,i0,a,i0,a,i0,a)') 'Tresca fixed point: ', &
+        stats%tresca_retries, ' substeps retried, ', stats%tresca_accepted, ' accepted, ', &
+        stats%fixed_point_iterations, ' fixed-point iterations'
 
 contains
 

@@ -33,9 +33,11 @@ contains
                     new_unittest('tangent_fd_stick', test_fd_stick), &
                     new_unittest('tangent_fd_slip', test_fd_slip), &
                     new_unittest('tangent_fd_rigid_master', test_fd_rigid), &
+                    new_unittest('tangent_fd_tresca', test_fd_tresca), &
                     new_unittest('contact_patch_test', test_patch), &
                     new_unittest('friction_block_slip', test_block_slip), &
                     new_unittest('friction_block_stick', test_block_stick), &
+                    new_unittest('tresca_fixed_point_solves_coulomb', test_tresca_fixed_point), &
                     new_unittest('frictionless_runs_no_friction_code', test_no_friction_code), &
                     new_unittest('rigid_master_adds_no_dofs', test_rigid_no_dofs), &
                     new_unittest('ironing_newton_quadratic', test_ironing_quadratic), &
@@ -165,7 +167,7 @@ contains
         end subroutine add_dense
     end subroutine contact_fd
 
-    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error)
+    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca)
         character(len=*), intent(in) :: layouts(:)
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -173,6 +175,8 @@ contains
         real(dp), intent(in) :: anchor_shift
         integer, intent(in) :: want_state
         type(error_t), allocatable, intent(out) :: error
+        !> Tresca mode: slip bound = this factor x mu p_N of the state (fixed for the FD).
+        real(dp), intent(in), optional :: tresca
         type(model_t) :: model
         real(dp), allocatable :: u(:), r(:)
         integer :: il
@@ -189,6 +193,7 @@ contains
                 if (allocated(error)) return
                 model%pairs(1)%active_last = .true.
                 model%pairs(1)%anchor = model%pairs(1)%out%xi_m - anchor_shift
+                if (present(tresca)) model%pairs(1)%slip_bound = tresca*mu*max(0.0_dp, model%pairs(1)%out%pn)
                 deallocate (r)
             end if
             call contact_fd(model%pairs(1), u, want_state, trim(layouts(il))// &
@@ -224,6 +229,20 @@ contains
         if (allocated(error)) return
         call run_fd([character(len=5) :: 'N4', 'NN2.2'], 0.3_dp, .true., 0.5_dp, state_slip, error)
     end subroutine test_fd_rigid
+
+    !> Tresca mode (prescribed slip bounds, the fixed point of the Newton solver):
+    !> its tangent has no normal-tangential coupling; checked against FD with the
+    !> bounds held fixed, sticking (bounds 10 mu p_N, a small shift) and slipping.
+    subroutine test_fd_tresca(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'N4', 'NN2.2'], 0.3_dp, .false., 1.0e-4_dp, state_stick, &
+                    error, tresca=10.0_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N2', 'N4', 'NN2.2'], 0.3_dp, .false., 0.05_dp, state_slip, &
+                    error, tresca=0.7_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N3', 'NN4'], 0.3_dp, .true., 0.5_dp, state_slip, error, tresca=1.0_dp)
+    end subroutine test_fd_tresca
 
     !> A body entry of a test case.
     function body(name, material, e, layout) result(b)
@@ -333,11 +352,13 @@ contains
     end subroutine patch_spread
 
     !> A block on a rigid plane, pressed then pushed (or barely pushed).
-    subroutine block_on_plane(push, mu, model, u, error)
+    subroutine block_on_plane(push, mu, model, u, error, stepping, stats_out)
         real(dp), intent(in) :: push, mu
         type(model_t), intent(out) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(error_t), allocatable, intent(out) :: error
+        type(stepping_t), intent(in), optional :: stepping
+        type(solver_stats_t), intent(out), optional :: stats_out
         type(case_t) :: c
         type(solver_stats_t) :: stats
         c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
@@ -349,8 +370,51 @@ contains
                                        penalty_tangent=1000.0_dp, friction=mu)
         call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error)
+        call solve_steps(model, u, stats, .true., error, stepping=stepping)
+        if (present(stats_out)) stats_out = stats
     end subroutine block_on_plane
+
+    !> The Tresca fixed point of the solver (successive approximations on the slip
+    !> bounds; here for every substep, `stepping_t%tresca_always`) solves the Coulomb
+    !> problem: the block pressed and slid on a rigid plane (mu = 0.3, slipping)
+    !> reaches plain Newton's state, and the Coulomb residual there is converged.
+    subroutine test_tresca_fixed_point(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: ma, mb
+        type(solver_stats_t) :: sa, sb
+        type(assembly_stats_t) :: as
+        real(dp), allocatable :: ua(:), ub(:), r(:)
+        real(dp) :: rn
+        call block_on_plane(0.1_dp, 0.3_dp, ma, ua, error, stats_out=sa)
+        if (allocated(error)) return
+        call block_on_plane(0.1_dp, 0.3_dp, mb, ub, error, stepping_t(tresca_always=.true.), sb)
+        if (allocated(error)) return
+        call check(error, sa%tresca_retries == 0, 'plain Newton needed no fixed point')
+        if (allocated(error)) return
+        call check(error, sb%tresca_accepted == sb%substeps .and. sb%tresca_retries == sb%substeps, &
+                   'every substep solved by the fixed point')
+        if (allocated(error)) return
+        call check(error, sb%fixed_point_iterations > sb%substeps, 'some substeps needed several bounds')
+        if (allocated(error)) return
+        ! both are solutions of the same incremental problems to tol_residual = 1e-10 of
+        ! each substep's first residual: they agree far below 1e-8 of the displacement
+        call check(error, maxval(abs(ub - ua)) <= 1.0e-8_dp*maxval(abs(ua)), 'same state as plain Newton')
+        if (allocated(error)) return
+        call check(error, .not. allocated(mb%pairs(1)%slip_bound), 'back in Coulomb mode')
+        if (allocated(error)) return
+        ! the Coulomb residual of the accepted last state (re-evaluated with the committed
+        ! anchors: slipping points then sit on the slip limit, the same traction); the
+        ! substeps' first residuals are below the force scale r0_max, and the fixed point
+        ! accepts at tol_residual = 1e-10 of them or at round-off floors below this
+        allocate (r(size(ub)))
+        call assemble(mb, ub, 2.0_dp, r, as, error)
+        if (allocated(error)) return
+        rn = norm2(merge(0.0_dp, r, mb%fixed))
+        call check(error, rn <= 1.0e-9_dp*sb%r0_max, 'Coulomb residual converged at the accepted state')
+        if (allocated(error)) return
+        call check(error, abs(mb%pairs(1)%force(1)), 0.3_dp*abs(mb%pairs(1)%force(2)), 'F_T = mu F_N', &
+                   rel=1.0e-8_dp)
+    end subroutine test_tresca_fixed_point
 
     subroutine test_block_slip(error)
         type(error_t), allocatable, intent(out) :: error

@@ -3,6 +3,10 @@
 !> convected master coordinate, residual and consistent tangent (docs/theory.md,
 !> section 7).
 !>
+!> Tresca mode (optional argument `bound`): the slip limit is a given bound instead
+!> of mu p_N; its tangent has no normal-tangential coupling (the successive
+!> approximations of `voiga_solver_newton`, docs/robustness.md, "Tresca fixed point").
+!>
 !> Local DOFs: the slave point's functions first (2 per function), then the
 !> master's (none for a rigid master). G maps them to x_s - x_m(xi), Dm to the
 !> master tangent a = dx_m/dxi at fixed xi, Ds to the slave tangent.
@@ -28,7 +32,9 @@ contains
     !> active point, with the traction t on the slave. Frictionless when mu = 0
     !> (no friction code runs). `anchor` is the committed stick point (convected
     !> master coordinate); `new_anchor` the one to commit if the step converges.
-    pure subroutine gpts_point(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor)
+    !> With `bound` (and mu > 0) the slip limit |t_T| <= bound is prescribed (Tresca
+    !> friction) instead of mu pn; without it the Coulomb code below runs unchanged.
+    pure subroutine gpts_point(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, bound)
         type(contact_law_t), intent(in) :: law
         !> Quadrature weight times d(xi_s)/d(reference parameter): da = |a_s| w.
         real(dp), intent(in) :: w
@@ -40,6 +46,8 @@ contains
         !> Normal gap, contact pressure (>= 0) and tangential traction t . t_hat.
         real(dp), intent(out) :: g, pn, pt
         real(dp), intent(out) :: new_anchor
+        !> Prescribed slip bound (traction, >= 0): Tresca mode.
+        real(dp), intent(in), optional :: bound
         real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r)), tmat(2, size(r))
         real(dp) :: c(size(r)), ng(size(r)), na(size(r)), gt(size(r)), dmt(size(r)), dst(size(r))
         real(dp) :: n(2), that(2), ts(2), t(2), la, las, den, da, slip, ttr, s
@@ -86,7 +94,26 @@ contains
         state = state_stick
         pt = 0.0_dp
         new_anchor = anchor
-        if (law%mu > 0.0_dp) then
+        if (law%mu > 0.0_dp .and. present(bound)) then
+            ! Tresca: the same predictor and return map with the slip limit fixed
+            slip = mp%xi - anchor
+            ttr = law%eps_t*abs(slip)*la
+            if (ttr <= bound) then
+                t = t - law%eps_t*slip*mp%a
+                tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*c + slip*amat(1, :))
+                tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*c + slip*amat(2, :))
+                pt = -law%eps_t*slip*la
+            else
+                ! t_T = -bound s t_hat; only t_hat moves (dt_hat = n na)
+                state = state_slip
+                s = sign(1.0_dp, slip)
+                t = t - bound*s*that
+                tmat(1, :) = tmat(1, :) - bound*s*n(1)*na
+                tmat(2, :) = tmat(2, :) - bound*s*n(2)*na
+                pt = -bound*s
+                new_anchor = mp%xi - s*bound/(law%eps_t*la)
+            end if
+        else if (law%mu > 0.0_dp) then
             ! elastic predictor on the convected coordinate
             slip = mp%xi - anchor
             ttr = law%eps_t*abs(slip)*la

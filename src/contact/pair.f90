@@ -46,6 +46,10 @@ module voiga_contact_pair
         !> contact at the last converged state; the projection there.
         real(dp), allocatable :: anchor(:), trial_anchor(:), xi_last(:), trial_xi(:)
         logical, allocatable :: active_last(:), trial_active(:)
+        !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
+        !> slave point is this prescribed traction instead of mu p_N (the fixed point
+        !> of `voiga_solver_newton` sets and deallocates it; never committed).
+        real(dp), allocatable :: slip_bound(:)
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
         !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
@@ -180,7 +184,12 @@ contains
                 if (size(rl) /= nd) deallocate (rl, kl)
             end if
             if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
-            call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
+            if (allocated(self%slip_bound)) then
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor, &
+                                self%slip_bound(k))
+            else
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
+            end if
             self%n_evaluations = self%n_evaluations + 1
             dofs = [sp%dofs, mp%dofs]
             r(dofs) = r(dofs) + rl

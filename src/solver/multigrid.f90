@@ -491,17 +491,21 @@ contains
     end subroutine precondition
 
     !> Solve A x = b (A: the fine operator of the last `setup`) by GMRES(restart),
-    !> right preconditioned by a V-cycle, to ||b - A x|| <= rtol ||b||.
+    !> right preconditioned by a V-cycle, to ||b - A x|| <= rtol ||b||; or, after
+    !> `soft_iterations` iterations, to `soft_rtol` (a looser target for a slowly
+    !> converging solve whose accuracy matters little).
     !> Not reaching it within `max_iterations` is a numerical error.
-    subroutine mg_solve(self, b, x, rtol, error)
+    subroutine mg_solve(self, b, x, rtol, error, soft_iterations, soft_rtol)
         class(multigrid_t), intent(inout) :: self
         real(dp), intent(in) :: b(:)
         real(dp), intent(out) :: x(:)
         real(dp), intent(in) :: rtol
         type(error_t), allocatable, intent(out) :: error
+        integer, intent(in), optional :: soft_iterations
+        real(dp), intent(in), optional :: soft_rtol
         real(dp), allocatable :: h(:, :), g(:), cs(:), sn(:), y(:)
-        real(dp) :: bnorm, beta, target, temp
-        integer :: n, m, j, i, total
+        real(dp) :: bnorm, beta, target, temp, soft_target
+        integer :: n, m, j, i, total, soft_it
         character(len=200) :: msg
 
         n = size(b)
@@ -513,6 +517,12 @@ contains
         self%last_residual = 0.0_dp
         if (bnorm == 0.0_dp) return
         target = rtol*bnorm
+        soft_it = huge(1)
+        soft_target = target
+        if (present(soft_iterations) .and. present(soft_rtol)) then
+            soft_it = soft_iterations
+            soft_target = max(target, soft_rtol*bnorm)
+        end if
         allocate (h(m + 1, m), g(m + 1), cs(m), sn(m), y(m))
         if (.not. allocated(self%v)) allocate (self%v(n, m + 1), self%w(n), self%r(n))
         associate (v => self%v, w => self%w, r => self%r)
@@ -562,6 +572,7 @@ contains
                 g(j + 1) = -sn(j)*g(j)
                 g(j) = cs(j)*g(j)
                 if (abs(g(j + 1)) <= target .or. total >= self%max_iterations) exit
+                if (total >= soft_it .and. abs(g(j + 1)) <= soft_target) exit
             end do
             ! y = H^-1 g (upper triangular), x += M^-1 V y
             do i = j, 1, -1
@@ -579,6 +590,7 @@ contains
             beta = norm2(r)
             self%last_residual = beta/bnorm
             if (beta <= target) exit
+            if (total >= soft_it .and. beta <= soft_target) exit
             if (total >= self%max_iterations .or. .not. (beta == beta)) then
                 write (msg, '(a,i0,a,es9.2,a,es9.2)') 'multigrid GMRES did not converge in ', total, &
                     ' iterations: relative residual ', beta/bnorm, ' > ', rtol

@@ -18,6 +18,13 @@
 !> subdivide a nominal step, so the case's steps are hit exactly and only their
 !> converged states are written. SIGINT/SIGTERM (voiga_solver_signals) are polled
 !> between iterations: the solve stops with the last converged state.
+!>
+!> Tresca fixed point (docs/robustness.md, "Tresca fixed point"): a frictional
+!> substep whose attempt from the last converged state failed at a fold (contact
+!> states switching, det K changing sign) is retried once at the same increment by
+!> successive approximations on the slip bounds: Newton on the Tresca problem (slip
+!> limit g_i fixed, no mu x penalty_normal coupling in the tangent), then
+!> g_i = mu p_N,i, until the Coulomb residual itself meets Newton's convergence test.
 module voiga_solver_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp, i8
@@ -73,10 +80,19 @@ module voiga_solver_newton
     !> Relative residual of an iterative linear solve at a Newton iteration whose
     !> contact states differ from the previous iteration's (multigrid only): the
     !> iteration is not in Newton's quadratic range, and its step mostly moves the
-    !> active set. Hertz N2 m8, one load step: 1e-2 takes the same 10 Newton
-    !> iterations as the exact solve with 31 GMRES iterations instead of 82; 1e-1
-    !> takes 11 with 16 (docs/performance.md).
-    real(dp), parameter :: active_set_forcing = 1.0e-1_dp
+    !> active set; after `soft_iterations` GMRES iterations `soft_forcing` is enough.
+    !> Measured (docs/performance.md, "Multigrid"): hertz N2 m8, one load step, the
+    !> exact-solve forcing takes 82 GMRES iterations in 10 Newton iterations, 1e-2 31
+    !> in 10, 1e-1 16 in 11; but 1e-1 costs Newton iterations elsewhere (hertz m3 N2,
+    !> 5 steps: 30 instead of 26). The first iteration after contact starts from a
+    !> deep penetration is the slow solve (m9: 14 GMRES iterations to 1e-1): the
+    !> current-length term of the contact tangent, pressure x d(length)/du, is then
+    !> large against the penalty (ratio ~ penetration / element size).
+    real(dp), parameter :: active_set_forcing = 1.0e-2_dp, soft_forcing = 1.0e-1_dp
+    integer, parameter :: soft_iterations = 10
+
+    !> Most Tresca solves (fixed-point iterations) of one retried substep.
+    integer, parameter :: max_fixed_point = 40
 
     !> Adaptive load stepping settings (`&solver`: min_step_fraction, max_cuts,
     !> grow_iterations; docs/robustness.md).
@@ -90,6 +106,10 @@ module voiga_solver_newton
         !> Start a substep from u_conv + (substep fraction) x (the last nominal step's
         !> increment) when that step is in the same load phase.
         logical :: predictor = .true.
+        !> Solve every substep of a frictional model by the Tresca fixed point (from the
+        !> last converged state), not only those whose Newton attempt folds: for tests
+        !> and comparisons (Fortran API only, not a case-file setting).
+        logical :: tresca_always = .false.
     end type stepping_t
 
     !> Counters of a run.
@@ -108,6 +128,12 @@ module voiga_solver_newton
         integer :: det_sign = 0, attempt_nonpositive_det = 0
         !> DOFs of each multigrid level (empty with the direct solver).
         integer, allocatable :: multigrid_levels(:)
+        !> The last Newton attempt failed with contact states switching (a period-2
+        !> cycle, or the iteration cap with switches among the last iterations).
+        logical :: attempt_switching = .false.
+        !> Substeps retried with the Tresca fixed point, of them accepted, and the
+        !> fixed-point iterations (Tresca solves) of all retries.
+        integer :: tresca_retries = 0, tresca_accepted = 0, fixed_point_iterations = 0
         !> Largest first residual of a step so far: the force scale of the round-off floor.
         real(dp) :: r0_max = 0.0_dp
         !> Converged substeps and cuts of the load increment.
@@ -160,6 +186,7 @@ contains
         integer :: step, nsteps, j, c, ip, it, first_cut, first
         logical :: loud, predicted, unpredicted_retry
         character(len=200) :: msg
+        type(error_t), allocatable :: tresca_error
         ! sign of det(K) at the last converged substep; det(K) <= 0 iterations and all
         ! iterations of the last failed attempt started from the converged state
         integer :: conv_det_sign, fold_iterations, fold_total
@@ -229,8 +256,43 @@ contains
                     end if
                 end if
                 unpredicted_retry = .false.
-                call set_prescribed(model, t, u)
-                call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, loud, error)
+                if (set%tresca_always .and. frictional(model)) then
+                    u = u_conv
+                    predicted = .false.
+                    call tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, &
+                                            loud, quiet, error)
+                else
+                    call set_prescribed(model, t, u)
+                    call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, loud, error)
+                end if
+                if (allocated(error) .and. .not. predicted .and. .not. set%tresca_always) then
+                    fold_iterations = stats%attempt_nonpositive_det
+                    fold_total = it
+                    ! contact states still switching in a frictional case (a period-2 cycle
+                    ! or the cap with switches; at a fold det K also changes sign, but the
+                    ! stick/slip switch of a stiff penalty stalls Newton with det K > 0 as
+                    ! well): retry the same increment with the Tresca fixed point before cutting
+                    if (error%code == error_code%numeric .and. stats%signal == 0 .and. &
+                        stats%attempt_switching .and. frictional(model)) then
+                        u = u_conv
+                        do ip = 1, size(model%pairs)
+                            call pair_reset_trial(model%pairs(ip))
+                        end do
+                        call tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, &
+                                                loud, quiet, tresca_error)
+                        if (allocated(tresca_error)) then
+                            if (stats%signal /= 0) then
+                                call move_alloc(tresca_error, error)
+                            else
+                                error%message = error%message//'; retried with the Tresca fixed point: '// &
+                                                tresca_error%message
+                                deallocate (tresca_error)
+                            end if
+                        else
+                            deallocate (error)
+                        end if
+                    end if
+                end if
                 if (.not. allocated(error)) then
                     if (it > 0) conv_det_sign = stats%det_sign
                     u_conv = u
@@ -249,10 +311,6 @@ contains
                     call pair_reset_trial(model%pairs(ip))
                 end do
                 if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
-                if (.not. predicted) then
-                    fold_iterations = stats%attempt_nonpositive_det
-                    fold_total = it
-                end if
                 if (predicted) then
                     ! a predicted start that fails is retried once from the last converged
                     ! state, at the same increment, before the increment is cut
@@ -392,8 +450,10 @@ contains
     !> Newton iterations at load time `t` from `u` (prescribed values set). On
     !> success `rec` holds the iteration's norms; `it` the iterations, `rn` the final
     !> residual norm. A numerical failure returns an error with code `numeric`; an
-    !> interrupt sets stats%signal and returns a generic error.
-    subroutine newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, error)
+    !> interrupt sets stats%signal and returns a generic error. With `r0_ref` the
+    !> relative tests (tol_residual, energy, divergence) use it instead of the first
+    !> residual (the Tresca solves of a fixed point, measured against the substep's).
+    subroutine newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, error, r0_ref)
         type(model_t), intent(inout) :: model
         integer, intent(in) :: step
         real(dp), intent(in) :: t
@@ -411,12 +471,13 @@ contains
         real(dp), intent(out) :: rn
         logical, intent(in) :: verbose
         type(error_t), allocatable, intent(out) :: error
+        real(dp), intent(in), optional :: r0_ref
         real(dp), allocatable :: du(:), norms(:), energies(:), rhs(:), u_prev(:), x0(:)
         ! contact state of every slave point after each iteration; shape: [npoints, 0:max_iterations]
         integer, allocatable :: states(:, :)
         real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor, log_det, eta
         integer :: nls, ip, flips
-        logical :: converged, multigrid
+        logical :: converged, multigrid, changing
         character(len=400) :: msg
 
         multigrid = model%linear_solver == 'multigrid'
@@ -435,6 +496,7 @@ contains
         alpha = 1.0_dp
         rn_prev = huge(1.0_dp)
         stats%attempt_nonpositive_det = 0
+        stats%attempt_switching = .false.
         do
             if (caught_signal() /= 0) then
                 stats%signal = caught_signal()
@@ -469,6 +531,7 @@ contains
             if (it == 0) then
                 r0 = rn
                 stats%r0_max = max(stats%r0_max, r0)
+                if (present(r0_ref)) r0 = r0_ref
             end if
             if (verbose) call print_iteration(model, step, it, rn, en, alpha, floor)
             if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp) converged = .true.
@@ -499,6 +562,7 @@ contains
                     abs(rn - norms(it - 1)) <= 1.0e-6_dp*rn .and. &
                     abs(norms(it) - norms(it - 2)) <= 1.0e-6_dp*rn) then
                     flips = count(states(:, it) /= states(:, it - 1))
+                    stats%attempt_switching = .true.
                     write (msg, '(a,i0,a,i0,a,es9.2,a,es9.2,a)') 'Newton cycles after ', it, &
                         ' iterations: ', flips, ' contact point(s) switch state (stick/slip or '// &
                         'contact/separation) with every iteration and the residual repeats (', rn, &
@@ -518,6 +582,7 @@ contains
                         ': the stiffness (penalty) is too large for double precision'
                 else
                     flips = count([(any(states(:, ip) /= states(:, ip - 1)), ip=max(1, it - 9), it)])
+                    stats%attempt_switching = flips > 0
                     if (flips > 0) write (msg, '(a,i0,a,i0,a)') trim(msg)// &
                         ': contact states still switched in ', flips, ' of the last ', &
                         it - max(1, it - 9) + 1, ' iterations (points on the stick/slip or contact limit)'
@@ -548,11 +613,15 @@ contains
             if (multigrid) then
                 eta = forcing(rn, r0, model%tol_residual)
                 ! while contact states still change, Newton is not in its quadratic range
-                ! and the step is a rough guess of the active set: 1e-1 is enough
-                if (it > 0) then
-                    if (any(states(:, it) /= states(:, it - 1))) eta = max(eta, active_set_forcing)
+                ! and the step mostly moves the active set: a looser solve will do
+                changing = .false.
+                if (it > 0) changing = any(states(:, it) /= states(:, it - 1))
+                if (changing) then
+                    eta = max(eta, active_set_forcing)
+                    call mg%solve(rhs, du, eta, error, soft_iterations, soft_forcing)
+                else
+                    call mg%solve(rhs, du, eta, error)
                 end if
-                call mg%solve(rhs, du, eta, error)
                 if (caught_signal() /= 0) stats%signal = caught_signal()
                 rec%linear_iterations = rec%linear_iterations + mg%last_iterations
                 if (verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', mg%last_iterations, &
@@ -594,6 +663,183 @@ contains
         end if
         eta = min(1.0e-3_dp, max(eta, 1.0e-12_dp))
     end function forcing
+
+    !> Retry a frictional substep by successive approximations on the slip bounds
+    !> (the fixed point of the existence theory of quasi-static Coulomb friction):
+    !> with the bounds g_i fixed, the incremental problem is a Tresca problem, whose
+    !> tangent has no mu x penalty_normal coupling; Newton solves it, then
+    !> g_i = mu p_N,i from the new state, until the **Coulomb** residual at the
+    !> Tresca solution meets Newton's convergence test against the substep's first
+    !> Coulomb residual (tol_residual, or the round-off floors): the accepted state
+    !> solves the Coulomb problem as a plain Newton result would. `u` holds the last
+    !> converged state on entry, the accepted one on success; the contact pairs' trial
+    !> history is then that of the Coulomb evaluation at it, and stats%det_sign the
+    !> sign of det K of the Coulomb tangent there. Fails (error code numeric) when a
+    !> Tresca solve fails, the bound changes grow three times in a row, or after
+    !> `max_fixed_point` solves.
+    subroutine tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, quiet, &
+                                  error)
+        type(model_t), intent(inout) :: model
+        integer, intent(in) :: step
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: u(:)
+        !> Residual at the last evaluation, shape [ndof].
+        real(dp), intent(inout) :: r(:)
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(inout) :: map
+        type(umfpack_t), intent(inout) :: lu
+        type(multigrid_t), intent(inout) :: mg
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        !> Newton iterations of all Tresca solves; the Coulomb residual norm at the end.
+        integer, intent(out) :: it
+        real(dp), intent(out) :: rn
+        logical, intent(in) :: verbose, quiet
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: inner
+        real(dp), allocatable :: bound(:), new_bound(:), x0(:)
+        real(dp) :: r0, floor, change, last_change, gmax, log_det, growth
+        integer :: fp, it_inner, growing
+        logical :: accepted
+        character(len=600) :: msg
+
+        it = 0
+        rn = 0.0_dp
+        stats%tresca_retries = stats%tresca_retries + 1
+        x0 = reference_coordinates(model)
+        ! initial bounds: mu p_N at the last converged state (p_N depends on u only)
+        call assemble(model, u, t, r, stats%assembly, error)
+        if (allocated(error)) return
+        bound = slip_bounds(model)
+        ! the reference of the convergence test: the Coulomb residual at the substep's
+        ! start, the first residual of the plain Newton attempt that failed
+        call set_prescribed(model, t, u)
+        call assemble(model, u, t, r, stats%assembly, error)
+        if (allocated(error)) return
+        r0 = norm2(merge(0.0_dp, r, model%fixed))
+        last_change = huge(1.0_dp)
+        growing = 0
+        growth = 0.0_dp
+        accepted = .false.
+        do fp = 1, max_fixed_point
+            stats%fixed_point_iterations = stats%fixed_point_iterations + 1
+            call set_slip_bounds(model, bound)
+            call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it_inner, rn, verbose, inner, r0)
+            call clear_slip_bounds(model)
+            it = it + it_inner
+            if (allocated(inner)) then
+                if (stats%signal /= 0) then
+                    call move_alloc(inner, error)
+                    return
+                end if
+                write (msg, '(a,i0,a)') 'the Tresca problem of fixed-point iteration ', fp, ' failed: '
+                call fatal_error(error, trim(msg)//' '//inner%message, error_code%numeric)
+                return
+            end if
+            ! the Coulomb residual and tangent at the Tresca solution, and the new bounds
+            call assemble(model, u, t, r, stats%assembly, error, k, map)
+            if (allocated(error)) return
+            rn = norm2(merge(0.0_dp, r, model%fixed))
+            floor = residual_floor(k, x0 + u, model%fixed)
+            new_bound = slip_bounds(model)
+            change = maxval(abs(new_bound - bound))
+            gmax = maxval(new_bound)
+            if (verbose) write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,es10.3,a,es9.2,a,i0)') '  step ', step, &
+                ' fixed point ', fp, '  Coulomb |r|=', rn, '  reference ', r0, '  max |g change|=', change, &
+                ' of max g ', gmax, '  Newton it ', it_inner
+            ! Newton's own tests (newton_solve), on the Coulomb residual
+            if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp .or. &
+                rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max) .or. &
+                (rn <= floor .and. rn <= floor_cap*max(r0, stats%r0_max))) then
+                accepted = .true.
+                exit
+            end if
+            if (.not. ieee_is_finite(rn)) exit
+            growing = merge(growing + 1, 0, change > last_change)
+            if (growing > 0) growth = max(growth, change/last_change)
+            if (growing == 0) growth = 0.0_dp
+            if (growing >= 3) exit
+            last_change = change
+            bound = new_bound
+        end do
+        if (.not. accepted) then
+            write (msg, '(a,i0,a,es9.2,a,es9.2,a,es9.2,a,es9.2,a)') 'the fixed point did not converge in ', &
+                fp - merge(1, 0, fp > max_fixed_point), ' iterations (Coulomb residual ', rn, ', reference ', r0, &
+                '; last bound change ', change, ' of max bound ', gmax, ')'
+            if (growing >= 3) then
+                write (msg, '(a,f0.2,a)') trim(msg)//': the successive approximations diverge (the bound '// &
+                    'change grew in 3 iterations in a row, by up to ', growth, ' per iteration): the map g -> '// &
+                    'mu p_N(g) is not a contraction here'
+                call fatal_error(error, trim(msg)//', the condition under which the existence theory of '// &
+                                 'quasi-static Coulomb friction guarantees a unique incremental solution '// &
+                                 '(small mu); a Coulomb solution may not exist near this state', &
+                                 error_code%numeric)
+            else
+                call fatal_error(error, trim(msg)//': the Coulomb incremental problem may have no '// &
+                                 'solution near this state', error_code%numeric)
+            end if
+            return
+        end if
+        ! the orientation of the Coulomb tangent at the accepted state (the
+        ! multigrid solver has no factors: the sign stays unknown)
+        if (model%linear_solver /= 'multigrid') then
+            call k%fix_dofs(model%fixed)
+            call lu%factorize(k, error)
+            if (allocated(error)) return
+            call lu%determinant(stats%det_sign, log_det, error)
+            if (allocated(error)) return
+        end if
+        stats%tresca_accepted = stats%tresca_accepted + 1
+        if (.not. quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,6(es9.2,a),i0)') 'tresca step ', &
+            step, '  t=', t, ': the Tresca fixed point converged in ', fp, ' iterations (', it, &
+            ' Newton iterations); Coulomb residual ', rn, ' (reference ', r0, ', round-off floor ', floor, &
+            ', force scale ', max(r0, stats%r0_max), '); last bound change ', change, ' of max bound ', gmax, &
+            '; det K sign ', stats%det_sign
+    end subroutine tresca_fixed_point
+
+    !> Whether any contact pair has friction.
+    pure logical function frictional(model)
+        type(model_t), intent(in) :: model
+        integer :: ip
+        frictional = any([(model%pairs(ip)%law%mu > 0.0_dp, ip=1, size(model%pairs))])
+    end function frictional
+
+    !> mu p_N at the last evaluation for every slave point of every frictional pair,
+    !> in pair order; shape: [sum of the frictional pairs' points].
+    pure function slip_bounds(model) result(bound)
+        type(model_t), intent(in) :: model
+        real(dp), allocatable :: bound(:)
+        integer :: ip
+        allocate (bound(0))
+        do ip = 1, size(model%pairs)
+            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
+            bound = [bound, model%pairs(ip)%law%mu*max(0.0_dp, model%pairs(ip)%out%pn)]
+        end do
+    end function slip_bounds
+
+    !> Put every frictional pair in Tresca mode with the bounds `bound` (layout of
+    !> `slip_bounds`).
+    pure subroutine set_slip_bounds(model, bound)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: bound(:)
+        integer :: ip, first, n
+        first = 0
+        do ip = 1, size(model%pairs)
+            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
+            n = size(model%pairs(ip)%out)
+            model%pairs(ip)%slip_bound = bound(first + 1:first + n)
+            first = first + n
+        end do
+    end subroutine set_slip_bounds
+
+    !> Back to Coulomb friction in every pair.
+    pure subroutine clear_slip_bounds(model)
+        type(model_t), intent(inout) :: model
+        integer :: ip
+        do ip = 1, size(model%pairs)
+            if (allocated(model%pairs(ip)%slip_bound)) deallocate (model%pairs(ip)%slip_bound)
+        end do
+    end subroutine clear_slip_bounds
 
     !> One line per Newton iteration: residual, energy norm, contact states.
     subroutine print_iteration(model, step, it, rn, en, alpha, floor)
