@@ -88,52 +88,21 @@ contains
             t%val(next(i)) = vals(k)
             next(i) = next(i) + 1
         end do
-        call merge_duplicates(t, a)
+        ! times the identity: sums the repeated entries, sorts the columns
+        call csr_matmul(t, identity(ncol), a, sorted=.true.)
     end subroutine csr_from_triplets
 
-    !> Sum repeated column entries of each row and sort the columns.
-    pure subroutine merge_duplicates(a, b)
-        type(csr_t), intent(in) :: a
-        type(csr_t), intent(out) :: b
-        type(csr_t) :: t
-        real(dp), allocatable :: acc(:)
-        integer, allocatable :: mark(:), cols(:)
-        integer :: i, k, j, n, nnz
-
-        allocate (acc(a%ncol), mark(a%ncol), cols(a%ncol))
-        mark = 0
-        acc = 0.0_dp
-        t%nrow = a%nrow
-        t%ncol = a%ncol
-        allocate (t%ptr(a%nrow + 1), t%col(size(a%col)), t%val(size(a%col)))
-        nnz = 0
-        t%ptr(1) = 1
-        do i = 1, a%nrow
-            n = 0
-            do k = a%ptr(i), a%ptr(i + 1) - 1
-                j = a%col(k)
-                if (mark(j) /= i) then
-                    mark(j) = i
-                    n = n + 1
-                    cols(n) = j
-                    acc(j) = 0.0_dp
-                end if
-                acc(j) = acc(j) + a%val(k)
-            end do
-            t%col(nnz + 1:nnz + n) = cols(1:n)
-            t%val(nnz + 1:nnz + n) = acc(cols(1:n))
-            nnz = nnz + n
-            t%ptr(i + 1) = nnz + 1
-        end do
-        t%col = t%col(1:nnz)
-        t%val = t%val(1:nnz)
-        ! two transposes sort every row
-        block
-            type(csr_t) :: tt
-            call csr_transpose(t, tt)
-            call csr_transpose(tt, b)
-        end block
-    end subroutine merge_duplicates
+    !> The n x n identity.
+    pure function identity(n) result(e)
+        integer, intent(in) :: n
+        type(csr_t) :: e
+        integer :: i
+        e%nrow = n
+        e%ncol = n
+        e%ptr = [(i, i=1, n + 1)]
+        e%col = [(i, i=1, n)]
+        e%val = [(1.0_dp, i=1, n)]
+    end function identity
 
     !> b = a^T (columns of each row of b come out ascending).
     pure subroutine csr_transpose(a, b)
