@@ -113,3 +113,27 @@ def test_unknown_linear_solver_refused(run, tmp_path: Path) -> None:
     assert res.returncode == 2
     assert "&solver" in res.stderr and "linear_solver = 'cg'" in res.stderr
     assert "'direct' or 'multigrid'" in res.stderr
+
+
+def test_restart_reproduces_multigrid_run(run, tmp_path: Path) -> None:
+    """A multigrid run continued from step 2 of its result file reproduces the rest to
+    1e-12 (the hierarchy is rebuilt the same; GMRES is deterministic)."""
+    from test_restart import truncate
+
+    case = make_case(tmp_path, "hertz", "m3-N2", "multigrid")
+    res = run(case, "--quiet")
+    assert res.returncode == 0, res.stdout + res.stderr
+    out = case.with_suffix(".h5")
+    partial = tmp_path / "partial.h5"
+    shutil.copy(out, partial)
+    truncate(partial, 2)
+    res = run("--restart", partial, "--quiet")
+    assert res.returncode == 0, res.stdout + res.stderr
+    with h5py.File(out) as fa, h5py.File(partial) as fb:
+        assert fb.attrs["status"] == b"converged"
+        assert list(fb["multigrid_level_dofs"][()]) == list(fa["multigrid_level_dofs"][()])
+        assert list(fa["steps"]) == list(fb["steps"])
+        for name in fa["steps"]:
+            ua, ub = fa["steps"][name]["displacement"][()], fb["steps"][name]["displacement"][()]
+            np.testing.assert_allclose(ub, ua, rtol=0, atol=1e-12, err_msg=name)
+            assert fa["steps"][name].attrs["linear_iterations"] == fb["steps"][name].attrs["linear_iterations"]
