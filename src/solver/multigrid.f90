@@ -59,7 +59,9 @@ module voiga_solver_multigrid
         integer, allocatable :: ids(:, :), extra(:)
     end type body_grid_t
 
-    !> The multigrid preconditioner and its GMRES.
+    !> The multigrid preconditioner and its GMRES. Holds a UMFPACK factorization:
+    !> declare one per solve sequence and do not assign these objects (gfortran
+    !> crashed finalizing the handle of an assigned structure-constructor temporary).
     type :: multigrid_t
         !> Largest coarse problem solved directly.
         integer :: coarse_dofs = 2000
