@@ -135,7 +135,12 @@ contains
                 else
                     call coarsen_space(spaces(ib), next(ib), maps(ib), changed(ib), error)
                 end if
-                if (allocated(error)) return
+                ! a coarse space that cannot be built (rank-deficient insertion, weights
+                ! that do not fit) ends this body's coarsening, not the run
+                if (allocated(error)) then
+                    deallocate (error)
+                    changed(ib) = .false.
+                end if
                 if (.not. changed(ib)) call identity_map(ncp(ib), maps(ib))
             end do
             if (.not. any(changed)) exit
