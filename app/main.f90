@@ -128,18 +128,21 @@ program voiga_main
                                 grow_iterations=case%solver%grow_iterations, &
                                 predictor=case%solver%predictor), resume)
     if (stats%signal /= 0) then
-        call results%finish('interrupted', wall_seconds() - t0, stats%cut_records)
+        call results%finish('interrupted', wall_seconds() - t0, stats%cut_records, &
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
             ' completed steps are in '//case%output
         ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
         call exit_code(128 + stats%signal)
     end if
     if (allocated(error)) then
-        call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records)
+        call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records, &
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
         write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
         call fail(error)
     end if
-    call results%finish('converged', wall_seconds() - t0, stats%cut_records)
+    call results%finish('converged', wall_seconds() - t0, stats%cut_records, &
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output

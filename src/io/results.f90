@@ -298,16 +298,24 @@ contains
     end subroutine write_cuts
 
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and close;
-    !> `cuts`: every cut of the run (written as /cuts when there is one).
-    subroutine results_finish(self, status, wall, cuts)
+    !> `cuts`: every cut of the run (written as /cuts when there is one); `tresca`:
+    !> the run's Tresca fixed-point counters [retried substeps, accepted, fixed-point
+    !> iterations].
+    subroutine results_finish(self, status, wall, cuts, tresca)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
         real(dp), intent(in) :: wall
         type(cut_record_t), intent(in), optional :: cuts(:)
+        integer, intent(in), optional :: tresca(3)
         if (.not. self%h5%is_open()) return
         if (present(cuts)) then
             call self%h5%write_attr('/', 'n_cuts', size(cuts))
             if (size(cuts) > 0) call write_cuts(self%h5, '', cuts)
+        end if
+        if (present(tresca)) then
+            call self%h5%write_attr('/', 'tresca_retries', tresca(1))
+            call self%h5%write_attr('/', 'tresca_accepted', tresca(2))
+            call self%h5%write_attr('/', 'fixed_point_iterations', tresca(3))
         end if
         call self%h5%write_attr('/', 'status', status)
         call self%h5%write_attr('/', 'wall_time', wall)

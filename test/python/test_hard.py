@@ -101,3 +101,7 @@ def test_tresca_retry_accepts_coulomb_solutions(voiga_bin: Path, tmp_path: Path)
     with h5py.File(tmp_path / "result.h5") as f:
         assert f.attrs["status"] == b"converged"
         assert f.attrs["n_steps_done"] == 2
+        # the run's counters are in the file too
+        assert f.attrs["tresca_accepted"] == len(accepted)
+        assert f.attrs["tresca_retries"] == int(summary.group(1)) >= len(accepted)
+        assert f.attrs["fixed_point_iterations"] >= len(accepted)

@@ -50,6 +50,8 @@ def test_stretch_result_file(run, tmp_path: Path) -> None:
     with h5py.File(tmp_path / "out" / "stretch.h5") as f:
         assert f.attrs["status"] == b"converged"
         assert f.attrs["n_steps_done"] == 2 and len(f["steps"]) == 2
+        # no friction, no Tresca retry
+        assert f.attrs["tresca_retries"] == f.attrs["tresca_accepted"] == 0
         # linear: one Newton iteration in step 1; step 2 starts from the predictor
         # (step 1's increment), which is exact for proportional loading
         assert f["steps/000001"].attrs["iterations"] == 1
