@@ -4,7 +4,7 @@ module voiga_linalg_lapack
     implicit none
     private
 
-    public :: solve_spd, band_factor, band_solve
+    public :: solve_spd, band_factor
 
     interface
         pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
@@ -20,15 +20,6 @@ module voiga_linalg_lapack
             real(dp), intent(inout) :: ab(ldab, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgbtrf
-        pure subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-            import :: dp
-            character(len=1), intent(in) :: trans
-            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb
-            real(dp), intent(in) :: ab(ldab, *)
-            integer, intent(in) :: ipiv(*)
-            real(dp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine dgbtrs
     end interface
 
 contains
@@ -56,15 +47,5 @@ contains
         integer, intent(out) :: ipiv(n), info
         call dgbtrf(n, n, kl, ku, ab, 2*kl + ku + 1, ipiv, info)
     end subroutine band_factor
-
-    !> Solve with the factors of `band_factor`; `b` [n] is overwritten by x.
-    pure subroutine band_solve(n, kl, ku, ab, ipiv, b, info)
-        integer, intent(in) :: n, kl, ku
-        real(dp), intent(in) :: ab(2*kl + ku + 1, n)
-        integer, intent(in) :: ipiv(n)
-        real(dp), intent(inout) :: b(n)
-        integer, intent(out) :: info
-        call dgbtrs('N', n, kl, ku, 1, ab, 2*kl + ku + 1, ipiv, b, n, info)
-    end subroutine band_solve
 
 end module voiga_linalg_lapack

@@ -347,6 +347,10 @@ contains
                 call csr_matmul(self%levels(l)%r, self%levels(l)%ap, self%levels(l + 1)%a, sorted=.true.)
                 call unit_diagonal(self%levels(l + 1)%a, self%levels(l + 1)%fixed)
             end do
+            do l = 1, nl - 1
+                call self%levels(l)%lines(1)%analyse(self%levels(l)%a)
+                call self%levels(l)%lines(2)%analyse(self%levels(l)%a)
+            end do
             do l = 1, nl
                 self%levels(l)%diag = csr_diagonal_positions(self%levels(l)%a)
                 if (any(self%levels(l)%diag == 0)) then

@@ -31,8 +31,13 @@ module voiga_solver_smoother
         !> 2 kl + ku + 1), one after another, and their pivots.
         real(dp), allocatable :: band(:)
         integer, allocatable :: ipiv(:)
+        !> Every line-block entry: its position in the matrix values (src) and in
+        !> `band` (dst).
+        integer, allocatable :: src(:), dst(:)
     contains
-        !> Extract and factorize every line's block of a matrix.
+        !> Bandwidths, band layout and gather map for a matrix pattern.
+        procedure :: analyse => lines_analyse
+        !> Gather and factorize every line's block of a matrix.
         procedure :: factor => lines_factor
         !> One block Gauss-Seidel sweep over the lines.
         procedure :: sweep => lines_sweep
@@ -65,58 +70,68 @@ contains
         allocate (self%kl(self%n), self%ku(self%n), self%band_start(self%n), self%piv_start(self%n))
     end subroutine new_line_set
 
-    !> Band LU factors of the lines' blocks of `a`.
+    !> For the pattern of `a`: every line's bandwidths, its place in the band
+    !> storage, and where each of its entries comes from in `a` (once per pattern).
+    pure subroutine lines_analyse(self, a)
+        class(line_set_t), intent(inout) :: self
+        type(csr_t), intent(in) :: a
+        integer :: l, k, q, i, j, r, c, m, nb, np, ne, pass, ld
+
+        ! pass 1: bandwidths and entry count; pass 2: the gather map
+        do pass = 1, 2
+            if (pass == 1) then
+                self%kl = 0
+                self%ku = 0
+            end if
+            ne = 0
+            do l = 1, self%n
+                ld = 2*self%kl(l) + self%ku(l) + 1
+                do k = self%ptr(l), self%ptr(l + 1) - 1
+                    i = self%dofs(k)
+                    r = self%pos(i)
+                    do q = a%ptr(i), a%ptr(i + 1) - 1
+                        j = a%col(q)
+                        if (self%line_of(j) /= l) cycle
+                        c = self%pos(j)
+                        ne = ne + 1
+                        if (pass == 1) then
+                            self%kl(l) = max(self%kl(l), r - c)
+                            self%ku(l) = max(self%ku(l), c - r)
+                        else
+                            ! entry (r, c) at ab(kl + ku + 1 + r - c, c)
+                            self%src(ne) = q
+                            self%dst(ne) = self%band_start(l) + (c - 1)*ld + self%kl(l) + self%ku(l) + r - c
+                        end if
+                    end do
+                end do
+            end do
+            if (pass == 1) then
+                nb = 0
+                np = 0
+                do l = 1, self%n
+                    m = self%ptr(l + 1) - self%ptr(l)
+                    self%band_start(l) = nb + 1
+                    self%piv_start(l) = np + 1
+                    nb = nb + (2*self%kl(l) + self%ku(l) + 1)*m
+                    np = np + m
+                end do
+                if (allocated(self%band)) deallocate (self%band, self%ipiv, self%src, self%dst)
+                allocate (self%band(nb), self%ipiv(np), self%src(ne), self%dst(ne))
+            end if
+        end do
+    end subroutine lines_analyse
+
+    !> Band LU factors of the lines' blocks of `a` (pattern as in the last `analyse`).
     subroutine lines_factor(self, a, error)
         class(line_set_t), intent(inout) :: self
         type(csr_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
-        integer :: l, k, q, i, j, r, c, m, nb, np, ld, info
+        integer :: l, m, info
         character(len=120) :: msg
 
-        ! bandwidths of every line's block
-        self%kl = 0
-        self%ku = 0
-        do l = 1, self%n
-            do k = self%ptr(l), self%ptr(l + 1) - 1
-                i = self%dofs(k)
-                r = self%pos(i)
-                do q = a%ptr(i), a%ptr(i + 1) - 1
-                    j = a%col(q)
-                    if (self%line_of(j) /= l) cycle
-                    c = self%pos(j)
-                    self%kl(l) = max(self%kl(l), r - c)
-                    self%ku(l) = max(self%ku(l), c - r)
-                end do
-            end do
-        end do
-        nb = 0
-        np = 0
-        do l = 1, self%n
-            m = self%ptr(l + 1) - self%ptr(l)
-            self%band_start(l) = nb + 1
-            self%piv_start(l) = np + 1
-            nb = nb + (2*self%kl(l) + self%ku(l) + 1)*m
-            np = np + m
-        end do
-        if (allocated(self%band)) then
-            if (size(self%band) /= nb) deallocate (self%band)
-        end if
-        if (.not. allocated(self%band)) allocate (self%band(nb))
-        if (.not. allocated(self%ipiv)) allocate (self%ipiv(np))
         self%band = 0.0_dp
+        self%band(self%dst) = a%val(self%src)
         do l = 1, self%n
-            ld = 2*self%kl(l) + self%ku(l) + 1
-            do k = self%ptr(l), self%ptr(l + 1) - 1
-                i = self%dofs(k)
-                r = self%pos(i)
-                do q = a%ptr(i), a%ptr(i + 1) - 1
-                    j = a%col(q)
-                    if (self%line_of(j) /= l) cycle
-                    c = self%pos(j)
-                    ! entry (r, c) at ab(kl + ku + 1 + r - c, c)
-                    self%band(self%band_start(l) + (c - 1)*ld + self%kl(l) + self%ku(l) + r - c) = a%val(q)
-                end do
-            end do
             m = self%ptr(l + 1) - self%ptr(l)
             call band_factor(m, self%kl(l), self%ku(l), self%band(self%band_start(l)), &
                              self%ipiv(self%piv_start(l)), info)
