@@ -14,7 +14,7 @@ module test_contact
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t
     use voiga_io_case, only: dirichlet_input_t, pressure_input_t
-    use voiga_contact_pair, only: contact_pair_t, pair_contribution
+    use voiga_contact_pair, only: contact_pair_t, pair_contribution, pair_zone
     use voiga_contact_gpts, only: state_inactive, state_stick, state_slip
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
     implicit none
@@ -41,7 +41,8 @@ contains
                     new_unittest('frictionless_runs_no_friction_code', test_no_friction_code), &
                     new_unittest('rigid_master_adds_no_dofs', test_rigid_no_dofs), &
                     new_unittest('ironing_newton_quadratic', test_ironing_quadratic), &
-                    new_unittest('fitted_pattern_keeps_couplings', test_fitted_pattern) &
+                    new_unittest('fitted_pattern_keeps_couplings', test_fitted_pattern), &
+                    new_unittest('contact_zone_holes_and_support', test_pair_zone) &
                     ]
     end subroutine collect_contact
 
@@ -587,5 +588,40 @@ contains
             end do
         end function dense
     end subroutine test_fitted_pattern
+
+    !> The contact-zone counts of the over-constraint diagnosis: open points inside
+    !> the zone count as holes only in runs shorter than one slave element; the
+    !> control points are those whose functions are nonzero at an active point.
+    subroutine test_pair_zone(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(contact_pair_t) :: pair
+        integer :: n_active, n_holes, n_gaps, n_cp
+
+        ! 3 slave elements of degree 2, 4 points each (knot spans 3, 4, 5)
+        pair%n_gauss = 4
+        pair%slave%degree = 2
+        pair%span = [3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5]
+        allocate (pair%out(12))
+        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call check(error, n_active == 0 .and. n_holes == 0 .and. n_gaps == 0 .and. n_cp == 0, &
+                   'no contact: all counts 0')
+        if (allocated(error)) return
+        ! a zone in elements 1-2 broken by the single open points 4 and 6
+        pair%out([2, 3, 5, 7, 8])%state = state_slip
+        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call check(error, n_active == 5, 'five active points')
+        if (allocated(error)) return
+        call check(error, n_holes == 2 .and. n_gaps == 2, 'two single-point holes')
+        if (allocated(error)) return
+        call check(error, n_cp == 4, 'spans 3..4 of degree 2: 4 control points')
+        if (allocated(error)) return
+        ! two zones 4 open points (one element) apart, then a 3-point gap
+        pair%out%state = state_inactive
+        pair%out([1, 2, 7, 8, 12])%state = state_stick
+        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call check(error, n_holes == 3 .and. n_gaps == 1, 'the 4-point gap is not a hole, the 3-point gap is')
+        if (allocated(error)) return
+        call check(error, n_cp == 5, 'spans 3..5 of degree 2: 5 control points')
+    end subroutine test_pair_zone
 
 end module test_contact

@@ -13,7 +13,7 @@ module voiga_contact_pair
     private
 
     public :: contact_pair_t, setup_points, pair_contribution, pair_commit, pair_reset_trial, &
-              contact_point_out_t, pair_wanted_ranges, pair_element_dofs
+              contact_point_out_t, pair_wanted_ranges, pair_element_dofs, pair_zone
 
     !> Per-slave-point output of the last evaluation.
     type :: contact_point_out_t
@@ -278,6 +278,43 @@ contains
         self%active_last = self%trial_active
         self%xi_last = self%trial_xi
     end subroutine pair_commit
+
+    !> The contact zone at the last evaluation, for the over-constraint diagnosis:
+    !> `n_active` points in contact; `n_holes` open points lying between active ones
+    !> in runs shorter than one slave element (a zone broken up point by point, not
+    !> two separate zones), in `n_gaps` such runs; `n_cp` slave control points whose
+    !> functions are nonzero at an active point (the degrees of freedom the active
+    !> constraints act on).
+    pure subroutine pair_zone(self, n_active, n_holes, n_gaps, n_cp)
+        type(contact_pair_t), intent(in) :: self
+        integer, intent(out) :: n_active, n_holes, n_gaps, n_cp
+        logical, allocatable :: active(:)
+        integer :: k, first, last, run
+
+        n_active = 0
+        n_holes = 0
+        n_gaps = 0
+        n_cp = 0
+        if (.not. allocated(self%out)) return
+        active = self%out%state /= state_inactive
+        n_active = count(active)
+        if (n_active == 0) return
+        first = findloc(active, .true., dim=1)
+        last = findloc(active, .true., dim=1, back=.true.)
+        run = 0
+        do k = first, last
+            if (active(k)) then
+                if (run > 0 .and. run < self%n_gauss) then
+                    n_holes = n_holes + run
+                    n_gaps = n_gaps + 1
+                end if
+                run = 0
+            else
+                run = run + 1
+            end if
+        end do
+        n_cp = maxval(self%span, mask=active) - minval(self%span, mask=active) + self%slave%degree + 1
+    end subroutine pair_zone
 
     !> Forget the trial history (a step is retried).
     pure subroutine pair_reset_trial(self)

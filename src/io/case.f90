@@ -62,6 +62,10 @@ module voiga_io_case
         !> 'multigrid' (GMRES preconditioned by geometric multigrid over the
         !> nested spline spaces; docs/performance.md).
         character(len=16) :: linear_solver = 'direct'
+        !> Newton step damping: 'residual' (halve a step that increases the residual
+        !> norm) or 'natural' (affine-invariant: the simplified Newton correction must
+        !> shrink; direct solver only; docs/robustness.md).
+        character(len=16) :: damping = 'residual'
     end type solver_input_t
 
     !> A prescribed displacement on a named edge (`&dirichlet`).
@@ -415,11 +419,11 @@ contains
         integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph, max_cuts, grow_iterations
         real(dp) :: tol_residual, tol_energy, min_step_fraction
         logical :: predictor
-        character(len=16) :: linear_solver
+        character(len=16) :: linear_solver, damping
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
-            min_step_fraction, max_cuts, grow_iterations, predictor, linear_solver
+            min_step_fraction, max_cuts, grow_iterations, predictor, linear_solver, damping
 
         n_steps = -1
         max_iterations = entry%max_iterations
@@ -431,6 +435,7 @@ contains
         grow_iterations = entry%grow_iterations
         predictor = entry%predictor
         linear_solver = entry%linear_solver
+        damping = entry%damping
         rewind (u)
         read (u, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -484,7 +489,18 @@ contains
                              "': must be 'direct' or 'multigrid'", error_code%input)
             return
         end if
+        if (trim(damping) /= 'residual' .and. trim(damping) /= 'natural') then
+            call fatal_error(error, where//"damping = '"//trim(damping)// &
+                             "': must be 'residual' or 'natural'", error_code%input)
+            return
+        end if
+        if (trim(damping) == 'natural' .and. trim(linear_solver) == 'multigrid') then
+            call fatal_error(error, where//"damping = 'natural' needs linear_solver = 'direct' "// &
+                             "(its test solves with the last factorization)", error_code%input)
+            return
+        end if
         entry%linear_solver = linear_solver
+        entry%damping = damping
         entry%n_steps = n_steps(1:nph)
         entry%min_step_fraction = min_step_fraction
         entry%max_cuts = max_cuts

@@ -99,6 +99,7 @@ contains
         call self%h5%write_attr('/', 'status', 'running')
         call self%h5%write_attr('/', 'n_dofs', model%ndof)
         call self%h5%write_attr('/', 'linear_solver', trim(model%linear_solver))
+        call self%h5%write_attr('/', 'damping', trim(model%damping))
         call self%h5%write_attr('/', 'n_steps_planned', sum(model%n_steps))
         call self%h5%write_attr('/', 'n_steps_done', 0)
         call self%h5%write_attr('/', 'n_cuts', 0)

@@ -66,6 +66,8 @@ module voiga_model
         real(dp) :: tol_residual = 1.0e-10_dp, tol_energy = 1.0e-20_dp
         !> Linear solver: 'direct' or 'multigrid' (`&solver linear_solver`).
         character(len=16) :: linear_solver = 'direct'
+        !> Newton step damping: 'residual' or 'natural' (`&solver damping`).
+        character(len=16) :: damping = 'residual'
         !> Is any body finite-strain?
         logical :: finite_strain = .false.
         !> fixed(dof): is the DOF prescribed? shape [ndof]
@@ -117,6 +119,7 @@ contains
         self%tol_residual = case%solver%tol_residual
         self%tol_energy = case%solver%tol_energy
         self%linear_solver = case%solver%linear_solver
+        self%damping = case%solver%damping
 
         allocate (self%fixed(self%ndof))
         self%fixed = .false.

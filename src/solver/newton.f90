@@ -37,7 +37,7 @@ module voiga_solver_newton
     use voiga_solver_multigrid, only: multigrid_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
-    use voiga_contact_pair, only: pair_commit, pair_reset_trial
+    use voiga_contact_pair, only: pair_commit, pair_reset_trial, pair_zone
     implicit none
     private
 
@@ -58,6 +58,11 @@ module voiga_solver_newton
 
     !> Most halvings of one Newton step.
     integer, parameter :: max_line_search = 8
+
+    !> Natural damping (`damping = 'natural'`): most step reductions of one Newton
+    !> iteration, and the smallest step length.
+    integer, parameter :: max_natural_damping = 10
+    real(dp), parameter :: min_natural_step = 1.0e-4_dp
 
     !> A Newton iteration whose residual exceeds this multiple of the substep's
     !> first residual has diverged (the substep is cut instead of iterated to the cap).
@@ -90,6 +95,14 @@ module voiga_solver_newton
     !> large against the penalty (ratio ~ penetration / element size).
     real(dp), parameter :: active_set_forcing = 1.0e-2_dp, soft_forcing = 1.0e-1_dp
     integer, parameter :: soft_iterations = 10
+
+    !> A contact zone counts as broken up (the locking diagnosis) with at least this
+    !> many gaps shorter than a slave element, holding at least this share of its
+    !> points. Measured (docs/robustness.md): penalty 1e6 x E, 3 to 5 gaps holding 32 to
+    !> 48 %; mu-1.0-deep (penalty 1e2 x E, a smooth pressure), one gap of 4 points
+    !> between the zone and a lone point at its edge, 8 %.
+    integer, parameter :: min_gaps = 2
+    real(dp), parameter :: min_hole_share = 0.2_dp
 
     !> Most Tresca solves (fixed-point iterations) of one retried substep.
     integer, parameter :: max_fixed_point = 40
@@ -331,6 +344,8 @@ contains
                     end if
                     if (fold_iterations > 0 .and. (fold_iterations < fold_total .or. conv_det_sign > 0)) &
                         error%message = error%message//fold_diagnosis(model, fold_iterations, fold_total)
+                    call append_locking_diagnosis(model, u_conv, t_begin + s*(t_end - t_begin), stats, &
+                                                  error%message)
                     exit steps
                 end if
                 cut = cut_record_t(step=step, time=t, fraction=ds, new_fraction=0.5_dp*ds, &
@@ -420,6 +435,54 @@ contains
         end do
     end function fold_diagnosis
 
+    !> Append to `message` what the contact zones look like at the last converged
+    !> state `u` (load time `t`) when one is broken up point by point (at least
+    !> `min_gaps` gaps shorter than a slave element, holding at least `min_hole_share`
+    !> of the zone's points) while its active points outnumber the slave control
+    !> points they act on: Gauss-point-to-surface constraints then over-constrain the
+    !> slave edge and, with a stiff penalty, lock (docs/robustness.md,
+    !> "Over-constrained contact zones"). Nothing is appended otherwise, or when the
+    !> evaluation there fails.
+    subroutine append_locking_diagnosis(model, u, t, stats, message)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: u(:), t
+        type(solver_stats_t), intent(inout) :: stats
+        character(len=:), allocatable, intent(inout) :: message
+        type(error_t), allocatable :: error
+        real(dp), allocatable :: r(:)
+        character(len=600) :: buf
+        integer :: ip, n_active, n_holes, n_gaps, n_cp
+
+        if (size(model%pairs) == 0) return
+        allocate (r(model%ndof))
+        call assemble(model, u, t, r, stats%assembly, error)
+        do ip = 1, size(model%pairs)
+            call pair_reset_trial(model%pairs(ip))
+        end do
+        if (allocated(error)) return
+        do ip = 1, size(model%pairs)
+            call pair_zone(model%pairs(ip), n_active, n_holes, n_gaps, n_cp)
+            if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
+                n_active <= n_cp) cycle
+            associate (pair => model%pairs(ip))
+                write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es8.1,a)') '; at the last converged state the contact '// &
+                    'zone of '''//trim(pair%slave_name)//''' on '''//trim(pair%master_name)// &
+                    ''' is broken up: ', n_holes, ' of its ', n_active + n_holes, ' slave points are open in gaps '// &
+                    'shorter than a slave element, and its ', n_active, ' active points act on ', n_cp, &
+                    ' control points of the slave edge: the Gauss-point-to-surface constraints outnumber '// &
+                    'the edge''s degrees of freedom and, with penalty_normal = ', pair%law%eps_n, &
+                    ', lock (the pressure alternates between neighbouring points instead of following '// &
+                    'a smooth field)'
+                message = message//trim(buf)
+                if (pair%law%mu > 0.0_dp) message = message//'; the slip bounds mu p_N then jump from '// &
+                    'point to point, which breaks up the stick/slip pattern as well'
+                write (buf, '(a,i0,a)') '; fewer slave points per element (&contact n_gauss, here ', &
+                    pair%n_gauss, ') or a smaller penalty_normal avoid this'
+                message = message//trim(buf)
+            end associate
+        end do
+    end subroutine append_locking_diagnosis
+
     !> Append `cut` to `list`.
     pure subroutine append_cut(list, cut)
         type(cut_record_t), allocatable, intent(inout) :: list(:)
@@ -476,12 +539,23 @@ contains
         ! contact state of every slave point after each iteration; shape: [npoints, 0:max_iterations]
         integer, allocatable :: states(:, :)
         real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor, log_det, eta
+        ! natural damping: simplified correction at the trial point, norms for the
+        ! a-priori step estimate
+        real(dp), allocatable :: du_bar(:), du_bar_acc(:)
+        type(csc_matrix_t) :: k_old
+        real(dp) :: theta, h_est, du_norm, du_norm_prev, alpha_prev
+        logical :: natural, have_bar, smooth
         integer :: nls, ip, flips
         logical :: converged, multigrid, changing
         character(len=400) :: msg
 
         multigrid = model%linear_solver == 'multigrid'
-        allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof))
+        natural = model%damping == 'natural' .and. .not. multigrid
+        have_bar = .false.
+        du_norm = 0.0_dp
+        du_norm_prev = 0.0_dp
+        alpha_prev = 1.0_dp
+        allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof), du_bar(model%ndof))
         x0 = reference_coordinates(model)
         allocate (states(sum([(size(model%pairs(ip)%out), ip=1, size(model%pairs))]), &
                          0:model%max_iterations))
@@ -516,10 +590,36 @@ contains
                 exit
             end if
             floor = residual_floor(k, x0 + u, model%fixed)
+            have_bar = .false.
+            ! where the contact states change the last tangent does not describe the
+            ! trial point (a new active set): the residual rule decides there
+            smooth = .false.
+            if (natural .and. it > 0) smooth = all(contact_states(model) == states(:, it - 1))
+            if (smooth .and. du_norm > 0.0_dp .and. rn > floor .and. &
+                rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
+                ! natural monotonicity test (affine invariant): the simplified Newton
+                ! correction at the trial point, with the last iteration's tangent,
+                ! must be shorter than (1 - alpha/4) times the Newton correction
+                rhs = -merge(0.0_dp, r, model%fixed)
+                call lu%solve(k_old, rhs, du_bar, error)
+                if (allocated(error)) exit
+                theta = norm2(du_bar)/du_norm
+                if (theta > 1.0_dp - 0.25_dp*alpha .and. nls < max_natural_damping) then
+                    ! Kantorovich estimate of the step the curvature allows
+                    h_est = 2.0_dp*norm2(du_bar - (1.0_dp - alpha)*du)/(alpha**2*du_norm)
+                    nls = nls + 1
+                    stats%line_search_steps = stats%line_search_steps + 1
+                    alpha = max(min(0.5_dp*alpha, 1.0_dp/max(h_est, tiny(1.0_dp))), min_natural_step)
+                    u = u_prev + alpha*du
+                    cycle
+                end if
+                du_bar_acc = du_bar
+                have_bar = .true.
+            end if
             ! backtracking: a Newton step that increases the residual is halved
             ! (contact stick/slip and active-set changes can make full steps cycle)
-            if (it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. rn > floor .and. &
-                rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
+            if (.not. smooth .and. it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
+                rn > floor .and. rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
                 nls = nls + 1
                 stats%line_search_steps = stats%line_search_steps + 1
                 alpha = 0.5_dp*alpha
@@ -634,11 +734,23 @@ contains
             en = abs(dot_product(du, rhs))
             if (it == 0) e1 = en
             energies(it + 1) = en
+            alpha_prev = alpha
             u_prev = u
             rn_prev = rn
             alpha = 1.0_dp
+            if (natural) then
+                ! the tangent the next trial points are tested with
+                k_old = k
+                du_norm_prev = du_norm
+                du_norm = norm2(du)
+                ! a-priori step from the last accepted step's contraction
+                if (have_bar .and. du_norm > 0.0_dp) then
+                    h_est = norm2(du_bar_acc - du)*du_norm/max(du_norm_prev*norm2(du_bar_acc), tiny(1.0_dp))
+                    alpha = max(min(1.0_dp, alpha_prev/max(h_est, tiny(1.0_dp))), min_natural_step)
+                end if
+            end if
             nls = 0
-            u = u + du
+            u = u + alpha*du
             it = it + 1
         end do
         stats%iterations = stats%iterations + it
