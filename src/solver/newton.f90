@@ -134,7 +134,7 @@ module voiga_solver_newton
         !> Substeps whose predicted start failed and that were retried from the last
         !> converged state.
         integer :: predictor_retries = 0
-        !> Residual evaluations spent on halving Newton steps.
+        !> Residual evaluations spent on shortening Newton steps (halving, or natural damping).
         integer :: line_search_steps = 0
         !> Sign of det(K) of the last factorization (free DOFs), and the iterations of
         !> the last Newton attempt whose tangent had det(K) <= 0 (`newton_solve`).
