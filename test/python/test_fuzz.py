@@ -27,6 +27,7 @@ BASE = """&case
 &solver
   n_steps = 2, 2
   max_iterations = 30
+  damping = 'natural'
 /
 &dirichlet
   body = 'slab', edge = 'top', fix_x = .true., fix_y = .true., ux = 0.0, 0.3, uy = -0.03, -0.03
