@@ -210,17 +210,24 @@ contains
             if (f%has_attr(g, 'tangent_det_sign')) call f%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
             if (allocated(error)) return
             do ip = 1, size(model%pairs)
-                if (.not. allocated(model%pairs(ip)%anchor)) cycle
+                if (.not. allocated(model%pairs(ip)%xi_last)) cycle
                 write (buf, '(i0)') ip
                 c = g//'/contact/'//trim(buf)//'/history'
-                call f%read(c//'/anchor', model%pairs(ip)%anchor, error)
-                if (allocated(error)) return
+                if (allocated(model%pairs(ip)%anchor)) then
+                    call f%read(c//'/anchor', model%pairs(ip)%anchor, error)
+                    if (allocated(error)) return
+                    model%pairs(ip)%trial_anchor = model%pairs(ip)%anchor
+                end if
+                if (allocated(model%pairs(ip)%traction)) then
+                    call f%read(c//'/traction', model%pairs(ip)%traction, error)
+                    if (allocated(error)) return
+                    model%pairs(ip)%trial_traction = model%pairs(ip)%traction
+                end if
                 call f%read(c//'/xi_last', model%pairs(ip)%xi_last, error)
                 if (allocated(error)) return
                 call f%read(c//'/active_last', active, error)
                 if (allocated(error)) return
                 model%pairs(ip)%active_last = active /= 0
-                model%pairs(ip)%trial_anchor = model%pairs(ip)%anchor
                 model%pairs(ip)%trial_xi = model%pairs(ip)%xi_last
                 model%pairs(ip)%trial_active = model%pairs(ip)%active_last
             end do

@@ -42,19 +42,25 @@ contains
                     new_unittest('rigid_master_adds_no_dofs', test_rigid_no_dofs), &
                     new_unittest('ironing_newton_quadratic', test_ironing_quadratic), &
                     new_unittest('fitted_pattern_keeps_couplings', test_fitted_pattern), &
-                    new_unittest('contact_zone_holes_and_support', test_pair_zone) &
+                    new_unittest('contact_zone_holes_and_support', test_pair_zone), &
+                    new_unittest('mortar_tangent_fd_frictionless', test_fd_mortar_frictionless), &
+                    new_unittest('mortar_tangent_fd_stick', test_fd_mortar_stick), &
+                    new_unittest('mortar_tangent_fd_slip', test_fd_mortar_slip), &
+                    new_unittest('mortar_tangent_fd_rigid_master', test_fd_mortar_rigid) &
                     ]
     end subroutine collect_contact
 
 
     !> Die (half annulus, outer radius 3, lowest point (2.5, 0)) over a 9 x 3 slab,
     !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0).
-    subroutine two_body_model(layout, mu, rigid, model, error)
+    subroutine two_body_model(layout, mu, rigid, model, error, method)
         character(len=*), intent(in) :: layout
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
+        !> Contact method ('gpts' when absent).
+        character(len=*), intent(in), optional :: method
         type(case_t) :: c
         type(discretization_t) :: discs(2)
         character(len=8), parameter :: names(2) = [character(len=8) :: 'die', 'slab']
@@ -80,6 +86,7 @@ contains
         c%contact(1)%penalty_normal = 100.0_dp
         c%contact(1)%penalty_tangent = 70.0_dp
         c%contact(1)%friction = mu
+        if (present(method)) c%contact(1)%method = method
         call new_discretization(discs(1), annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
                                 c%bodies(1)%layout, '', error)
         if (allocated(error)) return
@@ -168,7 +175,7 @@ contains
         end subroutine add_dense
     end subroutine contact_fd
 
-    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca)
+    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method)
         character(len=*), intent(in) :: layouts(:)
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -178,12 +185,15 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Tresca mode: slip bound = this factor x mu p_N of the state (fixed for the FD).
         real(dp), intent(in), optional :: tresca
+        !> Contact method ('gpts' when absent); mortar: the shift is that of the last
+        !> converged projections, the committed tractions are zero.
+        character(len=*), intent(in), optional :: method
         type(model_t) :: model
         real(dp), allocatable :: u(:), r(:)
         integer :: il
 
         do il = 1, size(layouts)
-            call two_body_model(trim(layouts(il)), mu, rigid, model, error)
+            call two_body_model(trim(layouts(il)), mu, rigid, model, error, method)
             if (allocated(error)) return
             call penetrating_state(model, u)
             if (mu > 0.0_dp) then
@@ -193,7 +203,11 @@ contains
                 call pair_contribution(model%pairs(1), u, r, error)
                 if (allocated(error)) return
                 model%pairs(1)%active_last = .true.
-                model%pairs(1)%anchor = model%pairs(1)%out%xi_m - anchor_shift
+                if (allocated(model%pairs(1)%anchor)) model%pairs(1)%anchor = model%pairs(1)%out%xi_m - anchor_shift
+                if (allocated(model%pairs(1)%traction)) then
+                    model%pairs(1)%xi_last = model%pairs(1)%out%xi_m - anchor_shift
+                    model%pairs(1)%traction = 0.0_dp
+                end if
                 if (present(tresca)) model%pairs(1)%slip_bound = tresca*mu*max(0.0_dp, model%pairs(1)%out%pn)
                 deallocate (r)
             end if
@@ -244,6 +258,38 @@ contains
         if (allocated(error)) return
         call run_fd([character(len=5) :: 'N3', 'NN4'], 0.3_dp, .true., 0.5_dp, state_slip, error, tresca=1.0_dp)
     end subroutine test_fd_tresca
+
+    !> Mortar pairs: the tangent, with the couplings through the control-point
+    !> tractions, against central differences of the residual.
+    subroutine test_fd_mortar_frictionless(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'N3', 'N4', 'NN4', 'NN2.1', 'NN2.2'], 0.0_dp, .false., &
+                    0.0_dp, state_stick, error, method='mortar')
+    end subroutine test_fd_mortar_frictionless
+
+    subroutine test_fd_mortar_stick(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'N3', 'N4', 'NN4', 'NN2.2'], 0.5_dp, .false., &
+                    1.0e-4_dp, state_stick, error, method='mortar')
+    end subroutine test_fd_mortar_stick
+
+    subroutine test_fd_mortar_slip(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'N3', 'N4', 'NN4', 'NN2.2'], 0.3_dp, .false., &
+                    0.05_dp, state_slip, error, method='mortar')
+    end subroutine test_fd_mortar_slip
+
+    subroutine test_fd_mortar_rigid(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'NN2.2'], 0.0_dp, .true., 0.0_dp, state_stick, error, &
+                    method='mortar')
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N3', 'NN4'], 0.3_dp, .true., 1.0e-3_dp, state_stick, error, &
+                    method='mortar')
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N4', 'NN2.2'], 0.3_dp, .true., 0.5_dp, state_slip, error, &
+                    method='mortar')
+    end subroutine test_fd_mortar_rigid
 
     !> A body entry of a test case.
     function body(name, material, e, layout) result(b)

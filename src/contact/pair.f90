@@ -1,7 +1,10 @@
 !> A contact pair: the slave body's contact edge integrated with Gauss points
-!> (GPTS, full pass: forces on slave and master), a master (another body's
-!> contact edge or a rigid line), the penalty/friction law, and the friction
-!> history per slave point (only when mu > 0).
+!> (full pass: forces on slave and master), a master (another body's contact edge
+!> or a rigid line), the penalty/friction law, and the friction history (only
+!> when mu > 0). Two methods: Gauss-point-to-surface (GPTS, `voiga_contact_gpts`:
+!> the penalty acts at every slave point, history per point) and the mortar-type
+!> penalty (`voiga_contact_mortar`: the penalty acts on gaps weighted with the
+!> slave edge's functions, once per slave control point, history per control point).
 module voiga_contact_pair
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
@@ -9,11 +12,17 @@ module voiga_contact_pair
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_gpts, only: contact_law_t, gpts_point, state_inactive, state_stick, state_slip
+    use voiga_contact_mortar, only: mortar_point, mortar_law
     implicit none
     private
 
     public :: contact_pair_t, setup_points, pair_contribution, pair_commit, pair_reset_trial, &
-              contact_point_out_t, pair_wanted_ranges, pair_element_dofs, pair_zone
+              contact_point_out_t, pair_wanted_ranges, pair_element_dofs, pair_zone, &
+              pair_n_blocks, pair_block_dofs, method_gpts, method_mortar, method_names
+
+    !> Contact methods (`&contact method`): Gauss-point-to-surface, mortar-type penalty.
+    integer, parameter :: method_gpts = 1, method_mortar = 2
+    character(len=*), parameter :: method_names(2) = [character(len=6) :: 'gpts', 'mortar']
 
     !> Per-slave-point output of the last evaluation.
     type :: contact_point_out_t
@@ -36,16 +45,22 @@ module voiga_contact_pair
         type(contact_surface_t) :: slave
         class(contact_master_t), allocatable :: master
         type(contact_law_t) :: law
+        !> `method_gpts` or `method_mortar`.
+        integer :: method = method_gpts
         !> Gauss points per slave element.
         integer :: n_gauss = 0
         !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts].
         real(dp), allocatable :: xi(:), w(:)
         integer, allocatable :: span(:)
         !> Friction history (allocated only when mu > 0) [npts]: committed and trial
-        !> stick anchors (master convective coordinate); whether the point was in
-        !> contact at the last converged state; the projection there.
+        !> stick anchors (master convective coordinate; GPTS only); whether the point
+        !> was in contact (GPTS) or had a projection (mortar) at the last converged
+        !> state; the projection there.
         real(dp), allocatable :: anchor(:), trial_anchor(:), xi_last(:), trial_xi(:)
         logical, allocatable :: active_last(:), trial_active(:)
+        !> Mortar friction history (mu > 0) [slave edge control points]: committed and
+        !> trial tangential traction t_A (along the master tangent).
+        real(dp), allocatable :: traction(:), trial_traction(:)
         !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
         !> slave point is this prescribed traction instead of mu p_N (the fixed point
         !> of `voiga_solver_newton` sets and deallocates it; never committed).
@@ -106,10 +121,16 @@ contains
         if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/2
         self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
         if (self%law%mu > 0.0_dp) then
-            allocate (self%anchor(ne*ng), self%trial_anchor(ne*ng), self%xi_last(ne*ng), &
-                      self%trial_xi(ne*ng), self%active_last(ne*ng), self%trial_active(ne*ng))
-            self%anchor = 0.0_dp
-            self%trial_anchor = 0.0_dp
+            allocate (self%xi_last(ne*ng), self%trial_xi(ne*ng), self%active_last(ne*ng), self%trial_active(ne*ng))
+            if (self%method == method_mortar) then
+                allocate (self%traction(size(self%slave%cps)), self%trial_traction(size(self%slave%cps)))
+                self%traction = 0.0_dp
+                self%trial_traction = 0.0_dp
+            else
+                allocate (self%anchor(ne*ng), self%trial_anchor(ne*ng))
+                self%anchor = 0.0_dp
+                self%trial_anchor = 0.0_dp
+            end if
             self%xi_last = 0.0_dp
             self%trial_xi = 0.0_dp
             self%active_last = .false.
@@ -143,6 +164,10 @@ contains
         logical :: found, converged
         character(len=96) :: buf
 
+        if (self%method == method_mortar) then
+            call mortar_contribution(self, u, r, error, add)
+            return
+        end if
         self%force = 0.0_dp
         call self%master%prepare(u)
         do k = 1, size(self%xi)
@@ -222,6 +247,245 @@ contains
         end do
     end subroutine pair_contribution
 
+    !> `pair_contribution` of a mortar pair (docs/theory.md, section 7.4): the
+    !> weighted gaps and slips of the slave control points from every slave point
+    !> with a projection; their pressures and tangential tractions
+    !> (`mortar_law`); at every point the interpolated traction's residual and
+    !> geometric tangent (`mortar_point`); and per active control point A the
+    !> coupling (eps_N / D_A) v_A v_A^T (+ friction: (eps_T / D_A) q_A m_A^T when
+    !> sticking, mu s (eps_N / D_A) q_A v_A^T when slipping), with v_A, q_A, m_A the
+    !> N_A-weighted sums of the points' `gn`, `gt`, `m`, added on the control
+    !> point's block (`pair_block_dofs`).
+    subroutine mortar_contribution(self, u, r, error, add)
+        type(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        type(error_t), allocatable, intent(out) :: error
+        interface
+            subroutine add(dofs, k)
+                import :: dp
+                integer, intent(in) :: dofs(:)
+                real(dp), intent(in) :: k(:, :)
+            end subroutine add
+        end interface
+        optional :: add
+        !> Per slave point: its derivative vectors over its local DOFs.
+        type :: point_vectors_t
+            integer, allocatable :: dofs(:)
+            real(dp), allocatable :: gn(:), gt(:), m(:)
+        end type point_vectors_t
+        type(surface_point_t), allocatable :: sps(:)
+        type(master_point_t), allocatable :: mps(:)
+        type(point_vectors_t), allocatable :: vec(:)
+        real(dp), allocatable :: w0(:), dxi(:), d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), rl(:), kl(:, :)
+        real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
+        integer, allocatable :: st_a(:), blk(:), pos(:)
+        logical, allocatable :: valid(:), slip(:)
+        real(dp) :: a0(2), pbar, tbar, t_old, c
+        integer :: npts, ncp, k, i, a, e, nd, j, ng
+        logical :: found, converged, miss
+        character(len=96) :: buf
+
+        npts = size(self%xi)
+        ncp = size(self%slave%cps)
+        ng = self%n_gauss
+        self%force = 0.0_dp
+        call self%master%prepare(u)
+        allocate (sps(npts), mps(npts), vec(npts), w0(npts), dxi(npts), valid(npts), slip(npts))
+        allocate (d_a(ncp), g_a(ncp), ds_a(ncp), p_a(ncp), t_a(ncp), st_a(ncp))
+        d_a = 0.0_dp
+        g_a = 0.0_dp
+        ds_a = 0.0_dp
+        dxi = 0.0_dp
+        valid = .false.
+        slip = .false.
+        ! pass 1: projections, weighted gaps and slips
+        do k = 1, npts
+            call surface_point(self%slave, u, self%xi(k), sps(k), self%span(k))
+            associate (sp => sps(k), mp => mps(k), out => self%out(k))
+                a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
+                w0(k) = norm2(a0)*self%w(k)
+                d_a(sp%local) = d_a(sp%local) + w0(k)*sp%r
+                out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
+                out%x = sp%x
+                out%state = state_inactive
+                out%pn = 0.0_dp
+                out%pt = 0.0_dp
+                call self%master%project(u, sp%x, mp, found, converged)
+                out%xi_m = mp%xi
+                out%first = mp%first
+                out%last = mp%last
+                out%gap = huge(1.0_dp)
+                if (allocated(self%xi_last)) then
+                    self%trial_xi(k) = mp%xi
+                    self%trial_active(k) = .false.
+                end if
+                if (.not. found) cycle
+                out%gap = dot_product(sp%x - mp%x, mp%n)
+                if (.not. converged) then
+                    if (out%gap >= self%gap_tol) cycle
+                    write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
+                    call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
+                                     trim(self%master_name)//"': the closest-point projection of "// &
+                                     trim(buf)//' did not converge', error_code%numeric)
+                    return
+                end if
+                valid(k) = .true.
+                g_a(sp%local) = g_a(sp%local) + w0(k)*sp%r*out%gap
+                if (allocated(self%xi_last)) then
+                    self%trial_active(k) = .true.
+                    if (self%active_last(k)) then
+                        slip(k) = .true.
+                        dxi(k) = mp%xi - self%xi_last(k)
+                        ds_a(sp%local) = ds_a(sp%local) + w0(k)*sp%r*dxi(k)*norm2(mp%a)
+                    end if
+                end if
+            end associate
+        end do
+        ! pass 2: the law at every control point
+        do a = 1, ncp
+            t_old = 0.0_dp
+            if (allocated(self%traction)) t_old = self%traction(a)
+            call mortar_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), st_a(a))
+            if (allocated(self%traction)) self%trial_traction(a) = t_a(a)
+        end do
+        ! pass 3: every point's interpolated traction
+        miss = .false.
+        do k = 1, npts
+            if (.not. valid(k)) cycle
+            associate (sp => sps(k), mp => mps(k), out => self%out(k))
+                if (all(st_a(sp%local) == state_inactive)) cycle
+                pbar = dot_product(sp%r, p_a(sp%local))
+                tbar = dot_product(sp%r, t_a(sp%local))
+                nd = size(sp%dofs) + size(mp%dofs)
+                if (allocated(rl)) then
+                    if (size(rl) /= nd) deallocate (rl, kl)
+                end if
+                if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
+                allocate (vec(k)%gn(nd), vec(k)%gt(nd), vec(k)%m(nd))
+                call mortar_point(w0(k), sp, mp, pbar, tbar, dxi(k), slip(k), rl, kl, vec(k)%gn, vec(k)%gt, &
+                                  vec(k)%m)
+                vec(k)%dofs = [sp%dofs, mp%dofs]
+                self%n_evaluations = self%n_evaluations + 1
+                if (allocated(self%traction)) self%n_friction = self%n_friction + 1
+                r(vec(k)%dofs) = r(vec(k)%dofs) + rl
+                self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
+                self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+                out%pn = pbar
+                out%pt = tbar
+                out%state = merge(state_slip, state_stick, any(st_a(sp%local) == state_slip))
+                if (present(add)) then
+                    e = (k - 1)/ng + 1
+                    if (mp%first < self%mlo(e) .or. mp%last > self%mhi(e)) then
+                        ! outside the pattern: widen it, the caller rebuilds and reassembles
+                        if (self%mlo(e) > self%mhi(e)) then
+                            self%mlo(e) = mp%first
+                            self%mhi(e) = mp%last
+                        else
+                            self%mlo(e) = min(self%mlo(e), mp%first)
+                            self%mhi(e) = max(self%mhi(e), mp%last)
+                        end if
+                        self%pattern_miss = .true.
+                        miss = .true.
+                    else
+                        call add(vec(k)%dofs, kl)
+                    end if
+                end if
+            end associate
+        end do
+        if (.not. present(add) .or. miss) return
+        ! pass 4: the coupling through the control-point tractions
+        do a = 1, ncp
+            if (st_a(a) == state_inactive) cycle
+            blk = pair_block_dofs(self, a)
+            allocate (v(size(blk)), q(size(blk)), mm(size(blk)), pos(0))
+            v = 0.0_dp
+            q = 0.0_dp
+            mm = 0.0_dp
+            do e = 1, size(self%slave%spans)
+                if (a < self%slave%spans(e) - self%slave%degree .or. a > self%slave%spans(e)) cycle
+                do k = (e - 1)*ng + 1, e*ng
+                    if (.not. allocated(vec(k)%dofs)) cycle
+                    i = findloc(sps(k)%local, a, dim=1)
+                    c = w0(k)*sps(k)%r(i)
+                    pos = [(findloc(blk, vec(k)%dofs(j), dim=1), j=1, size(vec(k)%dofs))]
+                    v(pos) = v(pos) + c*vec(k)%gn
+                    q(pos) = q(pos) + c*vec(k)%gt
+                    mm(pos) = mm(pos) + c*vec(k)%m
+                end do
+            end do
+            allocate (kc(size(blk), size(blk)))
+            do j = 1, size(blk)
+                kc(:, j) = self%law%eps_n/d_a(a)*v*v(j)
+            end do
+            if (self%law%mu > 0.0_dp) then
+                if (st_a(a) == state_slip) then
+                    do j = 1, size(blk)
+                        kc(:, j) = kc(:, j) + self%law%mu*sign(1.0_dp, t_a(a))*self%law%eps_n/d_a(a)*q*v(j)
+                    end do
+                else
+                    do j = 1, size(blk)
+                        kc(:, j) = kc(:, j) + self%law%eps_t/d_a(a)*q*mm(j)
+                    end do
+                end if
+            end if
+            call add(blk, kc)
+            deallocate (v, q, mm, pos, kc)
+        end do
+    end subroutine mortar_contribution
+
+    !> Number of stiffness-pattern blocks the pair adds to the bodies' elements:
+    !> GPTS with a deformable master, one per slave element (its edge DOFs with its
+    !> master range); mortar, one per slave control point (`pair_block_dofs`); none
+    !> otherwise.
+    pure integer function pair_n_blocks(self) result(n)
+        type(contact_pair_t), intent(in) :: self
+        n = 0
+        if (self%method == method_mortar) then
+            n = size(self%slave%cps)
+        else if (self%master%deformable) then
+            n = count(self%mlo <= self%mhi)
+        end if
+    end function pair_n_blocks
+
+    !> Global DOFs of pattern block `b` (1 .. `pair_n_blocks`). GPTS: the b-th slave
+    !> element with a nonempty master range, its edge DOFs then the range's. Mortar:
+    !> slave control point b couples every DOF of every point in its support with
+    !> every other, so its block is the edge DOFs and master ranges of all the slave
+    !> elements its function is nonzero on (sorted, each once).
+    pure function pair_block_dofs(self, b) result(dofs)
+        type(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: b
+        integer, allocatable :: dofs(:)
+        integer, allocatable :: mdofs(:)
+        logical, allocatable :: used(:)
+        integer :: e, nb, p, lo, hi
+
+        p = self%slave%degree
+        mdofs = self%master%all_dofs()
+        if (self%method /= method_mortar) then
+            nb = 0
+            do e = 1, size(self%mlo)
+                if (self%mlo(e) > self%mhi(e)) cycle
+                nb = nb + 1
+                if (nb == b) exit
+            end do
+            dofs = [pair_element_dofs(self, e), mdofs(2*self%mlo(e) - 1:2*self%mhi(e))]
+            return
+        end if
+        lo = huge(1)
+        hi = 0
+        allocate (used(size(mdofs)/2), source=.false.)
+        do e = 1, size(self%slave%spans)
+            if (b < self%slave%spans(e) - p .or. b > self%slave%spans(e)) cycle
+            lo = min(lo, self%slave%spans(e) - p)
+            hi = max(hi, self%slave%spans(e))
+            if (self%mlo(e) <= self%mhi(e)) used(self%mlo(e):self%mhi(e)) = .true.
+        end do
+        dofs = reshape(self%slave%dofs(:, lo:hi), [2*(hi - lo + 1)])
+        dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
+    end function pair_block_dofs
+
     !> Global DOFs of slave element `e`'s control points on the contact edge.
     pure function pair_element_dofs(self, e) result(dofs)
         type(contact_pair_t), intent(in) :: self
@@ -273,8 +537,9 @@ contains
     !> The step converged: the trial history becomes the committed one.
     pure subroutine pair_commit(self)
         type(contact_pair_t), intent(inout) :: self
-        if (.not. allocated(self%anchor)) return
-        self%anchor = self%trial_anchor
+        if (.not. allocated(self%xi_last)) return
+        if (allocated(self%anchor)) self%anchor = self%trial_anchor
+        if (allocated(self%traction)) self%traction = self%trial_traction
         self%active_last = self%trial_active
         self%xi_last = self%trial_xi
     end subroutine pair_commit
@@ -319,8 +584,9 @@ contains
     !> Forget the trial history (a step is retried).
     pure subroutine pair_reset_trial(self)
         type(contact_pair_t), intent(inout) :: self
-        if (.not. allocated(self%anchor)) return
-        self%trial_anchor = self%anchor
+        if (.not. allocated(self%xi_last)) return
+        if (allocated(self%anchor)) self%trial_anchor = self%anchor
+        if (allocated(self%traction)) self%trial_traction = self%traction
         self%trial_active = self%active_last
         self%trial_xi = self%xi_last
     end subroutine pair_reset_trial

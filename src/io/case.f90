@@ -94,6 +94,8 @@ module voiga_io_case
         real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
         !> Gauss points per slave contact element (0: layer degree + 1).
         integer :: n_gauss = 0
+        !> 'gpts' (Gauss-point-to-surface) or 'mortar' (mortar-type penalty).
+        character(len=16) :: method = 'gpts'
     end type contact_input_t
 
     !> A case.
@@ -624,12 +626,13 @@ contains
         type(contact_input_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         character(len=32) :: slave, master
+        character(len=16) :: method
         real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, e_max
         integer :: n_gauss, ios, ib
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss
+            friction, n_gauss, method
 
         slave = ''
         master = ''
@@ -639,6 +642,7 @@ contains
         penalty_tangent = unset
         friction = 0.0_dp
         n_gauss = 0
+        method = 'gpts'
         read (u, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call group_error(path, 'contact', k, ios, msg, try_contact, error)
@@ -702,6 +706,11 @@ contains
             call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
             return
         end if
+        if (trim(method) /= 'gpts' .and. trim(method) /= 'mortar') then
+            call fatal_error(error, where//"method = '"//trim(method)//"' is not one of 'gpts', 'mortar'", &
+                             error_code%input)
+            return
+        end if
         ! conditioning: a penalty above 1e12 x E leaves the stiffness matrix with fewer
         ! than 4 significant digits in double precision
         e_max = self%bodies(body_index(self, slave))%youngs_modulus
@@ -713,7 +722,7 @@ contains
             return
         end if
         entry = contact_input_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-                                friction, n_gauss)
+                                friction, n_gauss, method)
     contains
         subroutine try_contact(text, ios, msg)
             character(len=*), intent(in) :: text

@@ -12,7 +12,7 @@ module voiga_io_results
     use voiga_io_dump, only: write_discretization
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
-    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_pair, only: contact_pair_t, method_names
     implicit none
     private
 
@@ -242,6 +242,7 @@ contains
         call h5%write_attr(c, 'penalty_normal', pair%law%eps_n)
         call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t)
         call h5%write_attr(c, 'friction', pair%law%mu)
+        call h5%write_attr(c, 'method', trim(method_names(pair%method)))
         select type (m => pair%master)
         type is (rigid_line_t)
             call h5%write(c//'/rigid_point', m%p0)
@@ -270,9 +271,10 @@ contains
         st = pair%out%state
         call h5%write(c//'/state', st)
         call h5%write(c//'/xi_slave', pair%xi)
-        if (allocated(pair%anchor)) then
+        if (allocated(pair%xi_last)) then
             ! committed friction history: what a restart needs
-            call h5%write(c//'/history/anchor', pair%anchor)
+            if (allocated(pair%anchor)) call h5%write(c//'/history/anchor', pair%anchor)
+            if (allocated(pair%traction)) call h5%write(c//'/history/traction', pair%traction)
             call h5%write(c//'/history/xi_last', pair%xi_last)
             call h5%write(c//'/history/active_last', merge(1, 0, pair%active_last))
         end if

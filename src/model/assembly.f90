@@ -8,7 +8,7 @@ module voiga_model_assembly
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
-    use voiga_contact_pair, only: pair_contribution, pair_wanted_ranges, pair_element_dofs
+    use voiga_contact_pair, only: pair_contribution, pair_wanted_ranges, pair_n_blocks, pair_block_dofs
     implicit none
     private
 
@@ -110,7 +110,7 @@ contains
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(out) :: k
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: ptr(:), dofs(:), mdofs(:)
+        integer, allocatable :: ptr(:), dofs(:), block(:)
         integer :: ib, e, nel, n, pos, ip
 
         nel = 0
@@ -121,17 +121,14 @@ contains
                 n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
         end do
-        ! a deformable master: each slave element's edge DOFs with the master's control
-        ! points in its range (contact_pair_t%mlo, mhi)
+        ! the contact pairs' blocks (pair_block_dofs): with a deformable master each
+        ! slave element's edge DOFs with the master's control points in its range
+        ! (contact_pair_t%mlo, mhi); a mortar pair, each slave control point's support
         do ip = 1, size(model%pairs)
-            associate (pair => model%pairs(ip))
-                if (.not. pair%master%deformable) cycle
-                do e = 1, size(pair%mlo)
-                    if (pair%mlo(e) > pair%mhi(e)) cycle
-                    nel = nel + 1
-                    n = n + size(pair_element_dofs(pair, e)) + 2*(pair%mhi(e) - pair%mlo(e) + 1)
-                end do
-            end associate
+            do e = 1, pair_n_blocks(model%pairs(ip))
+                nel = nel + 1
+                n = n + size(pair_block_dofs(model%pairs(ip), e))
+            end do
         end do
         allocate (ptr(nel + 1), dofs(n))
         ptr(1) = 1
@@ -145,18 +142,12 @@ contains
             end do
         end do
         do ip = 1, size(model%pairs)
-            associate (pair => model%pairs(ip))
-                if (.not. pair%master%deformable) cycle
-                mdofs = pair%master%all_dofs()
-                do e = 1, size(pair%mlo)
-                    if (pair%mlo(e) > pair%mhi(e)) cycle
-                    pos = pos + 1
-                    n = size(pair_element_dofs(pair, e)) + 2*(pair%mhi(e) - pair%mlo(e) + 1)
-                    ptr(pos + 1) = ptr(pos) + n
-                    dofs(ptr(pos):ptr(pos + 1) - 1) = [pair_element_dofs(pair, e), &
-                                                       mdofs(2*pair%mlo(e) - 1:2*pair%mhi(e))]
-                end do
-            end associate
+            do e = 1, pair_n_blocks(model%pairs(ip))
+                pos = pos + 1
+                block = pair_block_dofs(model%pairs(ip), e)
+                ptr(pos + 1) = ptr(pos) + size(block)
+                dofs(ptr(pos):ptr(pos + 1) - 1) = block
+            end do
         end do
         call new_csc_pattern(k, model%ndof, ptr, dofs, error)
     end subroutine stiffness_pattern

@@ -37,7 +37,7 @@ module voiga_solver_newton
     use voiga_solver_multigrid, only: multigrid_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
-    use voiga_contact_pair, only: pair_commit, pair_reset_trial, pair_zone
+    use voiga_contact_pair, only: contact_pair_t, pair_commit, pair_reset_trial, pair_zone, method_gpts
     implicit none
     private
 
@@ -476,8 +476,9 @@ contains
                 message = message//trim(buf)
                 if (pair%law%mu > 0.0_dp) message = message//'; the slip bounds mu p_N then jump from '// &
                     'point to point, which breaks up the stick/slip pattern as well'
-                write (buf, '(a,i0,a)') '; fewer slave points per element (&contact n_gauss, here ', &
-                    pair%n_gauss, ') or a smaller penalty_normal avoid this'
+                write (buf, '(a,i0,a)') '; method = ''mortar'' (one constraint per slave control point), '// &
+                    'fewer slave points per element (&contact n_gauss, here ', pair%n_gauss, &
+                    ') or a smaller penalty_normal avoid this'
                 message = message//trim(buf)
             end associate
         end do
@@ -909,11 +910,19 @@ contains
             '; det K sign ', stats%det_sign
     end subroutine tresca_fixed_point
 
-    !> Whether any contact pair has friction.
+    !> Whether the Tresca fixed point applies to a pair: GPTS with friction (a
+    !> mortar pair's slip limits belong to its control points, not to its slave
+    !> points; it keeps Coulomb friction).
+    pure logical function tresca_pair(pair)
+        type(contact_pair_t), intent(in) :: pair
+        tresca_pair = pair%law%mu > 0.0_dp .and. pair%method == method_gpts
+    end function tresca_pair
+
+    !> Whether any contact pair has friction the Tresca fixed point applies to.
     pure logical function frictional(model)
         type(model_t), intent(in) :: model
         integer :: ip
-        frictional = any([(model%pairs(ip)%law%mu > 0.0_dp, ip=1, size(model%pairs))])
+        frictional = any([(tresca_pair(model%pairs(ip)), ip=1, size(model%pairs))])
     end function frictional
 
     !> mu p_N at the last evaluation for every slave point of every frictional pair,
@@ -924,7 +933,7 @@ contains
         integer :: ip
         allocate (bound(0))
         do ip = 1, size(model%pairs)
-            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
+            if (.not. tresca_pair(model%pairs(ip))) cycle
             bound = [bound, model%pairs(ip)%law%mu*max(0.0_dp, model%pairs(ip)%out%pn)]
         end do
     end function slip_bounds
@@ -937,7 +946,7 @@ contains
         integer :: ip, first, n
         first = 0
         do ip = 1, size(model%pairs)
-            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
+            if (.not. tresca_pair(model%pairs(ip))) cycle
             n = size(model%pairs(ip)%out)
             model%pairs(ip)%slip_bound = bound(first + 1:first + n)
             first = first + n

@@ -243,6 +243,12 @@ def suite() -> list[HardCase]:
                               "4 slave points per element, natural damping",
                               (contact(penalty_normal=1e6 * E_SLAB, penalty_tangent=10.0**tangent * E_SLAB,
                                        n_gauss=4), solver(damping="natural"))))
+    # the 1e6 case with the mortar-type penalty (one constraint per slave control
+    # point) and the committed 16 points per element
+    cases.append(HardCase("penalty-n1e6-t1e2-mortar", "ironing", "m1-NN2.2",
+                          "penalty_normal 1e6 x E, penalty_tangent 1e2 x E, mortar, natural damping",
+                          (contact(penalty_normal=1e6 * E_SLAB, penalty_tangent=100.0 * E_SLAB,
+                                   method="mortar"), solver(damping="natural"))))
     cases.append(HardCase("penalty-1e6-mu0", "ironing", "m1-NN2.2", "penalty 1e6 x E, frictionless",
                           (contact(penalty_normal=1e6 * E_SLAB, friction=0.0),)))
     # the same on the hertz cylinder (E = 1, rigid plane): 1e9 x E converges on the

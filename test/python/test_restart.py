@@ -30,15 +30,15 @@ CASE = """&case
 /
 &contact
   slave = 'slab', master = 'rigid', rigid_point = 0.0, -3.0, rigid_normal = 0.0, 1.0,
-  penalty_normal = 100.0, penalty_tangent = 100.0, friction = 0.3, n_gauss = 8
+  penalty_normal = 100.0, penalty_tangent = 100.0, friction = 0.3, n_gauss = 8, method = '{method}'
 /
 """
 
 
-def setup(tmp: Path, slide: int) -> Path:
+def setup(tmp: Path, slide: int, method: str = "gpts") -> Path:
     shutil.copy(REPO / "cases" / "ironing" / "geometry.h5", tmp / "geometry.h5")
     case = tmp / "case.nml"
-    case.write_text(CASE.format(slide=slide))
+    case.write_text(CASE.format(slide=slide, method=method))
     return case
 
 
@@ -68,11 +68,20 @@ def compare(a: Path, b: Path) -> None:
         assert sb[k]["det"] == sa[k]["det"], k
 
 
+@pytest.mark.parametrize("method", ["gpts", "mortar"])
 @pytest.mark.parametrize("keep", [2, 5])
-def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int) -> None:
-    case = setup(tmp_path, 6)
+def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, method: str) -> None:
+    """The friction history is the stick anchors per slave point (GPTS) or the
+    tangential tractions per slave control point (mortar)."""
+    case = setup(tmp_path, 6, method)
     res = run(case, "--quiet")
     assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "run.h5") as f:
+        history = f["steps"][max(f["steps"], key=int)]["contact/1/history"]
+        assert ("traction" in history) == (method == "mortar")
+        assert ("anchor" in history) == (method == "gpts")
+        if method == "mortar":        # the slab slides: its control points carry mu p_A
+            assert np.abs(history["traction"][()]).max() > 0.0
     full = tmp_path / "full.h5"
     shutil.copy(tmp_path / "run.h5", full)
     partial = tmp_path / "partial.h5"
