@@ -53,14 +53,19 @@ contains
     !> range (r_k < 1e-3 r_0) and above round-off (r_k+1 > 1e-13 r_0) every
     !> iteration must satisfy r_k+1/r_0 <= 100 (r_k/r_0)^2. A linearly converging
     !> sequence with rate above 0.1 fails this as soon as r_k < 1e-3 r_0. At least
-    !> one such iteration is required.
-    logical function quadratic(r)
+    !> one such iteration is required. `floor`: the solver's round-off estimate of the
+    !> residual (`residual_floor`); an iterate below it is above round-off no more.
+    logical function quadratic(r, floor)
         real(dp), intent(in) :: r(:)
+        real(dp), intent(in), optional :: floor
         integer :: k, n
         quadratic = .true.
         n = 0
         do k = 2, size(r) - 1
             if (r(k) >= 1.0e-3_dp*r(1) .or. r(k + 1) <= 1.0e-13_dp*r(1)) cycle
+            if (present(floor)) then
+                if (r(k + 1) <= floor) cycle
+            end if
             n = n + 1
             if (r(k + 1)/r(1) > 100.0_dp*(r(k)/r(1))**2) quadratic = .false.
         end do

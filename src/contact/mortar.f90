@@ -91,17 +91,19 @@ contains
     !> The law at one slave control point: weighted gap `g_a`, weight `d_a` =
     !> int N_A dA0, weighted slip increment `ds_a` and committed tangential traction
     !> `t_old`; gives the pressure `p` (active when g_a < gap_tol d_a), the
-    !> tangential traction `t` (zero without friction) and the state. Frictionless
+    !> tangential traction `t` (zero without friction), its trial value and the state. Frictionless
     !> when mu = 0 (no friction code runs).
-    pure subroutine mortar_law(law, g_a, d_a, ds_a, t_old, gap_tol, p, t, state)
+    pure subroutine mortar_law(law, g_a, d_a, ds_a, t_old, gap_tol, p, t, state, ttr)
         type(contact_law_t), intent(in) :: law
         real(dp), intent(in) :: g_a, d_a, ds_a, t_old, gap_tol
         real(dp), intent(out) :: p, t
         integer, intent(out) :: state
-        real(dp) :: ttr
+        !> Trial tangential traction (elastic predictor; 0 when open or frictionless).
+        real(dp), intent(out) :: ttr
 
         p = 0.0_dp
         t = 0.0_dp
+        ttr = 0.0_dp
         state = state_inactive
         if (d_a <= 0.0_dp .or. g_a >= gap_tol*d_a) return
         p = -law%eps_n*g_a/d_a

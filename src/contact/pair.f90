@@ -18,7 +18,8 @@ module voiga_contact_pair
 
     public :: contact_pair_t, setup_points, pair_contribution, pair_commit, pair_reset_trial, &
               contact_point_out_t, pair_wanted_ranges, pair_element_dofs, pair_zone, &
-              pair_n_blocks, pair_block_dofs, method_gpts, method_mortar, method_names
+              pair_n_blocks, pair_block_dofs, method_gpts, method_mortar, method_names, &
+              pair_crossing_fraction, mortar_snapshot_t
 
     !> Contact methods (`&contact method`): Gauss-point-to-surface, mortar-type penalty.
     integer, parameter :: method_gpts = 1, method_mortar = 2
@@ -35,6 +36,17 @@ module voiga_contact_pair
         integer :: first = 1, last = 0
         integer :: state = state_inactive
     end type contact_point_out_t
+
+    !> A mortar pair's control points at one evaluation [slave edge control points]
+    !> (for the step control of `voiga_solver_newton`, `pair_crossing_fraction`).
+    type :: mortar_snapshot_t
+        !> Weighted gaps g_A (huge where no point of the support has a projection),
+        !> weights D_A = int N_A dA0 (A is active when g_A < gap_tol D_A), trial
+        !> tangential tractions (before the return map).
+        real(dp), allocatable :: g(:), d(:), t_trial(:)
+        !> state_inactive, state_stick or state_slip.
+        integer, allocatable :: state(:)
+    end type mortar_snapshot_t
 
     !> A slave/master pair.
     type :: contact_pair_t
@@ -61,6 +73,8 @@ module voiga_contact_pair
         !> Mortar friction history (mu > 0) [slave edge control points]: committed and
         !> trial tangential traction t_A (along the master tangent).
         real(dp), allocatable :: traction(:), trial_traction(:)
+        !> Mortar: the control points at the last evaluation.
+        type(mortar_snapshot_t) :: last
         !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
         !> slave point is this prescribed traction instead of mu p_N (the fixed point
         !> of `voiga_solver_newton` sets and deallocates it; never committed).
@@ -278,6 +292,10 @@ contains
         type(master_point_t), allocatable :: mps(:)
         type(point_vectors_t), allocatable :: vec(:)
         real(dp), allocatable :: w0(:), dxi(:), d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), rl(:), kl(:, :)
+        ! weight of the points with a projection in each control point's support
+        real(dp), allocatable :: d_seen(:)
+        ! trial tangential tractions
+        real(dp), allocatable :: t_tr(:)
         real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
         integer, allocatable :: st_a(:), blk(:), pos(:)
         logical, allocatable :: valid(:), slip(:)
@@ -292,8 +310,9 @@ contains
         self%force = 0.0_dp
         call self%master%prepare(u)
         allocate (sps(npts), mps(npts), vec(npts), w0(npts), dxi(npts), valid(npts), slip(npts))
-        allocate (d_a(ncp), g_a(ncp), ds_a(ncp), p_a(ncp), t_a(ncp), st_a(ncp))
+        allocate (d_a(ncp), g_a(ncp), ds_a(ncp), p_a(ncp), t_a(ncp), st_a(ncp), d_seen(ncp), t_tr(ncp))
         d_a = 0.0_dp
+        d_seen = 0.0_dp
         g_a = 0.0_dp
         ds_a = 0.0_dp
         dxi = 0.0_dp
@@ -331,6 +350,7 @@ contains
                     return
                 end if
                 valid(k) = .true.
+                d_seen(sp%local) = d_seen(sp%local) + w0(k)*sp%r
                 g_a(sp%local) = g_a(sp%local) + w0(k)*sp%r*out%gap
                 if (allocated(self%xi_last)) then
                     self%trial_active(k) = .true.
@@ -342,11 +362,14 @@ contains
                 end if
             end associate
         end do
-        ! pass 2: the law at every control point
+        ! pass 2: the law at every control point (open where no point of its support
+        ! has a projection: its weighted gap is then empty, not zero)
         do a = 1, ncp
+            if (d_seen(a) <= 0.0_dp) g_a(a) = huge(1.0_dp)
             t_old = 0.0_dp
             if (allocated(self%traction)) t_old = self%traction(a)
-            call mortar_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), st_a(a))
+            call mortar_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), st_a(a), &
+                            t_tr(a))
             if (allocated(self%traction)) self%trial_traction(a) = t_a(a)
         end do
         ! pass 3: every point's interpolated traction
@@ -393,6 +416,7 @@ contains
                 end if
             end associate
         end do
+        self%last = mortar_snapshot_t(g_a, d_a, t_tr, st_a)
         if (.not. present(add) .or. miss) return
         ! pass 4: the coupling through the control-point tractions
         do a = 1, ncp
@@ -433,6 +457,36 @@ contains
             deallocate (v, q, mm, pos, kc)
         end do
     end subroutine mortar_contribution
+
+    !> Mortar step control: the fraction of the way from the evaluation `before` to
+    !> the last one at which the first control point crosses a state boundary the
+    !> last tangent did not describe (linear interpolation); 1 if none, always 1 for
+    !> GPTS. Two crossings, each a jump the Newton step cannot see:
+    !> - a control point open before closes: `overshoot` times the fraction where
+    !>   g_A = 0 (just closed, so that the next tangent carries its penalty);
+    !> - a control point slipping before has a trial traction of the other sign: the
+    !>   fraction where t_A^tr = 0, inside its stick band |t_A^tr| <= mu p_A (a
+    !>   slipping point has no tangential stiffness, so the step overshoots a narrow
+    !>   stick band and the slip direction flips from iteration to iteration).
+    pure real(dp) function pair_crossing_fraction(self, before, overshoot) result(frac)
+        type(contact_pair_t), intent(in) :: self
+        type(mortar_snapshot_t), intent(in) :: before
+        real(dp), intent(in) :: overshoot
+        real(dp) :: tol
+        integer :: a
+        frac = 1.0_dp
+        if (self%method /= method_mortar .or. .not. allocated(self%last%g) .or. .not. allocated(before%g)) return
+        if (size(before%g) /= size(self%last%g)) return
+        do a = 1, size(self%last%g)
+            tol = self%gap_tol*self%last%d(a)
+            ! (huge: no point of the support had a projection, nothing to interpolate)
+            if (before%g(a) >= tol .and. before%g(a) < huge(1.0_dp) .and. self%last%g(a) < tol) &
+                frac = min(frac, overshoot*before%g(a)/(before%g(a) - self%last%g(a)))
+            if (before%state(a) == state_slip .and. self%last%state(a) /= state_inactive .and. &
+                before%t_trial(a)*self%last%t_trial(a) < 0.0_dp) &
+                frac = min(frac, before%t_trial(a)/(before%t_trial(a) - self%last%t_trial(a)))
+        end do
+    end function pair_crossing_fraction
 
     !> Number of stiffness-pattern blocks the pair adds to the bodies' elements:
     !> GPTS with a deformable master, one per slave element (its edge DOFs with its

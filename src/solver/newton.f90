@@ -37,7 +37,8 @@ module voiga_solver_newton
     use voiga_solver_multigrid, only: multigrid_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
-    use voiga_contact_pair, only: contact_pair_t, pair_commit, pair_reset_trial, pair_zone, method_gpts
+    use voiga_contact_pair, only: contact_pair_t, pair_commit, pair_reset_trial, pair_zone, method_gpts, &
+                                  pair_crossing_fraction, mortar_snapshot_t
     implicit none
     private
 
@@ -58,6 +59,12 @@ module voiga_solver_newton
 
     !> Most halvings of one Newton step.
     integer, parameter :: max_line_search = 8
+
+    !> Mortar pairs: a Newton step that closes an open control point is shortened to
+    !> this multiple of the fraction at which the first one closes (a little beyond,
+    !> so that it is active and its stiffness in the next tangent;
+    !> `pair_crossing_fraction`).
+    real(dp), parameter :: closing_overshoot = 1.01_dp
 
     !> Natural damping (`damping = 'natural'`): most step reductions of one Newton
     !> iteration, and the smallest step length.
@@ -476,9 +483,9 @@ contains
                 message = message//trim(buf)
                 if (pair%law%mu > 0.0_dp) message = message//'; the slip bounds mu p_N then jump from '// &
                     'point to point, which breaks up the stick/slip pattern as well'
-                write (buf, '(a,i0,a)') '; method = ''mortar'' (one constraint per slave control point), '// &
-                    'fewer slave points per element (&contact n_gauss, here ', pair%n_gauss, &
-                    ') or a smaller penalty_normal avoid this'
+                write (buf, '(a,i0,a)') '; one constraint per slave control point (&contact method = '// &
+                    '''mortar'') or fewer slave points per element (&contact n_gauss, here ', pair%n_gauss, &
+                    ') remove the over-constraint, a smaller penalty_normal eases it'
                 message = message//trim(buf)
             end associate
         end do
@@ -545,13 +552,18 @@ contains
         real(dp), allocatable :: du_bar(:), du_bar_acc(:)
         type(csc_matrix_t) :: k_old
         real(dp) :: theta, h_est, du_norm, du_norm_prev, alpha_prev
-        logical :: natural, have_bar, smooth
+        logical :: natural, have_bar, smooth, closing
+        ! mortar pairs: the control points of every pair at the last accepted iterate
+        type(mortar_snapshot_t), allocatable :: accepted(:)
+        real(dp) :: frac
         integer :: nls, ip, flips
         logical :: converged, multigrid, changing
         character(len=400) :: msg
 
         multigrid = model%linear_solver == 'multigrid'
         natural = model%damping == 'natural' .and. .not. multigrid
+        closing = .false.
+        allocate (accepted(size(model%pairs)))
         have_bar = .false.
         du_norm = 0.0_dp
         du_norm_prev = 0.0_dp
@@ -592,10 +604,26 @@ contains
             end if
             floor = residual_floor(k, x0 + u, model%fixed)
             have_bar = .false.
+            ! a step that carries a mortar control point across a state boundary the
+            ! tangent did not describe (it closes, or its slip reverses) is shortened to
+            ! where the first one crosses (once per iteration), and that point accepted
+            if (it > 0 .and. nls == 0 .and. .not. closing) then
+                frac = 1.0_dp
+                do ip = 1, size(model%pairs)
+                    frac = min(frac, pair_crossing_fraction(model%pairs(ip), accepted(ip), closing_overshoot))
+                end do
+                if (frac < 1.0_dp) then
+                    closing = .true.
+                    stats%line_search_steps = stats%line_search_steps + 1
+                    alpha = alpha*frac
+                    u = u_prev + alpha*du
+                    cycle
+                end if
+            end if
             ! where the contact states change the last tangent does not describe the
             ! trial point (a new active set): the residual rule decides there
             smooth = .false.
-            if (natural .and. it > 0) smooth = all(contact_states(model) == states(:, it - 1))
+            if (natural .and. it > 0 .and. .not. closing) smooth = all(contact_states(model) == states(:, it - 1))
             if (smooth .and. du_norm > 0.0_dp .and. rn > floor .and. &
                 rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
                 ! natural monotonicity test (affine invariant): the simplified Newton
@@ -619,7 +647,7 @@ contains
             end if
             ! backtracking: a Newton step that increases the residual is halved
             ! (contact stick/slip and active-set changes can make full steps cycle)
-            if (.not. smooth .and. it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
+            if (.not. smooth .and. .not. closing .and. it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
                 rn > floor .and. rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
                 nls = nls + 1
                 stats%line_search_steps = stats%line_search_steps + 1
@@ -629,6 +657,9 @@ contains
             end if
             norms(it + 1) = rn
             states(:, it) = contact_states(model)
+            do ip = 1, size(model%pairs)
+                accepted(ip) = model%pairs(ip)%last
+            end do
             if (it == 0) then
                 r0 = rn
                 stats%r0_max = max(stats%r0_max, r0)
@@ -751,6 +782,7 @@ contains
                 end if
             end if
             nls = 0
+            closing = .false.
             u = u + alpha*du
             it = it + 1
         end do

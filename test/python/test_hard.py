@@ -73,8 +73,8 @@ TRESCA_LINE = re.compile(r"^tresca step (\d+) .* converged in (\d+) iterations .
 
 
 def test_tresca_retry_accepts_coulomb_solutions(voiga_bin: Path, tmp_path: Path) -> None:
-    """Penalty 1e6 x E with friction (mu = 0.3), the first two press steps of
-    penalty-1e6 (the same loads): at load time 0.75 the Newton attempt from the last
+    """Penalty 1e6 x E with friction (mu = 0.3), GPTS, the first two press steps of
+    gpts-locking-1e6 (the same loads): at load time 0.75 the Newton attempt from the last
     converged state folds (stick/slip cycles, det K changing sign) and the substep is
     retried with the Tresca fixed point (docs/robustness.md, "Tresca fixed point"). The
     run converges; every accepted state's Coulomb residual passed Newton's own test:
