@@ -17,7 +17,7 @@ module voiga_contact_gpts
     implicit none
     private
 
-    public :: contact_law_t, gpts_point, state_inactive, state_stick, state_slip
+    public :: contact_law_t, gpts_point, point_operators, state_inactive, state_stick, state_slip
 
     integer, parameter :: state_inactive = 0, state_stick = 1, state_slip = 2
 
@@ -51,25 +51,9 @@ contains
         real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r)), tmat(2, size(r))
         real(dp) :: c(size(r)), ng(size(r)), na(size(r)), gt(size(r)), dmt(size(r)), dst(size(r))
         real(dp) :: n(2), that(2), ts(2), t(2), la, las, den, da, slip, ttr, s
-        integer :: ns, nm, a
+        integer :: a
 
-        ns = size(sp%r)
-        nm = size(mp%r)
-        gm = 0.0_dp
-        dm = 0.0_dp
-        ds = 0.0_dp
-        do a = 1, ns
-            gm(1, 2*a - 1) = sp%r(a)
-            gm(2, 2*a) = sp%r(a)
-            ds(1, 2*a - 1) = sp%dr(a)
-            ds(2, 2*a) = sp%dr(a)
-        end do
-        do a = 1, nm
-            gm(1, 2*(ns + a) - 1) = -mp%r(a)
-            gm(2, 2*(ns + a)) = -mp%r(a)
-            dm(1, 2*(ns + a) - 1) = mp%dr(a)
-            dm(2, 2*(ns + a)) = mp%dr(a)
-        end do
+        call point_operators(sp, mp, gm, dm, ds)
         n = mp%n
         la = norm2(mp%a)
         that = mp%a/la
@@ -143,5 +127,32 @@ contains
             k(:, a) = -da*matmul(transpose(gm), tmat(:, a)) + da*dmt*c(a) - w*gt*dst(a)
         end do
     end subroutine gpts_point
+
+    !> The linear maps of a slave point and its projection on the local DOFs (the
+    !> slave point's functions first, 2 per function, then the master's): `gm` to
+    !> x_s - x_m(xi), `dm` to the master tangent dx_m/dxi at fixed xi, `ds` to the
+    !> slave tangent. Shapes [2, 2 (ns + nm)].
+    pure subroutine point_operators(sp, mp, gm, dm, ds)
+        type(surface_point_t), intent(in) :: sp
+        type(master_point_t), intent(in) :: mp
+        real(dp), intent(out) :: gm(:, :), dm(:, :), ds(:, :)
+        integer :: ns, a
+        ns = size(sp%r)
+        gm = 0.0_dp
+        dm = 0.0_dp
+        ds = 0.0_dp
+        do a = 1, ns
+            gm(1, 2*a - 1) = sp%r(a)
+            gm(2, 2*a) = sp%r(a)
+            ds(1, 2*a - 1) = sp%dr(a)
+            ds(2, 2*a) = sp%dr(a)
+        end do
+        do a = 1, size(mp%r)
+            gm(1, 2*(ns + a) - 1) = -mp%r(a)
+            gm(2, 2*(ns + a)) = -mp%r(a)
+            dm(1, 2*(ns + a) - 1) = mp%dr(a)
+            dm(2, 2*(ns + a)) = mp%dr(a)
+        end do
+    end subroutine point_operators
 
 end module voiga_contact_gpts

@@ -19,7 +19,7 @@ module voiga_contact_mortar
     use voiga_kinds, only: dp
     use voiga_contact_surface, only: surface_point_t
     use voiga_contact_master, only: master_point_t
-    use voiga_contact_gpts, only: contact_law_t, state_inactive, state_stick, state_slip
+    use voiga_contact_gpts, only: contact_law_t, point_operators, state_inactive, state_stick, state_slip
     implicit none
     private
 
@@ -42,24 +42,11 @@ contains
         real(dp), intent(in) :: pbar, tbar, dxi
         logical, intent(in) :: slip
         real(dp), intent(out) :: r(:), k(:, :), gn(:), gt(:), m(:)
-        real(dp) :: gm(2, size(r)), dm(2, size(r)), amat(2, size(r))
+        real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r))
         real(dp) :: c(size(r)), na(size(r)), dmt(size(r)), n(2), that(2), t(2), dt(2), la, g, den
-        integer :: ns, nm, a
+        integer :: a
 
-        ns = size(sp%r)
-        nm = size(mp%r)
-        gm = 0.0_dp
-        dm = 0.0_dp
-        do a = 1, ns
-            gm(1, 2*a - 1) = sp%r(a)
-            gm(2, 2*a) = sp%r(a)
-        end do
-        do a = 1, nm
-            gm(1, 2*(ns + a) - 1) = -mp%r(a)
-            gm(2, 2*(ns + a)) = -mp%r(a)
-            dm(1, 2*(ns + a) - 1) = mp%dr(a)
-            dm(2, 2*(ns + a)) = mp%dr(a)
-        end do
+        call point_operators(sp, mp, gm, dm, ds)
         n = mp%n
         la = norm2(mp%a)
         that = mp%a/la

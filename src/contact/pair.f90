@@ -174,9 +174,8 @@ contains
         real(dp), allocatable :: rl(:), kl(:, :)
         integer, allocatable :: dofs(:)
         real(dp) :: g, pn, pt, anchor, new_anchor
-        integer :: k, state, nd, e
-        logical :: found, converged
-        character(len=96) :: buf
+        integer :: k, state, nd
+        logical :: found, converged, inside
 
         if (self%method == method_mortar) then
             call mortar_contribution(self, u, r, error, add)
@@ -185,18 +184,7 @@ contains
         self%force = 0.0_dp
         call self%master%prepare(u)
         do k = 1, size(self%xi)
-            call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
-            self%out(k)%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
-            self%out(k)%x = sp%x
-            self%out(k)%state = state_inactive
-            self%out(k)%pn = 0.0_dp
-            self%out(k)%pt = 0.0_dp
-            call self%master%project(u, sp%x, mp, found, converged)
-            self%out(k)%xi_m = mp%xi
-            self%out(k)%first = mp%first
-            self%out(k)%last = mp%last
-            self%out(k)%gap = huge(1.0_dp)
-            if (found) self%out(k)%gap = dot_product(sp%x - mp%x, mp%n)
+            call project_point(self, u, k, sp, mp, found, converged)
             if (allocated(self%anchor)) then
                 self%trial_xi(k) = mp%xi
                 self%trial_active(k) = .false.
@@ -205,10 +193,7 @@ contains
             if (.not. found) cycle
             if (self%out(k)%gap >= self%gap_tol) cycle
             if (.not. converged) then
-                write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
-                call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
-                                 trim(self%master_name)//"': the closest-point projection of "// &
-                                 trim(buf)//' did not converge', error_code%numeric)
+                call projection_error(self, k, error)
                 return
             end if
             ! a point that was not in contact at the last converged state sticks where
@@ -236,20 +221,8 @@ contains
             self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
             self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
             if (present(add)) then
-                e = (k - 1)/self%n_gauss + 1
-                if (mp%first < self%mlo(e) .or. mp%last > self%mhi(e)) then
-                    ! outside the pattern: widen it, the caller rebuilds and reassembles
-                    if (self%mlo(e) > self%mhi(e)) then
-                        self%mlo(e) = mp%first
-                        self%mhi(e) = mp%last
-                    else
-                        self%mlo(e) = min(self%mlo(e), mp%first)
-                        self%mhi(e) = max(self%mhi(e), mp%last)
-                    end if
-                    self%pattern_miss = .true.
-                else
-                    call add(dofs, kl)
-                end if
+                call fit_pattern(self, k, mp, inside)
+                if (inside) call add(dofs, kl)
             end if
             self%out(k)%state = state
             self%out(k)%pn = pn
@@ -301,8 +274,7 @@ contains
         logical, allocatable :: valid(:), slip(:)
         real(dp) :: a0(2), pbar, tbar, t_old, c
         integer :: npts, ncp, k, i, a, e, nd, j, ng
-        logical :: found, converged, miss
-        character(len=96) :: buf
+        logical :: found, converged, miss, inside
 
         npts = size(self%xi)
         ncp = size(self%slave%cps)
@@ -320,33 +292,19 @@ contains
         slip = .false.
         ! pass 1: projections, weighted gaps and slips
         do k = 1, npts
-            call surface_point(self%slave, u, self%xi(k), sps(k), self%span(k))
+            call project_point(self, u, k, sps(k), mps(k), found, converged)
             associate (sp => sps(k), mp => mps(k), out => self%out(k))
                 a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
                 w0(k) = norm2(a0)*self%w(k)
                 d_a(sp%local) = d_a(sp%local) + w0(k)*sp%r
-                out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
-                out%x = sp%x
-                out%state = state_inactive
-                out%pn = 0.0_dp
-                out%pt = 0.0_dp
-                call self%master%project(u, sp%x, mp, found, converged)
-                out%xi_m = mp%xi
-                out%first = mp%first
-                out%last = mp%last
-                out%gap = huge(1.0_dp)
                 if (allocated(self%xi_last)) then
                     self%trial_xi(k) = mp%xi
                     self%trial_active(k) = .false.
                 end if
                 if (.not. found) cycle
-                out%gap = dot_product(sp%x - mp%x, mp%n)
                 if (.not. converged) then
                     if (out%gap >= self%gap_tol) cycle
-                    write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
-                    call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
-                                     trim(self%master_name)//"': the closest-point projection of "// &
-                                     trim(buf)//' did not converge', error_code%numeric)
+                    call projection_error(self, k, error)
                     return
                 end if
                 valid(k) = .true.
@@ -398,20 +356,11 @@ contains
                 out%pt = tbar
                 out%state = merge(state_slip, state_stick, any(st_a(sp%local) == state_slip))
                 if (present(add)) then
-                    e = (k - 1)/ng + 1
-                    if (mp%first < self%mlo(e) .or. mp%last > self%mhi(e)) then
-                        ! outside the pattern: widen it, the caller rebuilds and reassembles
-                        if (self%mlo(e) > self%mhi(e)) then
-                            self%mlo(e) = mp%first
-                            self%mhi(e) = mp%last
-                        else
-                            self%mlo(e) = min(self%mlo(e), mp%first)
-                            self%mhi(e) = max(self%mhi(e), mp%last)
-                        end if
-                        self%pattern_miss = .true.
-                        miss = .true.
-                    else
+                    call fit_pattern(self, k, mp, inside)
+                    if (inside) then
                         call add(vec(k)%dofs, kl)
+                    else
+                        miss = .true.
                     end if
                 end if
             end associate
@@ -487,6 +436,66 @@ contains
                 frac = min(frac, before%t_trial(a)/(before%t_trial(a) - self%last%t_trial(a)))
         end do
     end function pair_crossing_fraction
+
+    !> Evaluate slave point `k` at `u` and project it onto the master (`prepare`d):
+    !> its output record is reset to not in contact, with its positions, projection
+    !> and gap (huge without a projection).
+    subroutine project_point(self, u, k, sp, mp, found, converged)
+        type(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        integer, intent(in) :: k
+        type(surface_point_t), intent(inout) :: sp
+        type(master_point_t), intent(out) :: mp
+        logical, intent(out) :: found, converged
+        call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
+        associate (out => self%out(k))
+            out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
+            out%x = sp%x
+            out%state = state_inactive
+            out%pn = 0.0_dp
+            out%pt = 0.0_dp
+            call self%master%project(u, sp%x, mp, found, converged)
+            out%xi_m = mp%xi
+            out%first = mp%first
+            out%last = mp%last
+            out%gap = huge(1.0_dp)
+            if (found) out%gap = dot_product(sp%x - mp%x, mp%n)
+        end associate
+    end subroutine project_point
+
+    !> The error of a slave point whose projection did not converge.
+    pure subroutine projection_error(self, k, error)
+        type(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: k
+        type(error_t), allocatable, intent(out) :: error
+        character(len=96) :: buf
+        write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
+        call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
+                         trim(self%master_name)//"': the closest-point projection of "// &
+                         trim(buf)//' did not converge', error_code%numeric)
+    end subroutine projection_error
+
+    !> `inside`: whether the master functions of slave point `k`'s projection lie in
+    !> its element's range of the stiffness pattern; if not, the range is widened and
+    !> `pattern_miss` set (the caller rebuilds the pattern and assembles again).
+    pure subroutine fit_pattern(self, k, mp, inside)
+        type(contact_pair_t), intent(inout) :: self
+        integer, intent(in) :: k
+        type(master_point_t), intent(in) :: mp
+        logical, intent(out) :: inside
+        integer :: e
+        e = (k - 1)/self%n_gauss + 1
+        inside = mp%first >= self%mlo(e) .and. mp%last <= self%mhi(e)
+        if (inside) return
+        if (self%mlo(e) > self%mhi(e)) then
+            self%mlo(e) = mp%first
+            self%mhi(e) = mp%last
+        else
+            self%mlo(e) = min(self%mlo(e), mp%first)
+            self%mhi(e) = max(self%mhi(e), mp%last)
+        end if
+        self%pattern_miss = .true.
+    end subroutine fit_pattern
 
     !> Number of stiffness-pattern blocks the pair adds to the bodies' elements:
     !> GPTS with a deformable master, one per slave element (its edge DOFs with its
