@@ -50,7 +50,9 @@ contains
                     new_unittest('mortar_tangent_fd_rigid_master', test_fd_mortar_rigid), &
                     new_unittest('mortar_patch_test', test_patch_mortar), &
                     new_unittest('mortar_ironing_newton_quadratic', test_ironing_quadratic_mortar), &
-                    new_unittest('mortar_crossing_fraction', test_crossing_fraction) &
+                    new_unittest('mortar_crossing_fraction', test_crossing_fraction), &
+                    new_unittest('mortar_friction_block_slip', test_block_slip_mortar), &
+                    new_unittest('mortar_frictionless_runs_no_friction_code', test_no_friction_code_mortar) &
                     ]
     end subroutine collect_contact
 
@@ -359,6 +361,44 @@ contains
         call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'GPTS: no step control')
     end subroutine test_crossing_fraction
 
+    !> The block pushed over the plane with the mortar-type penalty: every control
+    !> point in contact slips and the tangential force is mu times the normal one.
+    subroutine test_block_slip_mortar(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        call block_on_plane(0.1_dp, 0.3_dp, model, u, error, method='mortar')
+        if (allocated(error)) return
+        associate (pair => model%pairs(1))
+            call check(error, count(pair%last%state == state_slip) >= 2 .and. &
+                       all(pair%last%state /= state_stick), 'every control point in contact slips')
+            if (allocated(error)) return
+            call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), 'F_T = mu F_N', rel=1.0e-8_dp)
+            if (allocated(error)) return
+            call check(error, pair%force(1) < 0.0_dp, 'friction opposes the push')
+        end associate
+    end subroutine test_block_slip_mortar
+
+    !> Frictionless mortar: no friction history, no friction evaluation, no
+    !> tangential traction.
+    subroutine test_no_friction_code_mortar(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        call block_on_plane(0.0_dp, 0.0_dp, model, u, error, method='mortar')
+        if (allocated(error)) return
+        associate (pair => model%pairs(1))
+            call check(error, .not. allocated(pair%traction) .and. .not. allocated(pair%xi_last), &
+                       'no friction history stored')
+            if (allocated(error)) return
+            call check(error, pair%n_friction == 0, 'no friction evaluation')
+            if (allocated(error)) return
+            call check(error, pair%n_evaluations > 0, 'contact evaluated')
+            if (allocated(error)) return
+            call check(error, all(pair%out%pt == 0.0_dp), 'no tangential traction')
+        end associate
+    end subroutine test_no_friction_code_mortar
+
     !> A body entry of a test case.
     function body(name, material, e, layout) result(b)
         character(len=*), intent(in) :: name, material
@@ -470,13 +510,15 @@ contains
     end subroutine patch_spread
 
     !> A block on a rigid plane, pressed then pushed (or barely pushed).
-    subroutine block_on_plane(push, mu, model, u, error, stepping, stats_out)
+    subroutine block_on_plane(push, mu, model, u, error, stepping, stats_out, method)
         real(dp), intent(in) :: push, mu
         type(model_t), intent(out) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(error_t), allocatable, intent(out) :: error
         type(stepping_t), intent(in), optional :: stepping
         type(solver_stats_t), intent(out), optional :: stats_out
+        !> Contact method ('gpts' when absent).
+        character(len=*), intent(in), optional :: method
         type(case_t) :: c
         type(solver_stats_t) :: stats
         c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
@@ -486,6 +528,7 @@ contains
         c%contact(1) = contact_input_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
                                        rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1000.0_dp, &
                                        penalty_tangent=1000.0_dp, friction=mu)
+        if (present(method)) c%contact(1)%method = method
         call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
         if (allocated(error)) return
         call solve_steps(model, u, stats, .true., error, stepping=stepping)

@@ -34,13 +34,15 @@ contains
     !> `gt` = G^T t_hat, `m` = d ds / du with ds = dxi |a_m| the point's slip since
     !> the last converged state (`dxi` = xi_m - xi_m,last; zero vector without
     !> `slip`, a point that had no projection then).
-    pure subroutine mortar_point(w0, sp, mp, pbar, tbar, dxi, slip, r, k, gn, gt, m)
+    pure subroutine mortar_point(w0, sp, mp, pbar, tbar, dxi, slip, friction, r, k, gn, gt, m)
         !> Reference length weight: Gauss weight x |dX/dxi|.
         real(dp), intent(in) :: w0
         type(surface_point_t), intent(in) :: sp
         type(master_point_t), intent(in) :: mp
         real(dp), intent(in) :: pbar, tbar, dxi
         logical, intent(in) :: slip
+        !> False: frictionless, `gt` and `m` are zero (no friction code runs).
+        logical, intent(in) :: friction
         real(dp), intent(out) :: r(:), k(:, :), gn(:), gt(:), m(:)
         real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r))
         real(dp) :: c(size(r)), na(size(r)), dmt(size(r)), n(2), that(2), t(2), dt(2), la, g, den
@@ -58,11 +60,11 @@ contains
         amat(2, :) = dm(2, :) + mp%a2(2)*c
         na = matmul(n, amat)/la     ! dn = -t_hat na, dt_hat = n na
         gn = matmul(n, gm)
-        gt = matmul(that, gm)
-        if (slip) then
-            m = la*c + dxi*matmul(that, amat)
-        else
-            m = 0.0_dp
+        gt = 0.0_dp
+        m = 0.0_dp
+        if (friction) then
+            gt = matmul(that, gm)
+            if (slip) m = la*c + dxi*matmul(that, amat)
         end if
         t = pbar*n + tbar*that
         ! d t at fixed pbar, tbar: pbar dn + tbar dt_hat = (tbar n - pbar t_hat) na

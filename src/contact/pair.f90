@@ -344,8 +344,8 @@ contains
                 end if
                 if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
                 allocate (vec(k)%gn(nd), vec(k)%gt(nd), vec(k)%m(nd))
-                call mortar_point(w0(k), sp, mp, pbar, tbar, dxi(k), slip(k), rl, kl, vec(k)%gn, vec(k)%gt, &
-                                  vec(k)%m)
+                call mortar_point(w0(k), sp, mp, pbar, tbar, dxi(k), slip(k), self%law%mu > 0.0_dp, rl, kl, &
+                                  vec(k)%gn, vec(k)%gt, vec(k)%m)
                 vec(k)%dofs = [sp%dofs, mp%dofs]
                 self%n_evaluations = self%n_evaluations + 1
                 if (allocated(self%traction)) self%n_friction = self%n_friction + 1
@@ -383,8 +383,10 @@ contains
                     c = w0(k)*sps(k)%r(i)
                     pos = [(findloc(blk, vec(k)%dofs(j), dim=1), j=1, size(vec(k)%dofs))]
                     v(pos) = v(pos) + c*vec(k)%gn
-                    q(pos) = q(pos) + c*vec(k)%gt
-                    mm(pos) = mm(pos) + c*vec(k)%m
+                    if (self%law%mu > 0.0_dp) then
+                        q(pos) = q(pos) + c*vec(k)%gt
+                        mm(pos) = mm(pos) + c*vec(k)%m
+                    end if
                 end do
             end do
             allocate (kc(size(blk), size(blk)))
