@@ -448,7 +448,7 @@ contains
     !> of the zone's points) while its active points outnumber the slave control
     !> points they act on: Gauss-point-to-surface constraints then over-constrain the
     !> slave edge and, with a stiff penalty, lock (docs/robustness.md,
-    !> "Over-constrained contact zones"). Nothing is appended otherwise, or when the
+    !> "Over-constrained contact zones"). GPTS pairs only. Nothing is appended otherwise, or when the
     !> evaluation there fails.
     subroutine append_locking_diagnosis(model, u, t, stats, message)
         type(model_t), intent(inout) :: model
@@ -468,6 +468,8 @@ contains
         end do
         if (allocated(error)) return
         do ip = 1, size(model%pairs)
+            ! a mortar pair has one constraint per control point: nothing to over-constrain
+            if (model%pairs(ip)%method /= method_gpts) cycle
             call pair_zone(model%pairs(ip), n_active, n_holes, n_gaps, n_cp)
             if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
                 n_active <= n_cp) cycle
