@@ -442,7 +442,7 @@ contains
     !> Evaluate slave point `k` at `u` and project it onto the master (`prepare`d):
     !> its output record is reset to not in contact, with its positions, projection
     !> and gap (huge without a projection).
-    subroutine project_point(self, u, k, sp, mp, found, converged)
+    pure subroutine project_point(self, u, k, sp, mp, found, converged)
         type(contact_pair_t), intent(inout) :: self
         real(dp), intent(in) :: u(:)
         integer, intent(in) :: k
