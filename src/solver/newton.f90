@@ -66,6 +66,11 @@ module voiga_solver_newton
     !> `pair_crossing_fraction`).
     real(dp), parameter :: closing_overshoot = 1.01_dp
 
+    !> A Newton iteration whose accepted step is at most this long creeps; an attempt
+    !> that fails with half its iterations creeping (residual damping) names natural
+    !> damping in its message.
+    real(dp), parameter :: creep_step = 0.0625_dp
+
     !> Natural damping (`damping = 'natural'`): most step reductions of one Newton
     !> iteration, and the smallest step length.
     integer, parameter :: max_natural_damping = 10
@@ -559,12 +564,15 @@ contains
         type(mortar_snapshot_t), allocatable :: accepted(:)
         real(dp) :: frac
         integer :: nls, ip, flips
+        ! iterations whose accepted step was at most creep_step
+        integer :: short_steps
         logical :: converged, multigrid, changing
-        character(len=400) :: msg
+        character(len=800) :: msg
 
         multigrid = model%linear_solver == 'multigrid'
         natural = model%damping == 'natural' .and. .not. multigrid
         closing = .false.
+        short_steps = 0
         allocate (accepted(size(model%pairs)))
         have_bar = .false.
         du_norm = 0.0_dp
@@ -659,6 +667,7 @@ contains
             end if
             norms(it + 1) = rn
             states(:, it) = contact_states(model)
+            if (it > 0 .and. alpha <= creep_step) short_steps = short_steps + 1
             do ip = 1, size(model%pairs)
                 accepted(ip) = model%pairs(ip)%last
             end do
@@ -720,6 +729,11 @@ contains
                     if (flips > 0) write (msg, '(a,i0,a,i0,a)') trim(msg)// &
                         ': contact states still switched in ', flips, ' of the last ', &
                         it - max(1, it - 9) + 1, ' iterations (points on the stick/slip or contact limit)'
+                    if (.not. natural .and. 2*short_steps >= model%max_iterations) &
+                        write (msg, '(a,i0,a)') trim(msg)//'; ', short_steps, ' of its iterations '// &
+                        'took steps of 1/16 or less: the residual rule creeps along the curvature of a '// &
+                        'stiff penalty, &solver damping = ''natural'' may pass it (docs/robustness.md, '// &
+                        '"Natural damping")'
                 end if
                 call fatal_error(error, trim(msg), error_code%numeric)
                 exit

@@ -91,3 +91,21 @@ def test_bad_damping_refused(voiga_bin: Path, tmp_path: Path, value: str, extra:
     assert "&solver" in proc.stderr
     for word in words:
         assert word in proc.stderr, proc.stderr
+
+
+@pytest.mark.parametrize("damping", ["residual", "natural"])
+def test_creeping_names_natural_damping(voiga_bin: Path, tmp_path: Path, damping: str) -> None:
+    """A stiff penalty (1e6 x E, mortar) on the first press step without cuts: with
+    residual damping Newton creeps (most steps 1/16 or shorter) and the failure message
+    names natural damping; with natural damping it does not."""
+    case = HardCase(f"creep-{damping}", "ironing", "m1-NN2.2", "",
+                    (contact(penalty_normal=1e6 * E_SLAB, penalty_tangent=1e6 * E_SLAB, method="mortar"),
+                     dirichlet("die", "inner", ux=[0.0], uy=[-0.05]),
+                     solver(n_steps=[1], damping=damping, max_cuts=0)))
+    proc = run_case(voiga_bin, tmp_path / "case", case)
+    hint = "damping = 'natural' may pass it"
+    if damping == "residual":
+        assert proc.returncode == 3, proc.stderr
+        assert hint in proc.stderr and "took steps of 1/16 or less" in proc.stderr, proc.stderr
+    else:
+        assert hint not in proc.stderr, proc.stderr
