@@ -361,44 +361,6 @@ contains
         call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'GPTS: no step control')
     end subroutine test_crossing_fraction
 
-    !> The block pushed over the plane with the mortar-type penalty: every control
-    !> point in contact slips and the tangential force is mu times the normal one.
-    subroutine test_block_slip_mortar(error)
-        type(error_t), allocatable, intent(out) :: error
-        type(model_t) :: model
-        real(dp), allocatable :: u(:)
-        call block_on_plane(0.1_dp, 0.3_dp, model, u, error, method='mortar')
-        if (allocated(error)) return
-        associate (pair => model%pairs(1))
-            call check(error, count(pair%last%state == state_slip) >= 2 .and. &
-                       all(pair%last%state /= state_stick), 'every control point in contact slips')
-            if (allocated(error)) return
-            call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), 'F_T = mu F_N', rel=1.0e-8_dp)
-            if (allocated(error)) return
-            call check(error, pair%force(1) < 0.0_dp, 'friction opposes the push')
-        end associate
-    end subroutine test_block_slip_mortar
-
-    !> Frictionless mortar: no friction history, no friction evaluation, no
-    !> tangential traction.
-    subroutine test_no_friction_code_mortar(error)
-        type(error_t), allocatable, intent(out) :: error
-        type(model_t) :: model
-        real(dp), allocatable :: u(:)
-        call block_on_plane(0.0_dp, 0.0_dp, model, u, error, method='mortar')
-        if (allocated(error)) return
-        associate (pair => model%pairs(1))
-            call check(error, .not. allocated(pair%traction) .and. .not. allocated(pair%xi_last), &
-                       'no friction history stored')
-            if (allocated(error)) return
-            call check(error, pair%n_friction == 0, 'no friction evaluation')
-            if (allocated(error)) return
-            call check(error, pair%n_evaluations > 0, 'contact evaluated')
-            if (allocated(error)) return
-            call check(error, all(pair%out%pt == 0.0_dp), 'no tangential traction')
-        end associate
-    end subroutine test_no_friction_code_mortar
-
     !> A body entry of a test case.
     function body(name, material, e, layout) result(b)
         character(len=*), intent(in) :: name, material
@@ -579,21 +541,42 @@ contains
 
     subroutine test_block_slip(error)
         type(error_t), allocatable, intent(out) :: error
+        call block_slip(error, 'gpts')
+    end subroutine test_block_slip
+
+    !> The same with the mortar-type penalty (its states per control point).
+    subroutine test_block_slip_mortar(error)
+        type(error_t), allocatable, intent(out) :: error
+        call block_slip(error, 'mortar')
+    end subroutine test_block_slip_mortar
+
+    !> The block pushed 0.1 over the plane, mu = 0.3: every point (GPTS) or control
+    !> point (mortar) in contact slips, and the tangential force is mu times the
+    !> normal one, opposing the push.
+    subroutine block_slip(error, method)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: method
         type(model_t) :: model
         real(dp), allocatable :: u(:)
-        call block_on_plane(0.1_dp, 0.3_dp, model, u, error)
+        logical :: slipping
+        call block_on_plane(0.1_dp, 0.3_dp, model, u, error, method=method)
         if (allocated(error)) return
         associate (pair => model%pairs(1))
-            ! the leading corner may lift off under the friction moment
-            call check(error, all(pair%out%state == state_slip .or. pair%out%state == state_inactive) &
-                       .and. count(pair%out%state == state_slip) >= size(pair%out) - 2, &
-                       'every point in contact slips')
+            if (method == 'mortar') then
+                slipping = count(pair%last%state == state_slip) >= 2 .and. all(pair%last%state /= state_stick)
+            else
+                ! the leading corner may lift off under the friction moment
+                slipping = all(pair%out%state == state_slip .or. pair%out%state == state_inactive) &
+                           .and. count(pair%out%state == state_slip) >= size(pair%out) - 2
+            end if
+            call check(error, slipping, method//': every point in contact slips')
             if (allocated(error)) return
-            call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), 'F_T = mu F_N', rel=1.0e-8_dp)
+            call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), method//': F_T = mu F_N', &
+                       rel=1.0e-8_dp)
             if (allocated(error)) return
-            call check(error, pair%force(1) < 0.0_dp, 'friction opposes the push')
+            call check(error, pair%force(1) < 0.0_dp, method//': friction opposes the push')
         end associate
-    end subroutine test_block_slip
+    end subroutine block_slip
 
     subroutine test_block_stick(error)
         type(error_t), allocatable, intent(out) :: error
@@ -625,20 +608,34 @@ contains
     !> mu = 0: no friction history, no friction evaluation.
     subroutine test_no_friction_code(error)
         type(error_t), allocatable, intent(out) :: error
+        call no_friction_code(error, 'gpts')
+    end subroutine test_no_friction_code
+
+    subroutine test_no_friction_code_mortar(error)
+        type(error_t), allocatable, intent(out) :: error
+        call no_friction_code(error, 'mortar')
+    end subroutine test_no_friction_code_mortar
+
+    !> A frictionless block pressed onto the plane: no friction history (anchors,
+    !> tractions, projections), no friction evaluation, no tangential traction.
+    subroutine no_friction_code(error, method)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: method
         type(model_t) :: model
         real(dp), allocatable :: u(:)
-        call block_on_plane(0.0_dp, 0.0_dp, model, u, error)
+        call block_on_plane(0.0_dp, 0.0_dp, model, u, error, method=method)
         if (allocated(error)) return
         associate (pair => model%pairs(1))
-            call check(error, .not. allocated(pair%anchor), 'no friction history stored')
+            call check(error, .not. (allocated(pair%anchor) .or. allocated(pair%traction) .or. &
+                                     allocated(pair%xi_last)), method//': no friction history stored')
             if (allocated(error)) return
-            call check(error, pair%n_friction == 0, 'no friction evaluation')
+            call check(error, pair%n_friction == 0, method//': no friction evaluation')
             if (allocated(error)) return
-            call check(error, pair%n_evaluations > 0, 'contact evaluated')
+            call check(error, pair%n_evaluations > 0, method//': contact evaluated')
             if (allocated(error)) return
-            call check(error, all(pair%out%pt == 0.0_dp), 'no tangential traction')
+            call check(error, all(pair%out%pt == 0.0_dp), method//': no tangential traction')
         end associate
-    end subroutine test_no_friction_code
+    end subroutine no_friction_code
 
     !> A rigid master has no DOFs: the model's DOFs are the bodies' only.
     subroutine test_rigid_no_dofs(error)

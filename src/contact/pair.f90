@@ -48,6 +48,15 @@ module voiga_contact_pair
         integer, allocatable :: state(:)
     end type mortar_snapshot_t
 
+    abstract interface
+        !> Receives a local stiffness matrix `k` on the global DOFs `dofs`.
+        subroutine add_matrix(dofs, k)
+            import :: dp
+            integer, intent(in) :: dofs(:)
+            real(dp), intent(in) :: k(:, :)
+        end subroutine add_matrix
+    end interface
+
     !> A slave/master pair.
     type :: contact_pair_t
         character(len=32) :: slave_name = '', master_name = ''
@@ -161,14 +170,7 @@ contains
         real(dp), intent(in) :: u(:)
         real(dp), intent(inout) :: r(:)
         type(error_t), allocatable, intent(out) :: error
-        interface
-            subroutine add(dofs, k)
-                import :: dp
-                integer, intent(in) :: dofs(:)
-                real(dp), intent(in) :: k(:, :)
-            end subroutine add
-        end interface
-        optional :: add
+        procedure(add_matrix), optional :: add
         type(surface_point_t) :: sp
         type(master_point_t) :: mp
         real(dp), allocatable :: rl(:), kl(:, :)
@@ -248,14 +250,7 @@ contains
         real(dp), intent(in) :: u(:)
         real(dp), intent(inout) :: r(:)
         type(error_t), allocatable, intent(out) :: error
-        interface
-            subroutine add(dofs, k)
-                import :: dp
-                integer, intent(in) :: dofs(:)
-                real(dp), intent(in) :: k(:, :)
-            end subroutine add
-        end interface
-        optional :: add
+        procedure(add_matrix), optional :: add
         !> Per slave point: its derivative vectors over its local DOFs.
         type :: point_vectors_t
             integer, allocatable :: dofs(:)
