@@ -356,8 +356,11 @@ contains
         pair%last%t_trial(3) = -3.0_dp
         call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'nothing crossed')
         if (allocated(error)) return
+        ! the same reversal in a GPTS pair: no step control
+        before%state(3) = state_slip
+        call check(error, pair_crossing_fraction(pair, before, 1.01_dp) < 1.0_dp, 'mortar: reversal seen')
+        if (allocated(error)) return
         pair%method = method_gpts
-        pair%last = mortar_snapshot_t()
         call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'GPTS: no step control')
     end subroutine test_crossing_fraction
 
