@@ -265,7 +265,7 @@ contains
         ! trial tangential tractions
         real(dp), allocatable :: t_tr(:)
         real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
-        integer, allocatable :: st_a(:), blk(:), pos(:)
+        integer, allocatable :: st_a(:), blk(:), pos(:), mdofs(:)
         logical, allocatable :: valid(:), slip(:)
         real(dp) :: a0(2), pbar, tbar, t_old, c
         integer :: npts, ncp, k, i, a, e, nd, j, ng
@@ -362,10 +362,11 @@ contains
         end do
         self%last = mortar_snapshot_t(g_a, d_a, t_tr, st_a)
         if (.not. present(add) .or. miss) return
+        mdofs = self%master%all_dofs()
         ! pass 4: the coupling through the control-point tractions
         do a = 1, ncp
             if (st_a(a) == state_inactive) cycle
-            blk = pair_block_dofs(self, a)
+            blk = pair_block_dofs(self, a, mdofs)
             allocate (v(size(blk)), q(size(blk)), mm(size(blk)), pos(0))
             v = 0.0_dp
             q = 0.0_dp
@@ -494,43 +495,38 @@ contains
         self%pattern_miss = .true.
     end subroutine fit_pattern
 
-    !> Number of stiffness-pattern blocks the pair adds to the bodies' elements:
-    !> GPTS with a deformable master, one per slave element (its edge DOFs with its
-    !> master range); mortar, one per slave control point (`pair_block_dofs`); none
-    !> otherwise.
+    !> Number of stiffness-pattern blocks the pair adds to the bodies' elements, some
+    !> possibly empty (`pair_block_dofs`): GPTS with a deformable master, one per
+    !> slave element; mortar, one per slave control point; none otherwise.
     pure integer function pair_n_blocks(self) result(n)
         type(contact_pair_t), intent(in) :: self
         n = 0
         if (self%method == method_mortar) then
             n = size(self%slave%cps)
         else if (self%master%deformable) then
-            n = count(self%mlo <= self%mhi)
+            n = size(self%mlo)
         end if
     end function pair_n_blocks
 
-    !> Global DOFs of pattern block `b` (1 .. `pair_n_blocks`). GPTS: the b-th slave
-    !> element with a nonempty master range, its edge DOFs then the range's. Mortar:
-    !> slave control point b couples every DOF of every point in its support with
-    !> every other, so its block is the edge DOFs and master ranges of all the slave
-    !> elements its function is nonzero on (sorted, each once).
-    pure function pair_block_dofs(self, b) result(dofs)
+    !> Global DOFs of pattern block `b` (1 .. `pair_n_blocks`); `mdofs` =
+    !> `self%master%all_dofs()`. GPTS: slave element b's edge DOFs then its master
+    !> range's (empty while the range is). Mortar: slave control point b couples
+    !> every DOF of every point in its support with every other, so its block is the
+    !> edge DOFs and master ranges of all the slave elements its function is nonzero
+    !> on (each once).
+    pure function pair_block_dofs(self, b, mdofs) result(dofs)
         type(contact_pair_t), intent(in) :: self
         integer, intent(in) :: b
+        integer, intent(in) :: mdofs(:)
         integer, allocatable :: dofs(:)
-        integer, allocatable :: mdofs(:)
         logical, allocatable :: used(:)
-        integer :: e, nb, p, lo, hi
+        integer :: e, p, lo, hi
 
         p = self%slave%degree
-        mdofs = self%master%all_dofs()
         if (self%method /= method_mortar) then
-            nb = 0
-            do e = 1, size(self%mlo)
-                if (self%mlo(e) > self%mhi(e)) cycle
-                nb = nb + 1
-                if (nb == b) exit
-            end do
-            dofs = [pair_element_dofs(self, e), mdofs(2*self%mlo(e) - 1:2*self%mhi(e))]
+            allocate (dofs(0))
+            if (self%mlo(b) <= self%mhi(b)) &
+                dofs = [pair_element_dofs(self, b), mdofs(2*self%mlo(b) - 1:2*self%mhi(b))]
             return
         end if
         lo = huge(1)

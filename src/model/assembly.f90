@@ -110,7 +110,12 @@ contains
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(out) :: k
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: ptr(:), dofs(:), block(:)
+        integer, allocatable :: ptr(:), dofs(:), mdofs(:)
+        !> The DOFs of one contact block.
+        type :: dof_block_t
+            integer, allocatable :: dofs(:)
+        end type dof_block_t
+        type(dof_block_t), allocatable :: blocks(:)
         integer :: ib, e, nel, n, pos, ip
 
         nel = 0
@@ -121,13 +126,19 @@ contains
                 n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
         end do
-        ! the contact pairs' blocks (pair_block_dofs): with a deformable master each
-        ! slave element's edge DOFs with the master's control points in its range
+        ! the contact pairs' nonempty blocks (pair_block_dofs): with a deformable master
+        ! each slave element's edge DOFs with the master's control points in its range
         ! (contact_pair_t%mlo, mhi); a mortar pair, each slave control point's support
+        allocate (blocks(sum([(pair_n_blocks(model%pairs(ip)), ip=1, size(model%pairs))])))
+        pos = 0
         do ip = 1, size(model%pairs)
+            mdofs = model%pairs(ip)%master%all_dofs()
             do e = 1, pair_n_blocks(model%pairs(ip))
+                pos = pos + 1
+                blocks(pos)%dofs = pair_block_dofs(model%pairs(ip), e, mdofs)
+                if (size(blocks(pos)%dofs) == 0) cycle
                 nel = nel + 1
-                n = n + size(pair_block_dofs(model%pairs(ip), e))
+                n = n + size(blocks(pos)%dofs)
             end do
         end do
         allocate (ptr(nel + 1), dofs(n))
@@ -141,13 +152,11 @@ contains
                 dofs(ptr(pos):ptr(pos + 1) - 1) = body_dofs(model%bodies(ib), e)
             end do
         end do
-        do ip = 1, size(model%pairs)
-            do e = 1, pair_n_blocks(model%pairs(ip))
-                pos = pos + 1
-                block = pair_block_dofs(model%pairs(ip), e)
-                ptr(pos + 1) = ptr(pos) + size(block)
-                dofs(ptr(pos):ptr(pos + 1) - 1) = block
-            end do
+        do e = 1, size(blocks)
+            if (size(blocks(e)%dofs) == 0) cycle
+            pos = pos + 1
+            ptr(pos + 1) = ptr(pos) + size(blocks(e)%dofs)
+            dofs(ptr(pos):ptr(pos + 1) - 1) = blocks(e)%dofs
         end do
         call new_csc_pattern(k, model%ndof, ptr, dofs, error)
     end subroutine stiffness_pattern

@@ -10,8 +10,7 @@ module voiga_model
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: element_points_t, reference_gradients
     use voiga_discretization_element, only: element_basis, element_nfun
-    use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit, method_gpts, &
-                                  method_mortar
+    use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit, method_names
     use voiga_contact_surface, only: new_contact_surface
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
@@ -205,7 +204,8 @@ contains
         pair%law%eps_t = inp%penalty_tangent
         pair%law%mu = inp%friction
         pair%n_gauss = inp%n_gauss
-        pair%method = merge(method_mortar, method_gpts, trim(inp%method) == 'mortar')
+        ! (the input is validated: one of the names)
+        pair%method = findloc(method_names, trim(inp%method), dim=1)
         call setup_points(pair)
         allocate (u0(self%ndof), r0(self%ndof))
         u0 = 0.0_dp
