@@ -13,7 +13,7 @@ SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # 3x slower while anything else ran (docs/performance.md).
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: all deps build run test test-fortran test-python clean bench paper stress
+.PHONY: all deps build run test test-fortran test-python clean bench paper stress regress
 
 all: build
 
@@ -77,3 +77,9 @@ paper: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post sweep --out $(PAPER_OUT) $(PAPER_ARGS) || status=$$?; \
 	$(PYTHON) -m post figures --results $(PAPER_OUT) --out docs/validation || status=$$?; \
 	exit $$status
+
+## regress: every committed case and every converging hard case, compared per step with
+## the baseline made by the binary before the solver redesign (test/regress/); REGRESS_ARGS
+## e.g. --only 'hertz/*', --jobs 1, --write (remake the baseline with this binary)
+regress: build
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/regress.py $(REGRESS_ARGS)

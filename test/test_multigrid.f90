@@ -14,6 +14,7 @@ module test_multigrid
                                 csr_from_csc, csr_matvec
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_multigrid, only: multigrid_t
+    use voiga_solver_linear, only: solve_accuracy_t
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_hierarchy, only: coarse_space_t, cp_map_t, coarsen_discretization, &
@@ -254,17 +255,17 @@ contains
             if (allocated(error)) return
             call check(error, mg%n_levels() >= 3, 'at least 3 levels')
             if (allocated(error)) return
-            call mg%setup(k, error)
+            call mg%factor(k, error)
             if (allocated(error)) return
-            call mg%solve(b, x, 1.0e-10_dp, error)
+            call mg%solve(k, b, x, error, solve_accuracy_t(rtol=1.0e-10_dp))
             if (allocated(error)) return
-            its(i) = mg%last_iterations
-            call lu%factorize(k, error)
+            its(i) = mg%last_iterations()
+            call lu%factor(k, error)
             if (allocated(error)) return
             call lu%solve(k, b, xd, error)
             if (allocated(error)) return
             write (label, '(a,i0,a,i0,a)') 'n = ', sizes(i), ' (', its(i), ' iterations)'
-            call check(error, mg%last_residual <= 1.0e-10_dp, trim(label)//': residual reached')
+            call check(error, mg%last_residual() <= 1.0e-10_dp, trim(label)//': residual reached')
             if (allocated(error)) return
             call check(error, maxval(abs(x - xd)) <= 1.0e-8_dp*maxval(abs(xd)), trim(label)//': = UMFPACK')
             if (allocated(error)) return

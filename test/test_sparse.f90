@@ -401,7 +401,7 @@ contains
     !> backward-stable LU gives residuals ~ 1e-16 and errors ~ 1e-13: 1e-12 holds
     !> with margin.
     subroutine solve_and_check(lu, a, xe, what, error)
-        type(umfpack_t), intent(in) :: lu
+        type(umfpack_t), intent(inout) :: lu
         type(csc_matrix_t), intent(in) :: a
         real(dp), intent(in) :: xe(:)
         character(len=*), intent(in) :: what
@@ -443,7 +443,7 @@ contains
         if (allocated(error)) return
         call check(error, a%missed, 0, 'missed')
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call check(error, lu%rcond > 0.0_dp, 'rcond estimate available')
         if (allocated(error)) return
@@ -460,7 +460,7 @@ contains
 
         call laplacian(m, a, reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]), error)
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         allocate (xe(m*m))
         xe = random_vector(rng, m*m)
@@ -470,7 +470,7 @@ contains
         ! new values, same pattern: an unsymmetric "convective" edge matrix
         call laplacian(m, a, reshape([3.0_dp, -1.0_dp, -2.0_dp, 3.0_dp], [2, 2]), error)
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 1, 'symbolic analysis reused')
         if (allocated(error)) return
@@ -502,7 +502,7 @@ contains
         do e = 1, 200
             call a%add_element([2*e - 1, 2*e], reshape([2.0_dp, 1.0_dp, 1.0_dp, 3.0_dp], [2, 2]))
         end do
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call lu%determinant(sgn, log_det, error)
         if (allocated(error)) return
@@ -518,7 +518,7 @@ contains
                 call a%add_element([2*e - 1, 2*e], reshape([2.0_dp, 1.0_dp, 1.0_dp, 3.0_dp], [2, 2]))
             end if
         end do
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call lu%determinant(sgn, log_det, error)
         if (allocated(error)) return
@@ -541,7 +541,7 @@ contains
         call laplacian(m, a, reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]), error)
         if (allocated(error)) return
         lu%wide = .true.
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call solve_and_check(lu, a, random_vector(rng, m*m), 'laplacian, 64-bit', error)
         if (allocated(error)) return
@@ -549,7 +549,7 @@ contains
         if (allocated(error)) return
         call check(error, sgn, 1, 'det of an SPD matrix, 64-bit')
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 1, 'symbolic analysis reused, 64-bit')
         if (allocated(error)) return
@@ -565,7 +565,7 @@ contains
 
         call laplacian(20, a, reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]), error)
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         ! same n, different pattern: an SPD 2-DOF-per-node bar
         call new_csc_pattern(b, 400, [(2*e - 1, e=1, 200), 401], [(e, e=1, 400)], error)
@@ -573,7 +573,7 @@ contains
         do e = 1, 200
             call b%add_element([2*e - 1, 2*e], random_spd(rng, 2))
         end do
-        call lu%factorize(b, error)
+        call lu%factor(b, error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 2, 'new pattern, new symbolic analysis')
         if (allocated(error)) return
@@ -582,7 +582,7 @@ contains
         ! and back to a smaller matrix
         call laplacian(7, a, reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]), error)
         if (allocated(error)) return
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 3, 'new n, new symbolic analysis')
         if (allocated(error)) return
@@ -611,7 +611,7 @@ contains
         do e = 1, nel
             call a%add_element([e, e + 1], reshape([1.0_dp, -1.0_dp, -1.0_dp, 1.0_dp], [2, 2]))
         end do
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (.not. allocated(error)) then
             call check(error, .false., 'singular matrix refused')
             return
@@ -639,7 +639,7 @@ contains
         fixed = .false.
         fixed(1) = .true.
         call a%fix_dofs(fixed)
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 1, 'symbolic kept after the failure')
         if (allocated(error)) return
@@ -650,7 +650,7 @@ contains
 
         ! all-zero values on a stored diagonal
         call a%zero()
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         failed = allocated(error)
         call check(error, failed, 'zero matrix refused')
     end subroutine test_singular
@@ -662,7 +662,7 @@ contains
         type(umfpack_t) :: lu, other
         real(dp) :: b(3), x(3), x4(4)
 
-        call lu%factorize(empty, error)
+        call lu%factor(empty, error)
         failed = allocated(error)
         call check(error, failed, 'matrix without pattern refused')
         if (allocated(error)) return
@@ -675,7 +675,7 @@ contains
         if (allocated(error)) return
         call a%add_element([1, 2], reshape([2.0_dp, -1.0_dp, -1.0_dp, 2.0_dp], [2, 2]))
         call a%add_element([2, 3], reshape([2.0_dp, -1.0_dp, -1.0_dp, 2.0_dp], [2, 2]))
-        call lu%factorize(a, error)
+        call lu%factor(a, error)
         if (allocated(error)) return
         call lu%solve(a, b, x4, error)
         failed = allocated(error)

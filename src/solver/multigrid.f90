@@ -25,6 +25,7 @@ module voiga_solver_multigrid
     use voiga_solver_csr, only: csr_t, csr_from_csc, csr_from_triplets, csr_transpose, csr_matmul, &
                                 csr_to_csc, csr_matvec, csr_diagonal_positions, csr_matmul_numeric
     use voiga_solver_umfpack, only: umfpack_t
+    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_smoother, only: line_set_t, new_line_set
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_discretization_patch, only: discretization_t
@@ -62,7 +63,7 @@ module voiga_solver_multigrid
     !> The multigrid preconditioner and its GMRES. Holds a UMFPACK factorization:
     !> declare one per solve sequence and do not assign these objects (gfortran
     !> crashed finalizing the handle of an assigned structure-constructor temporary).
-    type :: multigrid_t
+    type, extends(linear_solver_t) :: multigrid_t
         !> Largest coarse problem solved directly.
         integer :: coarse_dofs = 2000
         !> Line Gauss-Seidel sweeps (each: xi lines, then eta lines) before and
@@ -71,9 +72,9 @@ module voiga_solver_multigrid
         !> GMRES restart length and iteration cap per solve.
         integer :: restart = 50, max_iterations = 500
         !> Counters (read only): setups, solves, GMRES iterations in all and in the last solve.
-        integer :: n_setups = 0, n_solves = 0, n_iterations = 0, last_iterations = 0
+        integer :: n_setups = 0, n_solves = 0, n_iterations = 0, iterations_last = 0
         !> Relative residual reached by the last solve (read only).
-        real(dp) :: last_residual = 0.0_dp
+        real(dp) :: residual_last = 0.0_dp
         type(mg_level_t), allocatable :: levels(:)
         !> The tangent's CSC pattern the operators were built for, and the position
         !> in the tangent's values of each fine CSR entry.
@@ -86,13 +87,15 @@ module voiga_solver_multigrid
         !> Build the hierarchy of spaces and prolongations (once per run).
         procedure :: build => mg_build
         !> Galerkin operators and coarsest factorization for a new tangent.
-        procedure :: setup => mg_setup
+        procedure :: factor => mg_setup
         !> Solve A x = b to a relative residual (GMRES + V-cycle).
         procedure :: solve => mg_solve
         !> Number of levels (1: no coarsening possible).
         procedure :: n_levels => mg_n_levels
         !> DOFs of every level.
         procedure :: level_dofs => mg_level_dofs
+        procedure :: last_iterations => mg_last_iterations
+        procedure :: last_residual => mg_last_residual
     end type multigrid_t
 
 contains
@@ -311,11 +314,22 @@ contains
         end do
     end function mg_level_dofs
 
-    !> Operators of every level for the tangent `k` (Dirichlet rows and columns
+    !> GMRES iterations of the last solve, and the relative residual it reached.
+    pure integer function mg_last_iterations(self) result(n)
+        class(multigrid_t), intent(in) :: self
+        n = self%iterations_last
+    end function mg_last_iterations
+
+    pure real(dp) function mg_last_residual(self) result(res)
+        class(multigrid_t), intent(in) :: self
+        res = self%residual_last
+    end function mg_last_residual
+
+    !> Operators of every level for the tangent `a` (Dirichlet rows and columns
     !> already replaced by the identity, `csc_matrix_t%fix_dofs`).
-    subroutine mg_setup(self, k, error)
+    subroutine mg_setup(self, a, error)
         class(multigrid_t), intent(inout) :: self
-        type(csc_matrix_t), intent(in) :: k
+        type(csc_matrix_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
         integer :: l, nl
         logical :: same
@@ -327,12 +341,12 @@ contains
         nl = size(self%levels)
         same = .false.
         if (allocated(self%colptr)) then
-            if (size(self%colptr) == size(k%colptr) .and. size(self%rowind) == size(k%rowind)) &
-                same = all(self%colptr == k%colptr) .and. all(self%rowind == k%rowind)
+            if (size(self%colptr) == size(a%colptr) .and. size(self%rowind) == size(a%rowind)) &
+                same = all(self%colptr == a%colptr) .and. all(self%rowind == a%rowind)
         end if
         if (same) then
             ! the patterns are those of the last set-up: values only
-            self%levels(1)%a%val = k%values(self%perm)
+            self%levels(1)%a%val = a%values(self%perm)
             do l = 1, nl - 1
                 call csr_matmul_numeric(self%levels(l)%a, self%levels(l)%p, self%levels(l)%ap)
                 call csr_matmul_numeric(self%levels(l)%r, self%levels(l)%ap, self%levels(l + 1)%a)
@@ -341,7 +355,7 @@ contains
                 end associate
             end do
         else
-            call fine_operator(self, k)
+            call fine_operator(self, a)
             do l = 1, nl - 1
                 call csr_matmul(self%levels(l)%a, self%levels(l)%p, self%levels(l)%ap)
                 call csr_matmul(self%levels(l)%r, self%levels(l)%ap, self%levels(l + 1)%a, sorted=.true.)
@@ -379,7 +393,7 @@ contains
         else
             call csr_to_csc(self%levels(nl)%a, self%coarse)
         end if
-        call self%lu%factorize(self%coarse, error)
+        call self%lu%factor(self%coarse, error)
         if (allocated(error)) then
             error%message = 'multigrid coarsest level: '//error%message
             return
@@ -501,21 +515,22 @@ contains
         z = self%levels(1)%x
     end subroutine precondition
 
-    !> Solve A x = b (A: the fine operator of the last `setup`) by GMRES(restart),
-    !> right preconditioned by a V-cycle, to ||b - A x|| <= rtol ||b||; or, after
-    !> `soft_iterations` iterations, to `soft_rtol` (a looser target for a slowly
-    !> converging solve whose accuracy matters little).
-    !> Not reaching it within `max_iterations` is a numerical error.
-    subroutine mg_solve(self, b, x, rtol, error, soft_iterations, soft_rtol)
+    !> Solve A x = b (A: the fine operator of the last `factor`; `a` is not used
+    !> again) by GMRES(restart), right preconditioned by a V-cycle, to
+    !> ||b - A x|| <= rtol ||b||; or, after `accuracy%soft_iterations` iterations, to
+    !> `accuracy%soft_rtol` (a looser target for a slowly converging solve whose
+    !> accuracy matters little). Without `accuracy`: rtol = 1e-12, the attainable
+    !> level in double precision. Not reaching it within `max_iterations` is a
+    !> numerical error.
+    subroutine mg_solve(self, a, b, x, error, accuracy)
         class(multigrid_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
         real(dp), intent(in) :: b(:)
         real(dp), intent(out) :: x(:)
-        real(dp), intent(in) :: rtol
         type(error_t), allocatable, intent(out) :: error
-        integer, intent(in), optional :: soft_iterations
-        real(dp), intent(in), optional :: soft_rtol
+        type(solve_accuracy_t), intent(in), optional :: accuracy
         real(dp), allocatable :: h(:, :), g(:), cs(:), sn(:), y(:)
-        real(dp) :: bnorm, beta, target, temp, soft_target
+        real(dp) :: bnorm, beta, target, temp, soft_target, rtol
         integer :: n, m, j, i, total, soft_it
         character(len=200) :: msg
 
@@ -523,16 +538,20 @@ contains
         m = self%restart
         x = 0.0_dp
         self%n_solves = self%n_solves + 1
-        self%last_iterations = 0
+        self%iterations_last = 0
         bnorm = norm2(b)
-        self%last_residual = 0.0_dp
+        self%residual_last = 0.0_dp
         if (bnorm == 0.0_dp) return
+        rtol = 1.0e-12_dp
+        if (present(accuracy)) rtol = accuracy%rtol
         target = rtol*bnorm
         soft_it = huge(1)
         soft_target = target
-        if (present(soft_iterations) .and. present(soft_rtol)) then
-            soft_it = soft_iterations
-            soft_target = max(target, soft_rtol*bnorm)
+        if (present(accuracy)) then
+            if (accuracy%soft_iterations > 0) then
+                soft_it = accuracy%soft_iterations
+                soft_target = max(target, accuracy%soft_rtol*bnorm)
+            end if
         end if
         allocate (h(m + 1, m), g(m + 1), cs(m), sn(m), y(m))
         if (.not. allocated(self%v)) allocate (self%v(n, m + 1), self%w(n), self%r(n))
@@ -599,7 +618,7 @@ contains
             call csr_matvec(self%levels(1)%a, x, r)
             r = b - r
             beta = norm2(r)
-            self%last_residual = beta/bnorm
+            self%residual_last = beta/bnorm
             if (beta <= target) exit
             if (total >= soft_it .and. beta <= soft_target) exit
             if (total >= self%max_iterations .or. .not. (beta == beta)) then
@@ -610,7 +629,7 @@ contains
             end if
         end do
         end associate
-        self%last_iterations = total
+        self%iterations_last = total
         self%n_iterations = self%n_iterations + total
     end subroutine mg_solve
 

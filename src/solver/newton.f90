@@ -35,6 +35,7 @@ module voiga_solver_newton
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_multigrid, only: multigrid_t
+    use voiga_solver_linear, only: solve_accuracy_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
     use voiga_contact_pair, only: contact_pair_t, pair_commit, pair_reset_trial, pair_zone, method_gpts, &
@@ -742,9 +743,9 @@ contains
             call k%fix_dofs(model%fixed)
             if (multigrid) then
                 ! no factors, no determinant: det_sign stays 0 (unknown)
-                call mg%setup(k, error)
+                call mg%factor(k, error)
             else
-                call lu%factorize(k, error)
+                call lu%factor(k, error)
                 if (.not. allocated(error)) then
                     ! the orientation of the tangent (O(n) from the factors): a sign
                     ! change marks a fold of the incremental problem (solve_steps)
@@ -766,14 +767,14 @@ contains
                 if (it > 0) changing = any(states(:, it) /= states(:, it - 1))
                 if (changing) then
                     eta = max(eta, active_set_forcing)
-                    call mg%solve(rhs, du, eta, error, soft_iterations, soft_forcing)
+                    call mg%solve(k, rhs, du, error, solve_accuracy_t(eta, soft_iterations, soft_forcing))
                 else
-                    call mg%solve(rhs, du, eta, error)
+                    call mg%solve(k, rhs, du, error, solve_accuracy_t(eta))
                 end if
                 if (caught_signal() /= 0) stats%signal = caught_signal()
-                rec%linear_iterations = rec%linear_iterations + mg%last_iterations
-                if (verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', mg%last_iterations, &
-                    ' iterations, relative residual ', mg%last_residual, ' (asked ', eta, ')'
+                rec%linear_iterations = rec%linear_iterations + mg%last_iterations()
+                if (verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', mg%last_iterations(), &
+                    ' iterations, relative residual ', mg%last_residual(), ' (asked ', eta, ')'
             else
                 call lu%solve(k, rhs, du, error)
             end if
@@ -945,7 +946,7 @@ contains
         ! multigrid solver has no factors: the sign stays unknown)
         if (model%linear_solver /= 'multigrid') then
             call k%fix_dofs(model%fixed)
-            call lu%factorize(k, error)
+            call lu%factor(k, error)
             if (allocated(error)) return
             call lu%determinant(stats%det_sign, log_det, error)
             if (allocated(error)) return

@@ -15,6 +15,7 @@ module voiga_solver_umfpack
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     implicit none
     private
 
@@ -60,7 +61,7 @@ module voiga_solver_umfpack
     !> while the pattern is unchanged. Not copyable: assigning one `umfpack_t` to
     !> another leaves the target empty (it will factorize afresh), so two objects
     !> never free the same handle.
-    type :: umfpack_t
+    type, extends(linear_solver_t) :: umfpack_t
         !> Number of symbolic analyses done so far (read only).
         integer :: n_symbolic = 0
         !> Number of successful numeric factorizations so far (read only).
@@ -82,11 +83,13 @@ module voiga_solver_umfpack
         integer(c_long), allocatable, private :: colptr_l(:), rowind_l(:)
     contains
         !> Symbolic analysis (when needed) and numeric LU of a matrix.
-        procedure :: factorize => umfpack_factorize
+        procedure :: factor => umfpack_factorize
         !> Solve A x = b with the current factorization.
         procedure :: solve => umfpack_solve
         !> Sign and log10 magnitude of det(A) of the current factorization.
         procedure :: determinant => umfpack_determinant
+        procedure :: has_determinant => umfpack_has_determinant
+        procedure :: factorizations => umfpack_factorizations
         !> Free the Symbolic and Numeric objects; safe to call any number of times.
         procedure :: release => umfpack_release
         procedure, private :: assign => umfpack_assign
@@ -293,8 +296,8 @@ contains
     !> matrix last passed to `factorize` (UMFPACK uses it for iterative
     !> refinement, done only when rcond < `refine_below_rcond`); its pattern is
     !> checked, its values are not.
-    subroutine umfpack_solve(self, a, b, x, error)
-        class(umfpack_t), intent(in) :: self
+    subroutine umfpack_solve(self, a, b, x, error, accuracy)
+        class(umfpack_t), intent(inout) :: self
         !> The factorized matrix.
         type(csc_matrix_t), intent(in) :: a
         !> Right-hand side; shape: [n].
@@ -302,6 +305,8 @@ contains
         !> Solution; shape: [n].
         real(dp), intent(out) :: x(:)
         type(error_t), allocatable, intent(out) :: error
+        !> Ignored: a direct solve is as accurate as the factorization.
+        type(solve_accuracy_t), intent(in), optional :: accuracy
         real(c_double) :: control(umfpack_control), info(umfpack_info)
         integer(c_int) :: status
         character(len=160) :: buf
@@ -368,6 +373,20 @@ contains
         if (mx < 0.0_c_double) sign = -1
         if (mx /= 0.0_c_double) log10_abs = log10(abs(mx)) + ex
     end subroutine umfpack_determinant
+
+    !> A direct solver knows the sign of det(A).
+    pure logical function umfpack_has_determinant(self)
+        class(umfpack_t), intent(in) :: self
+        umfpack_has_determinant = .true.
+    end function umfpack_has_determinant
+
+    !> Symbolic analyses and numeric factorizations so far.
+    pure subroutine umfpack_factorizations(self, symbolic, numeric)
+        class(umfpack_t), intent(in) :: self
+        integer, intent(out) :: symbolic, numeric
+        symbolic = self%n_symbolic
+        numeric = self%n_numeric
+    end subroutine umfpack_factorizations
 
     !> Free both UMFPACK objects and forget the pattern; the counters are kept.
     subroutine umfpack_release(self)
