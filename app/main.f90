@@ -9,6 +9,7 @@ program voiga_main
     use voiga_discretization_bodies, only: discretize_bodies
     use voiga_model, only: model_t, new_model
     use voiga_io_results, only: results_t
+    use voiga_contact_pair, only: history_item_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
     use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_solver_heap, only: keep_freed_memory
@@ -175,8 +176,8 @@ contains
         type(h5file_t) :: f
         character(len=:), allocatable :: g, c
         character(len=16) :: buf
-        integer :: done, ip
-        integer, allocatable :: active(:)
+        integer :: done, ip, i
+        type(history_item_t), allocatable :: history(:)
 
         call f%open(path, 'r', error)
         if (allocated(error)) return
@@ -210,26 +211,20 @@ contains
             if (f%has_attr(g, 'tangent_det_sign')) call f%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
             if (allocated(error)) return
             do ip = 1, size(model%pairs)
-                if (.not. allocated(model%pairs(ip)%xi_last)) cycle
+                history = model%pairs(ip)%pair%history()
+                if (size(history) == 0) cycle
                 write (buf, '(i0)') ip
                 c = g//'/contact/'//trim(buf)//'/history'
-                if (allocated(model%pairs(ip)%anchor)) then
-                    call f%read(c//'/anchor', model%pairs(ip)%anchor, error)
+                do i = 1, size(history)
+                    if (allocated(history(i)%values)) then
+                        call f%read(c//'/'//trim(history(i)%name), history(i)%values, error)
+                    else
+                        call f%read(c//'/'//trim(history(i)%name), history(i)%flags, error)
+                    end if
                     if (allocated(error)) return
-                    model%pairs(ip)%trial_anchor = model%pairs(ip)%anchor
-                end if
-                if (allocated(model%pairs(ip)%traction)) then
-                    call f%read(c//'/traction', model%pairs(ip)%traction, error)
-                    if (allocated(error)) return
-                    model%pairs(ip)%trial_traction = model%pairs(ip)%traction
-                end if
-                call f%read(c//'/xi_last', model%pairs(ip)%xi_last, error)
+                end do
+                call model%pairs(ip)%pair%set_history(history, error)
                 if (allocated(error)) return
-                call f%read(c//'/active_last', active, error)
-                if (allocated(error)) return
-                model%pairs(ip)%active_last = active /= 0
-                model%pairs(ip)%trial_xi = model%pairs(ip)%xi_last
-                model%pairs(ip)%trial_active = model%pairs(ip)%active_last
             end do
         end if
         call f%close()

@@ -14,9 +14,10 @@ module test_contact
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t, residual_floor, reference_coordinates
     use voiga_io_case, only: dirichlet_input_t, pressure_input_t
-    use voiga_contact_pair, only: contact_pair_t, pair_contribution, pair_zone, pair_crossing_fraction, &
-                                  mortar_snapshot_t, method_mortar, method_gpts
-    use voiga_contact_gpts, only: state_inactive, state_stick, state_slip
+    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_gpts, only: gpts_pair_t
+    use voiga_contact_mortar, only: mortar_pair_t, mortar_snapshot_t
+    use voiga_contact_law, only: state_inactive, state_stick, state_slip
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
     implicit none
     private
@@ -131,7 +132,7 @@ contains
 
     !> Dense contact tangent vs central differences of the contact residual.
     subroutine contact_fd(pair, u, want_state, label, error)
-        type(contact_pair_t), intent(inout) :: pair
+        class(contact_pair_t), intent(inout) :: pair
         real(dp), intent(inout) :: u(:)
         integer, intent(in) :: want_state
         character(len=*), intent(in) :: label
@@ -146,7 +147,7 @@ contains
         allocate (kd(n, n), r(n), rp(n), rm(n), kfd(n, n))
         kd = 0.0_dp
         r = 0.0_dp
-        call pair_contribution(pair, u, r, error, add_dense)
+        call pair%evaluate(u, r, error, add_dense)
         if (allocated(error)) return
         nact = count(pair%out%state /= state_inactive)
         call check(error, nact >= 3, label//': at least 3 active points')
@@ -157,11 +158,11 @@ contains
         do j = 1, n
             u(j) = u(j) + h
             rp = 0.0_dp
-            call pair_contribution(pair, u, rp, error)
+            call pair%evaluate(u, rp, error)
             if (allocated(error)) return
             u(j) = u(j) - 2*h
             rm = 0.0_dp
-            call pair_contribution(pair, u, rm, error)
+            call pair%evaluate(u, rm, error)
             if (allocated(error)) return
             u(j) = u(j) + h
             kfd(:, j) = (rp - rm)/(2*h)
@@ -207,18 +208,21 @@ contains
                 ! committed history: every point was in contact, anchored near or far
                 allocate (r(size(u)))
                 r = 0.0_dp
-                call pair_contribution(model%pairs(1), u, r, error)
+                call model%pairs(1)%pair%evaluate(u, r, error)
                 if (allocated(error)) return
-                model%pairs(1)%active_last = .true.
-                if (allocated(model%pairs(1)%anchor)) model%pairs(1)%anchor = model%pairs(1)%out%xi_m - anchor_shift
-                if (allocated(model%pairs(1)%traction)) then
-                    model%pairs(1)%xi_last = model%pairs(1)%out%xi_m - anchor_shift
-                    model%pairs(1)%traction = 0.0_dp
-                end if
-                if (present(tresca)) model%pairs(1)%slip_bound = tresca*mu*max(0.0_dp, model%pairs(1)%out%pn)
+                select type (pair => model%pairs(1)%pair)
+                type is (gpts_pair_t)
+                    pair%active_last = .true.
+                    pair%anchor = pair%out%xi_m - anchor_shift
+                    if (present(tresca)) pair%slip_bound = tresca*mu*max(0.0_dp, pair%out%pn)
+                type is (mortar_pair_t)
+                    pair%active_last = .true.
+                    pair%xi_last = pair%out%xi_m - anchor_shift
+                    pair%traction = 0.0_dp
+                end select
                 deallocate (r)
             end if
-            call contact_fd(model%pairs(1), u, want_state, trim(layouts(il))// &
+            call contact_fd(model%pairs(1)%pair, u, want_state, trim(layouts(il))// &
                             merge(' rigid', '      ', rigid), error)
             if (allocated(error)) return
         end do
@@ -326,43 +330,41 @@ contains
         end do
     end subroutine test_patch_mortar
 
-    !> The step control of mortar pairs (`pair_crossing_fraction`): the fraction of a
+    !> The step control of mortar pairs (`step_limit`): the fraction of a
     !> step at which the first control point closes (times the overshoot) or its slip
     !> reverses (where the trial traction is zero); 1 for GPTS and for steps that
     !> cross nothing the tangent did not describe.
     subroutine test_crossing_fraction(error)
         type(error_t), allocatable, intent(out) :: error
-        type(contact_pair_t) :: pair
-        type(mortar_snapshot_t) :: before
+        type(mortar_pair_t) :: pair
+        type(gpts_pair_t) :: gpts
         real(dp), parameter :: one(3) = 1.0_dp
-        pair%method = method_mortar
         pair%gap_tol = 0.0_dp
         ! A1 closes at 1/2 of the way, A2 stays open, A3 slips and its trial traction
         ! goes from +1 to -3: zero at 1/4
-        before = mortar_snapshot_t([1.0_dp, 1.0_dp, -2.0_dp], one, [0.0_dp, 0.0_dp, 1.0_dp], &
-                                   [state_inactive, state_inactive, state_slip])
+        pair%accepted = mortar_snapshot_t([1.0_dp, 1.0_dp, -2.0_dp], one, [0.0_dp, 0.0_dp, 1.0_dp], &
+                                          [state_inactive, state_inactive, state_slip])
         pair%last = mortar_snapshot_t([-1.0_dp, 0.5_dp, -2.0_dp], one, [0.0_dp, 0.0_dp, -3.0_dp], &
                                       [state_stick, state_inactive, state_slip])
-        call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 0.25_dp, 'slip reversal first', &
+        call check(error, pair%step_limit(1.01_dp), 0.25_dp, 'slip reversal first', &
                    abs=1.0e-15_dp)
         if (allocated(error)) return
         ! without the reversal: the closing, with the overshoot
         pair%last%t_trial(3) = 0.5_dp
-        call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 0.505_dp, 'closing', abs=1.0e-15_dp)
+        call check(error, pair%step_limit(1.01_dp), 0.505_dp, 'closing', abs=1.0e-15_dp)
         if (allocated(error)) return
         ! a sticking point whose trial traction changes sign, a closed point that
         ! stays closed: nothing the tangent did not describe
-        before%g(1) = -0.5_dp
-        before%state(3) = state_stick
+        pair%accepted%g(1) = -0.5_dp
+        pair%accepted%state(3) = state_stick
         pair%last%t_trial(3) = -3.0_dp
-        call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'nothing crossed')
+        call check(error, pair%step_limit(1.01_dp), 1.0_dp, 'nothing crossed')
         if (allocated(error)) return
         ! the same reversal in a GPTS pair: no step control
-        before%state(3) = state_slip
-        call check(error, pair_crossing_fraction(pair, before, 1.01_dp) < 1.0_dp, 'mortar: reversal seen')
+        pair%accepted%state(3) = state_slip
+        call check(error, pair%step_limit(1.01_dp) < 1.0_dp, 'mortar: reversal seen')
         if (allocated(error)) return
-        pair%method = method_gpts
-        call check(error, pair_crossing_fraction(pair, before, 1.01_dp), 1.0_dp, 'GPTS: no step control')
+        call check(error, gpts%step_limit(1.01_dp), 1.0_dp, 'GPTS: no step control')
     end subroutine test_crossing_fraction
 
     !> A mortar control point none of whose support's slave points has a projection
@@ -378,9 +380,10 @@ contains
         if (allocated(error)) return
         call penetrating_state(model, u)
         allocate (r(size(u)), source=0.0_dp)
-        call pair_contribution(model%pairs(1), u, r, error)
+        call model%pairs(1)%pair%evaluate(u, r, error)
         if (allocated(error)) return
-        associate (pair => model%pairs(1))
+        select type (pair => model%pairs(1)%pair)
+        type is (mortar_pair_t)
             ! control points whose function is nonzero at a projected slave point
             allocate (seen(size(pair%slave%cps)), source=.false.)
             do k = 1, size(pair%xi)
@@ -394,7 +397,9 @@ contains
                        'those are open')
             if (allocated(error)) return
             call check(error, count(pair%last%state /= state_inactive) >= 2, 'others are active')
-        end associate
+        class default
+            call check(error, .false., 'a mortar pair')
+        end select
     end subroutine test_mortar_unprojected_open
 
     !> A body entry of a test case.
@@ -497,13 +502,13 @@ contains
         if (allocated(error)) return
         call solve_steps(model, u, stats, .true., error)
         if (allocated(error)) return
-        associate (out => model%pairs(1)%out)
+        associate (out => model%pairs(1)%pair%out)
             call check(error, all(out%state /= state_inactive), 'every slave point in contact')
             if (allocated(error)) return
             spread = (maxval(out%pn) - minval(out%pn))/(sum(out%pn)/size(out))
         end associate
         ! momentum: the contact force carries the applied load exactly
-        call check(error, model%pairs(1)%force(2), 2.0_dp*p, 'total contact force = applied load', &
+        call check(error, model%pairs(1)%pair%force(2), 2.0_dp*p, 'total contact force = applied load', &
                    rel=1.0e-10_dp)
     end subroutine patch_spread
 
@@ -559,7 +564,10 @@ contains
         ! each substep's first residual: they agree far below 1e-8 of the displacement
         call check(error, maxval(abs(ub - ua)) <= 1.0e-8_dp*maxval(abs(ua)), 'same state as plain Newton')
         if (allocated(error)) return
-        call check(error, .not. allocated(mb%pairs(1)%slip_bound), 'back in Coulomb mode')
+        select type (pair => mb%pairs(1)%pair)
+        type is (gpts_pair_t)
+            call check(error, .not. allocated(pair%slip_bound), 'back in Coulomb mode')
+        end select
         if (allocated(error)) return
         ! the Coulomb residual of the accepted last state (re-evaluated with the committed
         ! anchors: slipping points then sit on the slip limit, the same traction); the
@@ -571,7 +579,7 @@ contains
         rn = norm2(merge(0.0_dp, r, mb%fixed))
         call check(error, rn <= 1.0e-9_dp*sb%r0_max, 'Coulomb residual converged at the accepted state')
         if (allocated(error)) return
-        call check(error, abs(mb%pairs(1)%force(1)), 0.3_dp*abs(mb%pairs(1)%force(2)), 'F_T = mu F_N', &
+        call check(error, abs(mb%pairs(1)%pair%force(1)), 0.3_dp*abs(mb%pairs(1)%pair%force(2)), 'F_T = mu F_N', &
                    rel=1.0e-8_dp)
     end subroutine test_tresca_fixed_point
 
@@ -597,14 +605,15 @@ contains
         logical :: slipping
         call block_on_plane(0.1_dp, 0.3_dp, model, u, error, method=method)
         if (allocated(error)) return
-        associate (pair => model%pairs(1))
-            if (method == 'mortar') then
+        associate (pair => model%pairs(1)%pair)
+            select type (pair)
+            type is (mortar_pair_t)
                 slipping = count(pair%last%state == state_slip) >= 2 .and. all(pair%last%state /= state_stick)
-            else
+            class default
                 ! the leading corner may lift off under the friction moment
                 slipping = all(pair%out%state == state_slip .or. pair%out%state == state_inactive) &
                            .and. count(pair%out%state == state_slip) >= size(pair%out) - 2
-            end if
+            end select
             call check(error, slipping, method//': every point in contact slips')
             if (allocated(error)) return
             call check(error, abs(pair%force(1)), 0.3_dp*abs(pair%force(2)), method//': F_T = mu F_N', &
@@ -622,7 +631,8 @@ contains
         integer :: k
         call block_on_plane(1.0e-4_dp, 1.0_dp, model, u, error)
         if (allocated(error)) return
-        associate (pair => model%pairs(1))
+        select type (pair => model%pairs(1)%pair)
+        type is (gpts_pair_t)
             call check(error, all(pair%out%state == state_stick), 'every point sticks')
             if (allocated(error)) return
             call check(error, abs(pair%force(1)) < abs(pair%force(2)), '|F_T| < mu F_N')
@@ -638,7 +648,7 @@ contains
                            'stick: no slip beyond the penalty compliance')
                 if (allocated(error)) return
             end do
-        end associate
+        end select
     end subroutine test_block_stick
 
     !> mu = 0: no friction history, no friction evaluation.
@@ -661,9 +671,16 @@ contains
         real(dp), allocatable :: u(:)
         call block_on_plane(0.0_dp, 0.0_dp, model, u, error, method=method)
         if (allocated(error)) return
-        associate (pair => model%pairs(1))
-            call check(error, .not. (allocated(pair%anchor) .or. allocated(pair%traction) .or. &
-                                     allocated(pair%xi_last)), method//': no friction history stored')
+        associate (pair => model%pairs(1)%pair)
+            call check(error, size(pair%history()) == 0 .and. .not. allocated(pair%xi_last), &
+                       method//': no friction history stored')
+            if (allocated(error)) return
+            select type (pair)
+            type is (gpts_pair_t)
+                call check(error, .not. allocated(pair%anchor), method//': no anchors')
+            type is (mortar_pair_t)
+                call check(error, .not. allocated(pair%traction), method//': no tractions')
+            end select
             if (allocated(error)) return
             call check(error, pair%n_friction == 0, method//': no friction evaluation')
             if (allocated(error)) return
@@ -682,7 +699,7 @@ contains
         if (allocated(error)) return
         call check(error, model%ndof, model%bodies(1)%disc%total_dofs, 'DOFs of the body only')
         if (allocated(error)) return
-        call check(error, size(model%pairs(1)%master%all_dofs()), 0, 'rigid master couples no DOF')
+        call check(error, size(model%pairs(1)%pair%master%all_dofs()), 0, 'rigid master couples no DOF')
     end subroutine test_rigid_no_dofs
 
     !> Frictional ironing (m1, NN2.2): press, then slide; Newton converges
@@ -726,7 +743,7 @@ contains
         ! the tangent is what is tested: every step starts from the last state
         call solve_steps(model, u, stats, .true., error, stepping=stepping_t(predictor=.false.))
         if (allocated(error)) return
-        call check(error, count(model%pairs(1)%out%state == state_slip) > 0, method//': points slip while ironing')
+        call check(error, count(model%pairs(1)%pair%out%state == state_slip) > 0, method//': points slip while ironing')
         if (allocated(error)) return
         ! the solver's round-off level of the residual at the end (the last iterate of
         ! a step may lie on it: mortar, step 12, 4.1e-14 after 6.1e-10)
@@ -814,7 +831,7 @@ contains
     !> control points are those whose functions are nonzero at an active point.
     subroutine test_pair_zone(error)
         type(error_t), allocatable, intent(out) :: error
-        type(contact_pair_t) :: pair
+        type(gpts_pair_t) :: pair
         integer :: n_active, n_holes, n_gaps, n_cp
 
         ! 3 slave elements of degree 2, 4 points each (knot spans 3, 4, 5)
@@ -822,13 +839,13 @@ contains
         pair%slave%degree = 2
         pair%span = [3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5]
         allocate (pair%out(12))
-        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call pair%zone(n_active, n_holes, n_gaps, n_cp)
         call check(error, n_active == 0 .and. n_holes == 0 .and. n_gaps == 0 .and. n_cp == 0, &
                    'no contact: all counts 0')
         if (allocated(error)) return
         ! a zone in elements 1-2 broken by the single open points 4 and 6
         pair%out([2, 3, 5, 7, 8])%state = state_slip
-        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call pair%zone(n_active, n_holes, n_gaps, n_cp)
         call check(error, n_active == 5, 'five active points')
         if (allocated(error)) return
         call check(error, n_holes == 2 .and. n_gaps == 2, 'two single-point holes')
@@ -838,7 +855,7 @@ contains
         ! two zones 4 open points (one element) apart, then a 3-point gap
         pair%out%state = state_inactive
         pair%out([1, 2, 7, 8, 12])%state = state_stick
-        call pair_zone(pair, n_active, n_holes, n_gaps, n_cp)
+        call pair%zone(n_active, n_holes, n_gaps, n_cp)
         call check(error, n_holes == 3 .and. n_gaps == 1, 'the 4-point gap is not a hole, the 3-point gap is')
         if (allocated(error)) return
         call check(error, n_cp == 5, 'spans 3..5 of degree 2: 5 control points')

@@ -1,32 +1,317 @@
-!> Gauss-point-to-surface (GPTS) penalty contact at one slave quadrature point:
-!> normal penalty, Coulomb friction by an elastic predictor and return map on the
-!> convected master coordinate, residual and consistent tangent (docs/theory.md,
-!> section 7).
+!> Gauss-point-to-surface (GPTS) penalty contact, the paper's method: the
+!> penalty acts at every slave Gauss point, with a normal penalty, Coulomb friction
+!> by an elastic predictor and return map on the convected master coordinate, and a
+!> consistent tangent (docs/theory.md, section 7); the friction history is kept per
+!> slave point.
 !>
-!> Tresca mode (optional argument `bound`): the slip limit is a given bound instead
-!> of mu p_N; its tangent has no normal-tangential coupling (the successive
-!> approximations of `voiga_solver_newton`, docs/robustness.md, "Tresca fixed point").
+!> Tresca mode (`outer_apply`, the outer-loop hook): the slip limit of each point
+!> is a fixed bound instead of mu p_N; its tangent has no normal-tangential
+!> coupling (the fixed point of `voiga_solver_outer`, docs/robustness.md).
 !>
-!> Local DOFs: the slave point's functions first (2 per function), then the
-!> master's (none for a rigid master). G maps them to x_s - x_m(xi), Dm to the
-!> master tangent a = dx_m/dxi at fixed xi, Ds to the slave tangent.
+!> Local DOFs of a point: the slave point's functions first (2 per function), then
+!> the master's (none for a rigid master); `voiga_contact_kinematics`.
 module voiga_contact_gpts
     use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
     use voiga_contact_surface, only: surface_point_t
     use voiga_contact_master, only: master_point_t
+    use voiga_contact_law, only: contact_law_t, state_inactive, state_stick, state_slip
+    use voiga_contact_kinematics, only: point_operators
+    use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
+                                  pair_reset_trial, pair_history, pair_set_history
     implicit none
     private
 
-    public :: contact_law_t, gpts_point, point_operators, state_inactive, state_stick, state_slip
+    public :: gpts_pair_t, gpts_point
 
-    integer, parameter :: state_inactive = 0, state_stick = 1, state_slip = 2
+    !> A contact zone counts as broken up (the locking diagnosis) with at least this
+    !> many gaps shorter than a slave element, holding at least this share of its
+    !> points. Measured (docs/robustness.md): penalty 1e6 x E, 3 to 5 gaps holding 32 to
+    !> 48 %; mu-1.0-deep (penalty 1e2 x E, a smooth pressure), one gap of 4 points
+    !> between the zone and a lone point at its edge, 8 %.
+    integer, parameter :: min_gaps = 2
+    real(dp), parameter :: min_hole_share = 0.2_dp
 
-    !> Penalty and friction parameters of a pair.
-    type :: contact_law_t
-        real(dp) :: eps_n = 0.0_dp, eps_t = 0.0_dp, mu = 0.0_dp
-    end type contact_law_t
+    !> A GPTS pair.
+    type, extends(contact_pair_t) :: gpts_pair_t
+        !> Committed and trial stick anchors (master convective coordinate) [npts],
+        !> allocated only when mu > 0.
+        real(dp), allocatable :: anchor(:), trial_anchor(:)
+        !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
+        !> slave point is this prescribed traction instead of mu p_N (never committed).
+        real(dp), allocatable :: slip_bound(:)
+        !> The bounds of the last `outer_capture` [npts].
+        real(dp), allocatable :: captured_bound(:)
+    contains
+        procedure :: evaluate => gpts_evaluate
+        procedure :: method_name => gpts_method_name
+        procedure :: n_blocks => gpts_n_blocks
+        procedure :: block_dofs => gpts_block_dofs
+        procedure :: setup_history => gpts_setup_history
+        procedure :: commit => gpts_commit
+        procedure :: reset_trial => gpts_reset_trial
+        procedure :: history => gpts_history
+        procedure :: set_history => gpts_set_history
+        procedure :: takes_outer => gpts_takes_outer
+        procedure :: outer_capture => gpts_outer_capture
+        procedure :: outer_apply => gpts_outer_apply
+        procedure :: outer_release => gpts_outer_release
+        procedure :: failure_diagnosis => gpts_failure_diagnosis
+        !> The contact zone at the last evaluation (for the locking diagnosis).
+        procedure :: zone => gpts_zone
+    end type gpts_pair_t
 
 contains
+
+    pure function gpts_method_name(self) result(name)
+        class(gpts_pair_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'gpts'
+    end function gpts_method_name
+
+    !> Contact residual and tangent of the pair at displacement `u`, added to `r`
+    !> (global) and handed point by point to `add` (global DOFs, local matrix).
+    !> Updates the trial history and the output. Fails if a projection does not
+    !> converge for a point that may be in contact.
+    subroutine gpts_evaluate(self, u, r, error, add)
+        class(gpts_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        type(error_t), allocatable, intent(out) :: error
+        procedure(add_matrix), optional :: add
+        type(surface_point_t) :: sp
+        type(master_point_t) :: mp
+        real(dp), allocatable :: rl(:), kl(:, :)
+        integer, allocatable :: dofs(:)
+        real(dp) :: g, pn, pt, anchor, new_anchor
+        integer :: k, state, nd
+        logical :: found, converged, inside
+
+        self%force = 0.0_dp
+        call self%master%prepare(u)
+        do k = 1, size(self%xi)
+            call self%project_point(u, k, sp, mp, found, converged)
+            if (allocated(self%anchor)) then
+                self%trial_xi(k) = mp%xi
+                self%trial_active(k) = .false.
+                self%trial_anchor(k) = mp%xi
+            end if
+            if (.not. found) cycle
+            if (self%out(k)%gap >= self%gap_tol) cycle
+            if (.not. converged) then
+                call self%projection_error(k, error)
+                return
+            end if
+            ! a point that was not in contact at the last converged state sticks where
+            ! it projected then
+            anchor = mp%xi
+            if (allocated(self%anchor)) then
+                anchor = merge(self%anchor(k), self%xi_last(k), self%active_last(k))
+                self%n_friction = self%n_friction + 1
+            end if
+            nd = size(sp%dofs) + size(mp%dofs)
+            if (allocated(rl)) then
+                if (size(rl) /= nd) deallocate (rl, kl)
+            end if
+            if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
+            if (allocated(self%slip_bound)) then
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor, &
+                                self%slip_bound(k))
+            else
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
+            end if
+            self%n_evaluations = self%n_evaluations + 1
+            dofs = [sp%dofs, mp%dofs]
+            r(dofs) = r(dofs) + rl
+            ! partition of unity: the slave part sums to -da t
+            self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
+            self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+            if (present(add)) then
+                call self%fit_pattern(k, mp, inside)
+                if (inside) call add(dofs, kl)
+            end if
+            self%out(k)%state = state
+            self%out(k)%pn = pn
+            self%out(k)%pt = pt
+            if (allocated(self%anchor)) then
+                self%trial_active(k) = .true.
+                self%trial_anchor(k) = new_anchor
+            end if
+        end do
+    end subroutine gpts_evaluate
+
+    !> With a deformable master, one pattern block per slave element (its edge DOFs
+    !> and its master range); none with a rigid master.
+    pure integer function gpts_n_blocks(self) result(n)
+        class(gpts_pair_t), intent(in) :: self
+        n = 0
+        if (self%master%deformable) n = size(self%mlo)
+    end function gpts_n_blocks
+
+    !> Slave element b's edge DOFs then its master range's (empty while the range is).
+    pure function gpts_block_dofs(self, b, mdofs) result(dofs)
+        class(gpts_pair_t), intent(in) :: self
+        integer, intent(in) :: b
+        integer, intent(in) :: mdofs(:)
+        integer, allocatable :: dofs(:)
+        allocate (dofs(0))
+        if (self%mlo(b) <= self%mhi(b)) &
+            dofs = [self%element_dofs(b), mdofs(2*self%mlo(b) - 1:2*self%mhi(b))]
+    end function gpts_block_dofs
+
+    !> With friction: the shared history and a stick anchor per slave point.
+    pure subroutine gpts_setup_history(self)
+        class(gpts_pair_t), intent(inout) :: self
+        call pair_setup_history(self)
+        if (self%law%mu <= 0.0_dp) return
+        allocate (self%anchor(size(self%xi)), self%trial_anchor(size(self%xi)))
+        self%anchor = 0.0_dp
+        self%trial_anchor = 0.0_dp
+    end subroutine gpts_setup_history
+
+    pure subroutine gpts_commit(self)
+        class(gpts_pair_t), intent(inout) :: self
+        if (allocated(self%anchor)) self%anchor = self%trial_anchor
+        call pair_commit(self)
+    end subroutine gpts_commit
+
+    pure subroutine gpts_reset_trial(self)
+        class(gpts_pair_t), intent(inout) :: self
+        if (allocated(self%anchor)) self%trial_anchor = self%anchor
+        call pair_reset_trial(self)
+    end subroutine gpts_reset_trial
+
+    !> `anchor`, then the shared history (empty without friction).
+    pure function gpts_history(self) result(items)
+        class(gpts_pair_t), intent(in) :: self
+        type(history_item_t), allocatable :: items(:)
+        type(history_item_t) :: anchor
+        items = pair_history(self)
+        if (.not. allocated(self%anchor)) return
+        anchor%name = 'anchor'
+        anchor%values = self%anchor
+        items = [anchor, items]
+    end function gpts_history
+
+    pure subroutine gpts_set_history(self, items, error)
+        class(gpts_pair_t), intent(inout) :: self
+        type(history_item_t), intent(in) :: items(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        call pair_set_history(self, items, error)
+        if (allocated(error) .or. .not. allocated(self%anchor)) return
+        do i = 1, size(items)
+            if (trim(items(i)%name) /= 'anchor') cycle
+            if (size(items(i)%values) /= size(self%anchor)) then
+                call fatal_error(error, 'history anchor: wrong length', error_code%input)
+                return
+            end if
+            self%anchor = items(i)%values
+            self%trial_anchor = self%anchor
+        end do
+    end subroutine gpts_set_history
+
+    !> The Tresca fixed point applies to a frictional GPTS pair (its slip limits
+    !> belong to slave points).
+    pure logical function gpts_takes_outer(self)
+        class(gpts_pair_t), intent(in) :: self
+        gpts_takes_outer = self%law%mu > 0.0_dp
+    end function gpts_takes_outer
+
+    !> The slip bounds mu p_N of the last evaluation become the captured ones;
+    !> `change`: the largest change from the previous capture (0 at the first),
+    !> `largest`: the largest bound.
+    pure subroutine gpts_outer_capture(self, change, largest)
+        class(gpts_pair_t), intent(inout) :: self
+        real(dp), intent(out) :: change, largest
+        real(dp), allocatable :: bound(:)
+        bound = self%law%mu*max(0.0_dp, self%out%pn)
+        change = 0.0_dp
+        if (allocated(self%captured_bound)) change = maxval(abs(bound - self%captured_bound))
+        largest = maxval(bound)
+        call move_alloc(bound, self%captured_bound)
+    end subroutine gpts_outer_capture
+
+    !> Tresca mode: the captured bounds are the slip limits.
+    pure subroutine gpts_outer_apply(self)
+        class(gpts_pair_t), intent(inout) :: self
+        self%slip_bound = self%captured_bound
+    end subroutine gpts_outer_apply
+
+    !> Back to Coulomb friction (the captured bounds are kept for the next change).
+    pure subroutine gpts_outer_release(self)
+        class(gpts_pair_t), intent(inout) :: self
+        if (allocated(self%slip_bound)) deallocate (self%slip_bound)
+    end subroutine gpts_outer_release
+
+    !> What the contact zone looks like at the last evaluation when it is broken up
+    !> point by point (at least `min_gaps` gaps shorter than a slave element, holding
+    !> at least `min_hole_share` of the zone's points) while its active points
+    !> outnumber the slave control points they act on: the Gauss-point-to-surface
+    !> constraints then over-constrain the slave edge and, with a stiff penalty,
+    !> lock (docs/robustness.md, "Over-constrained contact zones"). Empty otherwise.
+    pure function gpts_failure_diagnosis(self) result(text)
+        class(gpts_pair_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        character(len=600) :: buf
+        integer :: n_active, n_holes, n_gaps, n_cp
+
+        text = ''
+        call self%zone(n_active, n_holes, n_gaps, n_cp)
+        if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
+            n_active <= n_cp) return
+        write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es8.1,a)') '; at the last converged state the contact '// &
+            'zone of '''//trim(self%slave_name)//''' on '''//trim(self%master_name)// &
+            ''' is broken up: ', n_holes, ' of its ', n_active + n_holes, ' slave points are open in gaps '// &
+            'shorter than a slave element, and its ', n_active, ' active points act on ', n_cp, &
+            ' control points of the slave edge: the Gauss-point-to-surface constraints outnumber '// &
+            'the edge''s degrees of freedom and, with penalty_normal = ', self%law%eps_n, &
+            ', lock (the pressure alternates between neighbouring points instead of following '// &
+            'a smooth field)'
+        text = trim(buf)
+        if (self%law%mu > 0.0_dp) text = text//'; the slip bounds mu p_N then jump from '// &
+                                         'point to point, which breaks up the stick/slip pattern as well'
+        write (buf, '(a,i0,a)') '; one constraint per slave control point (&contact method = '// &
+            '''mortar'') or fewer slave points per element (&contact n_gauss, here ', self%n_gauss, &
+            ') remove the over-constraint, a smaller penalty_normal eases it'
+        text = text//trim(buf)
+    end function gpts_failure_diagnosis
+
+    !> The contact zone at the last evaluation: `n_active` points in contact;
+    !> `n_holes` open points lying between active ones in runs shorter than one slave
+    !> element (a zone broken up point by point, not two separate zones), in `n_gaps`
+    !> such runs; `n_cp` slave control points whose functions are nonzero at an active
+    !> point (the degrees of freedom the active constraints act on).
+    pure subroutine gpts_zone(self, n_active, n_holes, n_gaps, n_cp)
+        class(gpts_pair_t), intent(in) :: self
+        integer, intent(out) :: n_active, n_holes, n_gaps, n_cp
+        logical, allocatable :: active(:)
+        integer :: k, first, last, run
+
+        n_active = 0
+        n_holes = 0
+        n_gaps = 0
+        n_cp = 0
+        if (.not. allocated(self%out)) return
+        active = self%out%state /= state_inactive
+        n_active = count(active)
+        if (n_active == 0) return
+        first = findloc(active, .true., dim=1)
+        last = findloc(active, .true., dim=1, back=.true.)
+        run = 0
+        do k = first, last
+            if (active(k)) then
+                if (run > 0 .and. run < self%n_gauss) then
+                    n_holes = n_holes + run
+                    n_gaps = n_gaps + 1
+                end if
+                run = 0
+            else
+                run = run + 1
+            end if
+        end do
+        n_cp = maxval(self%span, mask=active) - minval(self%span, mask=active) + self%slave%degree + 1
+    end subroutine gpts_zone
 
     !> Residual `r` (internal-force sign: r = -int G^T t da) and tangent `k` of an
     !> active point, with the traction t on the slave. Frictionless when mu = 0
@@ -127,32 +412,4 @@ contains
             k(:, a) = -da*matmul(transpose(gm), tmat(:, a)) + da*dmt*c(a) - w*gt*dst(a)
         end do
     end subroutine gpts_point
-
-    !> The linear maps of a slave point and its projection on the local DOFs (the
-    !> slave point's functions first, 2 per function, then the master's): `gm` to
-    !> x_s - x_m(xi), `dm` to the master tangent dx_m/dxi at fixed xi, `ds` to the
-    !> slave tangent. Shapes [2, 2 (ns + nm)].
-    pure subroutine point_operators(sp, mp, gm, dm, ds)
-        type(surface_point_t), intent(in) :: sp
-        type(master_point_t), intent(in) :: mp
-        real(dp), intent(out) :: gm(:, :), dm(:, :), ds(:, :)
-        integer :: ns, a
-        ns = size(sp%r)
-        gm = 0.0_dp
-        dm = 0.0_dp
-        ds = 0.0_dp
-        do a = 1, ns
-            gm(1, 2*a - 1) = sp%r(a)
-            gm(2, 2*a) = sp%r(a)
-            ds(1, 2*a - 1) = sp%dr(a)
-            ds(2, 2*a) = sp%dr(a)
-        end do
-        do a = 1, size(mp%r)
-            gm(1, 2*(ns + a) - 1) = -mp%r(a)
-            gm(2, 2*(ns + a)) = -mp%r(a)
-            dm(1, 2*(ns + a) - 1) = mp%dr(a)
-            dm(2, 2*(ns + a)) = mp%dr(a)
-        end do
-    end subroutine point_operators
-
 end module voiga_contact_gpts

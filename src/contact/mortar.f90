@@ -9,23 +9,408 @@
 !> p(xi) = sum_A N_A(xi) p_A. Friction: per control point, the tangential traction
 !> t_A is the state variable, with an elastic predictor on the weighted increment
 !> of slip ds_A = int N_A (xi_m - xi_m,last) |a_m| dA0 and a return map onto
-!> |t_A| <= mu p_A. The integrals use the reference length dA0 of the slave edge
-!> (nominal tractions); the residual at a point is r = -w0 G^T (p n + t t_hat), as
-!> in `voiga_contact_gpts`.
+!> |t_A| <= mu p_A (`voiga_contact_law`). The integrals use the reference length
+!> dA0 of the slave edge (nominal tractions); the residual at a point is
+!> r = -w0 G^T (p n + t t_hat), as in `voiga_contact_gpts`.
 !>
-!> This module holds the per-point and per-control-point kernels; the sums over
-!> points are in `voiga_contact_pair`. Local DOFs as in `voiga_contact_gpts`.
+!> Step control (`step_limit`): a Newton step that closes an open control point,
+!> or reverses the trial traction of a slipping one, is shortened to the first
+!> crossing. Local DOFs as in `voiga_contact_kinematics`.
 module voiga_contact_mortar
     use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
     use voiga_contact_surface, only: surface_point_t
     use voiga_contact_master, only: master_point_t
-    use voiga_contact_gpts, only: contact_law_t, point_operators, state_inactive, state_stick, state_slip
+    use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
+    use voiga_contact_kinematics, only: point_operators
+    use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
+                                  pair_reset_trial, pair_history, pair_set_history
     implicit none
     private
 
-    public :: mortar_point, mortar_law
+    public :: mortar_pair_t, mortar_snapshot_t, mortar_point
+
+    !> A mortar pair's control points at one evaluation [slave edge control points]
+    !> (for the step control, `step_limit`).
+    type :: mortar_snapshot_t
+        !> Weighted gaps g_A (huge where no point of the support has a projection),
+        !> weights D_A = int N_A dA0 (A is active when g_A < gap_tol D_A), trial
+        !> tangential tractions (before the return map).
+        real(dp), allocatable :: g(:), d(:), t_trial(:)
+        !> state_inactive, state_stick or state_slip.
+        integer, allocatable :: state(:)
+    end type mortar_snapshot_t
+
+    !> A mortar-type penalty pair.
+    type, extends(contact_pair_t) :: mortar_pair_t
+        !> Friction history (mu > 0) [slave edge control points]: committed and
+        !> trial tangential traction t_A (along the master tangent).
+        real(dp), allocatable :: traction(:), trial_traction(:)
+        !> The control points at the last evaluation, and at the last accepted
+        !> Newton iterate (`accept_iterate`).
+        type(mortar_snapshot_t) :: last, accepted
+    contains
+        procedure :: evaluate => mortar_evaluate
+        procedure :: method_name => mortar_method_name
+        procedure :: n_blocks => mortar_n_blocks
+        procedure :: block_dofs => mortar_block_dofs
+        procedure :: setup_history => mortar_setup_history
+        procedure :: commit => mortar_commit
+        procedure :: reset_trial => mortar_reset_trial
+        procedure :: history => mortar_history
+        procedure :: set_history => mortar_set_history
+        procedure :: accept_iterate => mortar_accept_iterate
+        procedure :: step_limit => mortar_step_limit
+    end type mortar_pair_t
+
+    !> Per slave point: its derivative vectors over its local DOFs.
+    type :: point_vectors_t
+        integer, allocatable :: dofs(:)
+        real(dp), allocatable :: gn(:), gt(:), m(:)
+    end type point_vectors_t
+
+    !> What one evaluation computes per slave point and per control point, passed
+    !> between its passes.
+    type :: mortar_work_t
+        type(surface_point_t), allocatable :: sps(:)
+        type(master_point_t), allocatable :: mps(:)
+        type(point_vectors_t), allocatable :: vec(:)
+        !> Per point [npts]: reference length weight, master coordinate change since
+        !> the last converged state, has a converged projection, had one then.
+        real(dp), allocatable :: w0(:), dxi(:)
+        logical, allocatable :: valid(:), slip(:)
+        !> Per control point [ncp]: weights, weighted gaps, weighted slips, pressures,
+        !> tangential tractions, their trial values, the weight of the points with a
+        !> projection in its support, states.
+        real(dp), allocatable :: d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), t_tr(:), d_seen(:)
+        integer, allocatable :: st_a(:)
+    end type mortar_work_t
 
 contains
+
+    pure function mortar_method_name(self) result(name)
+        class(mortar_pair_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'mortar'
+    end function mortar_method_name
+
+    !> Residual and tangent of a mortar pair (docs/theory.md, section 7.4): the
+    !> weighted gaps and slips of the slave control points from every slave point
+    !> with a projection (`mortar_project`); their pressures and tangential tractions
+    !> (`control_point_law`); at every point the interpolated traction's residual and
+    !> geometric tangent (`mortar_points`); and per active control point the
+    !> coupling through its traction (`mortar_coupling`).
+    subroutine mortar_evaluate(self, u, r, error, add)
+        class(mortar_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        type(error_t), allocatable, intent(out) :: error
+        procedure(add_matrix), optional :: add
+        type(mortar_work_t) :: wk
+        real(dp) :: t_old
+        integer :: a
+        logical :: miss
+
+        self%force = 0.0_dp
+        call self%master%prepare(u)
+        call mortar_project(self, u, wk, error)
+        if (allocated(error)) return
+        ! the law at every control point (open where no point of its support has a
+        ! projection: its weighted gap is then empty, not zero)
+        do a = 1, size(self%slave%cps)
+            if (wk%d_seen(a) <= 0.0_dp) wk%g_a(a) = huge(1.0_dp)
+            t_old = 0.0_dp
+            if (allocated(self%traction)) t_old = self%traction(a)
+            call control_point_law(self%law, wk%g_a(a), wk%d_a(a), wk%ds_a(a), t_old, self%gap_tol, wk%p_a(a), &
+                                   wk%t_a(a), wk%st_a(a), wk%t_tr(a))
+            if (allocated(self%traction)) self%trial_traction(a) = wk%t_a(a)
+        end do
+        call mortar_points(self, r, wk, miss, add)
+        self%last = mortar_snapshot_t(wk%g_a, wk%d_a, wk%t_tr, wk%st_a)
+        if (.not. present(add) .or. miss) return
+        call mortar_coupling(self, wk, add)
+    end subroutine mortar_evaluate
+
+    !> Pass 1: every slave point's projection, and the weighted gaps, slips and
+    !> weights of the control points.
+    subroutine mortar_project(self, u, wk, error)
+        class(mortar_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        type(mortar_work_t), intent(out) :: wk
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: a0(2)
+        integer :: npts, ncp, k
+        logical :: found, converged
+
+        npts = size(self%xi)
+        ncp = size(self%slave%cps)
+        allocate (wk%sps(npts), wk%mps(npts), wk%vec(npts), wk%w0(npts), wk%dxi(npts), wk%valid(npts), &
+                  wk%slip(npts))
+        allocate (wk%d_a(ncp), wk%g_a(ncp), wk%ds_a(ncp), wk%p_a(ncp), wk%t_a(ncp), wk%st_a(ncp), &
+                  wk%d_seen(ncp), wk%t_tr(ncp))
+        wk%d_a = 0.0_dp
+        wk%d_seen = 0.0_dp
+        wk%g_a = 0.0_dp
+        wk%ds_a = 0.0_dp
+        wk%dxi = 0.0_dp
+        wk%valid = .false.
+        wk%slip = .false.
+        do k = 1, npts
+            call self%project_point(u, k, wk%sps(k), wk%mps(k), found, converged)
+            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k))
+                a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
+                wk%w0(k) = norm2(a0)*self%w(k)
+                wk%d_a(sp%local) = wk%d_a(sp%local) + wk%w0(k)*sp%r
+                if (allocated(self%xi_last)) then
+                    self%trial_xi(k) = mp%xi
+                    self%trial_active(k) = .false.
+                end if
+                if (.not. found) cycle
+                if (.not. converged) then
+                    if (out%gap >= self%gap_tol) cycle
+                    call self%projection_error(k, error)
+                    return
+                end if
+                wk%valid(k) = .true.
+                wk%d_seen(sp%local) = wk%d_seen(sp%local) + wk%w0(k)*sp%r
+                wk%g_a(sp%local) = wk%g_a(sp%local) + wk%w0(k)*sp%r*out%gap
+                if (allocated(self%xi_last)) then
+                    self%trial_active(k) = .true.
+                    if (self%active_last(k)) then
+                        wk%slip(k) = .true.
+                        wk%dxi(k) = mp%xi - self%xi_last(k)
+                        wk%ds_a(sp%local) = wk%ds_a(sp%local) + wk%w0(k)*sp%r*wk%dxi(k)*norm2(mp%a)
+                    end if
+                end if
+            end associate
+        end do
+    end subroutine mortar_project
+
+    !> Pass 3: every point's interpolated traction: residual, resultant, output and
+    !> (with `add`) geometric tangent; `miss`: a point fell outside the pattern.
+    subroutine mortar_points(self, r, wk, miss, add)
+        class(mortar_pair_t), intent(inout) :: self
+        real(dp), intent(inout) :: r(:)
+        type(mortar_work_t), intent(inout) :: wk
+        logical, intent(out) :: miss
+        procedure(add_matrix), optional :: add
+        real(dp), allocatable :: rl(:), kl(:, :)
+        real(dp) :: pbar, tbar
+        integer :: k, nd
+        logical :: inside
+
+        miss = .false.
+        do k = 1, size(self%xi)
+            if (.not. wk%valid(k)) cycle
+            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k), vec => wk%vec(k))
+                if (all(wk%st_a(sp%local) == state_inactive)) cycle
+                pbar = dot_product(sp%r, wk%p_a(sp%local))
+                tbar = dot_product(sp%r, wk%t_a(sp%local))
+                nd = size(sp%dofs) + size(mp%dofs)
+                if (allocated(rl)) then
+                    if (size(rl) /= nd) deallocate (rl, kl)
+                end if
+                if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
+                allocate (vec%gn(nd), vec%gt(nd), vec%m(nd))
+                call mortar_point(wk%w0(k), sp, mp, pbar, tbar, wk%dxi(k), wk%slip(k), self%law%mu > 0.0_dp, &
+                                  rl, kl, vec%gn, vec%gt, vec%m)
+                vec%dofs = [sp%dofs, mp%dofs]
+                self%n_evaluations = self%n_evaluations + 1
+                if (allocated(self%traction)) self%n_friction = self%n_friction + 1
+                r(vec%dofs) = r(vec%dofs) + rl
+                self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
+                self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+                out%pn = pbar
+                out%pt = tbar
+                out%state = merge(state_slip, state_stick, any(wk%st_a(sp%local) == state_slip))
+                if (present(add)) then
+                    call self%fit_pattern(k, mp, inside)
+                    if (inside) then
+                        call add(vec%dofs, kl)
+                    else
+                        miss = .true.
+                    end if
+                end if
+            end associate
+        end do
+    end subroutine mortar_points
+
+    !> Pass 4: per active control point A the coupling through its traction,
+    !> (eps_N / D_A) v_A v_A^T (+ friction: (eps_T / D_A) q_A m_A^T when sticking,
+    !> mu s (eps_N / D_A) q_A v_A^T when slipping), with v_A, q_A, m_A the
+    !> N_A-weighted sums of the points' `gn`, `gt`, `m`, added on the control
+    !> point's block (`block_dofs`).
+    subroutine mortar_coupling(self, wk, add)
+        class(mortar_pair_t), intent(inout) :: self
+        type(mortar_work_t), intent(in) :: wk
+        procedure(add_matrix) :: add
+        real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
+        integer, allocatable :: blk(:), pos(:), mdofs(:)
+        real(dp) :: c
+        integer :: k, i, a, e, j, ng
+
+        ng = self%n_gauss
+        mdofs = self%master%all_dofs()
+        do a = 1, size(self%slave%cps)
+            if (wk%st_a(a) == state_inactive) cycle
+            blk = self%block_dofs(a, mdofs)
+            allocate (v(size(blk)), q(size(blk)), mm(size(blk)), pos(0))
+            v = 0.0_dp
+            q = 0.0_dp
+            mm = 0.0_dp
+            do e = 1, size(self%slave%spans)
+                if (a < self%slave%spans(e) - self%slave%degree .or. a > self%slave%spans(e)) cycle
+                do k = (e - 1)*ng + 1, e*ng
+                    if (.not. allocated(wk%vec(k)%dofs)) cycle
+                    i = findloc(wk%sps(k)%local, a, dim=1)
+                    c = wk%w0(k)*wk%sps(k)%r(i)
+                    pos = [(findloc(blk, wk%vec(k)%dofs(j), dim=1), j=1, size(wk%vec(k)%dofs))]
+                    v(pos) = v(pos) + c*wk%vec(k)%gn
+                    if (self%law%mu > 0.0_dp) then
+                        q(pos) = q(pos) + c*wk%vec(k)%gt
+                        mm(pos) = mm(pos) + c*wk%vec(k)%m
+                    end if
+                end do
+            end do
+            allocate (kc(size(blk), size(blk)))
+            do j = 1, size(blk)
+                kc(:, j) = self%law%eps_n/wk%d_a(a)*v*v(j)
+            end do
+            if (self%law%mu > 0.0_dp) then
+                if (wk%st_a(a) == state_slip) then
+                    do j = 1, size(blk)
+                        kc(:, j) = kc(:, j) + self%law%mu*sign(1.0_dp, wk%t_a(a))*self%law%eps_n/wk%d_a(a)*q*v(j)
+                    end do
+                else
+                    do j = 1, size(blk)
+                        kc(:, j) = kc(:, j) + self%law%eps_t/wk%d_a(a)*q*mm(j)
+                    end do
+                end if
+            end if
+            call add(blk, kc)
+            deallocate (v, q, mm, pos, kc)
+        end do
+    end subroutine mortar_coupling
+
+    !> One pattern block per slave control point.
+    pure integer function mortar_n_blocks(self) result(n)
+        class(mortar_pair_t), intent(in) :: self
+        n = size(self%slave%cps)
+    end function mortar_n_blocks
+
+    !> Slave control point b couples every DOF of every point in its support with
+    !> every other, so its block is the edge DOFs and master ranges of all the slave
+    !> elements its function is nonzero on (each once).
+    pure function mortar_block_dofs(self, b, mdofs) result(dofs)
+        class(mortar_pair_t), intent(in) :: self
+        integer, intent(in) :: b
+        integer, intent(in) :: mdofs(:)
+        integer, allocatable :: dofs(:)
+        logical, allocatable :: used(:)
+        integer :: e, p, lo, hi
+
+        p = self%slave%degree
+        lo = huge(1)
+        hi = 0
+        allocate (used(size(mdofs)/2), source=.false.)
+        do e = 1, size(self%slave%spans)
+            if (b < self%slave%spans(e) - p .or. b > self%slave%spans(e)) cycle
+            lo = min(lo, self%slave%spans(e) - p)
+            hi = max(hi, self%slave%spans(e))
+            if (self%mlo(e) <= self%mhi(e)) used(self%mlo(e):self%mhi(e)) = .true.
+        end do
+        dofs = reshape(self%slave%dofs(:, lo:hi), [2*(hi - lo + 1)])
+        dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
+    end function mortar_block_dofs
+
+    !> With friction: the shared history and a tangential traction per control point.
+    pure subroutine mortar_setup_history(self)
+        class(mortar_pair_t), intent(inout) :: self
+        call pair_setup_history(self)
+        if (self%law%mu <= 0.0_dp) return
+        allocate (self%traction(size(self%slave%cps)), self%trial_traction(size(self%slave%cps)))
+        self%traction = 0.0_dp
+        self%trial_traction = 0.0_dp
+    end subroutine mortar_setup_history
+
+    pure subroutine mortar_commit(self)
+        class(mortar_pair_t), intent(inout) :: self
+        if (allocated(self%traction)) self%traction = self%trial_traction
+        call pair_commit(self)
+    end subroutine mortar_commit
+
+    pure subroutine mortar_reset_trial(self)
+        class(mortar_pair_t), intent(inout) :: self
+        if (allocated(self%traction)) self%trial_traction = self%traction
+        call pair_reset_trial(self)
+    end subroutine mortar_reset_trial
+
+    !> `traction`, then the shared history (empty without friction).
+    pure function mortar_history(self) result(items)
+        class(mortar_pair_t), intent(in) :: self
+        type(history_item_t), allocatable :: items(:)
+        type(history_item_t) :: traction
+        items = pair_history(self)
+        if (.not. allocated(self%traction)) return
+        traction%name = 'traction'
+        traction%values = self%traction
+        items = [traction, items]
+    end function mortar_history
+
+    pure subroutine mortar_set_history(self, items, error)
+        class(mortar_pair_t), intent(inout) :: self
+        type(history_item_t), intent(in) :: items(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        call pair_set_history(self, items, error)
+        if (allocated(error) .or. .not. allocated(self%traction)) return
+        do i = 1, size(items)
+            if (trim(items(i)%name) /= 'traction') cycle
+            if (size(items(i)%values) /= size(self%traction)) then
+                call fatal_error(error, 'history traction: wrong length', error_code%input)
+                return
+            end if
+            self%traction = items(i)%values
+            self%trial_traction = self%traction
+        end do
+    end subroutine mortar_set_history
+
+    !> The last evaluation is an accepted Newton iterate: the reference of `step_limit`.
+    pure subroutine mortar_accept_iterate(self)
+        class(mortar_pair_t), intent(inout) :: self
+        self%accepted = self%last
+    end subroutine mortar_accept_iterate
+
+    !> Step control: the fraction of the way from the accepted iterate to the last
+    !> evaluation at which the first control point crosses a state boundary the
+    !> last tangent did not describe (linear interpolation); 1 if none. Two
+    !> crossings, each a jump the Newton step cannot see:
+    !> - a control point open before closes: `overshoot` times the fraction where
+    !>   g_A = 0 (just closed, so that the next tangent carries its penalty);
+    !> - a control point slipping before has a trial traction of the other sign: the
+    !>   fraction where t_A^tr = 0, inside its stick band |t_A^tr| <= mu p_A (a
+    !>   slipping point has no tangential stiffness, so the step overshoots a narrow
+    !>   stick band and the slip direction flips from iteration to iteration).
+    pure real(dp) function mortar_step_limit(self, overshoot) result(frac)
+        class(mortar_pair_t), intent(in) :: self
+        real(dp), intent(in) :: overshoot
+        real(dp) :: tol
+        integer :: a
+        frac = 1.0_dp
+        associate (before => self%accepted, last => self%last)
+            if (.not. allocated(last%g) .or. .not. allocated(before%g)) return
+            if (size(before%g) /= size(last%g)) return
+            do a = 1, size(last%g)
+                tol = self%gap_tol*last%d(a)
+                ! (huge: no point of the support had a projection, nothing to interpolate)
+                if (before%g(a) >= tol .and. before%g(a) < huge(1.0_dp) .and. last%g(a) < tol) &
+                    frac = min(frac, overshoot*before%g(a)/(before%g(a) - last%g(a)))
+                if (before%state(a) == state_slip .and. last%state(a) /= state_inactive .and. &
+                    before%t_trial(a)*last%t_trial(a) < 0.0_dp) &
+                    frac = min(frac, before%t_trial(a)/(before%t_trial(a) - last%t_trial(a)))
+            end do
+        end associate
+    end function mortar_step_limit
 
     !> Residual `r` and geometric tangent `k` of one slave point whose interpolated
     !> pressure `pbar` and tangential traction `tbar` are held fixed; and the point's
@@ -76,36 +461,4 @@ contains
             k(:, a) = -w0*matmul(dt, gm)*na(a) + w0*dmt*c(a)
         end do
     end subroutine mortar_point
-
-    !> The law at one slave control point: weighted gap `g_a`, weight `d_a` =
-    !> int N_A dA0, weighted slip increment `ds_a` and committed tangential traction
-    !> `t_old`; gives the pressure `p` (active when g_a < gap_tol d_a), the
-    !> tangential traction `t` (zero without friction), its trial value and the state. Frictionless
-    !> when mu = 0 (no friction code runs).
-    pure subroutine mortar_law(law, g_a, d_a, ds_a, t_old, gap_tol, p, t, state, ttr)
-        type(contact_law_t), intent(in) :: law
-        real(dp), intent(in) :: g_a, d_a, ds_a, t_old, gap_tol
-        real(dp), intent(out) :: p, t
-        integer, intent(out) :: state
-        !> Trial tangential traction (elastic predictor; 0 when open or frictionless).
-        real(dp), intent(out) :: ttr
-
-        p = 0.0_dp
-        t = 0.0_dp
-        ttr = 0.0_dp
-        state = state_inactive
-        if (d_a <= 0.0_dp .or. g_a >= gap_tol*d_a) return
-        p = -law%eps_n*g_a/d_a
-        state = state_stick
-        if (law%mu > 0.0_dp) then
-            ttr = t_old - law%eps_t*ds_a/d_a
-            if (abs(ttr) <= law%mu*p) then
-                t = ttr
-            else
-                state = state_slip
-                t = law%mu*p*sign(1.0_dp, ttr)
-            end if
-        end if
-    end subroutine mortar_law
-
 end module voiga_contact_mortar

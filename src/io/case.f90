@@ -7,6 +7,7 @@ module voiga_io_case
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_discretization_layout, only: layout_t
     use voiga_io_namelist, only: group_error, group_names, lower
+    use voiga_contact_factory, only: contact_input_t => contact_settings_t
     implicit none
     private
 
@@ -85,18 +86,6 @@ module voiga_io_case
         real(dp), allocatable :: values(:)
     end type pressure_input_t
 
-    !> A contact pair (`&contact`).
-    type :: contact_input_t
-        !> Slave body; master body, or 'rigid' for a fixed rigid line.
-        character(len=32) :: slave = '', master = ''
-        !> Rigid line: a point on it and its outward normal.
-        real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
-        real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
-        !> Gauss points per slave contact element (0: layer degree + 1).
-        integer :: n_gauss = 0
-        !> 'gpts' (Gauss-point-to-surface) or 'mortar' (mortar-type penalty).
-        character(len=16) :: method = 'gpts'
-    end type contact_input_t
 
     !> A case.
     type :: case_t

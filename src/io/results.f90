@@ -12,7 +12,7 @@ module voiga_io_results
     use voiga_io_dump, only: write_discretization
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
-    use voiga_contact_pair, only: contact_pair_t, method_names
+    use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
     implicit none
     private
 
@@ -169,7 +169,7 @@ contains
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
         !> Contact pairs with the output of their last evaluation.
-        type(contact_pair_t), intent(in) :: pairs(:)
+        type(pair_slot_t), intent(in) :: pairs(:)
         !> Wall time so far (s).
         real(dp), intent(in) :: wall
         !> The cuts made while solving this step.
@@ -209,7 +209,7 @@ contains
         if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
         call self%h5%write(g//'/displacement', u)
         do k = 1, size(pairs)
-            call write_contact(self%h5, g, k, pairs(k))
+            call write_contact(self%h5, g, k, pairs(k)%pair)
         end do
         self%n_written = self%n_written + 1
         if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts)
@@ -226,12 +226,13 @@ contains
         type(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         integer, intent(in) :: k
-        type(contact_pair_t), intent(in) :: pair
+        class(contact_pair_t), intent(in) :: pair
         character(len=:), allocatable :: c
         character(len=8) :: buf
         integer :: i, n
         real(dp), allocatable :: a2(:, :), a1(:)
         integer, allocatable :: st(:)
+        type(history_item_t), allocatable :: history(:)
 
         write (buf, '(i0)') k
         c = g//'/contact/'//trim(buf)
@@ -242,7 +243,7 @@ contains
         call h5%write_attr(c, 'penalty_normal', pair%law%eps_n)
         call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t)
         call h5%write_attr(c, 'friction', pair%law%mu)
-        call h5%write_attr(c, 'method', trim(method_names(pair%method)))
+        call h5%write_attr(c, 'method', pair%method_name())
         select type (m => pair%master)
         type is (rigid_line_t)
             call h5%write(c//'/rigid_point', m%p0)
@@ -271,13 +272,15 @@ contains
         st = pair%out%state
         call h5%write(c//'/state', st)
         call h5%write(c//'/xi_slave', pair%xi)
-        if (allocated(pair%xi_last)) then
-            ! committed friction history: what a restart needs
-            if (allocated(pair%anchor)) call h5%write(c//'/history/anchor', pair%anchor)
-            if (allocated(pair%traction)) call h5%write(c//'/history/traction', pair%traction)
-            call h5%write(c//'/history/xi_last', pair%xi_last)
-            call h5%write(c//'/history/active_last', merge(1, 0, pair%active_last))
-        end if
+        ! committed friction history: what a restart needs
+        history = pair%history()
+        do i = 1, size(history)
+            if (allocated(history(i)%values)) then
+                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%values)
+            else
+                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%flags)
+            end if
+        end do
     end subroutine write_contact
 
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,

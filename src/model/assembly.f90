@@ -8,7 +8,6 @@ module voiga_model_assembly
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
-    use voiga_contact_pair, only: pair_contribution, pair_wanted_ranges, pair_n_blocks, pair_block_dofs
     implicit none
     private
 
@@ -126,16 +125,16 @@ contains
                 n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
         end do
-        ! the contact pairs' nonempty blocks (pair_block_dofs): with a deformable master
+        ! the contact pairs' nonempty blocks (contact_pair_t%block_dofs): with a deformable master
         ! each slave element's edge DOFs with the master's control points in its range
         ! (contact_pair_t%mlo, mhi); a mortar pair, each slave control point's support
-        allocate (blocks(sum([(pair_n_blocks(model%pairs(ip)), ip=1, size(model%pairs))])))
+        allocate (blocks(sum([(model%pairs(ip)%pair%n_blocks(), ip=1, size(model%pairs))])))
         pos = 0
         do ip = 1, size(model%pairs)
-            mdofs = model%pairs(ip)%master%all_dofs()
-            do e = 1, pair_n_blocks(model%pairs(ip))
+            mdofs = model%pairs(ip)%pair%master%all_dofs()
+            do e = 1, model%pairs(ip)%pair%n_blocks()
                 pos = pos + 1
-                blocks(pos)%dofs = pair_block_dofs(model%pairs(ip), e, mdofs)
+                blocks(pos)%dofs = model%pairs(ip)%pair%block_dofs(e, mdofs)
                 if (size(blocks(pos)%dofs) == 0) cycle
                 nel = nel + 1
                 n = n + size(blocks(pos)%dofs)
@@ -181,7 +180,7 @@ contains
         type(assembly_map_t), intent(inout), optional :: map
         !> Fit the contact part of the pattern to `u` (the start of a substep): each
         !> slave element coupled with the master control points near its points
-        !> (`pair_wanted_ranges`), rebuilt only if a range changed. The pattern then
+        !> (`contact_pair_t%wanted_ranges`), rebuilt only if a range changed. The pattern then
         !> depends on `u` only, so a restarted run gets the same patterns.
         logical, intent(in), optional :: refit
         ! bulk residual [ndof] and stiffness values [nnz], kept for a rebuild
@@ -192,7 +191,7 @@ contains
         if (present(refit)) fit = refit .and. present(k)
         keep = .false.
         if (present(k) .and. present(map)) &
-            keep = any([(model%pairs(ip)%master%deformable, ip=1, size(model%pairs))])
+            keep = any([(model%pairs(ip)%pair%master%deformable, ip=1, size(model%pairs))])
         call assemble_bulk(model, u, t, r, stats, error, k, map)
         if (allocated(error)) return
         if (keep) then
@@ -207,13 +206,13 @@ contains
                 if (refit_contact_ranges(model)) then
                     ! the ranges now hold every projection of this evaluation
                     do ip = 1, size(model%pairs)
-                        model%pairs(ip)%pattern_miss = .true.
+                        model%pairs(ip)%pair%pattern_miss = .true.
                     end do
                 end if
             end if
-            if (.not. any([(model%pairs(ip)%pattern_miss, ip=1, size(model%pairs))])) return
+            if (.not. any([(model%pairs(ip)%pair%pattern_miss, ip=1, size(model%pairs))])) return
             do ip = 1, size(model%pairs)
-                model%pairs(ip)%pattern_miss = .false.
+                model%pairs(ip)%pair%pattern_miss = .false.
             end do
             if (keep) then
                 call rebuild_pattern(model, k, error, map, k_bulk)
@@ -281,7 +280,7 @@ contains
     end subroutine rebuild_pattern
 
     !> Fit the contact ranges of every deformable-master pair to its last evaluation
-    !> (`pair_wanted_ranges`); true if a range changed (the pattern must be rebuilt).
+    !> (`contact_pair_t%wanted_ranges`); true if a range changed (the pattern must be rebuilt).
     function refit_contact_ranges(model) result(changed)
         type(model_t), intent(inout) :: model
         logical :: changed
@@ -289,10 +288,10 @@ contains
         integer :: ip
         changed = .false.
         do ip = 1, size(model%pairs)
-            associate (pair => model%pairs(ip))
+            associate (pair => model%pairs(ip)%pair)
                 if (.not. pair%master%deformable) cycle
                 allocate (lo(size(pair%mlo)), hi(size(pair%mhi)))
-                call pair_wanted_ranges(pair, size(pair%master%all_dofs())/2, 8, lo, hi)
+                call pair%wanted_ranges(size(pair%master%all_dofs())/2, 8, lo, hi)
                 if (any(lo /= pair%mlo) .or. any(hi /= pair%mhi)) then
                     changed = .true.
                     pair%mlo = lo
@@ -401,9 +400,9 @@ contains
         call system_clock(c0, rate)
         do ip = 1, size(model%pairs)
             if (present(k)) then
-                call pair_contribution(model%pairs(ip), u, r, error, add_to_k)
+                call model%pairs(ip)%pair%evaluate(u, r, error, add_to_k)
             else
-                call pair_contribution(model%pairs(ip), u, r, error)
+                call model%pairs(ip)%pair%evaluate(u, r, error)
             end if
             if (allocated(error)) exit
         end do

@@ -3,14 +3,15 @@
 module voiga_model
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_case, only: case_t, contact_input_t
+    use voiga_io_case, only: case_t
     use voiga_material, only: material_t
     use voiga_material_factory, only: new_material
     use voiga_discretization_patch, only: discretization_t, edge_cps
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: element_points_t, reference_gradients
     use voiga_discretization_element, only: element_basis, element_nfun
-    use voiga_contact_pair, only: contact_pair_t, setup_points, pair_contribution, pair_commit, method_names
+    use voiga_contact_pair, only: pair_slot_t
+    use voiga_contact_factory, only: contact_settings_t, new_contact_pair
     use voiga_contact_surface, only: new_contact_surface
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
@@ -72,8 +73,9 @@ module voiga_model
         logical :: finite_strain = .false.
         !> fixed(dof): is the DOF prescribed? shape [ndof]
         logical, allocatable :: fixed(:)
-        !> Contact pairs (their friction history changes as steps converge).
-        type(contact_pair_t), allocatable :: pairs(:)
+        !> Contact pairs, each of its method's type (their friction history changes
+        !> as steps converge).
+        type(pair_slot_t), allocatable :: pairs(:)
     end type model_t
 
 contains
@@ -176,16 +178,19 @@ contains
 
     !> Build a contact pair; its history starts from the projections in the
     !> reference configuration.
-    subroutine new_pair(self, inp, pair, error)
+    subroutine new_pair(self, inp, slot, error)
         type(model_t), intent(in) :: self
-        type(contact_input_t), intent(in) :: inp
-        type(contact_pair_t), intent(out) :: pair
+        type(contact_settings_t), intent(in) :: inp
+        type(pair_slot_t), intent(out) :: slot
         type(error_t), allocatable, intent(out) :: error
         type(rigid_line_t) :: rigid
         type(nurbs_master_t) :: master
         real(dp), allocatable :: u0(:), r0(:)
         integer :: ib
 
+        call new_contact_pair(slot%pair, inp%method, error)
+        if (allocated(error)) return
+        associate (pair => slot%pair)
         pair%slave_name = inp%slave
         pair%master_name = inp%master
         ib = find_body(self, inp%slave)
@@ -204,17 +209,16 @@ contains
         pair%law%eps_t = inp%penalty_tangent
         pair%law%mu = inp%friction
         pair%n_gauss = inp%n_gauss
-        ! (the input is validated: one of the names)
-        pair%method = findloc(method_names, trim(inp%method), dim=1)
-        call setup_points(pair)
+        call pair%setup()
         allocate (u0(self%ndof), r0(self%ndof))
         u0 = 0.0_dp
         r0 = 0.0_dp
-        call pair_contribution(pair, u0, r0, error)
+        call pair%evaluate(u0, r0, error)
         if (allocated(error)) return
-        call pair_commit(pair)
+        call pair%commit()
         pair%n_evaluations = 0
         pair%n_friction = 0
+        end associate
     end subroutine new_pair
 
     !> The quadrature points of every element of `body` (reference gradients and

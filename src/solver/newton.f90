@@ -38,8 +38,6 @@ module voiga_solver_newton
     use voiga_solver_linear, only: solve_accuracy_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_io_results, only: results_t, step_record_t, cut_record_t
-    use voiga_contact_pair, only: contact_pair_t, pair_commit, pair_reset_trial, pair_zone, method_gpts, &
-                                  pair_crossing_fraction, mortar_snapshot_t
     implicit none
     private
 
@@ -108,14 +106,6 @@ module voiga_solver_newton
     !> large against the penalty (ratio ~ penetration / element size).
     real(dp), parameter :: active_set_forcing = 1.0e-2_dp, soft_forcing = 1.0e-1_dp
     integer, parameter :: soft_iterations = 10
-
-    !> A contact zone counts as broken up (the locking diagnosis) with at least this
-    !> many gaps shorter than a slave element, holding at least this share of its
-    !> points. Measured (docs/robustness.md): penalty 1e6 x E, 3 to 5 gaps holding 32 to
-    !> 48 %; mu-1.0-deep (penalty 1e2 x E, a smooth pressure), one gap of 4 points
-    !> between the zone and a lone point at its edge, 8 %.
-    integer, parameter :: min_gaps = 2
-    real(dp), parameter :: min_hole_share = 0.2_dp
 
     !> Most Tresca solves (fixed-point iterations) of one retried substep.
     integer, parameter :: max_fixed_point = 40
@@ -302,7 +292,7 @@ contains
                         stats%attempt_switching .and. frictional(model)) then
                         u = u_conv
                         do ip = 1, size(model%pairs)
-                            call pair_reset_trial(model%pairs(ip))
+                            call model%pairs(ip)%pair%reset_trial()
                         end do
                         call tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, &
                                                 loud, quiet, tresca_error)
@@ -323,7 +313,7 @@ contains
                     if (it > 0) conv_det_sign = stats%det_sign
                     u_conv = u
                     do ip = 1, size(model%pairs)
-                        call pair_commit(model%pairs(ip))
+                        call model%pairs(ip)%pair%commit()
                     end do
                     s = s + ds
                     rec%substeps = rec%substeps + 1
@@ -334,7 +324,7 @@ contains
                 ! failed: back to the last converged state, forget the contact trial history
                 u = u_conv
                 do ip = 1, size(model%pairs)
-                    call pair_reset_trial(model%pairs(ip))
+                    call model%pairs(ip)%pair%reset_trial()
                 end do
                 if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
                 if (predicted) then
@@ -438,9 +428,9 @@ contains
                'quasi-static path ends here (a limit point; the physical system would move '// &
                'dynamically) or it goes on only through increments below min_step_fraction'
         do ip = 1, size(model%pairs)
-            if (model%pairs(ip)%law%mu <= 0.0_dp) cycle
-            write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', model%pairs(ip)%law%mu, &
-                ', penalty_normal = ', model%pairs(ip)%law%eps_n, '): slipping points couple the '
+            if (model%pairs(ip)%pair%law%mu <= 0.0_dp) cycle
+            write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', model%pairs(ip)%pair%law%mu, &
+                ', penalty_normal = ', model%pairs(ip)%pair%law%eps_n, '): slipping points couple the '
             text = text//trim(buf)//' normal penalty into the tangential direction (mu x penalty_normal) '// &
                    'which can make the tangent indefinite (the friction-induced instability); a smaller '// &
                    'penalty_normal or mu keeps the path stable longer'
@@ -463,39 +453,17 @@ contains
         character(len=:), allocatable, intent(inout) :: message
         type(error_t), allocatable :: error
         real(dp), allocatable :: r(:)
-        character(len=600) :: buf
-        integer :: ip, n_active, n_holes, n_gaps, n_cp
+        integer :: ip
 
         if (size(model%pairs) == 0) return
         allocate (r(model%ndof))
         call assemble(model, u, t, r, stats%assembly, error)
         do ip = 1, size(model%pairs)
-            call pair_reset_trial(model%pairs(ip))
+            call model%pairs(ip)%pair%reset_trial()
         end do
         if (allocated(error)) return
         do ip = 1, size(model%pairs)
-            ! a mortar pair has one constraint per control point: nothing to over-constrain
-            if (model%pairs(ip)%method /= method_gpts) cycle
-            call pair_zone(model%pairs(ip), n_active, n_holes, n_gaps, n_cp)
-            if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
-                n_active <= n_cp) cycle
-            associate (pair => model%pairs(ip))
-                write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es8.1,a)') '; at the last converged state the contact '// &
-                    'zone of '''//trim(pair%slave_name)//''' on '''//trim(pair%master_name)// &
-                    ''' is broken up: ', n_holes, ' of its ', n_active + n_holes, ' slave points are open in gaps '// &
-                    'shorter than a slave element, and its ', n_active, ' active points act on ', n_cp, &
-                    ' control points of the slave edge: the Gauss-point-to-surface constraints outnumber '// &
-                    'the edge''s degrees of freedom and, with penalty_normal = ', pair%law%eps_n, &
-                    ', lock (the pressure alternates between neighbouring points instead of following '// &
-                    'a smooth field)'
-                message = message//trim(buf)
-                if (pair%law%mu > 0.0_dp) message = message//'; the slip bounds mu p_N then jump from '// &
-                    'point to point, which breaks up the stick/slip pattern as well'
-                write (buf, '(a,i0,a)') '; one constraint per slave control point (&contact method = '// &
-                    '''mortar'') or fewer slave points per element (&contact n_gauss, here ', pair%n_gauss, &
-                    ') remove the over-constraint, a smaller penalty_normal eases it'
-                message = message//trim(buf)
-            end associate
+            message = message//model%pairs(ip)%pair%failure_diagnosis()
         end do
     end subroutine append_locking_diagnosis
 
@@ -561,8 +529,6 @@ contains
         type(csc_matrix_t) :: k_old
         real(dp) :: theta, h_est, du_norm, du_norm_prev, alpha_prev
         logical :: natural, have_bar, smooth, closing
-        ! mortar pairs: the control points of every pair at the last accepted iterate
-        type(mortar_snapshot_t), allocatable :: accepted(:)
         real(dp) :: frac
         integer :: nls, ip, flips
         ! iterations whose accepted step was at most creep_step
@@ -574,14 +540,13 @@ contains
         natural = model%damping == 'natural' .and. .not. multigrid
         closing = .false.
         short_steps = 0
-        allocate (accepted(size(model%pairs)))
         have_bar = .false.
         du_norm = 0.0_dp
         du_norm_prev = 0.0_dp
         alpha_prev = 1.0_dp
         allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof), du_bar(model%ndof))
         x0 = reference_coordinates(model)
-        allocate (states(sum([(size(model%pairs(ip)%out), ip=1, size(model%pairs))]), &
+        allocate (states(sum([(size(model%pairs(ip)%pair%out), ip=1, size(model%pairs))]), &
                          0:model%max_iterations))
         allocate (norms(model%max_iterations + 1), energies(model%max_iterations))
         converged = .false.
@@ -621,7 +586,7 @@ contains
             if (it > 0 .and. nls == 0 .and. .not. closing) then
                 frac = 1.0_dp
                 do ip = 1, size(model%pairs)
-                    frac = min(frac, pair_crossing_fraction(model%pairs(ip), accepted(ip), closing_overshoot))
+                    frac = min(frac, model%pairs(ip)%pair%step_limit(closing_overshoot))
                 end do
                 if (frac < 1.0_dp) then
                     closing = .true.
@@ -670,7 +635,7 @@ contains
             states(:, it) = contact_states(model)
             if (it > 0 .and. alpha <= creep_step) short_steps = short_steps + 1
             do ip = 1, size(model%pairs)
-                accepted(ip) = model%pairs(ip)%last
+                call model%pairs(ip)%pair%accept_iterate()
             end do
             if (it == 0) then
                 r0 = rn
@@ -859,7 +824,7 @@ contains
         logical, intent(in) :: verbose, quiet
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: inner
-        real(dp), allocatable :: bound(:), new_bound(:), x0(:)
+        real(dp), allocatable :: x0(:)
         real(dp) :: r0, floor, change, last_change, gmax, log_det, growth
         integer :: fp, it_inner, growing
         logical :: accepted
@@ -872,7 +837,7 @@ contains
         ! initial bounds: mu p_N at the last converged state (p_N depends on u only)
         call assemble(model, u, t, r, stats%assembly, error)
         if (allocated(error)) return
-        bound = slip_bounds(model)
+        call capture_slip_bounds(model, change, gmax)
         ! the reference of the convergence test: the Coulomb residual at the substep's
         ! start, the first residual of the plain Newton attempt that failed
         call set_prescribed(model, t, u)
@@ -885,7 +850,7 @@ contains
         accepted = .false.
         do fp = 1, max_fixed_point
             stats%fixed_point_iterations = stats%fixed_point_iterations + 1
-            call set_slip_bounds(model, bound)
+            call apply_slip_bounds(model)
             call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it_inner, rn, verbose, inner, r0)
             call clear_slip_bounds(model)
             it = it + it_inner
@@ -903,9 +868,7 @@ contains
             if (allocated(error)) return
             rn = norm2(merge(0.0_dp, r, model%fixed))
             floor = residual_floor(k, x0 + u, model%fixed)
-            new_bound = slip_bounds(model)
-            change = maxval(abs(new_bound - bound))
-            gmax = maxval(new_bound)
+            call capture_slip_bounds(model, change, gmax)
             if (verbose) write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,es10.3,a,es9.2,a,i0)') '  step ', step, &
                 ' fixed point ', fp, '  Coulomb |r|=', rn, '  reference ', r0, '  max |g change|=', change, &
                 ' of max g ', gmax, '  Newton it ', it_inner
@@ -922,7 +885,6 @@ contains
             if (growing == 0) growth = 0.0_dp
             if (growing >= 3) exit
             last_change = change
-            bound = new_bound
         end do
         if (.not. accepted) then
             write (msg, '(a,i0,a,es9.2,a,es9.2,a,es9.2,a,es9.2,a)') 'the fixed point did not converge in ', &
@@ -959,55 +921,45 @@ contains
             '; det K sign ', stats%det_sign
     end subroutine tresca_fixed_point
 
-    !> Whether the Tresca fixed point applies to a pair: GPTS with friction (a
-    !> mortar pair's slip limits belong to its control points, not to its slave
-    !> points; it keeps Coulomb friction).
-    pure logical function tresca_pair(pair)
-        type(contact_pair_t), intent(in) :: pair
-        tresca_pair = pair%law%mu > 0.0_dp .and. pair%method == method_gpts
-    end function tresca_pair
-
-    !> Whether any contact pair has friction the Tresca fixed point applies to.
+    !> Whether any contact pair takes part in the Tresca fixed point (frictional GPTS).
     pure logical function frictional(model)
         type(model_t), intent(in) :: model
         integer :: ip
-        frictional = any([(tresca_pair(model%pairs(ip)), ip=1, size(model%pairs))])
+        frictional = any([(model%pairs(ip)%pair%takes_outer(), ip=1, size(model%pairs))])
     end function frictional
 
-    !> mu p_N at the last evaluation for every slave point of every frictional pair,
-    !> in pair order; shape: [sum of the frictional pairs' points].
-    pure function slip_bounds(model) result(bound)
-        type(model_t), intent(in) :: model
-        real(dp), allocatable :: bound(:)
-        integer :: ip
-        allocate (bound(0))
-        do ip = 1, size(model%pairs)
-            if (.not. tresca_pair(model%pairs(ip))) cycle
-            bound = [bound, model%pairs(ip)%law%mu*max(0.0_dp, model%pairs(ip)%out%pn)]
-        end do
-    end function slip_bounds
-
-    !> Put every frictional pair in Tresca mode with the bounds `bound` (layout of
-    !> `slip_bounds`).
-    pure subroutine set_slip_bounds(model, bound)
+    !> Every frictional pair captures the slip bounds mu p_N of its last evaluation;
+    !> the largest change from the previous capture and the largest bound.
+    pure subroutine capture_slip_bounds(model, change, gmax)
         type(model_t), intent(inout) :: model
-        real(dp), intent(in) :: bound(:)
-        integer :: ip, first, n
-        first = 0
+        real(dp), intent(out) :: change, gmax
+        real(dp) :: c, g
+        integer :: ip
+        change = -huge(1.0_dp)
+        gmax = -huge(1.0_dp)
         do ip = 1, size(model%pairs)
-            if (.not. tresca_pair(model%pairs(ip))) cycle
-            n = size(model%pairs(ip)%out)
-            model%pairs(ip)%slip_bound = bound(first + 1:first + n)
-            first = first + n
+            if (.not. model%pairs(ip)%pair%takes_outer()) cycle
+            call model%pairs(ip)%pair%outer_capture(c, g)
+            change = max(change, c)
+            gmax = max(gmax, g)
         end do
-    end subroutine set_slip_bounds
+    end subroutine capture_slip_bounds
+
+    !> Put every frictional pair in Tresca mode with its captured bounds.
+    pure subroutine apply_slip_bounds(model)
+        type(model_t), intent(inout) :: model
+        integer :: ip
+        do ip = 1, size(model%pairs)
+            if (model%pairs(ip)%pair%takes_outer()) call model%pairs(ip)%pair%outer_apply()
+        end do
+    end subroutine apply_slip_bounds
 
     !> Back to Coulomb friction in every pair.
     pure subroutine clear_slip_bounds(model)
         type(model_t), intent(inout) :: model
         integer :: ip
         do ip = 1, size(model%pairs)
-            if (allocated(model%pairs(ip)%slip_bound)) deallocate (model%pairs(ip)%slip_bound)
+            call model%pairs(ip)%pair%outer_release()
         end do
     end subroutine clear_slip_bounds
 
@@ -1021,8 +973,8 @@ contains
             ' it ', it, '  |r|=', rn, '  |du.r|=', merge(en, 0.0_dp, it > 0), '  step length ', alpha, &
             '  floor ', floor
         do ip = 1, size(model%pairs)
-            write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', count(model%pairs(ip)%out%state == 1), &
-                ' slip=', count(model%pairs(ip)%out%state == 2), ' of ', size(model%pairs(ip)%out)
+            write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', count(model%pairs(ip)%pair%out%state == 1), &
+                ' slip=', count(model%pairs(ip)%pair%out%state == 2), ' of ', size(model%pairs(ip)%pair%out)
         end do
         write (*, '(a)') ''
     end subroutine print_iteration
@@ -1060,7 +1012,7 @@ contains
         integer :: ip, k
         allocate (states(0))
         do ip = 1, size(model%pairs)
-            states = [states, (model%pairs(ip)%out(k)%state, k=1, size(model%pairs(ip)%out))]
+            states = [states, (model%pairs(ip)%pair%out(k)%state, k=1, size(model%pairs(ip)%pair%out))]
         end do
     end function contact_states
 

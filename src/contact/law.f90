@@ -1,0 +1,54 @@
+!> The contact law: normal penalty and Coulomb friction by an elastic predictor
+!> and a return map (docs/theory.md, section 7). The per-point form of GPTS, whose
+!> tangent is interleaved with the kinematics of the point, is in
+!> `voiga_contact_gpts`; here the law's parameters, the contact states and the law
+!> at one slave control point of the mortar-type penalty.
+module voiga_contact_law
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
+
+    !> Contact states of a slave point or control point.
+    integer, parameter :: state_inactive = 0, state_stick = 1, state_slip = 2
+
+    !> Penalty and friction parameters of a pair.
+    type :: contact_law_t
+        real(dp) :: eps_n = 0.0_dp, eps_t = 0.0_dp, mu = 0.0_dp
+    end type contact_law_t
+
+contains
+
+    !> The law at one slave control point of the mortar-type penalty: weighted gap
+    !> `g_a`, weight `d_a` = int N_A dA0, weighted slip increment `ds_a` and
+    !> committed tangential traction `t_old`; gives the pressure `p` (active when
+    !> g_a < gap_tol d_a), the tangential traction `t` (zero without friction), its
+    !> trial value and the state. Frictionless when mu = 0 (no friction code runs).
+    pure subroutine control_point_law(law, g_a, d_a, ds_a, t_old, gap_tol, p, t, state, ttr)
+        type(contact_law_t), intent(in) :: law
+        real(dp), intent(in) :: g_a, d_a, ds_a, t_old, gap_tol
+        real(dp), intent(out) :: p, t
+        integer, intent(out) :: state
+        !> Trial tangential traction (elastic predictor; 0 when open or frictionless).
+        real(dp), intent(out) :: ttr
+
+        p = 0.0_dp
+        t = 0.0_dp
+        ttr = 0.0_dp
+        state = state_inactive
+        if (d_a <= 0.0_dp .or. g_a >= gap_tol*d_a) return
+        p = -law%eps_n*g_a/d_a
+        state = state_stick
+        if (law%mu > 0.0_dp) then
+            ttr = t_old - law%eps_t*ds_a/d_a
+            if (abs(ttr) <= law%mu*p) then
+                t = ttr
+            else
+                state = state_slip
+                t = law%mu*p*sign(1.0_dp, ttr)
+            end if
+        end if
+    end subroutine control_point_law
+
+end module voiga_contact_law
