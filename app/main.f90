@@ -1,18 +1,21 @@
-!> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet]`.
+!> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet]`. Parses
+!> the arguments, reads the case, builds the model and runs the solver; the
+!> terminal output is `voiga_app_console`'s.
 program voiga_main
     use voiga_error, only: error_t, error_code, fatal_error
     use voiga_version, only: voiga_version_string
-    use voiga_io_case, only: case_t, read_case
+    use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_dump, only: write_discretization
+    use voiga_io_bodies, only: discretize_bodies
+    use voiga_io_results, only: restart_case, read_restart
     use voiga_discretization_patch, only: discretization_t
-    use voiga_discretization_bodies, only: discretize_bodies
     use voiga_model, only: model_t, new_model
-    use voiga_io_results, only: results_t
-    use voiga_contact_pair, only: history_item_t
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
+    use voiga_solver_records, only: solver_stats_t, wall_seconds
+    use voiga_solver_stepping, only: solve_steps, resume_t
     use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_solver_heap, only: keep_freed_memory
+    use voiga_app_console, only: console_t
     use voiga_kinds, only: dp
     implicit none
 
@@ -21,10 +24,9 @@ program voiga_main
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error
-    type(h5file_t) :: h5
     type(model_t) :: model
     type(resume_t) :: resume
-    type(results_t) :: results
+    type(console_t) :: results
     type(solver_stats_t) :: stats
     real(dp), allocatable :: u(:)
     real(dp) :: t0
@@ -90,28 +92,19 @@ program voiga_main
         total = total + discs(i)%total_dofs
     end do
     write (*, '(a,i0)') 'dofs all total=', total
+    call check_edges(case, discs, error)
+    if (allocated(error)) call fail(error)
 
-    if (allocated(dump_path)) then
-        call h5%open(dump_path, 'w', error)
-        if (allocated(error)) call fail(error)
-        call h5%write_attr('/', 'title', case%title)
-        call h5%write_attr('/', 'scene', case%scene)
-        call h5%write_attr('/', 'mesh', case%mesh)
-        call h5%write_attr('/', 'layout', case%layout)
-        call h5%write_attr('/', 'voiga_version', voiga_version_string)
-        do i = 1, size(discs)
-            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
-        end do
-        call h5%close()
-        if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
-    end if
-
+    if (allocated(dump_path)) call dump(dump_path, case, discs)
     if (check) stop
 
-    call new_model(model, case, discs, error)
+    call new_model(model, case%bodies, discs, case%solver%n_gauss, case%dirichlet, case%pressure, &
+                   case%contact, error)
     if (allocated(error)) call fail(error)
+    results%quiet = quiet
+    results%verbose = verbose
     if (allocated(restart_path)) then
-        call load_restart(restart_path, model, resume, error)
+        call read_restart(restart_path, model, resume, error)
         if (allocated(error)) call fail(error)
         case%output = restart_path
         call results%reopen(restart_path, error)
@@ -123,14 +116,10 @@ program voiga_main
     end if
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
     call catch_signals()
-    call solve_steps(model, u, stats, quiet, error, results, t0, verbose, &
-                     stepping_t(min_step_fraction=case%solver%min_step_fraction, &
-                                max_cuts=case%solver%max_cuts, &
-                                grow_iterations=case%solver%grow_iterations, &
-                                predictor=case%solver%predictor), resume)
+    call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
     if (stats%signal /= 0) then
         call results%finish('interrupted', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
             ' completed steps are in '//case%output
         ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
@@ -138,12 +127,12 @@ program voiga_main
     end if
     if (allocated(error)) then
         call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
         write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
         call fail(error)
     end if
     call results%finish('converged', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                        [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output
@@ -153,82 +142,27 @@ program voiga_main
 
 contains
 
-    !> The case file recorded in a result file.
-    subroutine restart_case(path, case_file, error)
+    !> Write the refined bulk patch and VO layer of every body to `path`.
+    subroutine dump(path, case, discs)
         character(len=*), intent(in) :: path
-        character(len=:), allocatable, intent(out) :: case_file
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: f
-        call f%open(path, 'r', error)
-        if (allocated(error)) return
-        call f%read_attr_str('/', 'case_file', case_file, error)
-        call f%close()
-        if (allocated(error)) error%message = '--restart: '//error%message
-    end subroutine restart_case
-
-    !> The state after the last completed step of a result file: displacement, the
-    !> solver's substep fraction and force scale, the friction history of each pair.
-    subroutine load_restart(path, model, state, error)
-        character(len=*), intent(in) :: path
-        type(model_t), intent(inout) :: model
-        type(resume_t), intent(out) :: state
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: f
-        character(len=:), allocatable :: g, c
-        character(len=16) :: buf
-        integer :: done, ip, i
-        type(history_item_t), allocatable :: history(:)
-
-        call f%open(path, 'r', error)
-        if (allocated(error)) return
-        call f%read_attr_int('/', 'n_steps_done', done, error)
-        if (allocated(error)) return
-        state%step = done
-        allocate (state%u(model%ndof))
-        state%u = 0.0_dp
-        if (done > 0) then
-            write (buf, '(i6.6)') done
-            g = '/steps/'//trim(buf)
-            call f%read(g//'/displacement', state%u, error)
-            if (allocated(error)) return
-            ! the step before (the predictor extrapolates the last step's increment)
-            allocate (state%u_before(size(state%u)))
-            state%u_before = 0.0_dp
-            if (done > 1) then
-                write (buf, '(i6.6)') done - 1
-                call f%read('/steps/'//trim(buf)//'/displacement', state%u_before, error)
-                if (allocated(error)) return
-            end if
-            if (size(state%u) /= model%ndof) then
-                call fatal_error(error, path//': --restart: the result file does not belong to this case '// &
-                                 '(different number of DOFs)', error_code%input)
-                return
-            end if
-            if (f%has_attr(g, 'next_fraction')) call f%read_attr_real(g, 'next_fraction', state%fraction, error)
-            if (allocated(error)) return
-            if (f%has_attr(g, 'r0_max')) call f%read_attr_real(g, 'r0_max', state%r0_max, error)
-            if (allocated(error)) return
-            if (f%has_attr(g, 'tangent_det_sign')) call f%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
-            if (allocated(error)) return
-            do ip = 1, size(model%pairs)
-                history = model%pairs(ip)%pair%history()
-                if (size(history) == 0) cycle
-                write (buf, '(i0)') ip
-                c = g//'/contact/'//trim(buf)//'/history'
-                do i = 1, size(history)
-                    if (allocated(history(i)%values)) then
-                        call f%read(c//'/'//trim(history(i)%name), history(i)%values, error)
-                    else
-                        call f%read(c//'/'//trim(history(i)%name), history(i)%flags, error)
-                    end if
-                    if (allocated(error)) return
-                end do
-                call model%pairs(ip)%pair%set_history(history, error)
-                if (allocated(error)) return
-            end do
-        end if
-        call f%close()
-    end subroutine load_restart
+        type(case_t), intent(in) :: case
+        type(discretization_t), intent(in) :: discs(:)
+        type(h5file_t) :: h5
+        type(error_t), allocatable :: error
+        integer :: i
+        call h5%open(path, 'w', error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'title', case%title)
+        call h5%write_attr('/', 'scene', case%scene)
+        call h5%write_attr('/', 'mesh', case%mesh)
+        call h5%write_attr('/', 'layout', case%layout)
+        call h5%write_attr('/', 'voiga_version', voiga_version_string)
+        do i = 1, size(discs)
+            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
+        end do
+        call h5%close()
+        if (.not. quiet) write (*, '(a)') 'wrote '//path
+    end subroutine dump
 
     function get_arg(k) result(val)
         integer, intent(in) :: k

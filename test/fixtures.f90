@@ -1,23 +1,53 @@
-!> Shared test fixtures: exact coarse patches of the scenes' shapes and a
-!> deterministic pseudo-random sequence.
+!> Shared test fixtures: exact coarse patches of the scenes' shapes, a
+!> deterministic pseudo-random sequence, and a scene built from plain settings
+!> (no case file).
 module voiga_test_fixtures
     use voiga_kinds, only: dp
+    use voiga_error, only: error_t
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_discretization_layout, only: layout_t
+    use voiga_discretization_patch, only: discretization_t
+    use voiga_model, only: model_t, new_model
+    use voiga_model_body, only: body_settings_t
+    use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
+    use voiga_contact_factory, only: contact_settings_t
+    use voiga_solver_settings, only: solver_settings_t
     implicit none
     private
 
-    public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout
+    public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model
+
+    !> The settings of a test scene, as a case file would give them.
+    type :: scene_t
+        type(body_settings_t), allocatable :: bodies(:)
+        type(solver_settings_t) :: solver
+        type(dirichlet_settings_t), allocatable :: dirichlet(:)
+        type(pressure_settings_t), allocatable :: pressure(:)
+        type(contact_settings_t), allocatable :: contact(:)
+    end type scene_t
 
     !> Park-Miller generator: same numbers on every compiler and run.
     type :: lcg_t
         integer(8) :: state = 12345_8
     contains
-
         procedure :: uniform => lcg_uniform
     end type lcg_t
 
 contains
+
+    !> The model of scene `c` on the discretizations `discs` (one per body); the
+    !> load and contact lists default to empty.
+    subroutine scene_model(c, discs, model, error)
+        type(scene_t), intent(inout) :: c
+        type(discretization_t), intent(in) :: discs(:)
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. allocated(c%dirichlet)) allocate (c%dirichlet(0))
+        if (.not. allocated(c%pressure)) allocate (c%pressure(0))
+        if (.not. allocated(c%contact)) allocate (c%contact(0))
+        if (.not. allocated(c%solver%n_steps)) c%solver%n_steps = [1]
+        call new_model(model, c%bodies, discs, c%solver%n_gauss, c%dirichlet, c%pressure, c%contact, error)
+    end subroutine scene_model
 
     !> A layout in the paper's notation: 'L1', 'Np' (degree p along the contact edge,
     !> 2 across), 'NNq' (bulk 2 x 2, layer of degree q), 'NNq.k' (k more elevations).

@@ -7,18 +7,23 @@ module test_contact
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
-    use voiga_io_case, only: case_t, body_input_t, contact_input_t
-    use voiga_model, only: model_t, new_model
+    use voiga_model, only: model_t
+    use voiga_model_body, only: body_settings_t
+    use voiga_contact_factory, only: contact_settings_t
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
                                     new_assembly_map
     use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t, residual_floor, reference_coordinates
-    use voiga_io_case, only: dirichlet_input_t, pressure_input_t
+    use voiga_solver_records, only: solver_stats_t
+    use voiga_solver_settings, only: solver_settings_t
+    use voiga_solver_stepping, only: solve_steps
+    use voiga_solver_convergence, only: residual_floor
+    use voiga_model, only: reference_coordinates
+    use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
     use voiga_contact_pair, only: contact_pair_t
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t, mortar_snapshot_t
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
-    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model
     implicit none
     private
 
@@ -69,13 +74,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Contact method ('gpts' when absent).
         character(len=*), intent(in), optional :: method
-        type(case_t) :: c
+        type(scene_t) :: c
         type(discretization_t) :: discs(2)
         character(len=8), parameter :: names(2) = [character(len=8) :: 'die', 'slab']
         integer :: i
 
-        c%path = 'test'
-        c%dir = ''
         allocate (c%bodies(2))
         do i = 1, 2
             c%bodies(i)%name = names(i)
@@ -101,7 +104,7 @@ contains
         call new_discretization(discs(2), rectangle(0.0_dp, -3.0_dp, 9.0_dp, 3.0_dp), &
                                 c%bodies(2)%layout, '', error)
         if (allocated(error)) return
-        call new_model(model, c, discs, error)
+        call scene_model(c, discs, model, error)
     end subroutine two_body_model
 
     !> A deformed, penetrating configuration: die moved down by 0.06 and sheared,
@@ -407,7 +410,7 @@ contains
         character(len=*), intent(in) :: name, material
         real(dp), intent(in) :: e
         type(layout_t), intent(in) :: layout
-        type(body_input_t) :: b
+        type(body_settings_t) :: b
         b%name = name
         b%material = material
         b%youngs_modulus = e
@@ -419,7 +422,7 @@ contains
         character(len=*), intent(in) :: b, edge
         logical, intent(in) :: fix(2)
         real(dp), intent(in) :: values(:, :)
-        type(dirichlet_input_t) :: d
+        type(dirichlet_settings_t) :: d
         d%body = b
         d%edge = edge
         d%fix = fix
@@ -428,23 +431,18 @@ contains
 
     !> Build a model from a case and the coarse patches of its bodies.
     subroutine build_model(c, coarse, model, error)
-        type(case_t), intent(inout) :: c
+        type(scene_t), intent(inout) :: c
         type(nurbs_surface_t), intent(in) :: coarse(:)
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
         type(discretization_t), allocatable :: discs(:)
         integer :: i
-        c%path = 'test'
-        c%dir = ''
-        if (.not. allocated(c%dirichlet)) allocate (c%dirichlet(0))
-        if (.not. allocated(c%pressure)) allocate (c%pressure(0))
-        if (.not. allocated(c%contact)) allocate (c%contact(0))
         allocate (discs(size(coarse)))
         do i = 1, size(coarse)
             call new_discretization(discs(i), coarse(i), c%bodies(i)%layout, '', error)
             if (allocated(error)) return
         end do
-        call new_model(model, c, discs, error)
+        call scene_model(c, discs, model, error)
     end subroutine build_model
 
     !> Two stacked blocks under uniform pressure. Matching meshes: the contact
@@ -481,7 +479,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Contact method ('gpts' when absent).
         character(len=*), intent(in), optional :: method
-        type(case_t) :: c
+        type(scene_t) :: c
         type(model_t) :: model
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
@@ -493,14 +491,14 @@ contains
         c%dirichlet = [bc('lower', 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
                        bc('lower', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
                        bc('upper', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1]))]
-        c%pressure = [pressure_input_t(body='upper', edge='top', values=[p])]
+        c%pressure = [pressure_settings_t(body='upper', edge='top', values=[p])]
         allocate (c%contact(1))
-        c%contact(1) = contact_input_t(slave='upper', master='lower', penalty_normal=1000.0_dp, n_gauss=ngp)
+        c%contact(1) = contact_settings_t(slave='upper', master='lower', penalty_normal=1000.0_dp, n_gauss=ngp)
         if (present(method)) c%contact(1)%method = method
         call build_model(c, [rectangle(0.0_dp, 1.0_dp, 2.0_dp, 1.0_dp), &
                              rectangle(0.0_dp, 0.0_dp, 2.0_dp, 1.0_dp)], model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error)
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         associate (out => model%pairs(1)%pair%out)
             call check(error, all(out%state /= state_inactive), 'every slave point in contact')
@@ -512,34 +510,36 @@ contains
                    rel=1.0e-10_dp)
     end subroutine patch_spread
 
-    !> A block on a rigid plane, pressed then pushed (or barely pushed).
-    subroutine block_on_plane(push, mu, model, u, error, stepping, stats_out, method)
+    !> A block on a rigid plane, pressed then pushed (or barely pushed); with
+    !> `tresca_always`, every substep solved by the Tresca fixed point.
+    subroutine block_on_plane(push, mu, model, u, error, tresca_always, stats_out, method)
         real(dp), intent(in) :: push, mu
         type(model_t), intent(out) :: model
         real(dp), allocatable, intent(out) :: u(:)
         type(error_t), allocatable, intent(out) :: error
-        type(stepping_t), intent(in), optional :: stepping
+        logical, intent(in), optional :: tresca_always
         type(solver_stats_t), intent(out), optional :: stats_out
         !> Contact method ('gpts' when absent).
         character(len=*), intent(in), optional :: method
-        type(case_t) :: c
+        type(scene_t) :: c
         type(solver_stats_t) :: stats
         c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
-        c%contact(1) = contact_input_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
+        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
                                        rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1000.0_dp, &
                                        penalty_tangent=1000.0_dp, friction=mu)
         if (present(method)) c%contact(1)%method = method
         call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error, stepping=stepping)
+        if (present(tresca_always)) c%solver%tresca_always = tresca_always
+        call solve_steps(model, c%solver, u, stats, error)
         if (present(stats_out)) stats_out = stats
     end subroutine block_on_plane
 
     !> The Tresca fixed point of the solver (successive approximations on the slip
-    !> bounds; here for every substep, `stepping_t%tresca_always`) solves the Coulomb
+    !> bounds; here for every substep, `solver_settings_t%tresca_always`) solves the Coulomb
     !> problem: the block pressed and slid on a rigid plane (mu = 0.3, slipping)
     !> reaches plain Newton's state, and the Coulomb residual there is converged.
     subroutine test_tresca_fixed_point(error)
@@ -551,7 +551,7 @@ contains
         real(dp) :: rn
         call block_on_plane(0.1_dp, 0.3_dp, ma, ua, error, stats_out=sa)
         if (allocated(error)) return
-        call block_on_plane(0.1_dp, 0.3_dp, mb, ub, error, stepping_t(tresca_always=.true.), sb)
+        call block_on_plane(0.1_dp, 0.3_dp, mb, ub, error, .true., sb)
         if (allocated(error)) return
         call check(error, sa%tresca_retries == 0, 'plain Newton needed no fixed point')
         if (allocated(error)) return
@@ -719,7 +719,7 @@ contains
     subroutine ironing_quadratic(error, method)
         type(error_t), allocatable, intent(out) :: error
         character(len=*), intent(in) :: method
-        type(case_t) :: c
+        type(scene_t) :: c
         type(model_t) :: model
         type(solver_stats_t) :: stats
         type(csc_matrix_t) :: k
@@ -735,13 +735,14 @@ contains
         c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &
                        bc('slab', 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))]
         allocate (c%contact(1))
-        c%contact(1) = contact_input_t(slave='die', master='slab', penalty_normal=100.0_dp, &
+        c%contact(1) = contact_settings_t(slave='die', master='slab', penalty_normal=100.0_dp, &
                                        penalty_tangent=100.0_dp, friction=0.3_dp, method=method)
         call build_model(c, [annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
                              rectangle(0.0_dp, -3.0_dp, 9.0_dp, 3.0_dp)], model, error)
         if (allocated(error)) return
         ! the tangent is what is tested: every step starts from the last state
-        call solve_steps(model, u, stats, .true., error, stepping=stepping_t(predictor=.false.))
+        c%solver%predictor = .false.
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         call check(error, count(model%pairs(1)%pair%out%state == state_slip) > 0, method//': points slip while ironing')
         if (allocated(error)) return

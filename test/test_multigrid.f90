@@ -19,11 +19,11 @@ module test_multigrid
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_hierarchy, only: coarse_space_t, cp_map_t, coarsen_discretization, &
                                               coarsen_space
-    use voiga_io_case, only: case_t, dirichlet_input_t
-    use voiga_model, only: model_t, new_model
+    use voiga_model, only: model_t
+    use voiga_model_loads, only: dirichlet_settings_t
     use voiga_model_assembly, only: assemble, stiffness_pattern, assembly_stats_t
     use voiga_linalg_lapack, only: solve_spd
-    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle, paper_layout
+    use voiga_test_fixtures, only: lcg_t, annulus_sector, rectangle, paper_layout, scene_t, scene_model
     implicit none
     private
 
@@ -278,11 +278,9 @@ contains
         integer, intent(in) :: n
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
-        type(case_t) :: c
+        type(scene_t) :: c
         type(discretization_t) :: discs(1)
         type(layout_t) :: layout
-        c%path = 'test'
-        c%dir = ''
         allocate (c%bodies(1))
         c%bodies(1)%name = 'square'
         c%bodies(1)%material = 'linear'
@@ -293,13 +291,13 @@ contains
         c%bodies(1)%layout = layout
         c%solver%n_steps = [1]
         allocate (c%pressure(0), c%contact(0))
-        c%dirichlet = [dirichlet_input_t(body='square', edge='bottom', fix=[.true., .true.], &
-                                         values=reshape([0.0_dp, 0.0_dp], [2, 1])), &
-                       dirichlet_input_t(body='square', edge='left', fix=[.true., .false.], &
-                                         values=reshape([0.0_dp, 0.0_dp], [2, 1]))]
+        c%dirichlet = [dirichlet_settings_t(body='square', edge='bottom', fix=[.true., .true.], &
+                                            values=reshape([0.0_dp, 0.0_dp], [2, 1])), &
+                       dirichlet_settings_t(body='square', edge='left', fix=[.true., .false.], &
+                                            values=reshape([0.0_dp, 0.0_dp], [2, 1]))]
         call new_discretization(discs(1), rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), layout, '', error)
         if (allocated(error)) return
-        call new_model(model, c, discs, error)
+        call scene_model(c, discs, model, error)
     end subroutine square_model
 
 end module test_multigrid

@@ -9,14 +9,16 @@ module test_solid
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_element, only: element_basis, element_nfun
-    use voiga_io_case, only: case_t, body_input_t, dirichlet_input_t, pressure_input_t
-    use voiga_model, only: model_t, new_model, body_points
+    use voiga_model, only: model_t
+    use voiga_model_body, only: body_points
+    use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
     use voiga_model_assembly, only: body_element, body_dofs, assemble, assembly_stats_t
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: reference_gradients
     use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t
-    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic
+    use voiga_solver_records, only: solver_stats_t
+    use voiga_solver_stepping, only: solve_steps
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model
     implicit none
     private
 
@@ -44,9 +46,7 @@ contains
         character(len=*), intent(in) :: material
         type(layout_t), intent(in) :: layout
         real(dp), intent(in) :: e, nu
-        type(case_t) :: c
-        c%path = 'test'
-        c%dir = ''
+        type(scene_t) :: c
         allocate (c%bodies(1))
         c%bodies(1)%name = 'block'
         c%bodies(1)%material = material
@@ -59,11 +59,11 @@ contains
 
     !> Append a Dirichlet condition.
     subroutine add_dirichlet(c, edge, fix, values)
-        type(case_t), intent(inout) :: c
+        type(scene_t), intent(inout) :: c
         character(len=*), intent(in) :: edge
         logical, intent(in) :: fix(2)
         real(dp), intent(in) :: values(:, :)
-        type(dirichlet_input_t) :: d
+        type(dirichlet_settings_t) :: d
         d%body = 'block'
         d%edge = edge
         d%fix = fix
@@ -74,14 +74,16 @@ contains
 
     !> Build model from a case and one coarse patch.
     subroutine build(c, coarse, model, error)
-        type(case_t), intent(in) :: c
+        type(scene_t), intent(in) :: c
         type(nurbs_surface_t), intent(in) :: coarse
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
         type(discretization_t) :: discs(1)
+        type(scene_t) :: scene
         call new_discretization(discs(1), coarse, c%bodies(1)%layout, '', error)
         if (allocated(error)) return
-        call new_model(model, c, discs, error)
+        scene = c
+        call scene_model(scene, discs, model, error)
     end subroutine build
 
     !> Random displacement of a die-shaped body with 0.6 <= J <= 1.6 (checked).
@@ -195,7 +197,7 @@ contains
     subroutine test_global_tangent(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
-        type(case_t) :: c
+        type(scene_t) :: c
         type(lcg_t) :: rng
         type(csc_matrix_t) :: k
         type(assembly_stats_t) :: stats
@@ -206,7 +208,7 @@ contains
 
         c = one_body_case('neo-hookean', paper_layout('NN2.2', [3, 2], 'outer'), 10.0_dp, 0.3_dp)
         call add_dirichlet(c, 'inner', [.true., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
-        c%pressure = [pressure_input_t(body='block', edge='outer', values=[0.3_dp])]
+        c%pressure = [pressure_settings_t(body='block', edge='outer', values=[0.3_dp])]
         call build(c, annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), model, error)
         if (allocated(error)) return
         allocate (u(model%ndof), r(model%ndof), rp(model%ndof), rm(model%ndof), col(model%ndof), &
@@ -285,7 +287,7 @@ contains
         logical, intent(in) :: by_pressure
         character(len=5), parameter :: names(4) = [character(len=5) :: 'N2', 'N4', 'NN2.2', 'NN4']
         type(model_t) :: model
-        type(case_t) :: c
+        type(scene_t) :: c
         type(lcg_t) :: rng
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
@@ -302,14 +304,14 @@ contains
             call add_dirichlet(c, 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
             if (by_pressure) then
                 ! force per length: a negative pressure pulls
-                c%pressure = [pressure_input_t(body='block', edge='right', values=[-sxx])]
+                c%pressure = [pressure_settings_t(body='block', edge='right', values=[-sxx])]
             else
                 call add_dirichlet(c, 'right', [.true., .false.], reshape([ex*3.0_dp, 0.0_dp], [2, 1]))
             end if
             call build(c, rectangle(0.0_dp, 0.0_dp, 3.0_dp, 2.0_dp), model, error)
             if (allocated(error)) return
             call distort_interior(model, rng, 0.15_dp)
-            call solve_steps(model, u, stats, .true., error)
+            call solve_steps(model, c%solver, u, stats, error)
             if (allocated(error)) return
             worst = 0.0_dp
             do a = 1, model%bodies(1)%disc%ncp
@@ -341,7 +343,7 @@ contains
         integer, intent(out) :: ndof
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
-        type(case_t) :: c
+        type(scene_t) :: c
         type(layout_t) :: layout
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:), r(:), dr(:, :), d2r(:, :), dndx(:, :), gx(:), wx(:)
@@ -356,10 +358,10 @@ contains
         ! quarter annulus 1 <= r <= 2 in the first quadrant: xi from angle 0 to 90 deg
         call add_dirichlet(c, 'start', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
         call add_dirichlet(c, 'end', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1]))
-        c%pressure = [pressure_input_t(body='block', edge='inner', values=[1.0_dp])]
+        c%pressure = [pressure_settings_t(body='block', edge='inner', values=[1.0_dp])]
         call build(c, annulus_sector([0.0_dp, 0.0_dp], 1.0_dp, 2.0_dp, 0.0_dp, 1), model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error)
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         ndof = model%ndof
         ng = p + 2
@@ -447,7 +449,7 @@ contains
     subroutine test_quadratic(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
-        type(case_t) :: c
+        type(scene_t) :: c
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
         integer :: k
@@ -455,7 +457,8 @@ contains
         call build(c, rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), model, error)
         if (allocated(error)) return
         ! the tangent is what is tested: every step starts from the last state
-        call solve_steps(model, u, stats, .true., error, stepping=stepping_t(predictor=.false.))
+        c%solver%predictor = .false.
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         call check(error, stats%steps, 3, 'all steps converged')
         if (allocated(error)) return
@@ -467,7 +470,7 @@ contains
     end subroutine test_quadratic
 
     subroutine quadratic_model(c)
-        type(case_t), intent(out) :: c
+        type(scene_t), intent(out) :: c
         c = one_body_case('neo-hookean', paper_layout('N2', [4, 4], 'top'), 1.0_dp, 0.3_dp)
         c%solver%n_steps = [3]
         call add_dirichlet(c, 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp], [2, 1]))
@@ -478,7 +481,7 @@ contains
     subroutine test_small_strain_only(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
-        type(case_t) :: c
+        type(scene_t) :: c
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
         real(dp), allocatable :: u_first(:)
@@ -488,7 +491,8 @@ contains
         call add_dirichlet(c, 'top', [.true., .true.], reshape([0.01_dp, -0.02_dp], [2, 1]))
         call build(c, rectangle(0.0_dp, 0.0_dp, 3.0_dp, 2.0_dp), model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error, stepping=stepping_t(predictor=.false.))
+        c%solver%predictor = .false.
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         call check(error, stats%iterations, 4, 'one Newton iteration per step')
         if (allocated(error)) return
@@ -497,7 +501,8 @@ contains
         u_first = u
         call build(c, rectangle(0.0_dp, 0.0_dp, 3.0_dp, 2.0_dp), model, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error)
+        c%solver%predictor = .true.
+        call solve_steps(model, c%solver, u, stats, error)
         if (allocated(error)) return
         call check(error, stats%iterations, 1, 'predictor: one Newton iteration in all')
         if (allocated(error)) return

@@ -8,10 +8,12 @@ module test_stepping
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
-    use voiga_io_case, only: case_t, dirichlet_input_t
-    use voiga_model, only: model_t, new_model
-    use voiga_solver_newton, only: solve_steps, solver_stats_t, stepping_t
-    use voiga_test_fixtures, only: rectangle
+    use voiga_model, only: model_t
+    use voiga_model_loads, only: dirichlet_settings_t
+    use voiga_solver_settings, only: solver_settings_t
+    use voiga_solver_records, only: solver_stats_t
+    use voiga_solver_stepping, only: solve_steps
+    use voiga_test_fixtures, only: rectangle, scene_t, scene_model
     implicit none
     private
 
@@ -32,17 +34,16 @@ contains
 
     !> Unit Neo-Hookean block (N2, 4 x 4 elements), bottom clamped, top pushed down
     !> by `squeeze` per phase (x held), `n` nominal steps per phase.
-    subroutine block_model(squeeze, n, model, error)
+    subroutine block_model(squeeze, n, model, settings, error)
         real(dp), intent(in) :: squeeze(:)
         integer, intent(in) :: n(:)
         type(model_t), intent(out) :: model
+        type(solver_settings_t), intent(out) :: settings
         type(error_t), allocatable, intent(out) :: error
-        type(case_t) :: c
+        type(scene_t) :: c
         type(discretization_t) :: discs(1)
         type(layout_t) :: layout
         real(dp), allocatable :: top(:, :)
-        c%path = 'test'
-        c%dir = ''
         allocate (c%bodies(1))
         c%bodies(1)%name = 'block'
         c%bodies(1)%material = 'neo-hookean'
@@ -56,12 +57,13 @@ contains
         allocate (c%pressure(0), c%contact(0), top(2, size(squeeze)))
         top(1, :) = 0.0_dp
         top(2, :) = -squeeze
-        c%dirichlet = [dirichlet_input_t(body='block', edge='bottom', fix=[.true., .true.], &
-                                         values=0.0_dp*top), &
-                       dirichlet_input_t(body='block', edge='top', fix=[.true., .true.], values=top)]
+        c%dirichlet = [dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true.], &
+                                            values=0.0_dp*top), &
+                       dirichlet_settings_t(body='block', edge='top', fix=[.true., .true.], values=top)]
+        settings = c%solver
         call new_discretization(discs(1), rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), layout, '', error)
         if (allocated(error)) return
-        call new_model(model, c, discs, error)
+        call scene_model(c, discs, model, error)
     end subroutine block_model
 
     !> 60 % compression in one step fails at full size (max_cuts = 0 fails, see
@@ -69,11 +71,12 @@ contains
     subroutine test_cut_converges(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
+        type(solver_settings_t) :: settings
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u1(:), u32(:)
-        call block_model([0.6_dp], [1], model, error)
+        call block_model([0.6_dp], [1], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u1, stats, .true., error)
+        call solve_steps(model, settings, u1, stats, error)
         if (allocated(error)) return
         call check(error, stats%steps, 1, 'the one nominal step converged')
         if (allocated(error)) return
@@ -89,9 +92,9 @@ contains
         if (allocated(error)) return
         call check(error, stats%records(1)%time, 1.0_dp, 'the nominal step is hit exactly')
         if (allocated(error)) return
-        call block_model([0.6_dp], [32], model, error)
+        call block_model([0.6_dp], [32], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u32, stats, .true., error)
+        call solve_steps(model, settings, u32, stats, error)
         if (allocated(error)) return
         call check(error, stats%cuts, 0, '32 small steps need no cut')
         if (allocated(error)) return
@@ -104,12 +107,13 @@ contains
     subroutine test_growth(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
+        type(solver_settings_t) :: settings
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
         integer :: k
-        call block_model([0.6_dp, 0.62_dp], [1, 4], model, error)
+        call block_model([0.6_dp, 0.62_dp], [1, 4], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., error)
+        call solve_steps(model, settings, u, stats, error)
         if (allocated(error)) return
         call check(error, stats%steps, 5, 'all steps converged')
         if (allocated(error)) return
@@ -131,12 +135,14 @@ contains
     subroutine test_minimum(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
+        type(solver_settings_t) :: settings
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
         type(error_t), allocatable :: run_error
-        call block_model([0.6_dp], [1], model, error)
+        call block_model([0.6_dp], [1], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., run_error, stepping=stepping_t(min_step_fraction=0.5_dp))
+        settings%min_step_fraction = 0.5_dp
+        call solve_steps(model, settings, u, stats, run_error)
         call check(error, allocated(run_error), 'the run failed')
         if (allocated(error)) return
         call check(error, run_error%code, error_code%numeric, 'a numerical failure (exit code 3)')
@@ -156,12 +162,14 @@ contains
     subroutine test_no_cuts(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
+        type(solver_settings_t) :: settings
         type(solver_stats_t) :: stats
         real(dp), allocatable :: u(:)
         type(error_t), allocatable :: run_error
-        call block_model([0.6_dp], [1], model, error)
+        call block_model([0.6_dp], [1], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u, stats, .true., run_error, stepping=stepping_t(max_cuts=0))
+        settings%max_cuts = 0
+        call solve_steps(model, settings, u, stats, run_error)
         call check(error, allocated(run_error), 'the run failed')
         if (allocated(error)) return
         call check(error, run_error%code, error_code%numeric, 'a numerical failure')
@@ -175,16 +183,18 @@ contains
     subroutine test_predictor(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: model
+        type(solver_settings_t) :: settings
         type(solver_stats_t) :: on, off
         real(dp), allocatable :: u_on(:), u_off(:)
         integer :: k
-        call block_model([0.3_dp, 0.0_dp], [10, 10], model, error)
+        call block_model([0.3_dp, 0.0_dp], [10, 10], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u_off, off, .true., error, stepping=stepping_t(predictor=.false.))
+        settings%predictor = .false.
+        call solve_steps(model, settings, u_off, off, error)
         if (allocated(error)) return
-        call block_model([0.3_dp, 0.0_dp], [10, 10], model, error)
+        call block_model([0.3_dp, 0.0_dp], [10, 10], model, settings, error)
         if (allocated(error)) return
-        call solve_steps(model, u_on, on, .true., error)
+        call solve_steps(model, settings, u_on, on, error)
         if (allocated(error)) return
         call check(error, maxval(abs(u_on - u_off)), 0.0_dp, 'same final state', abs=1.0e-8_dp)
         if (allocated(error)) return

@@ -5,7 +5,7 @@
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use voiga_kinds, only: dp, i8
-    use voiga_error, only: error_t
+    use voiga_error, only: error_t, fatal_error, error_code
     use voiga_version, only: voiga_version_string
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
@@ -13,56 +13,17 @@ module voiga_io_results
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
+    use voiga_solver_records, only: step_record_t, cut_record_t, stage_names
+    use voiga_solver_progress, only: progress_t, step_report_t
+    use voiga_solver_stepping, only: resume_t
     implicit none
     private
 
-    public :: results_t, step_record_t, cut_record_t, stage_names
+    public :: results_t, restart_case, read_restart
 
-    !> Stages whose seconds are recorded per step.
-    character(len=*), parameter :: stage_names(5) = [character(len=13) :: 'assembly', 'contact', &
-                                                     'factorization', 'solve', 'output']
-
-    !> What one converged step reports.
-    type :: step_record_t
-        integer :: step = 0
-        real(dp) :: time = 0.0_dp
-        integer :: iterations = 0
-        !> Residual norm (free DOFs) before each iteration and after the last, [iterations + 1].
-        real(dp), allocatable :: residual_norms(:)
-        !> |du . r| of each iteration, [iterations].
-        real(dp), allocatable :: energy_norms(:)
-        !> Resultant reaction force of each Dirichlet condition, [2, n_dirichlet].
-        real(dp), allocatable :: reactions(:, :)
-        !> Seconds per stage (order of `stage_names`).
-        real(dp) :: seconds(5) = 0.0_dp
-        !> Converged substeps the nominal step took (1: no cut) and the cuts on the way.
-        integer :: substeps = 1, cuts = 0
-        !> Newton iterations of all substeps, failed attempts included (`iterations`,
-        !> `residual_norms` and `energy_norms` are those of the last substep).
-        integer :: iterations_total = 0
-        !> Sign of det(K) (free DOFs) of the last tangent factorized up to this step
-        !> (0: singular, or no factorization yet).
-        integer :: det_sign = 0
-        !> GMRES iterations of all Newton iterations of the step (multigrid; 0 with
-        !> the direct solver).
-        integer :: linear_iterations = 0
-    end type step_record_t
-
-    !> One cut of the load increment (adaptive stepping, docs/robustness.md).
-    type :: cut_record_t
-        !> Nominal step being solved.
-        integer :: step = 0
-        !> Load time the failed attempt aimed at.
-        real(dp) :: time = 0.0_dp
-        !> Increment of the failed attempt and the new one, as fractions of the nominal step.
-        real(dp) :: fraction = 0.0_dp, new_fraction = 0.0_dp
-        !> Why the attempt failed (fixed length: gfortran 12 corrupts the heap when
-        !> arrays of a type with a deferred-length component grow by constructor).
-        character(len=256) :: reason = ''
-    end type cut_record_t
-
-    !> An open result file.
-    type :: results_t
+    !> An open result file; as a `progress_t` it writes every converged step the
+    !> solver reports (and the levels of a multigrid solver).
+    type, extends(progress_t) :: results_t
         type(h5file_t) :: h5
         integer :: n_written = 0
     contains
@@ -72,6 +33,8 @@ module voiga_io_results
         procedure :: finish => results_finish
         !> Record the DOFs of each multigrid level (/multigrid_level_dofs).
         procedure :: write_multigrid => results_write_multigrid
+        procedure :: set_up => results_set_up
+        procedure :: step_done => results_step_done
     end type results_t
 
 contains
@@ -98,9 +61,9 @@ contains
         call self%h5%write_attr('/', 'case_file', case%path)
         call self%h5%write_attr('/', 'status', 'running')
         call self%h5%write_attr('/', 'n_dofs', model%ndof)
-        call self%h5%write_attr('/', 'linear_solver', trim(model%linear_solver))
-        call self%h5%write_attr('/', 'damping', trim(model%damping))
-        call self%h5%write_attr('/', 'n_steps_planned', sum(model%n_steps))
+        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver))
+        call self%h5%write_attr('/', 'damping', trim(case%solver%damping))
+        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps())
         call self%h5%write_attr('/', 'n_steps_done', 0)
         call self%h5%write_attr('/', 'n_cuts', 0)
         call self%h5%write_attr('/', 'wall_time', 0.0_dp)
@@ -328,6 +291,25 @@ contains
         call self%h5%close()
     end subroutine results_finish
 
+    !> The solver is set up: the levels of its multigrid hierarchy.
+    subroutine results_set_up(self, level_dofs, error)
+        class(results_t), intent(inout) :: self
+        integer, intent(in) :: level_dofs(:)
+        type(error_t), allocatable, intent(out) :: error
+        call self%write_multigrid(level_dofs)
+    end subroutine results_set_up
+
+    !> A converged step: written with the contact output of `model`'s pairs.
+    subroutine results_step_done(self, report, u, model, error)
+        class(results_t), intent(inout) :: self
+        type(step_report_t), intent(in) :: report
+        real(dp), intent(in) :: u(:)
+        type(model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        call self%write_step(report%record, u, report%wall, model%pairs, report%cuts, report%n_cuts, &
+                             report%next_fraction, report%r0_max)
+    end subroutine results_step_done
+
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
     subroutine results_write_multigrid(self, level_dofs)
         class(results_t), intent(inout) :: self
@@ -337,5 +319,102 @@ contains
         call self%h5%write('/multigrid_level_dofs', level_dofs)
         call self%h5%flush()
     end subroutine results_write_multigrid
+
+    !> The case file recorded in the result file `path`.
+    subroutine restart_case(path, case_file, error)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: case_file
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: f
+        call f%open(path, 'r', error)
+        if (allocated(error)) return
+        call f%read_attr_str('/', 'case_file', case_file, error)
+        call f%close()
+        if (allocated(error)) error%message = '--restart: '//error%message
+    end subroutine restart_case
+
+    !> The state after the last written step of the result file `path` (as
+    !> `write_step` wrote it): displacement, the solver's substep fraction, force
+    !> scale and det K sign, and the committed history of each contact pair of
+    !> `model`, which is set on the pairs. The file is only read.
+    subroutine read_restart(path, model, state, error)
+        character(len=*), intent(in) :: path
+        type(model_t), intent(inout) :: model
+        type(resume_t), intent(out) :: state
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: h5
+        call h5%open(path, 'r', error)
+        if (allocated(error)) return
+        call read_state(h5, model, state, error)
+        call h5%close()
+    end subroutine read_restart
+
+    subroutine read_state(h5, model, state, error)
+        type(h5file_t), intent(inout) :: h5
+        type(model_t), intent(inout) :: model
+        type(resume_t), intent(out) :: state
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: g
+        character(len=16) :: buf
+        integer :: done, ip
+
+        call h5%read_attr_int('/', 'n_steps_done', done, error)
+        if (allocated(error)) return
+        state%step = done
+        allocate (state%u(model%ndof))
+        state%u = 0.0_dp
+        if (done == 0) return
+        write (buf, '(i6.6)') done
+        g = '/steps/'//trim(buf)
+        call h5%read(g//'/displacement', state%u, error)
+        if (allocated(error)) return
+        ! the step before (the predictor extrapolates the last step's increment)
+        allocate (state%u_before(size(state%u)))
+        state%u_before = 0.0_dp
+        if (done > 1) then
+            write (buf, '(i6.6)') done - 1
+            call h5%read('/steps/'//trim(buf)//'/displacement', state%u_before, error)
+            if (allocated(error)) return
+        end if
+        if (size(state%u) /= model%ndof) then
+            call fatal_error(error, h5%path//': --restart: the result file does not belong to this '// &
+                             'case (different number of DOFs)', error_code%input)
+            return
+        end if
+        if (h5%has_attr(g, 'next_fraction')) call h5%read_attr_real(g, 'next_fraction', state%fraction, error)
+        if (allocated(error)) return
+        if (h5%has_attr(g, 'r0_max')) call h5%read_attr_real(g, 'r0_max', state%r0_max, error)
+        if (allocated(error)) return
+        if (h5%has_attr(g, 'tangent_det_sign')) &
+            call h5%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
+        if (allocated(error)) return
+        do ip = 1, size(model%pairs)
+            write (buf, '(i0)') ip
+            call read_history(h5, g//'/contact/'//trim(buf)//'/history', model%pairs(ip)%pair, error)
+            if (allocated(error)) return
+        end do
+    end subroutine read_state
+
+    !> Read the committed history `pair` keeps (its `history` names the arrays) from
+    !> group `c` and set it on the pair.
+    subroutine read_history(h5, c, pair, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: c
+        class(contact_pair_t), intent(inout) :: pair
+        type(error_t), allocatable, intent(out) :: error
+        type(history_item_t), allocatable :: history(:)
+        integer :: i
+        history = pair%history()
+        if (size(history) == 0) return
+        do i = 1, size(history)
+            if (allocated(history(i)%values)) then
+                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error)
+            else
+                call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error)
+            end if
+            if (allocated(error)) return
+        end do
+        call pair%set_history(history, error)
+    end subroutine read_history
 
 end module voiga_io_results

@@ -8,7 +8,10 @@ module voiga_material_factory
     implicit none
     private
 
-    public :: new_material
+    public :: new_material, material_names
+
+    !> The valid values of `&body material` (the case reader checks against them).
+    character(len=*), parameter :: material_names(2) = [character(len=11) :: 'linear', 'neo-hookean']
 
 contains
 
@@ -27,6 +30,7 @@ contains
             mat%finite_strain = .true.
         case default
             call fatal_error(error, "unknown material '"//trim(name)//"'", error_code%input)
+            return
             return
         end select
         call lame_from_young(mat, youngs_modulus, poisson_ratio)

@@ -3,7 +3,9 @@
 module voiga_model_assembly
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t, body_t, phase_value
+    use voiga_model, only: model_t
+    use voiga_model_body, only: body_t
+    use voiga_model_loads, only: phase_value
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element

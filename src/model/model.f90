@@ -1,15 +1,12 @@
 !> The mechanical model: bodies (discretization + material + DOF offset),
-!> prescribed displacements and pressures with their load histories.
+!> prescribed displacements and pressures with their load histories, and the
+!> contact pairs. Physics only: how it is solved is the solver's (`&solver`).
 module voiga_model
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_case, only: case_t
-    use voiga_material, only: material_t
-    use voiga_material_factory, only: new_material
     use voiga_discretization_patch, only: discretization_t, edge_cps
-    use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: element_points_t, reference_gradients
-    use voiga_discretization_element, only: element_basis, element_nfun
+    use voiga_model_body, only: body_t, body_settings_t, new_body
+    use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
     use voiga_contact_pair, only: pair_slot_t
     use voiga_contact_factory, only: contact_settings_t, new_contact_pair
     use voiga_contact_surface, only: new_contact_surface
@@ -18,57 +15,14 @@ module voiga_model
     implicit none
     private
 
-    public :: model_t, body_t, dirichlet_t, pressure_t, new_model, phase_value, n_total_steps, &
-              step_time, body_points
+    public :: model_t, new_model, set_prescribed, reference_coordinates
 
-    !> A deformable body.
-    type :: body_t
-        character(len=32) :: name = ''
-        type(discretization_t) :: disc
-        class(material_t), allocatable :: mat
-        !> Global DOFs of this body are dof0 + 1 .. dof0 + 2 ncp (2(a-1)+i for point a, component i).
-        integer :: dof0 = 0
-        !> Gauss points per direction used for this body [xi, eta], and the points
-        !> and weights on [-1, 1] along xi (gx, wx) and eta (ge, we).
-        integer :: n_gauss(2) = 0
-        real(dp), allocatable :: gx(:), wx(:), ge(:), we(:)
-        !> Every element's quadrature points (reference gradients, weights) [nel].
-        type(element_points_t), allocatable :: points(:)
-    end type body_t
-
-    !> Prescribed displacement on the control points of an edge.
-    type :: dirichlet_t
-        integer :: body = 0
-        character(len=32) :: edge = ''
-        !> Global DOF numbers of the edge's x and y components, shape [2, ncp_edge].
-        integer, allocatable :: dofs(:, :)
-        logical :: fix(2) = .false.
-        !> Value at the end of each phase [2, n_phases].
-        real(dp), allocatable :: values(:, :)
-    end type dirichlet_t
-
-    !> Pressure on an edge (reference configuration, positive into the body).
-    type :: pressure_t
-        integer :: body = 0
-        !> Edge index 1..4 (xi0, xi1, eta0, eta1) of the oriented patch.
-        integer :: edge = 0
-        real(dp), allocatable :: values(:)
-    end type pressure_t
-
-    !> Everything the solver needs.
+    !> Everything the solver needs to know of the physics.
     type :: model_t
         type(body_t), allocatable :: bodies(:)
         integer :: ndof = 0
         type(dirichlet_t), allocatable :: dirichlet(:)
         type(pressure_t), allocatable :: pressure(:)
-        !> Steps per phase.
-        integer, allocatable :: n_steps(:)
-        integer :: max_iterations = 25
-        real(dp) :: tol_residual = 1.0e-10_dp, tol_energy = 1.0e-20_dp
-        !> Linear solver: 'direct' or 'multigrid' (`&solver linear_solver`).
-        character(len=16) :: linear_solver = 'direct'
-        !> Newton step damping: 'residual' or 'natural' (`&solver damping`).
-        character(len=16) :: damping = 'residual'
         !> Is any body finite-strain?
         logical :: finite_strain = .false.
         !> fixed(dof): is the DOF prescribed? shape [ndof]
@@ -80,104 +34,96 @@ module voiga_model
 
 contains
 
-    !> Build the model of `case` from its discretized bodies `discs` (moved in).
-    subroutine new_model(self, case, discs, error)
+    !> Build the model of bodies `bodies` discretized by `discs` (one each, in
+    !> order), with `n_gauss` points per direction (0: automatic), the loads and the
+    !> contact pairs. The names in the loads and pairs must be valid (the case
+    !> reader checks them); an unknown edge is an error.
+    subroutine new_model(self, bodies, discs, n_gauss, dirichlet, pressure, contact, error)
         type(model_t), intent(out) :: self
-        type(case_t), intent(in) :: case
-        type(discretization_t), intent(inout) :: discs(:)
+        type(body_settings_t), intent(in) :: bodies(:)
+        type(discretization_t), intent(in) :: discs(:)
+        integer, intent(in) :: n_gauss
+        type(dirichlet_settings_t), intent(in) :: dirichlet(:)
+        type(pressure_settings_t), intent(in) :: pressure(:)
+        type(contact_settings_t), intent(in) :: contact(:)
         type(error_t), allocatable, intent(out) :: error
-        integer :: i, k, ib, ie, ng
-        integer, allocatable :: cps(:)
-        character(len=64) :: buf
+        integer :: i, k
 
-        allocate (self%bodies(size(case%bodies)))
+        allocate (self%bodies(size(bodies)))
         self%ndof = 0
-        do i = 1, size(case%bodies)
-            associate (b => self%bodies(i), inp => case%bodies(i))
-                b%name = inp%name
-                b%disc = discs(i)
-                call new_material(b%mat, inp%material, inp%youngs_modulus, inp%poisson_ratio, error)
-                if (allocated(error)) return
-                b%dof0 = self%ndof
-                self%ndof = self%ndof + 2*b%disc%ncp
-                ng = case%solver%n_gauss
-                if (ng > 0) then
-                    b%n_gauss = ng
-                else
-                    ! degree + 1 per direction; the VO row needs the layer's degree along xi
-                    b%n_gauss(1) = b%disc%bulk%degree(1) + 1
-                    if (b%disc%has_layer) b%n_gauss(1) = max(b%n_gauss(1), b%disc%layer%degree + 1)
-                    b%n_gauss(2) = b%disc%bulk%degree(2) + 1
-                end if
-                allocate (b%gx(b%n_gauss(1)), b%wx(b%n_gauss(1)), b%ge(b%n_gauss(2)), b%we(b%n_gauss(2)))
-                call gauss_legendre(b%n_gauss(1), b%gx, b%wx)
-                call gauss_legendre(b%n_gauss(2), b%ge, b%we)
-                call body_points(b)
-                self%finite_strain = self%finite_strain .or. b%mat%finite_strain
-            end associate
+        do i = 1, size(bodies)
+            call new_body(self%bodies(i), bodies(i), discs(i), self%ndof, n_gauss, error)
+            if (allocated(error)) return
+            self%ndof = self%ndof + 2*self%bodies(i)%disc%ncp
+            self%finite_strain = self%finite_strain .or. self%bodies(i)%mat%finite_strain
         end do
-        self%n_steps = case%solver%n_steps
-        self%max_iterations = case%solver%max_iterations
-        self%tol_residual = case%solver%tol_residual
-        self%tol_energy = case%solver%tol_energy
-        self%linear_solver = case%solver%linear_solver
-        self%damping = case%solver%damping
-
         allocate (self%fixed(self%ndof))
         self%fixed = .false.
-        allocate (self%dirichlet(size(case%dirichlet)))
-        do k = 1, size(case%dirichlet)
-            ib = find_body(self, case%dirichlet(k)%body)
-            call edge_cps(self%bodies(ib)%disc, case%dirichlet(k)%edge, cps, error)
-            if (allocated(error)) then
-                write (buf, '(a,i0,a)') ': &dirichlet (', k, '): edge: '
-                error%message = case%path//trim(buf)//' '//error%message//" of body '"// &
-                                trim(case%dirichlet(k)%body)//"' (edges: "//edge_names(self%bodies(ib)%disc)//')'
-                return
-            end if
-            associate (d => self%dirichlet(k))
-                d%body = ib
-                d%edge = case%dirichlet(k)%edge
-                d%fix = case%dirichlet(k)%fix
-                d%values = case%dirichlet(k)%values
-                allocate (d%dofs(2, size(cps)))
-                d%dofs(1, :) = self%bodies(ib)%dof0 + 2*cps - 1
-                d%dofs(2, :) = self%bodies(ib)%dof0 + 2*cps
-                if (d%fix(1)) self%fixed(d%dofs(1, :)) = .true.
-                if (d%fix(2)) self%fixed(d%dofs(2, :)) = .true.
-            end associate
+        allocate (self%dirichlet(size(dirichlet)))
+        do k = 1, size(dirichlet)
+            call new_dirichlet(self, dirichlet(k), self%dirichlet(k), error)
+            if (allocated(error)) return
         end do
-        allocate (self%pressure(size(case%pressure)))
-        do k = 1, size(case%pressure)
-            ib = find_body(self, case%pressure(k)%body)
-            ie = 0
-            do i = 1, 4
-                if (trim(self%bodies(ib)%disc%edges(i)%name) == trim(case%pressure(k)%edge)) ie = i
-            end do
-            if (ie == 0) then
-                write (buf, '(a,i0,a)') ': &pressure (', k, '): edge: '
-                call fatal_error(error, case%path//trim(buf)//" no edge named '"// &
-                                 trim(case%pressure(k)%edge)//"' on body '"//trim(case%pressure(k)%body)// &
-                                 "' (edges: "//edge_names(self%bodies(ib)%disc)//')', error_code%input)
-                return
-            end if
-            self%pressure(k)%body = ib
-            self%pressure(k)%edge = ie
-            self%pressure(k)%values = case%pressure(k)%values
+        allocate (self%pressure(size(pressure)))
+        do k = 1, size(pressure)
+            call new_pressure(self, pressure(k), self%pressure(k), error)
+            if (allocated(error)) return
         end do
-        if (.not. allocated(case%contact)) then
-            allocate (self%pairs(0))
-            return
-        end if
-        allocate (self%pairs(size(case%contact)))
-        do k = 1, size(case%contact)
-            call new_pair(self, case%contact(k), self%pairs(k), error)
+        allocate (self%pairs(size(contact)))
+        do k = 1, size(contact)
+            call new_pair(self, contact(k), self%pairs(k), error)
             if (allocated(error)) return
         end do
     end subroutine new_model
 
-    !> Build a contact pair; its history starts from the projections in the
-    !> reference configuration.
+    !> A prescribed displacement on its edge's control points; marks them fixed.
+    subroutine new_dirichlet(self, inp, d, error)
+        type(model_t), intent(inout) :: self
+        type(dirichlet_settings_t), intent(in) :: inp
+        type(dirichlet_t), intent(out) :: d
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: cps(:)
+        integer :: ib
+        ib = find_body(self, inp%body)
+        call edge_cps(self%bodies(ib)%disc, inp%edge, cps, error)
+        if (allocated(error)) then
+            error%message = 'dirichlet: '//error%message//" of body '"//trim(inp%body)//"'"
+            return
+        end if
+        d%body = ib
+        d%edge = inp%edge
+        d%fix = inp%fix
+        d%values = inp%values
+        allocate (d%dofs(2, size(cps)))
+        d%dofs(1, :) = self%bodies(ib)%dof0 + 2*cps - 1
+        d%dofs(2, :) = self%bodies(ib)%dof0 + 2*cps
+        if (d%fix(1)) self%fixed(d%dofs(1, :)) = .true.
+        if (d%fix(2)) self%fixed(d%dofs(2, :)) = .true.
+    end subroutine new_dirichlet
+
+    !> A pressure on its edge (by the edge's index in the oriented patch).
+    subroutine new_pressure(self, inp, p, error)
+        type(model_t), intent(in) :: self
+        type(pressure_settings_t), intent(in) :: inp
+        type(pressure_t), intent(out) :: p
+        type(error_t), allocatable, intent(out) :: error
+        integer :: ib, i
+        ib = find_body(self, inp%body)
+        p%body = ib
+        p%edge = 0
+        do i = 1, 4
+            if (trim(self%bodies(ib)%disc%edges(i)%name) == trim(inp%edge)) p%edge = i
+        end do
+        if (p%edge == 0) then
+            call fatal_error(error, "pressure: no edge named '"//trim(inp%edge)//"' on body '"// &
+                             trim(inp%body)//"'", error_code%input)
+            return
+        end if
+        p%values = inp%values
+    end subroutine new_pressure
+
+    !> Build a contact pair of the method the settings name; its history starts
+    !> from the projections in the reference configuration.
     subroutine new_pair(self, inp, slot, error)
         type(model_t), intent(in) :: self
         type(contact_settings_t), intent(in) :: inp
@@ -191,70 +137,35 @@ contains
         call new_contact_pair(slot%pair, inp%method, error)
         if (allocated(error)) return
         associate (pair => slot%pair)
-        pair%slave_name = inp%slave
-        pair%master_name = inp%master
-        ib = find_body(self, inp%slave)
-        pair%slave_body = ib
-        call new_contact_surface(pair%slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
-        if (trim(inp%master) == 'rigid') then
-            call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
-            allocate (pair%master, source=rigid)
-        else
-            ib = find_body(self, inp%master)
-            pair%master_body = ib
-            call new_nurbs_master(master, self%bodies(ib)%disc, self%bodies(ib)%dof0)
-            allocate (pair%master, source=master)
-        end if
-        pair%law%eps_n = inp%penalty_normal
-        pair%law%eps_t = inp%penalty_tangent
-        pair%law%mu = inp%friction
-        pair%n_gauss = inp%n_gauss
-        call pair%setup()
-        allocate (u0(self%ndof), r0(self%ndof))
-        u0 = 0.0_dp
-        r0 = 0.0_dp
-        call pair%evaluate(u0, r0, error)
-        if (allocated(error)) return
-        call pair%commit()
-        pair%n_evaluations = 0
-        pair%n_friction = 0
+            pair%slave_name = inp%slave
+            pair%master_name = inp%master
+            ib = find_body(self, inp%slave)
+            pair%slave_body = ib
+            call new_contact_surface(pair%slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
+            if (trim(inp%master) == 'rigid') then
+                call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
+                allocate (pair%master, source=rigid)
+            else
+                ib = find_body(self, inp%master)
+                pair%master_body = ib
+                call new_nurbs_master(master, self%bodies(ib)%disc, self%bodies(ib)%dof0)
+                allocate (pair%master, source=master)
+            end if
+            pair%law%eps_n = inp%penalty_normal
+            pair%law%eps_t = inp%penalty_tangent
+            pair%law%mu = inp%friction
+            pair%n_gauss = inp%n_gauss
+            call pair%setup()
+            allocate (u0(self%ndof), r0(self%ndof))
+            u0 = 0.0_dp
+            r0 = 0.0_dp
+            call pair%evaluate(u0, r0, error)
+            if (allocated(error)) return
+            call pair%commit()
+            pair%n_evaluations = 0
+            pair%n_friction = 0
         end associate
     end subroutine new_pair
-
-    !> The quadrature points of every element of `body` (reference gradients and
-    !> weights x |det|), from its discretization and Gauss rule. `new_model` calls
-    !> it; call it again after changing the body's reference control points.
-    pure subroutine body_points(body)
-        type(body_t), intent(inout) :: body
-        real(dp), allocatable :: r(:), dr(:, :), x0(:, :)
-        real(dp) :: xi, eta, det, hx, he
-        integer :: e, i, j, q, nen
-
-        if (allocated(body%points)) deallocate (body%points)
-        allocate (body%points(body%disc%nel))
-        do e = 1, body%disc%nel
-            associate (el => body%disc%elements(e), pts => body%points(e))
-                nen = element_nfun(body%disc, e)
-                allocate (r(nen), dr(2, nen))
-                x0 = body%disc%x(:, el%conn)
-                allocate (pts%dndx(2, nen, size(body%gx)*size(body%ge)), pts%wdv(size(body%gx)*size(body%ge)))
-                hx = 0.5_dp*(el%xi(2) - el%xi(1))
-                he = 0.5_dp*(el%eta(2) - el%eta(1))
-                q = 0
-                do j = 1, size(body%ge)
-                    eta = el%eta(1) + he*(body%ge(j) + 1.0_dp)
-                    do i = 1, size(body%gx)
-                        xi = el%xi(1) + hx*(body%gx(i) + 1.0_dp)
-                        q = q + 1
-                        call element_basis(body%disc, e, xi, eta, r, dr)
-                        call reference_gradients(x0, dr, pts%dndx(:, :, q), det)
-                        pts%wdv(q) = body%wx(i)*body%we(j)*hx*he*abs(det)
-                    end do
-                end do
-                deallocate (r, dr)
-            end associate
-        end do
-    end subroutine body_points
 
     pure integer function find_body(self, name) result(ib)
         type(model_t), intent(in) :: self
@@ -266,51 +177,33 @@ contains
         end do
     end function find_body
 
-    pure function edge_names(disc) result(list)
-        type(discretization_t), intent(in) :: disc
-        character(len=:), allocatable :: list
-        integer :: i
-        list = ''
-        do i = 1, 4
-            list = list//"'"//trim(disc%edges(i)%name)//"'"
-            if (i < 4) list = list//', '
-        end do
-    end function edge_names
-
-    !> Total number of load steps over all phases.
-    pure integer function n_total_steps(self)
-        type(model_t), intent(in) :: self
-        n_total_steps = sum(self%n_steps)
-    end function n_total_steps
-
-    !> Load "time" at the end of global step `step` (0 = start; phase k ends at time k).
-    pure real(dp) function step_time(self, step) result(t)
-        type(model_t), intent(in) :: self
-        integer, intent(in) :: step
-        integer :: k, left
-        left = step
-        t = 0.0_dp
-        do k = 1, size(self%n_steps)
-            if (left <= self%n_steps(k)) then
-                t = real(k - 1, dp) + real(left, dp)/real(self%n_steps(k), dp)
-                return
-            end if
-            left = left - self%n_steps(k)
-        end do
-        t = real(size(self%n_steps), dp)
-    end function step_time
-
-    !> Value of a phase-wise linear history at load time `t`: 0 at t = 0, `values(k)` at t = k.
-    pure real(dp) function phase_value(values, t) result(v)
-        real(dp), intent(in) :: values(:)
+    !> Put the prescribed values at load time `t` into `u`.
+    pure subroutine set_prescribed(model, t, u)
+        type(model_t), intent(in) :: model
         real(dp), intent(in) :: t
-        integer :: k
-        real(dp) :: a, s
-        k = min(max(ceiling(t), 1), size(values))
-        s = t - real(k - 1, dp)
-        a = 0.0_dp
-        if (k > 1) a = values(k - 1)
-        v = a + s*(values(k) - a)
-    end function phase_value
+        real(dp), intent(inout) :: u(:)
+        integer :: j, c
+        do j = 1, size(model%dirichlet)
+            do c = 1, 2
+                if (model%dirichlet(j)%fix(c)) then
+                    u(model%dirichlet(j)%dofs(c, :)) = phase_value(model%dirichlet(j)%values(c, :), t)
+                end if
+            end do
+        end do
+    end subroutine set_prescribed
+
+    !> Reference coordinates of the control point of every DOF; shape: [ndof]
+    !> (2(a-1)+i of body b at dof0 + 2(a-1) + i, as the displacement).
+    pure function reference_coordinates(model) result(x0)
+        type(model_t), intent(in) :: model
+        real(dp), allocatable :: x0(:)
+        integer :: ib, n
+        allocate (x0(model%ndof))
+        x0 = 0.0_dp
+        do ib = 1, size(model%bodies)
+            n = size(model%bodies(ib)%disc%x)
+            x0(model%bodies(ib)%dof0 + 1:model%bodies(ib)%dof0 + n) = reshape(model%bodies(ib)%disc%x, [n])
+        end do
+    end function reference_coordinates
 
 end module voiga_model

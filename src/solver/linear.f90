@@ -32,6 +32,8 @@ module voiga_solver_linear
         procedure(factor_interface), deferred :: factor
         !> Solve a x = b with what `factor` prepared (`a`: the matrix passed to it).
         procedure(solve_interface), deferred :: solve
+        !> Whether it solves iteratively, to the accuracy asked (default: no).
+        procedure :: iterative => linear_iterative
         !> Whether `determinant` gives the sign of det(a) (default: no).
         procedure :: has_determinant => linear_has_determinant
         !> Sign and log10 magnitude of det(a) of the last `factor` (default: sign 0, unknown).
@@ -66,6 +68,11 @@ module voiga_solver_linear
     end interface
 
 contains
+
+    pure logical function linear_iterative(self)
+        class(linear_solver_t), intent(in) :: self
+        linear_iterative = .false.
+    end function linear_iterative
 
     pure logical function linear_has_determinant(self)
         class(linear_solver_t), intent(in) :: self

@@ -94,6 +94,7 @@ module voiga_solver_multigrid
         procedure :: n_levels => mg_n_levels
         !> DOFs of every level.
         procedure :: level_dofs => mg_level_dofs
+        procedure :: iterative => mg_iterative
         procedure :: last_iterations => mg_last_iterations
         procedure :: last_residual => mg_last_residual
     end type multigrid_t
@@ -313,6 +314,11 @@ contains
             n(l) = self%levels(l)%n
         end do
     end function mg_level_dofs
+
+    pure logical function mg_iterative(self)
+        class(multigrid_t), intent(in) :: self
+        mg_iterative = .true.
+    end function mg_iterative
 
     !> GMRES iterations of the last solve, and the relative residual it reached.
     pure integer function mg_last_iterations(self) result(n)

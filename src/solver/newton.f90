@@ -1,97 +1,34 @@
-!> Quasi-static load stepping with Newton-Raphson and adaptive load increments.
-!>
-!> Per (sub)step: prescribed displacements are set to their values at the load
-!> time, then Newton iterates K du = -r on the free DOFs (the prescribed DOFs are
-!> eliminated symmetrically, their corrections are zero) until
-!> ||r|| <= tol_residual ||r_0|| or |du.r| <= tol_energy |du_1.r_0|, with r_0 the
-!> substep's first residual, or until the residual has reached its round-off level
-!> (`residual_floor`): with a stiff penalty, ||K|| is so large that rounding the
-!> coordinates alone moves the residual by more than tol_residual ||r_0||.
-!>
-!> Adaptive stepping (docs/robustness.md): a substep that fails numerically (the
-!> iteration cap, a residual that is not finite or grows by `divergence_ratio`, an
-!> inverted element, a contact projection that does not converge, a singular
-!> matrix) is cut: the last converged state (u and the contact pairs' trial
-!> history) is restored and the increment halved, down to `min_step_fraction` of
-!> the nominal step; after a substep that converged in at most `grow_iterations`
-!> iterations the increment doubles again (never beyond the nominal step). Substeps
-!> subdivide a nominal step, so the case's steps are hit exactly and only their
-!> converged states are written. SIGINT/SIGTERM (voiga_solver_signals) are polled
-!> between iterations: the solve stops with the last converged state.
-!>
-!> Tresca fixed point (docs/robustness.md, "Tresca fixed point"): a frictional
-!> substep whose attempt from the last converged state failed at a fold (contact
-!> states switching, det K changing sign) is retried once at the same increment by
-!> successive approximations on the slip bounds: Newton on the Tresca problem (slip
-!> limit g_i fixed, no mu x penalty_normal coupling in the tangent), then
-!> g_i = mu p_N,i, until the Coulomb residual itself meets Newton's convergence test.
+!> One Newton attempt at a load time: K du = -r on the free DOFs (the prescribed
+!> DOFs are eliminated symmetrically, their corrections are zero), iterated from a
+!> given start until `voiga_solver_convergence` says it has converged, or until it
+!> fails with a reason (the iteration cap, a residual that is not finite or grows
+!> by `divergence_ratio`, contact states cycling, an inverted element, a contact
+!> projection that does not converge, a singular matrix). The load stepping
+!> (`voiga_solver_stepping`) decides what a failure leads to; the step length of
+!> each iteration follows `voiga_solver_step_length`. SIGINT/SIGTERM
+!> (voiga_solver_signals) are polled between iterations.
 module voiga_solver_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use voiga_kinds, only: dp, i8
+    use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t, phase_value, step_time, n_total_steps
-    use voiga_model_assembly, only: assembly_stats_t, assemble, stiffness_pattern, assembly_map_t, &
-                                    new_assembly_map
+    use voiga_model, only: model_t, reference_coordinates
+    use voiga_model_assembly, only: assemble, stiffness_pattern, assembly_map_t, new_assembly_map
+    use voiga_contact_law, only: state_stick, state_slip
     use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_umfpack, only: umfpack_t
-    use voiga_solver_multigrid, only: multigrid_t
-    use voiga_solver_linear, only: solve_accuracy_t
+    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
+    use voiga_solver_linear_factory, only: new_linear_solver
+    use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_signals, only: caught_signal, signal_name
-    use voiga_io_results, only: results_t, step_record_t, cut_record_t
+    use voiga_solver_records, only: solver_stats_t, step_record_t, wall_seconds
+    use voiga_solver_progress, only: progress_t, iteration_report_t
+    use voiga_solver_convergence, only: convergence_t, converged, at_roundoff, residual_floor, floor_cap, &
+                                        divergence_ratio
+    use voiga_solver_step_length, only: crossing_limit, backtracks, natural_reduction, natural_first_step, &
+                                        creep_step
     implicit none
     private
 
-    public :: solve_steps, solver_stats_t, wall_seconds, resume_t, stepping_t
-    public :: residual_floor, reference_coordinates
-
-    !> Where a restarted run continues: after step `step`, from displacement `u`, with
-    !> the substep fraction and force scale the interrupted run had there (the contact
-    !> pairs' committed history is set on the model by the caller).
-    type :: resume_t
-        integer :: step = 0
-        !> Displacement after `step` and after the step before it.
-        real(dp), allocatable :: u(:), u_before(:)
-        real(dp) :: fraction = 1.0_dp, r0_max = 0.0_dp
-        !> Sign of det K of the last tangent factorized before `step` was written.
-        integer :: det_sign = 0
-    end type resume_t
-
-    !> Most halvings of one Newton step.
-    integer, parameter :: max_line_search = 8
-
-    !> Mortar pairs: a Newton step that closes an open control point is shortened to
-    !> this multiple of the fraction at which the first one closes (a little beyond,
-    !> so that it is active and its stiffness in the next tangent;
-    !> `pair_crossing_fraction`).
-    real(dp), parameter :: closing_overshoot = 1.01_dp
-
-    !> A Newton iteration whose accepted step is at most this long creeps; an attempt
-    !> that fails with half its iterations creeping (residual damping) names natural
-    !> damping in its message.
-    real(dp), parameter :: creep_step = 0.0625_dp
-
-    !> Natural damping (`damping = 'natural'`): most step reductions of one Newton
-    !> iteration, and the smallest step length.
-    integer, parameter :: max_natural_damping = 10
-    real(dp), parameter :: min_natural_step = 1.0e-4_dp
-
-    !> A Newton iteration whose residual exceeds this multiple of the substep's
-    !> first residual has diverged (the substep is cut instead of iterated to the cap).
-    real(dp), parameter :: divergence_ratio = 1.0e10_dp
-
-    !> Safety factor of the round-off floor `residual_floor` (rounding errors of a
-    !> sum of many element contributions add up; measured over 148 converged
-    !> substeps of ironing with penalty 1e6 x E: the final residual is 0.06 to 0.9
-    !> times eps || |K| |x| ||, 5.7 at most; docs/robustness.md).
-    real(dp), parameter :: floor_factor = 10.0_dp
-
-    !> The round-off floor ends the iteration only when the residual is also below
-    !> this fraction of the run's force scale (the largest first residual of a
-    !> substep so far, or this substep's): a floor above it (a penalty too stiff for
-    !> double precision) fails the substep instead of accepting it. The force scale,
-    !> not the substep's own first residual: the floor does not shrink with the load
-    !> increment, so a cut substep would otherwise never reach it.
-    real(dp), parameter :: floor_cap = 1.0e-6_dp
+    public :: newton_t, new_newton, attempt_t, newton_attempt, contact_states
 
     !> Relative residual of an iterative linear solve at a Newton iteration whose
     !> contact states differ from the previous iteration's (multigrid only): the
@@ -107,674 +44,414 @@ module voiga_solver_newton
     real(dp), parameter :: active_set_forcing = 1.0e-2_dp, soft_forcing = 1.0e-1_dp
     integer, parameter :: soft_iterations = 10
 
-    !> Most Tresca solves (fixed-point iterations) of one retried substep.
-    integer, parameter :: max_fixed_point = 40
+    !> What a run's Newton attempts share, set up once: the settings, the tangent's
+    !> pattern and element map, the linear solver, the reference coordinates.
+    type :: newton_t
+        type(solver_settings_t) :: settings
+        !> The tangent (its pattern follows the contact couplings) and, with natural
+        !> damping, the tangent of the last factorization.
+        type(csc_matrix_t) :: k, k_old
+        type(assembly_map_t) :: map
+        class(linear_solver_t), allocatable :: linear
+        !> Natural damping (`&solver damping = 'natural'`).
+        logical :: natural = .false.
+        !> Reference coordinates of every DOF's control point; residual at the last
+        !> evaluation. Shapes: [ndof].
+        real(dp), allocatable :: x0(:), r(:)
+    end type newton_t
 
-    !> Adaptive load stepping settings (`&solver`: min_step_fraction, max_cuts,
-    !> grow_iterations; docs/robustness.md).
-    type :: stepping_t
-        !> Smallest load increment, as a fraction of the nominal step.
-        real(dp) :: min_step_fraction = 1.0e-4_dp
-        !> Most cuts per nominal step (0: a failed step fails the run).
-        integer :: max_cuts = 30
-        !> The increment doubles after a substep converged in at most this many iterations.
-        integer :: grow_iterations = 5
-        !> Start a substep from u_conv + (substep fraction) x (the last nominal step's
-        !> increment) when that step is in the same load phase.
-        logical :: predictor = .true.
-        !> Solve every substep of a frictional model by the Tresca fixed point (from the
-        !> last converged state), not only those whose Newton attempt folds: for tests
-        !> and comparisons (Fortran API only, not a case-file setting).
-        logical :: tresca_always = .false.
-    end type stepping_t
+    !> How an attempt ended (its error, if it failed, says why).
+    type :: attempt_t
+        !> Newton iterations, and the residual norm at the end.
+        integer :: iterations = 0
+        real(dp) :: residual = 0.0_dp
+        !> Sign of det K of the last tangent factorized (0: none, or unknown), and the
+        !> iterations whose tangent had det K <= 0.
+        integer :: det_sign = 0, nonpositive_det = 0
+        !> The attempt failed with contact states switching (a period-2 cycle, or the
+        !> iteration cap with switches among the last iterations).
+        logical :: switching = .false.
+    end type attempt_t
 
-    !> Counters of a run.
-    type :: solver_stats_t
-        type(assembly_stats_t) :: assembly
-        !> Converged nominal steps; Newton iterations of all attempts.
-        integer :: steps = 0, iterations = 0
-        integer :: symbolic_factorizations = 0, numeric_factorizations = 0
-        !> Substeps whose predicted start failed and that were retried from the last
-        !> converged state.
-        integer :: predictor_retries = 0
-        !> Residual evaluations spent on shortening Newton steps (halving, or natural damping).
-        integer :: line_search_steps = 0
-        !> Sign of det(K) of the last factorization (free DOFs), and the iterations of
-        !> the last Newton attempt whose tangent had det(K) <= 0 (`newton_solve`).
-        integer :: det_sign = 0, attempt_nonpositive_det = 0
-        !> DOFs of each multigrid level (empty with the direct solver).
-        integer, allocatable :: multigrid_levels(:)
-        !> The last Newton attempt failed with contact states switching (a period-2
-        !> cycle, or the iteration cap with switches among the last iterations).
-        logical :: attempt_switching = .false.
-        !> Substeps retried with the Tresca fixed point, of them accepted, and the
-        !> fixed-point iterations (Tresca solves) of all retries.
-        integer :: tresca_retries = 0, tresca_accepted = 0, fixed_point_iterations = 0
-        !> Largest first residual of a step so far: the force scale of the round-off floor.
-        real(dp) :: r0_max = 0.0_dp
-        !> Converged substeps and cuts of the load increment.
-        integer :: substeps = 0, cuts = 0
-        !> The signal that interrupted the run (0: none).
-        integer :: signal = 0
-        !> The record of every converged step (residual and energy norms, reactions, seconds).
-        type(step_record_t), allocatable :: records(:)
-        !> Every cut of the run.
-        type(cut_record_t), allocatable :: cut_records(:)
-    end type solver_stats_t
+    !> One attempt's state between iterations.
+    type :: iterate_t
+        !> Iterations done, step reductions of the current one, iterations whose
+        !> accepted step was at most `creep_step`.
+        integer :: it = 0, nls = 0, short_steps = 0
+        type(convergence_t) :: c
+        real(dp) :: alpha = 1.0_dp, alpha_prev = 1.0_dp, rn_prev = huge(1.0_dp)
+        !> Natural damping: norms of the last two corrections.
+        real(dp) :: du_norm = 0.0_dp, du_norm_prev = 0.0_dp
+        !> The step was cut to a contact crossing; the simplified correction of the
+        !> accepted point is known.
+        logical :: closing = .false., have_bar = .false.
+        real(dp), allocatable :: du(:), u_prev(:), rhs(:), du_bar(:), du_bar_acc(:)
+        !> Residual before each iteration and after the last; |du.r| of each.
+        real(dp), allocatable :: norms(:), energies(:)
+        !> Contact state of every slave point after each iteration; shape: [npoints, 0:max_iterations].
+        integer, allocatable :: states(:, :)
+    end type iterate_t
 
 contains
 
-    !> Wall-clock seconds since an arbitrary origin.
-    real(dp) function wall_seconds()
-        integer(i8) :: count, rate
-        call system_clock(count, rate)
-        wall_seconds = real(count, dp)/real(rate, dp)
-    end function wall_seconds
-
-    !> Run every load step of `model` from zero displacement; write each converged
-    !> nominal step to `results` (if present) and report progress (and every cut)
-    !> unless `quiet`. `u` holds the last converged displacement on return (also on
-    !> failure). An interrupt (stats%signal /= 0) returns an error too.
-    subroutine solve_steps(model, u, stats, quiet, error, results, t0, verbose, stepping, resume)
-        type(model_t), intent(inout) :: model
-        real(dp), allocatable, intent(out) :: u(:)
-        type(solver_stats_t), intent(out) :: stats
-        logical, intent(in) :: quiet
+    !> Set up the attempts of a run of `model`: the tangent's pattern, the element
+    !> map, the linear solver the settings name.
+    subroutine new_newton(self, model, settings, error)
+        type(newton_t), intent(out) :: self
+        type(model_t), intent(in) :: model
+        type(solver_settings_t), intent(in) :: settings
         type(error_t), allocatable, intent(out) :: error
-        type(results_t), intent(inout), optional :: results
-        !> Wall time origin of the run (for the time written to the results).
-        real(dp), intent(in), optional :: t0
-        !> Print every Newton iteration (residual, energy, contact states).
-        logical, intent(in), optional :: verbose
-        !> Adaptive stepping settings (default: `stepping_t()`).
-        type(stepping_t), intent(in), optional :: stepping
-        !> Continue an interrupted run instead of starting from zero.
-        type(resume_t), intent(in), optional :: resume
-        type(stepping_t) :: set
-        type(csc_matrix_t) :: k
-        type(assembly_map_t) :: map
-        type(umfpack_t) :: lu
-        type(multigrid_t) :: mg
-        type(step_record_t) :: rec
-        type(cut_record_t) :: cut
-        real(dp), allocatable :: r(:), u_conv(:), u_step(:), u_step_before(:)
-        real(dp) :: t, t_begin, t_end, tic, start, frac, s, ds, rn
-        integer :: step, nsteps, j, c, ip, it, first_cut, first
-        logical :: loud, predicted, unpredicted_retry
-        character(len=200) :: msg
-        type(error_t), allocatable :: tresca_error
-        ! sign of det(K) at the last converged substep; det(K) <= 0 iterations and all
-        ! iterations of the last failed attempt started from the converged state
-        integer :: conv_det_sign, fold_iterations, fold_total
-
-        start = wall_seconds()
-        if (present(t0)) start = t0
-        if (present(stepping)) set = stepping
-        loud = .false.
-        if (present(verbose)) loud = verbose
-        call stiffness_pattern(model, k, error)
+        self%settings = settings
+        call stiffness_pattern(model, self%k, error)
         if (allocated(error)) return
-        call new_assembly_map(model, k, map)
-        if (model%linear_solver == 'multigrid') then
-            call mg%build(model%bodies(:)%disc, model%bodies(:)%dof0, model%ndof, model%fixed, error)
-            if (allocated(error)) return
-            stats%multigrid_levels = mg%level_dofs()
-            if (present(results)) call results%write_multigrid(stats%multigrid_levels)
-            if (.not. quiet) write (*, '(a,i0,a,*(1x,i0))') 'multigrid: ', mg%n_levels(), &
-                ' levels, DOFs', stats%multigrid_levels
-        end if
-        allocate (u(model%ndof), r(model%ndof))
-        u = 0.0_dp
-        u_conv = u
-        ! converged states at the ends of the last two nominal steps (step 0: zero)
-        u_step = u
-        nsteps = n_total_steps(model)
-        allocate (stats%records(0), stats%cut_records(0))
-        ! the load increment as a fraction of the nominal step; carried over steps
-        frac = 1.0_dp
-        unpredicted_retry = .false.
-        first = 1
-        conv_det_sign = 0
-        if (present(resume)) then
-            if (allocated(resume%u)) then
-                u = resume%u
-                u_conv = u
-                u_step = u
-                if (allocated(resume%u_before)) u_step_before = resume%u_before
-                frac = resume%fraction
-                stats%r0_max = resume%r0_max
-                conv_det_sign = resume%det_sign
-                first = resume%step + 1
-            end if
-        end if
-        steps: do step = first, nsteps
-            t_begin = step_time(model, step - 1)
-            t_end = step_time(model, step)
-            rec = step_record_t()
-            rec%step = step
-            rec%time = t_end
-            rec%substeps = 0
-            first_cut = size(stats%cut_records) + 1
-            fold_iterations = 0
-            fold_total = 0
-            ! s: converged part of the nominal step (sums of powers of 2: exact)
-            s = 0.0_dp
-            do while (s < 1.0_dp)
-                ds = min(frac, 1.0_dp - s)
-                t = t_end
-                if (s + ds < 1.0_dp) t = t_begin + (s + ds)*(t_end - t_begin)
-                predicted = .false.
-                if (set%predictor .and. .not. unpredicted_retry .and. allocated(u_step_before) &
-                    .and. step >= 2) then
-                    if (phase_of_step(model, step - 1) == phase_of_step(model, step)) then
-                        u = u + ds*(u_step - u_step_before)
-                        predicted = .true.
-                    end if
-                end if
-                unpredicted_retry = .false.
-                if (set%tresca_always .and. frictional(model)) then
-                    u = u_conv
-                    predicted = .false.
-                    call tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, &
-                                            loud, quiet, error)
-                else
-                    call set_prescribed(model, t, u)
-                    call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, loud, error)
-                end if
-                if (allocated(error) .and. .not. predicted .and. .not. set%tresca_always) then
-                    fold_iterations = stats%attempt_nonpositive_det
-                    fold_total = it
-                    ! contact states still switching in a frictional case (a period-2 cycle
-                    ! or the cap with switches; at a fold det K also changes sign, but the
-                    ! stick/slip switch of a stiff penalty stalls Newton with det K > 0 as
-                    ! well): retry the same increment with the Tresca fixed point before cutting
-                    if (error%code == error_code%numeric .and. stats%signal == 0 .and. &
-                        stats%attempt_switching .and. frictional(model)) then
-                        u = u_conv
-                        do ip = 1, size(model%pairs)
-                            call model%pairs(ip)%pair%reset_trial()
-                        end do
-                        call tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, &
-                                                loud, quiet, tresca_error)
-                        if (allocated(tresca_error)) then
-                            if (stats%signal /= 0) then
-                                call move_alloc(tresca_error, error)
-                            else
-                                error%message = error%message//'; retried with the Tresca fixed point: '// &
-                                                tresca_error%message
-                                deallocate (tresca_error)
-                            end if
-                        else
-                            deallocate (error)
-                        end if
-                    end if
-                end if
-                if (.not. allocated(error)) then
-                    if (it > 0) conv_det_sign = stats%det_sign
-                    u_conv = u
-                    do ip = 1, size(model%pairs)
-                        call model%pairs(ip)%pair%commit()
-                    end do
-                    s = s + ds
-                    rec%substeps = rec%substeps + 1
-                    stats%substeps = stats%substeps + 1
-                    if (it <= set%grow_iterations) frac = min(1.0_dp, 2.0_dp*frac)
-                    cycle
-                end if
-                ! failed: back to the last converged state, forget the contact trial history
-                u = u_conv
-                do ip = 1, size(model%pairs)
-                    call model%pairs(ip)%pair%reset_trial()
-                end do
-                if (stats%signal /= 0 .or. error%code /= error_code%numeric) exit steps
-                if (predicted) then
-                    ! a predicted start that fails is retried once from the last converged
-                    ! state, at the same increment, before the increment is cut
-                    unpredicted_retry = .true.
-                    stats%predictor_retries = stats%predictor_retries + 1
-                    if (.not. quiet) write (*, '(a,i0,a,f10.6,a)') 'retry step ', step, '  t=', t, &
-                        ' from the last converged state (the predicted start failed: '//error%message//')'
-                    deallocate (error)
-                    cycle
-                end if
-                if (rec%cuts >= set%max_cuts .or. &
-                    0.5_dp*ds < set%min_step_fraction*(1.0_dp - 1.0e-12_dp)) then
-                    if (rec%cuts > 0 .or. set%max_cuts > 0) then
-                        write (msg, '(a,i0,a,es9.2,a,es9.2,a,i0,a)') ' (after ', rec%cuts, &
-                            ' cuts; increment ', ds, ' of the nominal step, minimum ', &
-                            set%min_step_fraction, ', max_cuts ', set%max_cuts, ')'
-                        error%message = error%message//trim(msg)
-                    end if
-                    if (fold_iterations > 0 .and. (fold_iterations < fold_total .or. conv_det_sign > 0)) &
-                        error%message = error%message//fold_diagnosis(model, fold_iterations, fold_total)
-                    call append_locking_diagnosis(model, u_conv, t_begin + s*(t_end - t_begin), stats, &
-                                                  error%message)
-                    exit steps
-                end if
-                cut = cut_record_t(step=step, time=t, fraction=ds, new_fraction=0.5_dp*ds, &
-                                   reason=error%message)
-                call append_cut(stats%cut_records, cut)
-                stats%cuts = stats%cuts + 1
-                rec%cuts = rec%cuts + 1
-                frac = 0.5_dp*ds
-                if (.not. quiet) then
-                    write (*, '(a,i0,a,f10.6,a,es9.2,a)') 'cut  step ', step, '  t=', t, &
-                        '  new increment ', frac, ' of the step: '//error%message
-                end if
-                deallocate (error)
-            end do
-            u_conv = u
-            u_step_before = u_step
-            u_step = u
-            stats%steps = step
-            rec%det_sign = conv_det_sign
-            allocate (rec%reactions(2, size(model%dirichlet)))
-            do j = 1, size(model%dirichlet)
-                do c = 1, 2
-                    rec%reactions(c, j) = sum(r(model%dirichlet(j)%dofs(c, :)))
-                end do
-            end do
-            if (present(results)) then
-                tic = wall_seconds()
-                call results%write_step(rec, u, wall_seconds() - start, model%pairs, &
-                                        stats%cut_records(first_cut:), stats%cuts, frac, stats%r0_max)
-                rec%seconds(5) = wall_seconds() - tic
-            end if
-            stats%records = [stats%records, rec]
-            if (.not. quiet) then
-                write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)', advance='no') 'step ', step, '/', &
-                    nsteps, '  t=', t_end, '  it=', rec%iterations, '  |r|=', rn, '  ', sum(rec%seconds), ' s'
-                if (rec%substeps > 1 .or. rec%cuts > 0) then
-                    write (*, '(a,i0,a,i0)') '  substeps=', rec%substeps, ' cuts=', rec%cuts
-                else
-                    write (*, '(a)') ''
-                end if
-            end if
-            ! (a signal during the last step's output: the run is complete anyway)
-            if (caught_signal() /= 0 .and. step < nsteps) then
-                stats%signal = caught_signal()
-                call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
-                exit steps
-            end if
-        end do steps
-        if (allocated(error) .and. stats%signal == 0) then
-            write (msg, '(a,i0,a,es12.5,a)') 'step ', step, ' (load time ', t, '):'
-            error%message = trim(msg)//' '//error%message
-        end if
-        stats%symbolic_factorizations = lu%n_symbolic
-        stats%numeric_factorizations = lu%n_numeric
-    end subroutine solve_steps
-
-    !> Why a step that cut down to its limit failed, when the tangent's determinant
-    !> changed sign near the last converged state: det K <= 0 in `nonpositive` of
-    !> the `total` iterations of the last attempt started there, det K > 0 in the
-    !> others or at the converged state. Pieces of the (piecewise smooth)
-    !> incremental problem with opposite orientation meet there, so the incremental
-    !> map folds (it is not coherently oriented): for some increments it has no
-    !> solution nearby. The message does not decide between a limit point of the
-    !> path and a passage narrower than the smallest increment (docs/robustness.md,
-    !> "Folds of the incremental problem").
-    pure function fold_diagnosis(model, nonpositive, total) result(text)
-        type(model_t), intent(in) :: model
-        integer, intent(in) :: nonpositive, total
-        character(len=:), allocatable :: text
-        character(len=300) :: buf
-        integer :: ip
-        write (buf, '(a,i0,a,i0,a)') '; the determinant of the tangent stiffness changes sign near '// &
-            'the last converged state (det K <= 0 in ', nonpositive, ' of the ', total, &
-            ' iterations of the last attempt, > 0 in the others or at that state)'
-        text = trim(buf)//': pieces of the incremental problem with opposite orientation meet '// &
-               'there, so it folds (for some increments it has no nearby solution): either the '// &
-               'quasi-static path ends here (a limit point; the physical system would move '// &
-               'dynamically) or it goes on only through increments below min_step_fraction'
-        do ip = 1, size(model%pairs)
-            if (model%pairs(ip)%pair%law%mu <= 0.0_dp) cycle
-            write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', model%pairs(ip)%pair%law%mu, &
-                ', penalty_normal = ', model%pairs(ip)%pair%law%eps_n, '): slipping points couple the '
-            text = text//trim(buf)//' normal penalty into the tangential direction (mu x penalty_normal) '// &
-                   'which can make the tangent indefinite (the friction-induced instability); a smaller '// &
-                   'penalty_normal or mu keeps the path stable longer'
-            exit
-        end do
-    end function fold_diagnosis
-
-    !> Append to `message` what the contact zones look like at the last converged
-    !> state `u` (load time `t`) when one is broken up point by point (at least
-    !> `min_gaps` gaps shorter than a slave element, holding at least `min_hole_share`
-    !> of the zone's points) while its active points outnumber the slave control
-    !> points they act on: Gauss-point-to-surface constraints then over-constrain the
-    !> slave edge and, with a stiff penalty, lock (docs/robustness.md,
-    !> "Over-constrained contact zones"). GPTS pairs only. Nothing is appended otherwise, or when the
-    !> evaluation there fails.
-    subroutine append_locking_diagnosis(model, u, t, stats, message)
-        type(model_t), intent(inout) :: model
-        real(dp), intent(in) :: u(:), t
-        type(solver_stats_t), intent(inout) :: stats
-        character(len=:), allocatable, intent(inout) :: message
-        type(error_t), allocatable :: error
-        real(dp), allocatable :: r(:)
-        integer :: ip
-
-        if (size(model%pairs) == 0) return
-        allocate (r(model%ndof))
-        call assemble(model, u, t, r, stats%assembly, error)
-        do ip = 1, size(model%pairs)
-            call model%pairs(ip)%pair%reset_trial()
-        end do
+        call new_assembly_map(model, self%k, self%map)
+        call new_linear_solver(self%linear, settings%linear_solver, model, error)
         if (allocated(error)) return
-        do ip = 1, size(model%pairs)
-            message = message//model%pairs(ip)%pair%failure_diagnosis()
-        end do
-    end subroutine append_locking_diagnosis
-
-    !> Append `cut` to `list`.
-    pure subroutine append_cut(list, cut)
-        type(cut_record_t), allocatable, intent(inout) :: list(:)
-        type(cut_record_t), intent(in) :: cut
-        type(cut_record_t), allocatable :: longer(:)
-        integer :: i
-        allocate (longer(size(list) + 1))
-        do i = 1, size(list)
-            longer(i) = list(i)
-        end do
-        longer(size(list) + 1) = cut
-        call move_alloc(longer, list)
-    end subroutine append_cut
-
-    !> Load phase (1-based) that nominal step `step` belongs to.
-    pure integer function phase_of_step(model, step) result(ph)
-        type(model_t), intent(in) :: model
-        integer, intent(in) :: step
-        integer :: total
-        total = 0
-        do ph = 1, size(model%n_steps)
-            total = total + model%n_steps(ph)
-            if (step <= total) return
-        end do
-        ph = size(model%n_steps)
-    end function phase_of_step
+        self%natural = trim(settings%damping) == 'natural'
+        self%x0 = reference_coordinates(model)
+        allocate (self%r(model%ndof))
+        self%r = 0.0_dp
+    end subroutine new_newton
 
     !> Newton iterations at load time `t` from `u` (prescribed values set). On
-    !> success `rec` holds the iteration's norms; `it` the iterations, `rn` the final
-    !> residual norm. A numerical failure returns an error with code `numeric`; an
-    !> interrupt sets stats%signal and returns a generic error. With `r0_ref` the
-    !> relative tests (tol_residual, energy, divergence) use it instead of the first
-    !> residual (the Tresca solves of a fixed point, measured against the substep's).
-    subroutine newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, error, r0_ref)
+    !> success `rec` holds the iteration's norms. A numerical failure returns an
+    !> error with code `numeric` and its reason; an interrupt sets stats%signal and
+    !> returns a generic error. With `r0_ref` the relative tests (tol_residual,
+    !> energy, divergence) use it instead of the first residual (the Tresca solves of
+    !> a fixed point, measured against the substep's).
+    subroutine newton_attempt(self, model, step, t, u, stats, rec, progress, attempt, error, r0_ref)
+        type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
         integer, intent(in) :: step
         real(dp), intent(in) :: t
         real(dp), intent(inout) :: u(:)
-        !> Residual at the last evaluation, shape [ndof].
-        real(dp), intent(inout) :: r(:)
-        type(csc_matrix_t), intent(inout) :: k
-        type(assembly_map_t), intent(inout) :: map
-        type(umfpack_t), intent(inout) :: lu
-        !> The multigrid solver (used when model%linear_solver is 'multigrid').
-        type(multigrid_t), intent(inout) :: mg
         type(solver_stats_t), intent(inout) :: stats
         type(step_record_t), intent(inout) :: rec
-        integer, intent(out) :: it
-        real(dp), intent(out) :: rn
-        logical, intent(in) :: verbose
+        class(progress_t), intent(inout) :: progress
+        type(attempt_t), intent(out) :: attempt
         type(error_t), allocatable, intent(out) :: error
         real(dp), intent(in), optional :: r0_ref
-        real(dp), allocatable :: du(:), norms(:), energies(:), rhs(:), u_prev(:), x0(:)
-        ! contact state of every slave point after each iteration; shape: [npoints, 0:max_iterations]
-        integer, allocatable :: states(:, :)
-        real(dp) :: r0, e1, en, tic, bulk0, contact0, alpha, rn_prev, floor, log_det, eta
-        ! natural damping: simplified correction at the trial point, norms for the
-        ! a-priori step estimate
-        real(dp), allocatable :: du_bar(:), du_bar_acc(:)
-        type(csc_matrix_t) :: k_old
-        real(dp) :: theta, h_est, du_norm, du_norm_prev, alpha_prev
-        logical :: natural, have_bar, smooth, closing
-        real(dp) :: frac
-        integer :: nls, ip, flips
-        ! iterations whose accepted step was at most creep_step
-        integer :: short_steps
-        logical :: converged, multigrid, changing
-        character(len=800) :: msg
+        type(iterate_t) :: st
+        logical :: done
 
-        multigrid = model%linear_solver == 'multigrid'
-        natural = model%damping == 'natural' .and. .not. multigrid
-        closing = .false.
-        short_steps = 0
-        have_bar = .false.
-        du_norm = 0.0_dp
-        du_norm_prev = 0.0_dp
-        alpha_prev = 1.0_dp
-        allocate (du(model%ndof), rhs(model%ndof), u_prev(model%ndof), du_bar(model%ndof))
-        x0 = reference_coordinates(model)
-        allocate (states(sum([(size(model%pairs(ip)%pair%out), ip=1, size(model%pairs))]), &
-                         0:model%max_iterations))
-        allocate (norms(model%max_iterations + 1), energies(model%max_iterations))
-        converged = .false.
-        r0 = 0.0_dp
-        e1 = 0.0_dp
-        en = huge(1.0_dp)
-        rn = 0.0_dp
-        it = 0
-        nls = 0
-        alpha = 1.0_dp
-        rn_prev = huge(1.0_dp)
-        stats%attempt_nonpositive_det = 0
-        stats%attempt_switching = .false.
+        call start_iterate(self, model, st)
         do
             if (caught_signal() /= 0) then
                 stats%signal = caught_signal()
                 call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
                 exit
             end if
-            bulk0 = stats%assembly%seconds_bulk
-            contact0 = stats%assembly%seconds_contact
-            ! the substep's first assembly also fits the contact pattern to its start
-            call assemble(model, u, t, r, stats%assembly, error, k, map, refit=(it == 0 .and. nls == 0))
-            rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
-            rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+            call evaluate(self, model, t, u, st, stats, rec, error)
             if (allocated(error)) exit
-            rn = norm2(merge(0.0_dp, r, model%fixed))
-            if (.not. ieee_is_finite(rn)) then
-                call fatal_error(error, 'the residual is not finite', error_code%numeric)
-                exit
-            end if
-            floor = residual_floor(k, x0 + u, model%fixed)
-            have_bar = .false.
-            ! a step that carries a mortar control point across a state boundary the
-            ! tangent did not describe (it closes, or its slip reverses) is shortened to
-            ! where the first one crosses (once per iteration), and that point accepted
-            if (it > 0 .and. nls == 0 .and. .not. closing) then
-                frac = 1.0_dp
-                do ip = 1, size(model%pairs)
-                    frac = min(frac, model%pairs(ip)%pair%step_limit(closing_overshoot))
-                end do
-                if (frac < 1.0_dp) then
-                    closing = .true.
-                    stats%line_search_steps = stats%line_search_steps + 1
-                    alpha = alpha*frac
-                    u = u_prev + alpha*du
-                    cycle
-                end if
-            end if
-            ! where the contact states change the last tangent does not describe the
-            ! trial point (a new active set): the residual rule decides there
-            smooth = .false.
-            if (natural .and. it > 0 .and. .not. closing) smooth = all(contact_states(model) == states(:, it - 1))
-            if (smooth .and. du_norm > 0.0_dp .and. rn > floor .and. &
-                rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
-                ! natural monotonicity test (affine invariant): the simplified Newton
-                ! correction at the trial point, with the last iteration's tangent,
-                ! must be shorter than (1 - alpha/4) times the Newton correction
-                rhs = -merge(0.0_dp, r, model%fixed)
-                call lu%solve(k_old, rhs, du_bar, error)
-                if (allocated(error)) exit
-                theta = norm2(du_bar)/du_norm
-                if (theta > 1.0_dp - 0.25_dp*alpha .and. nls < max_natural_damping) then
-                    ! Kantorovich estimate of the step the curvature allows
-                    h_est = 2.0_dp*norm2(du_bar - (1.0_dp - alpha)*du)/(alpha**2*du_norm)
-                    nls = nls + 1
-                    stats%line_search_steps = stats%line_search_steps + 1
-                    alpha = max(min(0.5_dp*alpha, 1.0_dp/max(h_est, tiny(1.0_dp))), min_natural_step)
-                    u = u_prev + alpha*du
-                    cycle
-                end if
-                du_bar_acc = du_bar
-                have_bar = .true.
-            end if
-            ! backtracking: a Newton step that increases the residual is halved
-            ! (contact stick/slip and active-set changes can make full steps cycle)
-            if (.not. smooth .and. .not. closing .and. it > 0 .and. rn > rn_prev .and. nls < max_line_search .and. &
-                rn > floor .and. rn > 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) then
-                nls = nls + 1
-                stats%line_search_steps = stats%line_search_steps + 1
-                alpha = 0.5_dp*alpha
-                u = u_prev + alpha*du
+            if (shortened(self, model, st, stats, error)) then
+                u = st%u_prev + st%alpha*st%du
                 cycle
             end if
-            norms(it + 1) = rn
-            states(:, it) = contact_states(model)
-            if (it > 0 .and. alpha <= creep_step) short_steps = short_steps + 1
-            do ip = 1, size(model%pairs)
-                call model%pairs(ip)%pair%accept_iterate()
-            end do
-            if (it == 0) then
-                r0 = rn
-                stats%r0_max = max(stats%r0_max, r0)
-                if (present(r0_ref)) r0 = r0_ref
+            if (allocated(error)) exit
+            call accept_iterate(model, st, stats, r0_ref)
+            call report_iteration(model, step, st, progress)
+            call assess(self%settings, self%natural, st, attempt, done, error)
+            if (done) exit
+            call direction(self, model, st, stats, rec, progress, attempt, error)
+            if (allocated(error)) exit
+            call advance(self, st)
+            st%u_prev = u
+            u = u + st%alpha*st%du
+            st%it = st%it + 1
+        end do
+        attempt%iterations = st%it
+        attempt%residual = st%c%residual
+        stats%iterations = stats%iterations + st%it
+        rec%iterations_total = rec%iterations_total + st%it
+        if (allocated(error)) return
+        rec%iterations = st%it
+        rec%residual_norms = st%norms(1:st%it + 1)
+        rec%energy_norms = st%energies(1:st%it)
+    end subroutine newton_attempt
+
+    !> A fresh attempt's state.
+    subroutine start_iterate(self, model, st)
+        type(newton_t), intent(in) :: self
+        type(model_t), intent(in) :: model
+        type(iterate_t), intent(out) :: st
+        integer :: ip, n
+        n = model%ndof
+        allocate (st%du(n), st%rhs(n), st%u_prev(n), st%du_bar(n))
+        allocate (st%states(sum([(size(model%pairs(ip)%pair%out), ip=1, size(model%pairs))]), &
+                            0:self%settings%max_iterations))
+        allocate (st%norms(self%settings%max_iterations + 1), st%energies(self%settings%max_iterations))
+    end subroutine start_iterate
+
+    !> Residual and tangent at the trial point `u`, and the round-off floor there.
+    !> The substep's first assembly also fits the contact pattern to its start.
+    subroutine evaluate(self, model, t, u, st, stats, rec, error)
+        type(newton_t), intent(inout) :: self
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: t, u(:)
+        type(iterate_t), intent(inout) :: st
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: bulk0, contact0
+        bulk0 = stats%assembly%seconds_bulk
+        contact0 = stats%assembly%seconds_contact
+        call assemble(model, u, t, self%r, stats%assembly, error, self%k, self%map, &
+                      refit=(st%it == 0 .and. st%nls == 0))
+        rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
+        rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+        if (allocated(error)) return
+        st%c%residual = norm2(merge(0.0_dp, self%r, model%fixed))
+        if (.not. ieee_is_finite(st%c%residual)) then
+            call fatal_error(error, 'the residual is not finite', error_code%numeric)
+            return
+        end if
+        st%c%floor = residual_floor(self%k, self%x0 + u, model%fixed)
+        st%have_bar = .false.
+    end subroutine evaluate
+
+    !> Whether the step-length rules shorten the step to the trial point (then
+    !> `st%alpha` is the new length); `voiga_solver_step_length`.
+    logical function shortened(self, model, st, stats, error) result(shorten)
+        type(newton_t), intent(inout) :: self
+        type(model_t), intent(in) :: model
+        type(iterate_t), intent(inout) :: st
+        type(solver_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: frac, new_alpha
+        logical :: smooth, roundoff, reduce
+
+        shorten = .false.
+        ! a step that carries a mortar control point across a state boundary the
+        ! tangent did not describe (it closes, or its slip reverses) is shortened to
+        ! where the first one crosses (once per iteration), and that point accepted
+        if (st%it > 0 .and. st%nls == 0 .and. .not. st%closing) then
+            frac = crossing_limit(model)
+            if (frac < 1.0_dp) then
+                st%closing = .true.
+                stats%line_search_steps = stats%line_search_steps + 1
+                st%alpha = st%alpha*frac
+                shorten = .true.
+                return
             end if
-            if (verbose) call print_iteration(model, step, it, rn, en, alpha, floor)
-            if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp) converged = .true.
-            ! the energy criterion alone may not hide a stalled residual
-            if (it > 1 .and. en <= model%tol_energy*e1 .and. rn <= sqrt(model%tol_residual)*r0) &
-                converged = .true.
-            ! round-off floor: nothing left to gain relative to the largest first residual
-            ! of the run (not the reactions, which can be huge with stiff penalties)
-            if (rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max)) converged = .true.
-            ! the residual is at the round-off level of the stiffness times the
-            ! coordinates (stiff penalties): accepted only after a Newton step and
-            ! below floor_cap of the force scale
-            if (it > 0 .and. rn <= floor .and. rn <= floor_cap*max(r0, stats%r0_max)) &
-                converged = .true.
-            if (converged) exit
+        end if
+        roundoff = at_roundoff(st%c%residual, st%c%floor, max(st%c%first, stats%r0_max))
+        ! where the contact states change the last tangent does not describe the
+        ! trial point (a new active set): the residual rule decides there
+        smooth = .false.
+        if (self%natural .and. st%it > 0 .and. .not. st%closing) &
+            smooth = all(contact_states(model) == st%states(:, st%it - 1))
+        if (smooth .and. st%du_norm > 0.0_dp .and. .not. roundoff) then
+            ! natural monotonicity test (affine invariant): the simplified Newton
+            ! correction at the trial point, with the last iteration's tangent
+            st%rhs = -merge(0.0_dp, self%r, model%fixed)
+            call self%linear%solve(self%k_old, st%rhs, st%du_bar, error)
+            if (allocated(error)) return
+            call natural_reduction(st%du_bar, st%du, st%du_norm, st%alpha, st%nls, reduce, new_alpha)
+            if (reduce) then
+                st%nls = st%nls + 1
+                stats%line_search_steps = stats%line_search_steps + 1
+                st%alpha = new_alpha
+                shorten = .true.
+                return
+            end if
+            st%du_bar_acc = st%du_bar
+            st%have_bar = .true.
+        end if
+        ! backtracking: a Newton step that increases the residual is halved
+        ! (contact stick/slip and active-set changes can make full steps cycle)
+        if (.not. smooth .and. .not. st%closing .and. st%it > 0) then
+            if (backtracks(st%c%residual, st%rn_prev, st%nls, roundoff)) then
+                st%nls = st%nls + 1
+                stats%line_search_steps = stats%line_search_steps + 1
+                st%alpha = 0.5_dp*st%alpha
+                shorten = .true.
+            end if
+        end if
+    end function shortened
+
+    !> The trial point is the next iterate: record its residual and contact states,
+    !> let the pairs take it as the reference of their step control; the first sets
+    !> the substep's reference residual.
+    subroutine accept_iterate(model, st, stats, r0_ref)
+        type(model_t), intent(inout) :: model
+        type(iterate_t), intent(inout) :: st
+        type(solver_stats_t), intent(inout) :: stats
+        real(dp), intent(in), optional :: r0_ref
+        integer :: ip
+        st%norms(st%it + 1) = st%c%residual
+        st%states(:, st%it) = contact_states(model)
+        if (st%it > 0 .and. st%alpha <= creep_step) st%short_steps = st%short_steps + 1
+        do ip = 1, size(model%pairs)
+            call model%pairs(ip)%pair%accept_iterate()
+        end do
+        if (st%it == 0) then
+            st%c%first = st%c%residual
+            stats%r0_max = max(stats%r0_max, st%c%first)
+            if (present(r0_ref)) st%c%first = r0_ref
+        end if
+        st%c%iteration = st%it
+        st%c%scale = max(st%c%first, stats%r0_max)
+    end subroutine accept_iterate
+
+    !> One line's worth of the iteration for the progress hooks.
+    subroutine report_iteration(model, step, st, progress)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: step
+        type(iterate_t), intent(in) :: st
+        class(progress_t), intent(inout) :: progress
+        type(iteration_report_t) :: report
+        integer :: ip
+        report%step = step
+        report%iteration = st%it
+        report%residual = st%c%residual
+        report%energy = merge(st%c%energy, 0.0_dp, st%it > 0)
+        report%step_length = st%alpha
+        report%floor = st%c%floor
+        allocate (report%stick(size(model%pairs)), report%slip(size(model%pairs)), report%points(size(model%pairs)))
+        do ip = 1, size(model%pairs)
+            associate (out => model%pairs(ip)%pair%out)
+                report%stick(ip) = count(out%state == state_stick)
+                report%slip(ip) = count(out%state == state_slip)
+                report%points(ip) = size(out)
+            end associate
+        end do
+        call progress%iteration(report)
+    end subroutine report_iteration
+
+    !> Converged, or failed with a reason, or go on (`done` false): the single
+    !> assessment of an accepted iterate.
+    pure subroutine assess(settings, natural, st, attempt, done, error)
+        type(solver_settings_t), intent(in) :: settings
+        logical, intent(in) :: natural
+        type(iterate_t), intent(in) :: st
+        type(attempt_t), intent(inout) :: attempt
+        logical, intent(out) :: done
+        type(error_t), allocatable, intent(out) :: error
+        character(len=800) :: msg
+        integer :: flips, ip
+
+        done = converged(st%c, settings%tol_residual, settings%tol_energy)
+        if (done) return
+        done = .true.
+        associate (it => st%it, rn => st%c%residual, r0 => st%c%first, states => st%states)
             if (it > 0 .and. rn > divergence_ratio*r0) then
                 write (msg, '(a,es9.2,a,es9.2,a,i0,a)') 'the residual grew from ', r0, ' to ', rn, &
                     ' in ', it, ' iterations'
                 call fatal_error(error, trim(msg), error_code%numeric)
-                exit
+                return
             end if
             ! a limit cycle: the contact states and the residual repeat with period 2
             ! twice in a row; continuing would repeat it up to the iteration cap
-            if (it >= 4 .and. .not. (rn <= floor)) then
-                if (all(states(:, it) == states(:, it - 2)) .and. &
-                    all(states(:, it - 1) == states(:, it - 3)) .and. &
-                    any(states(:, it) /= states(:, it - 1)) .and. &
-                    abs(rn - norms(it - 1)) <= 1.0e-6_dp*rn .and. &
-                    abs(norms(it) - norms(it - 2)) <= 1.0e-6_dp*rn) then
+            if (it >= 4 .and. .not. (rn <= st%c%floor)) then
+                if (all(states(:, it) == states(:, it - 2)) .and. all(states(:, it - 1) == states(:, it - 3)) .and. &
+                    any(states(:, it) /= states(:, it - 1)) .and. abs(rn - st%norms(it - 1)) <= 1.0e-6_dp*rn .and. &
+                    abs(st%norms(it) - st%norms(it - 2)) <= 1.0e-6_dp*rn) then
                     flips = count(states(:, it) /= states(:, it - 1))
-                    stats%attempt_switching = .true.
+                    attempt%switching = .true.
                     write (msg, '(a,i0,a,i0,a,es9.2,a,es9.2,a)') 'Newton cycles after ', it, &
                         ' iterations: ', flips, ' contact point(s) switch state (stick/slip or '// &
                         'contact/separation) with every iteration and the residual repeats (', rn, &
                         ', first ', r0, '): the friction and contact laws are not smooth where '// &
                         'the point sits on the stick/slip or contact limit'
                     call fatal_error(error, trim(msg), error_code%numeric)
-                    exit
+                    return
                 end if
             end if
-            if (it == model%max_iterations) then
+            if (it == settings%max_iterations) then
                 write (msg, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', &
-                    model%max_iterations, ' iterations (residual ', rn, ', first ', r0, ')'
-                if (rn <= floor) then
+                    settings%max_iterations, ' iterations (residual ', rn, ', first ', r0, ')'
+                if (rn <= st%c%floor) then
                     write (msg, '(a,es9.2,a,es9.2,a,es9.2,a)') trim(msg)//': the residual is at its '// &
-                        'round-off level ', floor, ' (stiffness x rounding of the coordinates), above ', &
-                        floor_cap, ' of the force scale ', max(r0, stats%r0_max), &
+                        'round-off level ', st%c%floor, ' (stiffness x rounding of the coordinates), above ', &
+                        floor_cap, ' of the force scale ', st%c%scale, &
                         ': the stiffness (penalty) is too large for double precision'
                 else
                     flips = count([(any(states(:, ip) /= states(:, ip - 1)), ip=max(1, it - 9), it)])
-                    stats%attempt_switching = flips > 0
+                    attempt%switching = flips > 0
                     if (flips > 0) write (msg, '(a,i0,a,i0,a)') trim(msg)// &
                         ': contact states still switched in ', flips, ' of the last ', &
                         it - max(1, it - 9) + 1, ' iterations (points on the stick/slip or contact limit)'
-                    if (.not. natural .and. 2*short_steps >= model%max_iterations) &
-                        write (msg, '(a,i0,a)') trim(msg)//'; ', short_steps, ' of its iterations '// &
+                    if (.not. natural .and. 2*st%short_steps >= settings%max_iterations) &
+                        write (msg, '(a,i0,a)') trim(msg)//'; ', st%short_steps, ' of its iterations '// &
                         'took steps of 1/16 or less: the residual rule creeps along the curvature of a '// &
                         'stiff penalty, &solver damping = ''natural'' may pass it (docs/robustness.md, '// &
                         '"Natural damping")'
                 end if
                 call fatal_error(error, trim(msg), error_code%numeric)
-                exit
+                return
             end if
-            tic = wall_seconds()
-            call k%fix_dofs(model%fixed)
-            if (multigrid) then
-                ! no factors, no determinant: det_sign stays 0 (unknown)
-                call mg%factor(k, error)
-            else
-                call lu%factor(k, error)
-                if (.not. allocated(error)) then
-                    ! the orientation of the tangent (O(n) from the factors): a sign
-                    ! change marks a fold of the incremental problem (solve_steps)
-                    call lu%determinant(stats%det_sign, log_det, error)
-                    if (stats%det_sign <= 0) stats%attempt_nonpositive_det = stats%attempt_nonpositive_det + 1
-                    if (verbose .and. .not. allocated(error)) write (*, '(a,i0,a,f0.2)') &
-                        '    det K: sign ', stats%det_sign, ', log10 |det K| ', log_det
-                end if
-            end if
-            rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
-            if (allocated(error)) exit
-            tic = wall_seconds()
-            rhs = -merge(0.0_dp, r, model%fixed)
-            if (multigrid) then
-                eta = forcing(rn, r0, model%tol_residual)
-                ! while contact states still change, Newton is not in its quadratic range
-                ! and the step mostly moves the active set: a looser solve will do
-                changing = .false.
-                if (it > 0) changing = any(states(:, it) /= states(:, it - 1))
-                if (changing) then
-                    eta = max(eta, active_set_forcing)
-                    call mg%solve(k, rhs, du, error, solve_accuracy_t(eta, soft_iterations, soft_forcing))
-                else
-                    call mg%solve(k, rhs, du, error, solve_accuracy_t(eta))
-                end if
-                if (caught_signal() /= 0) stats%signal = caught_signal()
-                rec%linear_iterations = rec%linear_iterations + mg%last_iterations()
-                if (verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', mg%last_iterations(), &
-                    ' iterations, relative residual ', mg%last_residual(), ' (asked ', eta, ')'
-            else
-                call lu%solve(k, rhs, du, error)
-            end if
-            rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
-            if (allocated(error)) exit
-            en = abs(dot_product(du, rhs))
-            if (it == 0) e1 = en
-            energies(it + 1) = en
-            alpha_prev = alpha
-            u_prev = u
-            rn_prev = rn
-            alpha = 1.0_dp
-            if (natural) then
-                ! the tangent the next trial points are tested with
-                k_old = k
-                du_norm_prev = du_norm
-                du_norm = norm2(du)
-                ! a-priori step from the last accepted step's contraction
-                if (have_bar .and. du_norm > 0.0_dp) then
-                    h_est = norm2(du_bar_acc - du)*du_norm/max(du_norm_prev*norm2(du_bar_acc), tiny(1.0_dp))
-                    alpha = max(min(1.0_dp, alpha_prev/max(h_est, tiny(1.0_dp))), min_natural_step)
-                end if
-            end if
-            nls = 0
-            closing = .false.
-            u = u + alpha*du
-            it = it + 1
-        end do
-        stats%iterations = stats%iterations + it
-        rec%iterations_total = rec%iterations_total + it
+        end associate
+        done = .false.
+    end subroutine assess
+
+    !> The Newton correction: factor the tangent (with its determinant's sign where
+    !> the linear solver knows it) and solve K du = -r.
+    subroutine direction(self, model, st, stats, rec, progress, attempt, error)
+        type(newton_t), intent(inout) :: self
+        type(model_t), intent(in) :: model
+        type(iterate_t), intent(inout) :: st
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        class(progress_t), intent(inout) :: progress
+        type(attempt_t), intent(inout) :: attempt
+        type(error_t), allocatable, intent(out) :: error
+        type(solve_accuracy_t) :: accuracy
+        real(dp) :: tic, log_det
+        logical :: changing
+
+        tic = wall_seconds()
+        call self%k%fix_dofs(model%fixed)
+        call self%linear%factor(self%k, error)
+        if (.not. allocated(error) .and. self%linear%has_determinant()) then
+            ! the orientation of the tangent (O(n) from the factors): a sign
+            ! change marks a fold of the incremental problem (voiga_solver_stepping)
+            call self%linear%determinant(attempt%det_sign, log_det, error)
+            if (attempt%det_sign <= 0) attempt%nonpositive_det = attempt%nonpositive_det + 1
+            if (.not. allocated(error)) call progress%factorized(attempt%det_sign, log_det)
+        end if
+        rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
         if (allocated(error)) return
-        rec%iterations = it
-        rec%residual_norms = norms(1:it + 1)
-        rec%energy_norms = energies(1:it)
-    end subroutine newton_solve
+        tic = wall_seconds()
+        st%rhs = -merge(0.0_dp, self%r, model%fixed)
+        ! an iterative solve: while contact states still change, Newton is not in its
+        ! quadratic range and the step mostly moves the active set: a looser solve will do
+        accuracy%rtol = forcing(st%c%residual, st%c%first, self%settings%tol_residual)
+        changing = .false.
+        if (st%it > 0) changing = any(st%states(:, st%it) /= st%states(:, st%it - 1))
+        if (changing) accuracy = solve_accuracy_t(max(accuracy%rtol, active_set_forcing), soft_iterations, &
+                                                  soft_forcing)
+        call self%linear%solve(self%k, st%rhs, st%du, error, accuracy)
+        if (caught_signal() /= 0) stats%signal = caught_signal()
+        if (self%linear%iterative()) then
+            rec%linear_iterations = rec%linear_iterations + self%linear%last_iterations()
+            call progress%linear_solved(self%linear%last_iterations(), self%linear%last_residual(), accuracy%rtol)
+        end if
+        rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
+    end subroutine direction
+
+    !> After the correction: its energy norm, the previous iterate kept for the step
+    !> rules, and the next step length (1; natural damping: its a-priori estimate).
+    subroutine advance(self, st)
+        type(newton_t), intent(inout) :: self
+        type(iterate_t), intent(inout) :: st
+        st%c%energy = abs(dot_product(st%du, st%rhs))
+        if (st%it == 0) st%c%first_energy = st%c%energy
+        st%energies(st%it + 1) = st%c%energy
+        st%alpha_prev = st%alpha
+        st%rn_prev = st%c%residual
+        st%alpha = 1.0_dp
+        if (self%natural) then
+            ! the tangent the next trial points are tested with
+            self%k_old = self%k
+            st%du_norm_prev = st%du_norm
+            st%du_norm = norm2(st%du)
+            ! a-priori step from the last accepted step's contraction
+            if (st%have_bar .and. st%du_norm > 0.0_dp) &
+                st%alpha = natural_first_step(st%du_bar_acc, st%du, st%du_norm, st%du_norm_prev, st%alpha_prev)
+        end if
+        st%nls = 0
+        st%closing = .false.
+    end subroutine advance
 
     !> Relative residual to which an iterative linear solve is taken at a Newton
     !> iteration with residual `rn` (first residual `r0`): eta = 1e-3 min(1, rn/r0),
@@ -791,219 +468,6 @@ contains
         eta = min(1.0e-3_dp, max(eta, 1.0e-12_dp))
     end function forcing
 
-    !> Retry a frictional substep by successive approximations on the slip bounds
-    !> (the fixed point of the existence theory of quasi-static Coulomb friction):
-    !> with the bounds g_i fixed, the incremental problem is a Tresca problem, whose
-    !> tangent has no mu x penalty_normal coupling; Newton solves it, then
-    !> g_i = mu p_N,i from the new state, until the **Coulomb** residual at the
-    !> Tresca solution meets Newton's convergence test against the substep's first
-    !> Coulomb residual (tol_residual, or the round-off floors): the accepted state
-    !> solves the Coulomb problem as a plain Newton result would. `u` holds the last
-    !> converged state on entry, the accepted one on success; the contact pairs' trial
-    !> history is then that of the Coulomb evaluation at it, and stats%det_sign the
-    !> sign of det K of the Coulomb tangent there. Fails (error code numeric) when a
-    !> Tresca solve fails, the bound changes grow three times in a row, or after
-    !> `max_fixed_point` solves.
-    subroutine tresca_fixed_point(model, step, t, u, r, k, map, lu, mg, stats, rec, it, rn, verbose, quiet, &
-                                  error)
-        type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t
-        real(dp), intent(inout) :: u(:)
-        !> Residual at the last evaluation, shape [ndof].
-        real(dp), intent(inout) :: r(:)
-        type(csc_matrix_t), intent(inout) :: k
-        type(assembly_map_t), intent(inout) :: map
-        type(umfpack_t), intent(inout) :: lu
-        type(multigrid_t), intent(inout) :: mg
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        !> Newton iterations of all Tresca solves; the Coulomb residual norm at the end.
-        integer, intent(out) :: it
-        real(dp), intent(out) :: rn
-        logical, intent(in) :: verbose, quiet
-        type(error_t), allocatable, intent(out) :: error
-        type(error_t), allocatable :: inner
-        real(dp), allocatable :: x0(:)
-        real(dp) :: r0, floor, change, last_change, gmax, log_det, growth
-        integer :: fp, it_inner, growing
-        logical :: accepted
-        character(len=600) :: msg
-
-        it = 0
-        rn = 0.0_dp
-        stats%tresca_retries = stats%tresca_retries + 1
-        x0 = reference_coordinates(model)
-        ! initial bounds: mu p_N at the last converged state (p_N depends on u only)
-        call assemble(model, u, t, r, stats%assembly, error)
-        if (allocated(error)) return
-        call capture_slip_bounds(model, change, gmax)
-        ! the reference of the convergence test: the Coulomb residual at the substep's
-        ! start, the first residual of the plain Newton attempt that failed
-        call set_prescribed(model, t, u)
-        call assemble(model, u, t, r, stats%assembly, error)
-        if (allocated(error)) return
-        r0 = norm2(merge(0.0_dp, r, model%fixed))
-        last_change = huge(1.0_dp)
-        growing = 0
-        growth = 0.0_dp
-        accepted = .false.
-        do fp = 1, max_fixed_point
-            stats%fixed_point_iterations = stats%fixed_point_iterations + 1
-            call apply_slip_bounds(model)
-            call newton_solve(model, step, t, u, r, k, map, lu, mg, stats, rec, it_inner, rn, verbose, inner, r0)
-            call clear_slip_bounds(model)
-            it = it + it_inner
-            if (allocated(inner)) then
-                if (stats%signal /= 0) then
-                    call move_alloc(inner, error)
-                    return
-                end if
-                write (msg, '(a,i0,a)') 'the Tresca problem of fixed-point iteration ', fp, ' failed: '
-                call fatal_error(error, trim(msg)//' '//inner%message, error_code%numeric)
-                return
-            end if
-            ! the Coulomb residual and tangent at the Tresca solution, and the new bounds
-            call assemble(model, u, t, r, stats%assembly, error, k, map)
-            if (allocated(error)) return
-            rn = norm2(merge(0.0_dp, r, model%fixed))
-            floor = residual_floor(k, x0 + u, model%fixed)
-            call capture_slip_bounds(model, change, gmax)
-            if (verbose) write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,es10.3,a,es9.2,a,i0)') '  step ', step, &
-                ' fixed point ', fp, '  Coulomb |r|=', rn, '  reference ', r0, '  max |g change|=', change, &
-                ' of max g ', gmax, '  Newton it ', it_inner
-            ! Newton's own tests (newton_solve), on the Coulomb residual
-            if (rn <= model%tol_residual*r0 .or. rn == 0.0_dp .or. &
-                rn <= 1.0e4_dp*epsilon(1.0_dp)*max(r0, stats%r0_max) .or. &
-                (rn <= floor .and. rn <= floor_cap*max(r0, stats%r0_max))) then
-                accepted = .true.
-                exit
-            end if
-            if (.not. ieee_is_finite(rn)) exit
-            growing = merge(growing + 1, 0, change > last_change)
-            if (growing > 0) growth = max(growth, change/last_change)
-            if (growing == 0) growth = 0.0_dp
-            if (growing >= 3) exit
-            last_change = change
-        end do
-        if (.not. accepted) then
-            write (msg, '(a,i0,a,es9.2,a,es9.2,a,es9.2,a,es9.2,a)') 'the fixed point did not converge in ', &
-                fp - merge(1, 0, fp > max_fixed_point), ' iterations (Coulomb residual ', rn, ', reference ', r0, &
-                '; last bound change ', change, ' of max bound ', gmax, ')'
-            if (growing >= 3) then
-                write (msg, '(a,f0.2,a)') trim(msg)//': the successive approximations diverge (the bound '// &
-                    'change grew in 3 iterations in a row, by up to ', growth, ' per iteration): the map g -> '// &
-                    'mu p_N(g) is not a contraction here'
-                call fatal_error(error, trim(msg)//', the condition under which the existence theory of '// &
-                                 'quasi-static Coulomb friction guarantees a unique incremental solution '// &
-                                 '(small mu); a Coulomb solution may not exist near this state', &
-                                 error_code%numeric)
-            else
-                call fatal_error(error, trim(msg)//': the Coulomb incremental problem may have no '// &
-                                 'solution near this state', error_code%numeric)
-            end if
-            return
-        end if
-        ! the orientation of the Coulomb tangent at the accepted state (the
-        ! multigrid solver has no factors: the sign stays unknown)
-        if (model%linear_solver /= 'multigrid') then
-            call k%fix_dofs(model%fixed)
-            call lu%factor(k, error)
-            if (allocated(error)) return
-            call lu%determinant(stats%det_sign, log_det, error)
-            if (allocated(error)) return
-        end if
-        stats%tresca_accepted = stats%tresca_accepted + 1
-        if (.not. quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,6(es9.2,a),i0)') 'tresca step ', &
-            step, '  t=', t, ': the Tresca fixed point converged in ', fp, ' iterations (', it, &
-            ' Newton iterations); Coulomb residual ', rn, ' (reference ', r0, ', round-off floor ', floor, &
-            ', force scale ', max(r0, stats%r0_max), '); last bound change ', change, ' of max bound ', gmax, &
-            '; det K sign ', stats%det_sign
-    end subroutine tresca_fixed_point
-
-    !> Whether any contact pair takes part in the Tresca fixed point (frictional GPTS).
-    pure logical function frictional(model)
-        type(model_t), intent(in) :: model
-        integer :: ip
-        frictional = any([(model%pairs(ip)%pair%takes_outer(), ip=1, size(model%pairs))])
-    end function frictional
-
-    !> Every frictional pair captures the slip bounds mu p_N of its last evaluation;
-    !> the largest change from the previous capture and the largest bound.
-    pure subroutine capture_slip_bounds(model, change, gmax)
-        type(model_t), intent(inout) :: model
-        real(dp), intent(out) :: change, gmax
-        real(dp) :: c, g
-        integer :: ip
-        change = -huge(1.0_dp)
-        gmax = -huge(1.0_dp)
-        do ip = 1, size(model%pairs)
-            if (.not. model%pairs(ip)%pair%takes_outer()) cycle
-            call model%pairs(ip)%pair%outer_capture(c, g)
-            change = max(change, c)
-            gmax = max(gmax, g)
-        end do
-    end subroutine capture_slip_bounds
-
-    !> Put every frictional pair in Tresca mode with its captured bounds.
-    pure subroutine apply_slip_bounds(model)
-        type(model_t), intent(inout) :: model
-        integer :: ip
-        do ip = 1, size(model%pairs)
-            if (model%pairs(ip)%pair%takes_outer()) call model%pairs(ip)%pair%outer_apply()
-        end do
-    end subroutine apply_slip_bounds
-
-    !> Back to Coulomb friction in every pair.
-    pure subroutine clear_slip_bounds(model)
-        type(model_t), intent(inout) :: model
-        integer :: ip
-        do ip = 1, size(model%pairs)
-            call model%pairs(ip)%pair%outer_release()
-        end do
-    end subroutine clear_slip_bounds
-
-    !> One line per Newton iteration: residual, energy norm, contact states.
-    subroutine print_iteration(model, step, it, rn, en, alpha, floor)
-        type(model_t), intent(in) :: model
-        integer, intent(in) :: step, it
-        real(dp), intent(in) :: rn, en, alpha, floor
-        integer :: ip
-        write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4,a,es9.2)', advance='no') '  step ', step, &
-            ' it ', it, '  |r|=', rn, '  |du.r|=', merge(en, 0.0_dp, it > 0), '  step length ', alpha, &
-            '  floor ', floor
-        do ip = 1, size(model%pairs)
-            write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', count(model%pairs(ip)%pair%out%state == 1), &
-                ' slip=', count(model%pairs(ip)%pair%out%state == 2), ' of ', size(model%pairs(ip)%pair%out)
-        end do
-        write (*, '(a)') ''
-    end subroutine print_iteration
-
-    !> Round-off level of the residual at coordinates `x`: floor_factor eps || |K| |x| ||
-    !> on the free DOFs. Rounding every coordinate x_j by its unit round-off eps |x_j|
-    !> changes the residual by up to (|K| eps |x|)_i; a residual below that is as
-    !> converged as double precision can tell (a componentwise backward error of the
-    !> coordinates of order eps). With a stiff penalty ||K|| is large and this floor
-    !> lies above tol_residual ||r_0||. `k` is the assembled tangent before the
-    !> Dirichlet elimination.
-    pure real(dp) function residual_floor(k, x, fixed) result(floor)
-        type(csc_matrix_t), intent(in) :: k
-        !> Current coordinates (reference + displacement) of every DOF; shape: [ndof].
-        real(dp), intent(in) :: x(:)
-        !> .true. for a Dirichlet DOF; shape: [ndof].
-        logical, intent(in) :: fixed(:)
-        real(dp), allocatable :: w(:)
-        integer :: j, p
-        allocate (w(k%n))
-        w = 0.0_dp
-        do j = 1, k%n
-            do p = k%colptr(j) + 1, k%colptr(j + 1)
-                w(k%rowind(p) + 1) = w(k%rowind(p) + 1) + abs(k%values(p))*abs(x(j))
-            end do
-        end do
-        floor = floor_factor*epsilon(1.0_dp)*norm2(merge(0.0_dp, w, fixed))
-    end function residual_floor
-
     !> The contact state (inactive, stick, slip) of every slave point of every pair,
     !> in pair order; shape: [sum of the pairs' points].
     pure function contact_states(model) result(states)
@@ -1015,34 +479,5 @@ contains
             states = [states, (model%pairs(ip)%pair%out(k)%state, k=1, size(model%pairs(ip)%pair%out))]
         end do
     end function contact_states
-
-    !> Reference coordinates of the control point of every DOF; shape: [ndof]
-    !> (2(a-1)+i of body b at dof0 + 2(a-1) + i, as the displacement).
-    pure function reference_coordinates(model) result(x0)
-        type(model_t), intent(in) :: model
-        real(dp), allocatable :: x0(:)
-        integer :: ib, n
-        allocate (x0(model%ndof))
-        x0 = 0.0_dp
-        do ib = 1, size(model%bodies)
-            n = size(model%bodies(ib)%disc%x)
-            x0(model%bodies(ib)%dof0 + 1:model%bodies(ib)%dof0 + n) = reshape(model%bodies(ib)%disc%x, [n])
-        end do
-    end function reference_coordinates
-
-    !> Put the prescribed values at load time `t` into `u`.
-    pure subroutine set_prescribed(model, t, u)
-        type(model_t), intent(in) :: model
-        real(dp), intent(in) :: t
-        real(dp), intent(inout) :: u(:)
-        integer :: j, c
-        do j = 1, size(model%dirichlet)
-            do c = 1, 2
-                if (model%dirichlet(j)%fix(c)) then
-                    u(model%dirichlet(j)%dofs(c, :)) = phase_value(model%dirichlet(j)%values(c, :), t)
-                end if
-            end do
-        end do
-    end subroutine set_prescribed
 
 end module voiga_solver_newton

@@ -1,6 +1,6 @@
 !> From a case to the discretized bodies: read each body's coarse patch from the
 !> geometry file and build its discretization with the case's layout.
-module voiga_discretization_bodies
+module voiga_io_bodies
     use voiga_error, only: error_t
     use voiga_io_case, only: case_t
     use voiga_io_hdf5, only: h5file_t
@@ -43,4 +43,4 @@ contains
         call geo%close()
     end subroutine discretize_bodies
 
-end module voiga_discretization_bodies
+end module voiga_io_bodies

@@ -1,0 +1,136 @@
+!> The terminal side of a run: the result file's progress hooks (`results_t`)
+!> plus one line per converged step, cut and retry (none with --quiet), and with
+!> --verbose one per Newton iteration and linear solve.
+module voiga_app_console
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t
+    use voiga_model, only: model_t
+    use voiga_io_results, only: results_t
+    use voiga_solver_records, only: cut_record_t, wall_seconds
+    use voiga_solver_progress, only: iteration_report_t, fixed_point_report_t, step_report_t
+    implicit none
+    private
+
+    public :: console_t
+
+    !> Writes the result file and prints.
+    type, extends(results_t) :: console_t
+        logical :: quiet = .false., verbose = .false.
+    contains
+        procedure :: set_up => console_set_up
+        procedure :: iteration => console_iteration
+        procedure :: factorized => console_factorized
+        procedure :: linear_solved => console_linear_solved
+        procedure :: retried => console_retried
+        procedure :: cut => console_cut
+        procedure :: fixed_point => console_fixed_point
+        procedure :: fixed_point_done => console_fixed_point_done
+        procedure :: step_done => console_step_done
+    end type console_t
+
+contains
+
+    subroutine console_set_up(self, level_dofs, error)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: level_dofs(:)
+        type(error_t), allocatable, intent(out) :: error
+        call self%results_t%set_up(level_dofs, error)
+        if (allocated(error)) return
+        if (.not. self%quiet) write (*, '(a,i0,a,*(1x,i0))') 'multigrid: ', size(level_dofs), &
+            ' levels, DOFs', level_dofs
+    end subroutine console_set_up
+
+    !> Residual, energy norm, step length, round-off floor and contact states.
+    subroutine console_iteration(self, report)
+        class(console_t), intent(inout) :: self
+        type(iteration_report_t), intent(in) :: report
+        integer :: ip
+        if (.not. self%verbose) return
+        write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4,a,es9.2)', advance='no') '  step ', report%step, &
+            ' it ', report%iteration, '  |r|=', report%residual, '  |du.r|=', report%energy, '  step length ', &
+            report%step_length, '  floor ', report%floor
+        do ip = 1, size(report%points)
+            write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', report%stick(ip), ' slip=', report%slip(ip), &
+                ' of ', report%points(ip)
+        end do
+        write (*, '(a)') ''
+    end subroutine console_iteration
+
+    subroutine console_factorized(self, sign, log10_det)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: sign
+        real(dp), intent(in) :: log10_det
+        if (self%verbose) write (*, '(a,i0,a,f0.2)') '    det K: sign ', sign, ', log10 |det K| ', log10_det
+    end subroutine console_factorized
+
+    subroutine console_linear_solved(self, iterations, residual, asked)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: iterations
+        real(dp), intent(in) :: residual, asked
+        if (self%verbose) write (*, '(a,i0,a,es9.2,a,es9.2,a)') '    gmres: ', iterations, &
+            ' iterations, relative residual ', residual, ' (asked ', asked, ')'
+    end subroutine console_linear_solved
+
+    subroutine console_retried(self, step, time, reason)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: step
+        real(dp), intent(in) :: time
+        character(len=*), intent(in) :: reason
+        if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a)') 'retry step ', step, '  t=', time, &
+            ' from the last converged state (the predicted start failed: '//reason//')'
+    end subroutine console_retried
+
+    subroutine console_cut(self, cut, reason)
+        class(console_t), intent(inout) :: self
+        type(cut_record_t), intent(in) :: cut
+        character(len=*), intent(in) :: reason
+        if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,es9.2,a)') 'cut  step ', cut%step, '  t=', cut%time, &
+            '  new increment ', cut%new_fraction, ' of the step: '//reason
+    end subroutine console_cut
+
+    subroutine console_fixed_point(self, report)
+        class(console_t), intent(inout) :: self
+        type(fixed_point_report_t), intent(in) :: report
+        if (self%verbose) write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,es10.3,a,es9.2,a,i0)') '  step ', &
+            report%step, ' fixed point ', report%iteration, '  Coulomb |r|=', report%residual, '  reference ', &
+            report%reference, '  max |g change|=', report%change, ' of max g ', report%largest, '  Newton it ', &
+            report%newton_iterations
+    end subroutine console_fixed_point
+
+    subroutine console_fixed_point_done(self, report)
+        class(console_t), intent(inout) :: self
+        type(fixed_point_report_t), intent(in) :: report
+        if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,6(es9.2,a),i0)') 'tresca step ', &
+            report%step, '  t=', report%time, ': the Tresca fixed point converged in ', report%iteration, &
+            ' iterations (', report%newton_iterations, ' Newton iterations); Coulomb residual ', report%residual, &
+            ' (reference ', report%reference, ', round-off floor ', report%floor, ', force scale ', report%scale, &
+            '); last bound change ', report%change, ' of max bound ', report%largest, '; det K sign ', &
+            report%det_sign
+    end subroutine console_fixed_point_done
+
+    !> The step goes to the result file, then one line: step, load time, Newton
+    !> iterations, residual, seconds (the file's writing included), substeps and cuts.
+    subroutine console_step_done(self, report, u, model, error)
+        class(console_t), intent(inout) :: self
+        type(step_report_t), intent(in) :: report
+        real(dp), intent(in) :: u(:)
+        type(model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: tic, seconds
+        tic = wall_seconds()
+        call self%results_t%step_done(report, u, model, error)
+        if (allocated(error) .or. self%quiet) return
+        associate (rec => report%record)
+            seconds = sum(rec%seconds(1:4)) + wall_seconds() - tic
+            write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)', advance='no') 'step ', rec%step, '/', &
+                report%n_steps, '  t=', rec%time, '  it=', rec%iterations, '  |r|=', report%residual, '  ', &
+                seconds, ' s'
+            if (rec%substeps > 1 .or. rec%cuts > 0) then
+                write (*, '(a,i0,a,i0)') '  substeps=', rec%substeps, ' cuts=', rec%cuts
+            else
+                write (*, '(a)') ''
+            end if
+        end associate
+    end subroutine console_step_done
+
+end module voiga_app_console

@@ -1,0 +1,133 @@
+!> The `&contact` group: a contact pair, its method and its law.
+module voiga_io_case_contact
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_io_namelist, only: group_error
+    use voiga_io_case_values, only: unset, body_index, quoted
+    use voiga_model_body, only: body_settings_t
+    use voiga_contact_factory, only: contact_settings_t, contact_method_names
+    implicit none
+    private
+
+    public :: read_contact
+
+contains
+
+    !> Read the next (the `k`-th) `&contact` group from unit `u` for a case with
+    !> `bodies`, and validate it. penalty_tangent defaults to penalty_normal.
+    subroutine read_contact(u, path, k, bodies, entry, error)
+        integer, intent(in) :: u, k
+        character(len=*), intent(in) :: path
+        type(body_settings_t), intent(in) :: bodies(:)
+        type(contact_settings_t), intent(out) :: entry
+        type(error_t), allocatable, intent(out) :: error
+        character(len=32) :: slave, master
+        character(len=16) :: method
+        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction
+        integer :: n_gauss, ios
+        character(len=512) :: msg
+        namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
+            friction, n_gauss, method
+
+        slave = ''
+        master = ''
+        rigid_point = 0.0_dp
+        rigid_normal = [0.0_dp, 1.0_dp]
+        penalty_normal = unset
+        penalty_tangent = unset
+        friction = 0.0_dp
+        n_gauss = 0
+        method = 'gpts'
+        read (u, nml=contact, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call group_error(path, 'contact', k, ios, msg, try_contact, error)
+            return
+        end if
+        if (penalty_tangent == unset) penalty_tangent = penalty_normal
+        entry = contact_settings_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
+                                   friction, n_gauss, method)
+        write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        call check_pair(entry, bodies, path//trim(msg)//' ', error)
+        if (allocated(error)) return
+        call check_law(entry, bodies, path//trim(msg)//' ', error)
+    contains
+        subroutine try_contact(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+            read (text, nml=contact, iostat=ios, iomsg=msg)
+        end subroutine try_contact
+    end subroutine read_contact
+
+    !> The slave and master are bodies of the case with a contact edge (or the
+    !> master is a valid rigid line).
+    subroutine check_pair(c, bodies, where, error)
+        type(contact_settings_t), intent(in) :: c
+        type(body_settings_t), intent(in) :: bodies(:)
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        integer :: ib
+        ib = body_index(bodies, c%slave)
+        if (ib == 0) then
+            call fatal_error(error, where//"slave = '"//trim(c%slave)//"' is not a body of the case", &
+                             error_code%input)
+            return
+        end if
+        if (len_trim(bodies(ib)%layout%contact_edge) == 0) then
+            call fatal_error(error, where//"slave = '"//trim(c%slave)//"' has no contact_edge in its &body", &
+                             error_code%input)
+            return
+        end if
+        if (trim(c%master) /= 'rigid') then
+            ib = body_index(bodies, c%master)
+            if (ib == 0) then
+                call fatal_error(error, where//"master = '"//trim(c%master)// &
+                                 "' is neither a body of the case nor 'rigid'", error_code%input)
+            else if (trim(c%master) == trim(c%slave)) then
+                call fatal_error(error, where//'master and slave must be different bodies', error_code%input)
+            else if (len_trim(bodies(ib)%layout%contact_edge) == 0) then
+                call fatal_error(error, where//"master = '"//trim(c%master)// &
+                                 "' has no contact_edge in its &body", error_code%input)
+            end if
+        else if (.not. all(ieee_is_finite(c%rigid_point)) .or. .not. all(ieee_is_finite(c%rigid_normal)) .or. &
+                 norm2(c%rigid_normal) <= 0.0_dp) then
+            call fatal_error(error, where//'rigid_point must be finite and rigid_normal finite and '// &
+                             'nonzero', error_code%input)
+        end if
+    end subroutine check_pair
+
+    !> Penalties, friction, points and method in range.
+    subroutine check_law(c, bodies, where, error)
+        type(contact_settings_t), intent(in) :: c
+        type(body_settings_t), intent(in) :: bodies(:)
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: e_max
+        if (c%penalty_normal == unset) then
+            call fatal_error(error, where//'penalty_normal is required', error_code%input)
+        else if (.not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
+            call fatal_error(error, where//'penalty_normal must be finite and > 0', error_code%input)
+        else if (.not. (c%friction >= 0.0_dp .and. ieee_is_finite(c%friction))) then
+            call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
+        else if (c%friction > 0.0_dp .and. .not. (c%penalty_tangent > 0.0_dp .and. &
+                                                  ieee_is_finite(c%penalty_tangent))) then
+            call fatal_error(error, where//'penalty_tangent must be finite and > 0', error_code%input)
+        else if (c%n_gauss < 0 .or. c%n_gauss > 30) then
+            call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
+        else if (.not. any(contact_method_names == c%method)) then
+            call fatal_error(error, where//"method = '"//trim(c%method)//"' is not one of "// &
+                             quoted(contact_method_names), error_code%input)
+        end if
+        if (allocated(error)) return
+        ! conditioning: a penalty above 1e12 x E leaves the stiffness matrix with fewer
+        ! than 4 significant digits in double precision
+        e_max = bodies(body_index(bodies, c%slave))%youngs_modulus
+        if (trim(c%master) /= 'rigid') e_max = max(e_max, bodies(body_index(bodies, c%master))%youngs_modulus)
+        if (c%penalty_normal > 1.0e12_dp*e_max .or. (c%friction > 0.0_dp .and. c%penalty_tangent > 1.0e12_dp*e_max)) &
+            call fatal_error(error, where//'penalty_normal and penalty_tangent must not exceed 1e12 times '// &
+                             "the largest Young's modulus of the two bodies (the stiffness matrix would "// &
+                             'lose its significant digits)', error_code%input)
+    end subroutine check_law
+
+end module voiga_io_case_contact

@@ -1,0 +1,63 @@
+!> The loads of the model: prescribed displacements and pressures on named edges,
+!> each with a value at the end of every load phase (linear within a phase); and
+!> the settings a case gives for one (`&dirichlet`, `&pressure`, read by
+!> `voiga_io_case_dirichlet` and `voiga_io_case_pressure`).
+module voiga_model_loads
+    use voiga_kinds, only: dp
+    implicit none
+    private
+
+    public :: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
+
+    !> A prescribed displacement on a named edge (docs/formats.md, `&dirichlet`).
+    type :: dirichlet_settings_t
+        character(len=32) :: body = '', edge = ''
+        !> Which components are prescribed [x, y].
+        logical :: fix(2) = .false.
+        !> Value at the end of each phase, shape [2, n_phases] (linear within a phase).
+        real(dp), allocatable :: values(:, :)
+    end type dirichlet_settings_t
+
+    !> A pressure (force per length, normal to the edge, reference configuration)
+    !> on a named edge (`&pressure`); positive pushes into the body.
+    type :: pressure_settings_t
+        character(len=32) :: body = '', edge = ''
+        !> Value at the end of each phase, shape [n_phases].
+        real(dp), allocatable :: values(:)
+    end type pressure_settings_t
+
+    !> Prescribed displacement on the control points of an edge.
+    type :: dirichlet_t
+        integer :: body = 0
+        character(len=32) :: edge = ''
+        !> Global DOF numbers of the edge's x and y components, shape [2, ncp_edge].
+        integer, allocatable :: dofs(:, :)
+        logical :: fix(2) = .false.
+        !> Value at the end of each phase [2, n_phases].
+        real(dp), allocatable :: values(:, :)
+    end type dirichlet_t
+
+    !> Pressure on an edge (reference configuration, positive into the body).
+    type :: pressure_t
+        integer :: body = 0
+        !> Edge index 1..4 (xi0, xi1, eta0, eta1) of the oriented patch.
+        integer :: edge = 0
+        real(dp), allocatable :: values(:)
+    end type pressure_t
+
+contains
+
+    !> Value of a phase-wise linear history at load time `t`: 0 at t = 0, `values(k)` at t = k.
+    pure real(dp) function phase_value(values, t) result(v)
+        real(dp), intent(in) :: values(:)
+        real(dp), intent(in) :: t
+        integer :: k
+        real(dp) :: a, s
+        k = min(max(ceiling(t), 1), size(values))
+        s = t - real(k - 1, dp)
+        a = 0.0_dp
+        if (k > 1) a = values(k - 1)
+        v = a + s*(values(k) - a)
+    end function phase_value
+
+end module voiga_model_loads
