@@ -329,8 +329,8 @@ contains
         if (allocated(error)) return
         allocate (array(dims(1)))
         call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
         if (st /= 0) call read_failed(self, path, error)
+        call h5dclose_f(did, st)
     end subroutine read_r1
 
     subroutine read_r2(self, path, array, error)
@@ -345,8 +345,8 @@ contains
         if (allocated(error)) return
         allocate (array(dims(1), dims(2)))
         call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
         if (st /= 0) call read_failed(self, path, error)
+        call h5dclose_f(did, st)
     end subroutine read_r2
 
     subroutine read_r3(self, path, array, error)
@@ -361,8 +361,8 @@ contains
         if (allocated(error)) return
         allocate (array(dims(1), dims(2), dims(3)))
         call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
         if (st /= 0) call read_failed(self, path, error)
+        call h5dclose_f(did, st)
     end subroutine read_r3
 
     subroutine read_i1(self, path, array, error)
@@ -377,8 +377,8 @@ contains
         if (allocated(error)) return
         allocate (array(dims(1)))
         call h5dread_f(did, H5T_NATIVE_INTEGER, array, dims, st)
-        call h5dclose_f(did, st)
         if (st /= 0) call read_failed(self, path, error)
+        call h5dclose_f(did, st)
     end subroutine read_i1
 
     subroutine read_failed(self, path, error)
