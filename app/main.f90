@@ -19,7 +19,7 @@ program voiga_main
     logical :: check, quiet, verbose
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
-    type(error_t), allocatable :: error
+    type(error_t), allocatable :: error, finish_error
     type(h5file_t) :: h5
     type(model_t) :: model
     type(resume_t) :: resume
@@ -93,15 +93,22 @@ program voiga_main
     if (allocated(dump_path)) then
         call h5%open(dump_path, 'w', error)
         if (allocated(error)) call fail(error)
-        call h5%write_attr('/', 'title', case%title)
-        call h5%write_attr('/', 'scene', case%scene)
-        call h5%write_attr('/', 'mesh', case%mesh)
-        call h5%write_attr('/', 'layout', case%layout)
-        call h5%write_attr('/', 'voiga_version', voiga_version_string)
+        call h5%write_attr('/', 'title', case%title, error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'scene', case%scene, error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'mesh', case%mesh, error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'layout', case%layout, error)
+        if (allocated(error)) call fail(error)
+        call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
+        if (allocated(error)) call fail(error)
         do i = 1, size(discs)
-            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
+            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i), error)
+            if (allocated(error)) call fail(error)
         end do
-        call h5%close()
+        call h5%close(error)
+        if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
 
@@ -129,7 +136,9 @@ program voiga_main
                                 predictor=case%solver%predictor), resume)
     if (stats%signal /= 0) then
         call results%finish('interrupted', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                            finish_error)
+        if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//finish_error%message
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
             ' completed steps are in '//case%output
         ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
@@ -137,12 +146,19 @@ program voiga_main
     end if
     if (allocated(error)) then
         call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
-        write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
+                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                            finish_error)
+        if (allocated(finish_error)) then
+            write (0, '(a)') 'voiga: error: '//finish_error%message
+        else
+            write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
+        end if
         call fail(error)
     end if
     call results%finish('converged', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                        [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                        error)
+    if (allocated(error)) call fail(error)
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output
@@ -158,10 +174,12 @@ contains
         character(len=:), allocatable, intent(out) :: case_file
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: f
+        type(error_t), allocatable :: close_error
         call f%open(path, 'r', error)
         if (allocated(error)) return
         call f%read_attr_str('/', 'case_file', case_file, error)
-        call f%close()
+        call f%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
         if (allocated(error)) error%message = '--restart: '//error%message
     end subroutine restart_case
 
@@ -232,7 +250,7 @@ contains
                 model%pairs(ip)%trial_active = model%pairs(ip)%active_last
             end do
         end if
-        call f%close()
+        call f%close(error)
     end subroutine load_restart
 
     function get_arg(k) result(val)

@@ -228,7 +228,8 @@ contains
             call mg%build(model%bodies(:)%disc, model%bodies(:)%dof0, model%ndof, model%fixed, error)
             if (allocated(error)) return
             stats%multigrid_levels = mg%level_dofs()
-            if (present(results)) call results%write_multigrid(stats%multigrid_levels)
+            if (present(results)) call results%write_multigrid(stats%multigrid_levels, error)
+            if (allocated(error)) return
             if (.not. quiet) write (*, '(a,i0,a,*(1x,i0))') 'multigrid: ', mg%n_levels(), &
                 ' levels, DOFs', stats%multigrid_levels
         end if
@@ -386,7 +387,9 @@ contains
             if (present(results)) then
                 tic = wall_seconds()
                 call results%write_step(rec, u, wall_seconds() - start, model%pairs, &
-                                        stats%cut_records(first_cut:), stats%cuts, frac, stats%r0_max)
+                                        stats%cut_records(first_cut:), stats%cuts, frac, &
+                                        stats%r0_max, error)
+                if (allocated(error)) exit steps
                 rec%seconds(5) = wall_seconds() - tic
             end if
             stats%records = [stats%records, rec]
