@@ -92,7 +92,8 @@ contains
         integer(hid_t) :: fid, sid, tid, did, i64
         integer :: st, bad
         character(len=8), target :: words(3) = [character(len=8) :: 'one', 'two', 'three']
-        integer(int64), target :: wide(2, 2) = reshape([1_int64, -7_int64, 1_int64, 2_int64**40], [2, 2])
+        integer(int64), target :: wide(2, 2) = reshape([1_int64, -7_int64, 1_int64, 2_int64**40], &
+                                                       [2, 2])
         integer, target :: three(3) = [1, 2, 3]
 
         bad = 0
@@ -172,8 +173,8 @@ contains
 
         call h5%open(path, 'r', error)
         if (allocated(error)) return
-        call check(error, all(h5%shape('/g/scalar') == [1]) .and. size(h5%shape('/g/scalar')) == 1, &
-                   'a scalar is a dataset of shape (1,)')
+        call check(error, all(h5%shape('/g/scalar') == [1]) .and. &
+                   size(h5%shape('/g/scalar')) == 1, 'a scalar is a dataset of shape (1,)')
         if (allocated(error)) return
         call check(error, all(h5%shape('/g/r3') == [2, 3, 4]), 'shape of a rank-3 dataset')
         if (allocated(error)) return

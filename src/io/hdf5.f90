@@ -33,8 +33,9 @@ module voiga_io_hdf5
                     H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
                     h5dopen_f, h5dcreate_f, h5dwrite_f, h5dread_f, h5dget_space_f, h5dget_type_f, &
                     h5screate_simple_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
-                    h5gcreate_f, h5lexists_f, h5ldelete_f, h5tget_class_f, H5T_INTEGER_F, H5T_FLOAT_F, &
-                    H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, h5kind_to_type, H5_INTEGER_KIND, h5eset_auto_f
+                    h5gcreate_f, h5lexists_f, h5ldelete_f, h5tget_class_f, H5T_INTEGER_F, &
+                    H5T_FLOAT_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, h5kind_to_type, &
+                    H5_INTEGER_KIND, h5eset_auto_f
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5_status, only: note, release, class_name, not_open, fits_integer
@@ -157,7 +158,8 @@ contains
             call h5fopen_f(path, merge(H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, mode == 'r'), self%id, st)
             if (st /= 0) then
                 self%id = -1
-                call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", error_code%input)
+                call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", &
+                                 error_code%input)
                 return
             end if
         case ('w')
@@ -210,8 +212,8 @@ contains
         integer :: st
         if (self%id < 0) return
         call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, st)
-        if (st /= 0) call fatal_error(error, self%path//": flushing the file failed in H5Fflush "// &
-                                      "(is the disk full?)")
+        if (st /= 0) call fatal_error(error, self%path//": flushing the file failed in "// &
+                                      "H5Fflush (is the disk full?)")
     end subroutine file_flush
 
     !> Does the object (group or dataset) at `path` exist? (No, when HDF5 fails.)
@@ -269,8 +271,8 @@ contains
         character(len=*), intent(in) :: path
         real(dp), contiguous, target, intent(in) :: array(..)
         type(error_t), allocatable, intent(out) :: error
-        call write_dataset(self, path, H5T_NATIVE_DOUBLE, written_dims(shape(array, kind=hsize_t)), &
-                           c_loc(array), error)
+        call write_dataset(self, path, H5T_NATIVE_DOUBLE, &
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
     end subroutine write_real
 
     !> Write an integer array of any rank (a scalar as one element) as native integers.
@@ -279,8 +281,8 @@ contains
         character(len=*), intent(in) :: path
         integer, contiguous, target, intent(in) :: array(..)
         type(error_t), allocatable, intent(out) :: error
-        call write_dataset(self, path, H5T_NATIVE_INTEGER, written_dims(shape(array, kind=hsize_t)), &
-                           c_loc(array), error)
+        call write_dataset(self, path, H5T_NATIVE_INTEGER, &
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
     end subroutine write_int
 
     !> The dataset shape of an array of shape `array_shape`: a scalar is one element.
@@ -406,8 +408,8 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=12) :: buf
         write (buf, '(i0)') array_rank
-        call fatal_error(error, self%path//": reading dataset '"//path//"' into an array of rank "// &
-                         trim(buf)//" is not supported")
+        call fatal_error(error, self%path//": reading dataset '"//path// &
+                         "' into an array of rank "//trim(buf)//" is not supported")
     end subroutine unsupported_rank
 
     !> Shape (Fortran order) of dataset `path`, checked to be readable as an array of
@@ -420,16 +422,17 @@ contains
         logical, intent(in) :: as_real
         integer(hsize_t), allocatable, intent(out) :: dims(:)
         type(error_t), allocatable, intent(out) :: error
-        integer :: class
+        integer :: type_class
         character(len=32) :: buf
         character(len=:), allocatable :: expected
 
-        call dataset_info(self, path, dims, class, error)
+        call dataset_info(self, path, dims, type_class, error)
         if (allocated(error)) return
         expected = merge('numbers ', 'integers', as_real)
-        if (.not. (class == H5T_INTEGER_F .or. (as_real .and. class == H5T_FLOAT_F))) then
-            call fatal_error(error, self%path//": dataset '"//path//"' holds "//class_name(class)// &
-                             ", not "//trim(expected), error_code%input)
+        if (.not. (type_class == H5T_INTEGER_F .or. &
+                   (as_real .and. type_class == H5T_FLOAT_F))) then
+            call fatal_error(error, self%path//": dataset '"//path//"' holds "// &
+                             class_name(type_class)//", not "//trim(expected), error_code%input)
             return
         end if
         if (array_rank == 0 .and. product(dims) == 1 .and. size(dims) <= 1) then
@@ -442,22 +445,23 @@ contains
     end subroutine dataset_layout
 
     !> Shape (Fortran order) and HDF5 type class of dataset `path`.
-    subroutine dataset_info(self, path, dims, class, error)
+    subroutine dataset_info(self, path, dims, type_class, error)
         class(h5file_t), intent(in) :: self
         character(len=*), intent(in) :: path
         integer(hsize_t), allocatable, intent(out) :: dims(:)
-        integer, intent(out) :: class
+        integer, intent(out) :: type_class
         type(error_t), allocatable, intent(out) :: error
         integer(hid_t) :: did, sid, tid
         integer(hsize_t), allocatable :: maxdims(:)
         integer :: st, ndims
         character(len=:), allocatable :: failed
 
-        class = -1
+        type_class = -1
         allocate (dims(0))
         if (not_open(self%id, path, error)) return
         if (.not. self%exists(path)) then
-            call fatal_error(error, self%path//": dataset '"//path//"' is missing", error_code%input)
+            call fatal_error(error, self%path//": dataset '"//path//"' is missing", &
+                             error_code%input)
             return
         end if
         sid = -1
@@ -471,7 +475,7 @@ contains
             call h5dget_type_f(did, tid, st)
             call note(st, 'H5Dget_type', failed)
             if (allocated(failed)) exit steps
-            call h5tget_class_f(tid, class, st)
+            call h5tget_class_f(tid, type_class, st)
             call note(st, 'H5Tget_class', failed)
             call h5dget_space_f(did, sid, st)
             call note(st, 'H5Dget_space', failed)
@@ -525,9 +529,9 @@ contains
         character(len=*), intent(in) :: path
         integer, allocatable :: dims(:)
         integer(hsize_t), allocatable :: d(:)
-        integer :: class
+        integer :: type_class
         type(error_t), allocatable :: error
-        call dataset_info(self, path, d, class, error)
+        call dataset_info(self, path, d, type_class, error)
         if (allocated(error)) then
             allocate (dims(0))
         else

@@ -3,8 +3,8 @@
 !> keep the files short; the interfaces and their documentation are in the module.
 submodule(voiga_io_hdf5) voiga_io_hdf5_attributes
     use, intrinsic :: iso_c_binding, only: c_f_pointer, c_char, c_null_char, c_associated
-    use hdf5, only: size_t, h5acreate_f, h5aopen_f, h5awrite_f, h5aread_f, h5aexists_f, h5adelete_f, &
-                    h5aget_type_f, h5aget_space_f, h5screate_f, H5S_SCALAR_F, &
+    use hdf5, only: size_t, h5acreate_f, h5aopen_f, h5awrite_f, h5aread_f, h5aexists_f, &
+                    h5adelete_f, h5aget_type_f, h5aget_space_f, h5screate_f, H5S_SCALAR_F, &
                     h5sget_simple_extent_npoints_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, &
                     h5tis_variable_str_f, H5T_STRING_F, H5T_FORTRAN_S1, h5dvlen_reclaim_f, &
                     H5P_DEFAULT_F, h5oopen_f, h5oclose_f
@@ -102,8 +102,8 @@ contains
     end procedure attr_exists
 
     !> Open attribute `name` of object `path` (handles `oid`, `aid`, -1 when not
-    !> opened), its file type `tid` and its class, checked to hold one value of a
-    !> class in `classes`; `what` names the expected kind in messages.
+    !> opened), its file type `tid` and its type class, checked to hold one value of a
+    !> type class in `classes`; `what` names the expected kind in messages.
     subroutine attr_open(self, path, name, classes, what, oid, aid, tid, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path, name
@@ -113,7 +113,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer(hid_t) :: sid
         integer(hsize_t) :: npoints
-        integer :: st, class
+        integer :: st, type_class
         character(len=:), allocatable :: failed, object
 
         oid = -1
@@ -140,7 +140,7 @@ contains
             call h5aget_type_f(aid, tid, st)
             call note(st, 'H5Aget_type', failed)
             if (allocated(failed)) exit steps
-            call h5tget_class_f(tid, class, st)
+            call h5tget_class_f(tid, type_class, st)
             call note(st, 'H5Tget_class', failed)
         end block steps
         call release(sid, failed)
@@ -148,8 +148,8 @@ contains
             call fatal_error(error, object//": reading failed in "//failed, error_code%input)
         else if (npoints /= 1) then
             call fatal_error(error, object//" holds more than one value", error_code%input)
-        else if (all(classes /= class)) then
-            call fatal_error(error, object//" holds "//class_name(class)//", not "//what, &
+        else if (all(classes /= type_class)) then
+            call fatal_error(error, object//" holds "//class_name(type_class)//", not "//what, &
                              error_code%input)
         end if
         if (allocated(error)) call attr_close(oid, aid, tid, failed)
@@ -196,8 +196,9 @@ contains
         end block steps
         call release(mtid, failed)
         call attr_close(oid, aid, ftid, failed)
-        if (allocated(failed)) call fatal_error(error, self%path//": reading attribute '"//name// &
-                                                "' of '"//path//"' failed in "//failed, error_code%input)
+        if (allocated(failed)) call fatal_error(error, self%path//": reading attribute '"// &
+                                                name//"' of '"//path//"' failed in "//failed, &
+                                                error_code%input)
     end procedure attr_read_str
 
     !> Read the fixed-length string attribute `aid` (memory type `mtid`, `n` characters).
@@ -272,13 +273,12 @@ contains
     end procedure attr_read_int
 
     module procedure attr_read_real
-
         value = 0.0_dp
         call read_attribute(self, path, name, [H5T_INTEGER_F, H5T_FLOAT_F], 'a number', &
                             H5T_NATIVE_DOUBLE, c_loc(value), error)
     end procedure attr_read_real
 
-    !> Read the one value of attribute `name` of `path`, of a class in `classes`, as
+    !> Read the one value of attribute `name` of `path`, of a type class in `classes`, as
     !> HDF5 type `mem_type` into `buf`.
     subroutine read_attribute(self, path, name, classes, what, mem_type, buf, error)
         class(h5file_t), intent(inout) :: self
@@ -299,8 +299,9 @@ contains
         call h5aread_f(aid, mem_type, p, st)
         call note(st, 'H5Aread', failed)
         call attr_close(oid, aid, tid, failed)
-        if (allocated(failed)) call fatal_error(error, self%path//": reading attribute '"//name// &
-                                                "' of '"//path//"' failed in "//failed, error_code%input)
+        if (allocated(failed)) call fatal_error(error, self%path//": reading attribute '"// &
+                                                name//"' of '"//path//"' failed in "//failed, &
+                                                error_code%input)
     end subroutine read_attribute
 
 end submodule voiga_io_hdf5_attributes

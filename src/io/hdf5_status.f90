@@ -7,7 +7,8 @@ module voiga_io_hdf5_status
     use, intrinsic :: iso_fortran_env, only: int64
     use hdf5, only: hid_t, h5dclose_f, h5sclose_f, h5tclose_f, h5aclose_f, h5gclose_f, h5oclose_f, &
                     h5iget_type_f, H5I_DATASET_F, H5I_DATASPACE_F, H5I_DATATYPE_F, H5I_ATTR_F, &
-                    H5I_GROUP_F, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, H5T_COMPOUND_F, H5T_ENUM_F
+                    H5I_GROUP_F, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, H5T_COMPOUND_F, &
+                    H5T_ENUM_F
     use voiga_error, only: error_t, fatal_error
     implicit none
     private
@@ -57,18 +58,18 @@ contains
     end subroutine release
 
     !> What an HDF5 type class holds, for messages.
-    function class_name(class) result(name)
-        integer, intent(in) :: class
+    function class_name(type_class) result(name)
+        integer, intent(in) :: type_class
         character(len=:), allocatable :: name
-        if (class == H5T_INTEGER_F) then
+        if (type_class == H5T_INTEGER_F) then
             name = 'integers'
-        else if (class == H5T_FLOAT_F) then
+        else if (type_class == H5T_FLOAT_F) then
             name = 'floating-point numbers'
-        else if (class == H5T_STRING_F) then
+        else if (type_class == H5T_STRING_F) then
             name = 'strings'
-        else if (class == H5T_COMPOUND_F) then
+        else if (type_class == H5T_COMPOUND_F) then
             name = 'compound values'
-        else if (class == H5T_ENUM_F) then
+        else if (type_class == H5T_ENUM_F) then
             name = 'enumeration values'
         else
             name = 'values of another HDF5 type class'

@@ -125,7 +125,8 @@ contains
             g = '/dirichlet/'//trim(buf)
             call self%h5%create_group(g, error)
             if (allocated(error)) return
-            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), error)
+            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), &
+                                    error)
             if (allocated(error)) return
             call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge), error)
             if (allocated(error)) return
@@ -213,7 +214,8 @@ contains
     end subroutine results_reopen
 
     !> Write one converged step and the current displacement; flush.
-    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, error)
+    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
+                                  error)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -245,7 +247,8 @@ contains
         if (allocated(error)) return
         call self%h5%write_attr(g, 'iterations', rec%iterations, error)
         if (allocated(error)) return
-        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations), error)
+        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations), &
+                                error)
         if (allocated(error)) return
         call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign, error)
         if (allocated(error)) return
@@ -255,7 +258,8 @@ contains
         if (allocated(error)) return
         call self%h5%write_attr(g, 'cuts', rec%cuts, error)
         if (allocated(error)) return
-        if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction, error)
+        if (present(next_fraction)) &
+            call self%h5%write_attr(g, 'next_fraction', next_fraction, error)
         if (allocated(error)) return
         if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max, error)
         if (allocated(error)) return
@@ -366,7 +370,8 @@ contains
             ! committed friction history: what a restart needs
             if (allocated(pair%anchor)) call h5%write(c//'/history/anchor', pair%anchor, error)
             if (allocated(error)) return
-            if (allocated(pair%traction)) call h5%write(c//'/history/traction', pair%traction, error)
+            if (allocated(pair%traction)) &
+                call h5%write(c//'/history/traction', pair%traction, error)
             if (allocated(error)) return
             call h5%write(c//'/history/xi_last', pair%xi_last, error)
             if (allocated(error)) return
