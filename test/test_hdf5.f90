@@ -49,6 +49,32 @@ contains
         if (ios == 0) close (u, status='delete')
     end subroutine remove
 
+    !> The raw-API fixture (`write_foreign_file`) as scratch file `name`, opened
+    !> read-write in `h5`.
+    subroutine open_foreign(name, h5, path, error)
+        character(len=*), intent(in) :: name
+        type(h5file_t), intent(inout) :: h5
+        character(len=:), allocatable, intent(out) :: path
+        type(error_t), allocatable, intent(out) :: error
+        path = scratch(name)
+        call write_foreign_file(path, error)
+        if (allocated(error)) return
+        call h5%open(path, 'rw', error)
+    end subroutine open_foreign
+
+    !> After a test's calls: nothing but the file itself is left open in `h5` (every
+    !> handle closed, on the failure paths too); close it and remove the file.
+    subroutine close_scratch(h5, path, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
+        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
+        if (allocated(error)) return
+        call h5%close(error)
+        if (allocated(error)) return
+        call remove(path)
+    end subroutine close_scratch
+
     !> Fail unless `got` is an error whose message names `word1` (and `word2`, `word3`).
     subroutine check_error(error, got, what, word1, word2, word3)
         type(error_t), allocatable, intent(out) :: error
@@ -211,9 +237,7 @@ contains
         if (allocated(error)) return
         call check(error, size(r1), 0, 'an empty dataset')
         if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_round_trip
 
     !> String (fixed and empty), integer and real attributes, on the root, a group and a
@@ -271,11 +295,7 @@ contains
         call h5%read_attr_int('/', 'nothing', n, got)
         call check_error(error, got, 'missing attribute', path, 'nothing', 'missing')
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_attributes
 
     !> Writing to a file opened read-only fails in HDF5 (the cheap stand-in for a full
@@ -316,11 +336,7 @@ contains
         if (allocated(error)) return
         call h5%flush(error)
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_read_only
 
     !> A file object that is not open refuses writes and reads; closing it is harmless.
@@ -353,10 +369,7 @@ contains
         integer, allocatable :: i(:)
         character(len=:), allocatable :: path
 
-        path = scratch('string')
-        call write_foreign_file(path, error)
-        if (allocated(error)) return
-        call h5%open(path, 'r', error)
+        call open_foreign('string', h5, path, error)
         if (allocated(error)) return
         call h5%read('/s', r, got)
         call check_error(error, got, 'strings as reals', path, "'/s'", 'strings')
@@ -364,11 +377,7 @@ contains
         call h5%read('/s', i, got)
         call check_error(error, got, 'strings as integers', path, "'/s'", 'strings')
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_string_dataset
 
     !> A compound dataset, floats read as integers (HDF5 would truncate: 2.7 -> 2), a
@@ -381,10 +390,7 @@ contains
         integer, allocatable :: i1(:)
         character(len=:), allocatable :: path
 
-        path = scratch('wrong-type')
-        call write_foreign_file(path, error)
-        if (allocated(error)) return
-        call h5%open(path, 'rw', error)
+        call open_foreign('wrong-type', h5, path, error)
         if (allocated(error)) return
         call h5%write('/f', [2.7_dp, -1.5_dp], error)
         if (allocated(error)) return
@@ -408,11 +414,7 @@ contains
         call h5%read('/nothing/here', r1, got)
         call check_error(error, got, 'missing dataset', "'/nothing/here'", 'missing')
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_wrong_type
 
     !> 64-bit integer datasets (h5py's default) read when their values fit a default
@@ -425,10 +427,7 @@ contains
         real(dp), allocatable :: r1(:)
         character(len=:), allocatable :: path
 
-        path = scratch('wide')
-        call write_foreign_file(path, error)
-        if (allocated(error)) return
-        call h5%open(path, 'r', error)
+        call open_foreign('wide', h5, path, error)
         if (allocated(error)) return
         call h5%read('/wide', i1, error)
         if (allocated(error)) return
@@ -441,11 +440,7 @@ contains
         if (allocated(error)) return
         call check(error, r1(2) == 2.0_dp**40, '2**40 read as real')
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_wide_integers
 
     !> An attribute of three values (which would overflow a scalar) and one of the
@@ -458,10 +453,7 @@ contains
         integer :: n
         real(dp) :: x
 
-        path = scratch('wrong-attributes')
-        call write_foreign_file(path, error)
-        if (allocated(error)) return
-        call h5%open(path, 'rw', error)
+        call open_foreign('wrong-attributes', h5, path, error)
         if (allocated(error)) return
         call h5%write_attr('/', 'name', 'text', error)
         if (allocated(error)) return
@@ -482,11 +474,7 @@ contains
         call h5%read_attr_str('/', 'x', text, got)
         call check_error(error, got, 'real as string', "'x'", 'not a string')
         if (allocated(error)) return
-        call check(error, open_objects(h5), 1, 'open HDF5 objects but the file')
-        if (allocated(error)) return
-        call h5%close(error)
-        if (allocated(error)) return
-        call remove(path)
+        call close_scratch(h5, path, error)
     end subroutine test_wrong_attributes
 
 end module test_hdf5
