@@ -401,6 +401,7 @@ contains
         end select
     end subroutine read_int
 
+    !> The error for an array rank `read` has no branch for.
     subroutine unsupported_rank(self, path, array_rank, error)
         class(h5file_t), intent(in) :: self
         character(len=*), intent(in) :: path
