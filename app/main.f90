@@ -5,8 +5,7 @@ program voiga_main
     use voiga_error, only: error_t, error_code, fatal_error
     use voiga_version, only: voiga_version_string
     use voiga_io_case, only: case_t, read_case, check_edges
-    use voiga_io_hdf5, only: h5file_t
-    use voiga_io_dump, only: write_discretization
+    use voiga_io_dump, only: write_dump
     use voiga_io_bodies, only: discretize_bodies
     use voiga_io_results, only: restart_case, read_restart
     use voiga_discretization_patch, only: discretization_t
@@ -23,7 +22,7 @@ program voiga_main
     logical :: check, quiet, verbose
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
-    type(error_t), allocatable :: error
+    type(error_t), allocatable :: error, finish_error
     type(model_t) :: model
     type(resume_t) :: resume
     type(console_t) :: results
@@ -95,7 +94,11 @@ program voiga_main
     call check_edges(case, discs, error)
     if (allocated(error)) call fail(error)
 
-    if (allocated(dump_path)) call dump(dump_path, case, discs)
+    if (allocated(dump_path)) then
+        call write_dump(dump_path, case, discs, error)
+        if (allocated(error)) call fail(error)
+        if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
+    end if
     if (check) stop
 
     call new_model(model, case%bodies, discs, case%solver%n_gauss, case%dirichlet, case%pressure, &
@@ -119,7 +122,9 @@ program voiga_main
     call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
     if (stats%signal /= 0) then
         call results%finish('interrupted', wall_seconds() - t0, stats%cut_records, &
-                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                             finish_error)
+        if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//finish_error%message
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
             ' completed steps are in '//case%output
         ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
@@ -127,12 +132,19 @@ program voiga_main
     end if
     if (allocated(error)) then
         call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records, &
-                            [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
-        write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                             finish_error)
+        if (allocated(finish_error)) then
+            write (0, '(a)') 'voiga: error: '//finish_error%message
+        else
+            write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
+        end if
         call fail(error)
     end if
     call results%finish('converged', wall_seconds() - t0, stats%cut_records, &
-                        [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations])
+                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
+                             error)
+    if (allocated(error)) call fail(error)
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output
@@ -141,28 +153,6 @@ program voiga_main
         stats%fixed_point_iterations, ' fixed-point iterations'
 
 contains
-
-    !> Write the refined bulk patch and VO layer of every body to `path`.
-    subroutine dump(path, case, discs)
-        character(len=*), intent(in) :: path
-        type(case_t), intent(in) :: case
-        type(discretization_t), intent(in) :: discs(:)
-        type(h5file_t) :: h5
-        type(error_t), allocatable :: error
-        integer :: i
-        call h5%open(path, 'w', error)
-        if (allocated(error)) call fail(error)
-        call h5%write_attr('/', 'title', case%title)
-        call h5%write_attr('/', 'scene', case%scene)
-        call h5%write_attr('/', 'mesh', case%mesh)
-        call h5%write_attr('/', 'layout', case%layout)
-        call h5%write_attr('/', 'voiga_version', voiga_version_string)
-        do i = 1, size(discs)
-            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
-        end do
-        call h5%close()
-        if (.not. quiet) write (*, '(a)') 'wrote '//path
-    end subroutine dump
 
     function get_arg(k) result(val)
         integer, intent(in) :: k

@@ -20,6 +20,7 @@ contains
         type(discretization_t), allocatable, intent(out) :: discs(:)
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: geo
+        type(error_t), allocatable :: close_error
         type(nurbs_surface_t) :: coarse
         integer :: i
 
@@ -40,7 +41,8 @@ contains
                                     case%path//": &body '"//trim(case%bodies(i)%name)//"': ", error)
             if (allocated(error)) exit
         end do
-        call geo%close()
+        call geo%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine discretize_bodies
 
 end module voiga_io_bodies

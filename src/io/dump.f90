@@ -1,36 +1,81 @@
 !> Writing a body's discretization (refined bulk patch, VO layer, DOF counts)
 !> to HDF5, in the schema of docs/formats.md ("discretization dump").
 module voiga_io_dump
+    use voiga_error, only: error_t
     use voiga_io_hdf5, only: h5file_t
     use voiga_discretization_patch, only: discretization_t
+    use voiga_io_case, only: case_t
+    use voiga_version, only: voiga_version_string
     implicit none
     private
 
-    public :: write_discretization
+    public :: write_discretization, write_dump
 
 contains
 
+    !> The dump file `path` (`voiga --dump`): the case's metadata and the refined
+    !> bulk patch and VO layer of every body (`discs`, one per body).
+    subroutine write_dump(path, case, discs, error)
+        character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: case
+        type(discretization_t), intent(in) :: discs(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: h5
+        integer :: i
+        call h5%open(path, 'w', error)
+        if (allocated(error)) return
+        call h5%write_attr('/', 'title', case%title, error)
+        if (allocated(error)) return
+        call h5%write_attr('/', 'scene', case%scene, error)
+        if (allocated(error)) return
+        call h5%write_attr('/', 'mesh', case%mesh, error)
+        if (allocated(error)) return
+        call h5%write_attr('/', 'layout', case%layout, error)
+        if (allocated(error)) return
+        call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
+        if (allocated(error)) return
+        do i = 1, size(discs)
+            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i), error)
+            if (allocated(error)) return
+        end do
+        call h5%close(error)
+    end subroutine write_dump
+
     !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`.
-    subroutine write_discretization(h5, group, disc)
+    subroutine write_discretization(h5, group, disc, error)
         type(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: group
         type(discretization_t), intent(in) :: disc
+        type(error_t), allocatable, intent(out) :: error
 
-        call h5%create_group(group)
-        call h5%write_attr(group, 'interface_dofs', disc%interface_dofs)
-        call h5%write_attr(group, 'bulk_dofs', disc%bulk_dofs)
-        call h5%write_attr(group, 'total_dofs', disc%total_dofs)
-        call h5%write_attr(group, 'n_elements', disc%nel)
-        call h5%write(group//'/bulk/degree', disc%bulk%degree)
-        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots_xi)
-        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots_eta)
-        call h5%write(group//'/bulk/control_points', disc%bulk%cp)
-        call h5%write(group//'/bulk/weights', disc%bulk%w)
+        call h5%create_group(group, error)
+        if (allocated(error)) return
+        call h5%write_attr(group, 'interface_dofs', disc%interface_dofs, error)
+        if (allocated(error)) return
+        call h5%write_attr(group, 'bulk_dofs', disc%bulk_dofs, error)
+        if (allocated(error)) return
+        call h5%write_attr(group, 'total_dofs', disc%total_dofs, error)
+        if (allocated(error)) return
+        call h5%write_attr(group, 'n_elements', disc%nel, error)
+        if (allocated(error)) return
+        call h5%write(group//'/bulk/degree', disc%bulk%degree, error)
+        if (allocated(error)) return
+        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots_xi, error)
+        if (allocated(error)) return
+        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots_eta, error)
+        if (allocated(error)) return
+        call h5%write(group//'/bulk/control_points', disc%bulk%cp, error)
+        if (allocated(error)) return
+        call h5%write(group//'/bulk/weights', disc%bulk%w, error)
+        if (allocated(error)) return
         if (disc%has_layer) then
-            call h5%write(group//'/layer/degree', [disc%layer%degree])
-            call h5%write(group//'/layer/knots', disc%layer%knots)
-            call h5%write(group//'/layer/control_points', disc%layer%cp)
-            call h5%write(group//'/layer/weights', disc%layer%w)
+            call h5%write(group//'/layer/degree', [disc%layer%degree], error)
+            if (allocated(error)) return
+            call h5%write(group//'/layer/knots', disc%layer%knots, error)
+            if (allocated(error)) return
+            call h5%write(group//'/layer/control_points', disc%layer%cp, error)
+            if (allocated(error)) return
+            call h5%write(group//'/layer/weights', disc%layer%w, error)
         end if
     end subroutine write_discretization
 

@@ -1,28 +1,44 @@
 !> A small HDF5 file object over the raw Fortran API.
 !>
-!> `call h%open(path, 'r'|'w'|'rw', error)`, `h%write(path, array)`, `h%read(path, array, error)`,
-!> attributes with `h%write_attr(path, name, value)`, `h%close()`. Paths are absolute
-!> ('/bodies/die/knots_xi'); missing parent groups are created on write. Every handle
-!> is closed on every path, and a finalizer closes a forgotten file. Arrays are
-!> written in Fortran order, so h5py shows them with the axes reversed (docs/formats.md).
-!> Strings are written as fixed-length ASCII; both fixed and variable-length
-!> string attributes are read.
+!> `call h%open(path, 'r'|'w'|'rw', error)`, `h%write(path, array, error)`,
+!> `h%read(path, array, error)`, attributes with `h%write_attr(path, name, value, error)`
+!> and `h%read_attr_*(path, name, value, error)`, `h%flush(error)`, `h%close(error)`.
+!> Paths are absolute ('/bodies/die/knots_xi'); missing parent groups are created on
+!> write, and a dataset or attribute that exists is replaced (a restarted run rewrites
+!> run-wide records).
+!>
+!> Every HDF5 call is checked: a failure comes back as an `error_t` naming the file,
+!> the object and the HDF5 call that failed, and every handle opened on the way is
+!> closed on every path. Writes that HDF5 only caches can fail at `flush` or `close`
+!> (a full disk), so those report errors too. The queries `exists`, `has_attr` and
+!> `shape` answer "no" (or an empty shape) when HDF5 fails.
+!>
+!> Arrays are written in Fortran order, so h5py shows them with the axes reversed
+!> (docs/formats.md); reals as 64-bit floats, integers as the native (32-bit) integer,
+!> a scalar as a dataset of one element and shape (1,). Strings are written as
+!> fixed-length ASCII attributes; fixed and variable-length string attributes are read.
+!>
+!> Reading converts with HDF5's own conversions, which are exact for what we accept:
+!> reals are read from any integer or floating-point dataset (an integer beyond 2^53
+!> would round); integers only from integer datasets of any width, through a 64-bit
+!> buffer whose values must fit a default integer. Refused with an error: strings,
+!> compound, enum and other classes (HDF5 either has no conversion, so the read
+!> fails, or converts lossily: floats to integers are truncated and clamped, NaN
+!> becomes the most negative integer, wide integers are clamped to the narrow range),
+!> a rank other than the array's, and attributes of more than one value.
 module voiga_io_hdf5
-    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_f_pointer, c_char, c_size_t, c_null_char
-    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5fopen_f, h5fcreate_f, h5fclose_f, h5fflush_f, &
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc
+    use, intrinsic :: iso_fortran_env, only: int64
+    use hdf5, only: hid_t, hsize_t, h5open_f, h5fopen_f, h5fcreate_f, h5fclose_f, h5fflush_f, &
                     H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
-                    h5dopen_f, h5dclose_f, h5dcreate_f, h5dwrite_f, h5dread_f, h5dget_space_f, &
-                    h5dvlen_reclaim_f, H5P_DEFAULT_F, &
-                    h5screate_simple_f, h5screate_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
-                    h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
-                    h5gcreate_f, h5gclose_f, h5lexists_f, h5ldelete_f, &
-                    h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5aexists_f, &
-                    h5aget_type_f, h5aget_space_f, h5adelete_f, &
-                    h5tcopy_f, h5tclose_f, h5tset_size_f, h5tget_size_f, h5tis_variable_str_f, &
-                    H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_STRING, &
-                    h5eset_auto_f, h5oopen_f, h5oclose_f
+                    h5dopen_f, h5dcreate_f, h5dwrite_f, h5dread_f, h5dget_space_f, h5dget_type_f, &
+                    h5screate_simple_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
+                    h5gcreate_f, h5lexists_f, h5ldelete_f, h5tget_class_f, H5T_INTEGER_F, &
+                    H5T_FLOAT_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, h5kind_to_type, &
+                    H5_INTEGER_KIND, h5eset_auto_f
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_io_hdf5_status, only: note, release, class_name, not_open, fits_integer
     implicit none
     private
 
@@ -38,10 +54,12 @@ module voiga_io_hdf5
         procedure :: flush => file_flush
         procedure :: exists => file_exists
         procedure :: is_open => file_is_open
-        generic :: write => write_r1, write_r2, write_r3, write_i1, write_i0, write_r0
-        procedure, private :: write_r1, write_r2, write_r3, write_i1, write_i0, write_r0
-        generic :: read => read_r1, read_r2, read_r3, read_i1
-        procedure, private :: read_r1, read_r2, read_r3, read_i1
+        !> Write a real (64-bit) or integer array of any rank, or a scalar.
+        generic :: write => write_real, write_int
+        procedure, private :: write_real, write_int
+        !> Read into an allocatable real array of rank 0 to 3 or integer array of rank 0 or 1.
+        generic :: read => read_real, read_int
+        procedure, private :: read_real, read_int
         generic :: write_attr => attr_write_str, attr_write_int, attr_write_real
         procedure, private :: attr_write_str, attr_write_int, attr_write_real
         procedure :: read_attr_str => attr_read_str
@@ -53,9 +71,67 @@ module voiga_io_hdf5
         final :: file_finalize
     end type h5file_t
 
+    interface
+
+        !> Write a string attribute (fixed-length ASCII; an empty string is stored as ' ').
+        module subroutine attr_write_str(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name, value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_write_str
+
+        !> Write an integer attribute (native integer).
+        module subroutine attr_write_int(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+            integer, target, intent(in) :: value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_write_int
+
+        !> Write a real attribute (64-bit float).
+        module subroutine attr_write_real(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+            real(dp), target, intent(in) :: value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_write_real
+
+        !> Does object `path` have attribute `name`? (No, when HDF5 fails.)
+        module logical function attr_exists(self, path, name)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+        end function attr_exists
+
+        !> Read a scalar string attribute, fixed or variable length (trailing blanks
+        !> and NULs removed).
+        module subroutine attr_read_str(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+            character(len=:), allocatable, intent(out) :: value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_read_str
+
+        !> Read a scalar integer attribute (any integer width; the value must fit).
+        module subroutine attr_read_int(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+            integer, intent(out) :: value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_read_int
+
+        !> Read a scalar real attribute (from any integer or floating-point type).
+        module subroutine attr_read_real(self, path, name, value, error)
+            class(h5file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name
+            real(dp), target, intent(out) :: value
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine attr_read_real
+    end interface
+
 contains
 
     !> Open `path`: mode 'r' read-only, 'rw' read-write, 'w' create (truncate).
+    !> A file this object had open is closed first.
     subroutine file_open(self, path, mode, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path, mode
@@ -63,10 +139,15 @@ contains
         integer :: st
         logical :: present
 
-        if (self%id >= 0) call self%close()
+        call self%close(error)
+        if (allocated(error)) return
         call h5open_f(st)
-        ! we report errors ourselves
-        call h5eset_auto_f(0, st)
+        ! we report errors ourselves: no HDF5 error stack on stderr
+        if (st == 0) call h5eset_auto_f(0, st)
+        if (st /= 0) then
+            call fatal_error(error, "cannot initialise the HDF5 library to open '"//path//"'")
+            return
+        end if
         select case (mode)
         case ('r', 'rw')
             inquire (file=path, exist=present)
@@ -77,7 +158,8 @@ contains
             call h5fopen_f(path, merge(H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, mode == 'r'), self%id, st)
             if (st /= 0) then
                 self%id = -1
-                call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", error_code%input)
+                call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", &
+                                 error_code%input)
                 return
             end if
         case ('w')
@@ -94,17 +176,26 @@ contains
         self%path = path
     end subroutine file_open
 
-    !> Close the file (no-op if it is not open).
-    subroutine file_close(self)
+    !> Close the file (nothing to do if it is not open). Data HDF5 still held in
+    !> its caches is written here, so a full disk can show up only now.
+    subroutine file_close(self, error)
         class(h5file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: error
+        integer :: st
+        if (self%id < 0) return
+        call h5fclose_f(self%id, st)
+        self%id = -1
+        if (st /= 0) call fatal_error(error, self%path//": closing the file failed in H5Fclose "// &
+                                      "(what was written may not be on disk)")
+    end subroutine file_close
+
+    !> Last resort for a file nobody closed: close it, ignoring the status (there
+    !> is nobody left to tell).
+    subroutine file_finalize(self)
+        type(h5file_t), intent(inout) :: self
         integer :: st
         if (self%id >= 0) call h5fclose_f(self%id, st)
         self%id = -1
-    end subroutine file_close
-
-    subroutine file_finalize(self)
-        type(h5file_t), intent(inout) :: self
-        call file_close(self)
     end subroutine file_finalize
 
     !> Is the file open?
@@ -113,14 +204,19 @@ contains
         file_is_open = self%id >= 0
     end function file_is_open
 
-    !> Write buffers to disk so that a later crash keeps what was written.
-    subroutine file_flush(self)
+    !> Write buffers to disk so that a later crash keeps what was written (nothing to
+    !> do if the file is not open).
+    subroutine file_flush(self, error)
         class(h5file_t), intent(in) :: self
+        type(error_t), allocatable, intent(out) :: error
         integer :: st
-        if (self%id >= 0) call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, st)
+        if (self%id < 0) return
+        call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, st)
+        if (st /= 0) call fatal_error(error, self%path//": flushing the file failed in "// &
+                                      "H5Fflush (is the disk full?)")
     end subroutine file_flush
 
-    !> Does the object (group or dataset) at `path` exist?
+    !> Does the object (group or dataset) at `path` exist? (No, when HDF5 fails.)
     logical function file_exists(self, path)
         class(h5file_t), intent(in) :: self
         character(len=*), intent(in) :: path
@@ -143,21 +239,306 @@ contains
     end function file_exists
 
     !> Create the group `path` and any missing parents.
-    subroutine group_create(self, path)
+    subroutine group_create(self, path, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
         integer :: i, st
         integer(hid_t) :: gid
+        character(len=:), allocatable :: failed
+
+        if (not_open(self%id, path, error)) return
         do i = 2, len(path) + 1
             if (i <= len(path)) then
                 if (path(i:i) /= '/') cycle
             end if
-            if (.not. self%exists(path(1:i - 1))) then
-                call h5gcreate_f(self%id, path(1:i - 1), gid, st)
-                if (st == 0) call h5gclose_f(gid, st)
+            if (self%exists(path(1:i - 1))) cycle
+            gid = -1
+            call h5gcreate_f(self%id, path(1:i - 1), gid, st)
+            call note(st, 'H5Gcreate', failed)
+            call release(gid, failed)
+            if (allocated(failed)) then
+                call fatal_error(error, self%path//": creating group '"//path(1:i - 1)// &
+                                 "' failed in "//failed)
+                return
             end if
         end do
     end subroutine group_create
+
+    !> Write a real array of any rank (a scalar as one element) as 64-bit floats.
+    subroutine write_real(self, path, array, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        real(dp), contiguous, target, intent(in) :: array(..)
+        type(error_t), allocatable, intent(out) :: error
+        call write_dataset(self, path, H5T_NATIVE_DOUBLE, &
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
+    end subroutine write_real
+
+    !> Write an integer array of any rank (a scalar as one element) as native integers.
+    subroutine write_int(self, path, array, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer, contiguous, target, intent(in) :: array(..)
+        type(error_t), allocatable, intent(out) :: error
+        call write_dataset(self, path, H5T_NATIVE_INTEGER, &
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
+    end subroutine write_int
+
+    !> The dataset shape of an array of shape `array_shape`: a scalar is one element.
+    pure function written_dims(array_shape) result(dims)
+        integer(hsize_t), intent(in) :: array_shape(:)
+        integer(hsize_t), allocatable :: dims(:)
+        if (size(array_shape) == 0) then
+            dims = [1_hsize_t]
+        else
+            ! (gfortran 12 gives an empty array constructor, e.g. `[real(dp) ::]`, passed
+            ! as assumed-rank, the extent -1)
+            dims = max(array_shape, 0_hsize_t)
+        end if
+    end function written_dims
+
+    !> Write the contiguous data at `buf`, of HDF5 type `dtype` (also the type in the
+    !> file) and shape `dims`, as dataset `path`, replacing one that exists.
+    subroutine write_dataset(self, path, dtype, dims, buf, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer(hid_t), intent(in) :: dtype
+        integer(hsize_t), intent(in) :: dims(:)
+        type(c_ptr), intent(in) :: buf
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: did, sid
+        integer :: st
+        character(len=:), allocatable :: failed
+
+        if (not_open(self%id, path, error)) return
+        if (len(parent_of(path)) > 0) then
+            call self%create_group(parent_of(path), error)
+            if (allocated(error)) return
+        end if
+        did = -1
+        sid = -1
+        steps: block
+            if (self%exists(path)) then
+                call h5ldelete_f(self%id, path, st)
+                call note(st, 'H5Ldelete', failed)
+                if (allocated(failed)) exit steps
+            end if
+            call h5screate_simple_f(size(dims), dims, sid, st)
+            call note(st, 'H5Screate_simple', failed)
+            if (allocated(failed)) exit steps
+            call h5dcreate_f(self%id, path, dtype, sid, did, st)
+            call note(st, 'H5Dcreate', failed)
+            if (allocated(failed)) exit steps
+            ! (an empty dataset has nothing to write, and HDF5 refuses a null buffer)
+            if (product(dims) == 0) exit steps
+            call h5dwrite_f(did, dtype, buf, st)
+            call note(st, 'H5Dwrite', failed)
+        end block steps
+        call release(did, failed)
+        call release(sid, failed)
+        if (allocated(failed)) call fatal_error(error, self%path//": writing dataset '"//path// &
+                                                "' failed in "//failed)
+    end subroutine write_dataset
+
+    !> Read a real dataset of the array's rank (rank 0: a scalar or one-element dataset),
+    !> converting integers and other floats.
+    subroutine read_real(self, path, array, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        real(dp), allocatable, target, intent(out) :: array(..)
+        type(error_t), allocatable, intent(out) :: error
+        integer(hsize_t), allocatable :: dims(:)
+
+        call dataset_layout(self, path, rank(array), .true., dims, error)
+        if (allocated(error)) return
+        select rank (array)
+        rank (0)
+            allocate (array)
+        rank (1)
+            allocate (array(dims(1)))
+        rank (2)
+            allocate (array(dims(1), dims(2)))
+        rank (3)
+            allocate (array(dims(1), dims(2), dims(3)))
+        rank default
+            call unsupported_rank(self, path, rank(array), error)
+            return
+        end select
+        call read_dataset(self, path, H5T_NATIVE_DOUBLE, product(dims), c_loc(array), error)
+    end subroutine read_real
+
+    !> Read an integer dataset (any integer width) of the array's rank; its values
+    !> must fit a default integer.
+    subroutine read_int(self, path, array, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer, allocatable, intent(out) :: array(..)
+        type(error_t), allocatable, intent(out) :: error
+        integer(hsize_t), allocatable :: dims(:)
+        integer(int64), allocatable, target :: wide(:)
+
+        call dataset_layout(self, path, rank(array), .false., dims, error)
+        if (allocated(error)) return
+        allocate (wide(product(dims)))
+        call read_dataset(self, path, h5kind_to_type(int64, H5_INTEGER_KIND), product(dims), &
+                          c_loc(wide), error)
+        if (allocated(error)) return
+        if (.not. fits_integer(wide)) then
+            call fatal_error(error, self%path//": dataset '"//path// &
+                             "' holds integers too large for a default integer", error_code%input)
+            return
+        end if
+        select rank (array)
+        rank (0)
+            allocate (array)
+            array = int(wide(1))
+        rank (1)
+            allocate (array(dims(1)))
+            array = int(wide)
+        rank default
+            call unsupported_rank(self, path, rank(array), error)
+        end select
+    end subroutine read_int
+
+    !> The error for an array rank `read` has no branch for.
+    subroutine unsupported_rank(self, path, array_rank, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: array_rank
+        type(error_t), allocatable, intent(out) :: error
+        character(len=12) :: buf
+        write (buf, '(i0)') array_rank
+        call fatal_error(error, self%path//": reading dataset '"//path// &
+                         "' into an array of rank "//trim(buf)//" is not supported")
+    end subroutine unsupported_rank
+
+    !> Shape (Fortran order) of dataset `path`, checked to be readable as an array of
+    !> rank `array_rank` (rank 0 takes a scalar or one-element dataset) holding
+    !> reals (`as_real`: integer or float datasets) or integers (integer datasets).
+    subroutine dataset_layout(self, path, array_rank, as_real, dims, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: array_rank
+        logical, intent(in) :: as_real
+        integer(hsize_t), allocatable, intent(out) :: dims(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: type_class
+        character(len=32) :: buf
+        character(len=:), allocatable :: expected
+
+        call dataset_info(self, path, dims, type_class, error)
+        if (allocated(error)) return
+        expected = merge('numbers ', 'integers', as_real)
+        if (.not. (type_class == H5T_INTEGER_F .or. &
+                   (as_real .and. type_class == H5T_FLOAT_F))) then
+            call fatal_error(error, self%path//": dataset '"//path//"' holds "// &
+                             class_name(type_class)//", not "//trim(expected), error_code%input)
+            return
+        end if
+        if (array_rank == 0 .and. product(dims) == 1 .and. size(dims) <= 1) then
+            dims = [integer(hsize_t) ::]
+        else if (size(dims) /= array_rank) then
+            write (buf, '(i0,a,i0)') size(dims), ', expected ', array_rank
+            call fatal_error(error, self%path//": dataset '"//path//"' has rank "//trim(buf), &
+                             error_code%input)
+        end if
+    end subroutine dataset_layout
+
+    !> Shape (Fortran order) and HDF5 type class of dataset `path`.
+    subroutine dataset_info(self, path, dims, type_class, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer(hsize_t), allocatable, intent(out) :: dims(:)
+        integer, intent(out) :: type_class
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: did, sid, tid
+        integer(hsize_t), allocatable :: maxdims(:)
+        integer :: st, ndims
+        character(len=:), allocatable :: failed
+
+        type_class = -1
+        allocate (dims(0))
+        if (not_open(self%id, path, error)) return
+        if (.not. self%exists(path)) then
+            call fatal_error(error, self%path//": dataset '"//path//"' is missing", &
+                             error_code%input)
+            return
+        end if
+        sid = -1
+        tid = -1
+        call h5dopen_f(self%id, path, did, st)
+        if (st /= 0) then
+            call fatal_error(error, self%path//": '"//path//"' is not a dataset", error_code%input)
+            return
+        end if
+        steps: block
+            call h5dget_type_f(did, tid, st)
+            call note(st, 'H5Dget_type', failed)
+            if (allocated(failed)) exit steps
+            call h5tget_class_f(tid, type_class, st)
+            call note(st, 'H5Tget_class', failed)
+            call h5dget_space_f(did, sid, st)
+            call note(st, 'H5Dget_space', failed)
+            if (allocated(failed)) exit steps
+            call h5sget_simple_extent_ndims_f(sid, ndims, st)
+            call note(st, 'H5Sget_simple_extent_ndims', failed)
+            if (allocated(failed)) exit steps
+            deallocate (dims)
+            allocate (dims(ndims), maxdims(ndims))
+            call h5sget_simple_extent_dims_f(sid, dims, maxdims, st)
+            ! (returns the rank on success)
+            call note(merge(0, -1, st == ndims), 'H5Sget_simple_extent_dims', failed)
+        end block steps
+        call release(tid, failed)
+        call release(sid, failed)
+        call release(did, failed)
+        if (allocated(failed)) call fatal_error(error, self%path//": inspecting dataset '"//path// &
+                                                "' failed in "//failed, error_code%input)
+    end subroutine dataset_info
+
+    !> Read all `n` values of dataset `path` as HDF5 type `mem_type` into `buf`.
+    subroutine read_dataset(self, path, mem_type, n, buf, error)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer(hid_t), intent(in) :: mem_type
+        integer(hsize_t), intent(in) :: n
+        type(c_ptr), intent(in) :: buf
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: did
+        integer :: st
+        character(len=:), allocatable :: failed
+        type(c_ptr) :: p
+
+        if (n == 0) return
+        p = buf
+        did = -1
+        call h5dopen_f(self%id, path, did, st)
+        call note(st, 'H5Dopen', failed)
+        if (.not. allocated(failed)) then
+            call h5dread_f(did, mem_type, p, st)
+            call note(st, 'H5Dread', failed)
+        end if
+        call release(did, failed)
+        if (allocated(failed)) call fatal_error(error, self%path//": reading dataset '"//path// &
+                                                "' failed in "//failed, error_code%input)
+    end subroutine read_dataset
+
+    !> Shape of dataset `path` in Fortran order (empty if missing or unreadable).
+    function dataset_shape(self, path) result(dims)
+        class(h5file_t), intent(in) :: self
+        character(len=*), intent(in) :: path
+        integer, allocatable :: dims(:)
+        integer(hsize_t), allocatable :: d(:)
+        integer :: type_class
+        type(error_t), allocatable :: error
+        call dataset_info(self, path, d, type_class, error)
+        if (allocated(error)) then
+            allocate (dims(0))
+        else
+            dims = int(d)
+        end if
+    end function dataset_shape
 
     !> Parent group of a path ('/a/b/c' -> '/a/b'); '' for top-level names.
     pure function parent_of(path) result(parent)
@@ -167,440 +548,5 @@ contains
         i = index(path, '/', back=.true.)
         parent = path(1:max(i - 1, 0))
     end function parent_of
-
-    !> Create a dataset of the given type and shape (replacing nothing: the path must be new).
-    subroutine create_dataset(self, path, dtype, dims, did, sid)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        integer(hid_t), intent(in) :: dtype
-        integer(hsize_t), intent(in) :: dims(:)
-        integer(hid_t), intent(out) :: did, sid
-        integer :: st
-        if (len(parent_of(path)) > 0) call self%create_group(parent_of(path))
-        ! a dataset that exists is replaced (a restarted run rewrites run-wide records)
-        if (self%exists(path)) call h5ldelete_f(self%id, path, st)
-        if (size(dims) == 0) then
-            call h5screate_f(H5S_SCALAR_F, sid, st)
-        else
-            call h5screate_simple_f(size(dims), dims, sid, st)
-        end if
-        call h5dcreate_f(self%id, path, dtype, sid, did, st)
-    end subroutine create_dataset
-
-    subroutine write_r0(self, path, value)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        real(dp), intent(in) :: value
-        call self%write(path, [value])
-    end subroutine write_r0
-
-    subroutine write_r1(self, path, array)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        real(dp), intent(in) :: array(:)
-        integer(hid_t) :: did, sid
-        integer(hsize_t) :: dims(1)
-        integer :: st
-        dims = shape(array, kind=hsize_t)
-        call create_dataset(self, path, H5T_NATIVE_DOUBLE, dims, did, sid)
-        call h5dwrite_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        call h5sclose_f(sid, st)
-    end subroutine write_r1
-
-    subroutine write_r2(self, path, array)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        real(dp), intent(in) :: array(:, :)
-        integer(hid_t) :: did, sid
-        integer(hsize_t) :: dims(2)
-        integer :: st
-        dims = shape(array, kind=hsize_t)
-        call create_dataset(self, path, H5T_NATIVE_DOUBLE, dims, did, sid)
-        call h5dwrite_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        call h5sclose_f(sid, st)
-    end subroutine write_r2
-
-    subroutine write_r3(self, path, array)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        real(dp), intent(in) :: array(:, :, :)
-        integer(hid_t) :: did, sid
-        integer(hsize_t) :: dims(3)
-        integer :: st
-        dims = shape(array, kind=hsize_t)
-        call create_dataset(self, path, H5T_NATIVE_DOUBLE, dims, did, sid)
-        call h5dwrite_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        call h5sclose_f(sid, st)
-    end subroutine write_r3
-
-    subroutine write_i1(self, path, array)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: array(:)
-        integer(hid_t) :: did, sid
-        integer(hsize_t) :: dims(1)
-        integer :: st
-        dims = shape(array, kind=hsize_t)
-        call create_dataset(self, path, H5T_NATIVE_INTEGER, dims, did, sid)
-        call h5dwrite_f(did, H5T_NATIVE_INTEGER, array, dims, st)
-        call h5dclose_f(did, st)
-        call h5sclose_f(sid, st)
-    end subroutine write_i1
-
-    subroutine write_i0(self, path, value)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: value
-        call self%write(path, [value])
-    end subroutine write_i0
-
-    !> Open dataset `path` and return its dims (Fortran order); error if missing
-    !> or of another rank.
-    subroutine open_dataset(self, path, rank, did, dims, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: rank
-        integer(hid_t), intent(out) :: did
-        integer(hsize_t), intent(out) :: dims(rank)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: sid
-        integer(hsize_t) :: maxdims(rank)
-        integer :: st, ndims
-        character(len=16) :: buf
-
-        did = -1
-        if (.not. self%exists(path)) then
-            call fatal_error(error, self%path//": dataset '"//path//"' is missing", error_code%input)
-            return
-        end if
-        call h5dopen_f(self%id, path, did, st)
-        if (st /= 0) then
-            did = -1
-            call fatal_error(error, self%path//": '"//path//"' is not a dataset", error_code%input)
-            return
-        end if
-        call h5dget_space_f(did, sid, st)
-        call h5sget_simple_extent_ndims_f(sid, ndims, st)
-        if (ndims /= rank) then
-            call h5sclose_f(sid, st)
-            call h5dclose_f(did, st)
-            did = -1
-            write (buf, '(i0,a,i0)') ndims, ' not ', rank
-            call fatal_error(error, self%path//": dataset '"//path//"' has rank "//trim(buf), &
-                             error_code%input)
-            return
-        end if
-        call h5sget_simple_extent_dims_f(sid, dims, maxdims, st)
-        call h5sclose_f(sid, st)
-    end subroutine open_dataset
-
-    !> Shape of dataset `path` in Fortran order (empty if missing).
-    function dataset_shape(self, path) result(dims)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, allocatable :: dims(:)
-        integer(hid_t) :: did, sid
-        integer(hsize_t) :: d(8), maxd(8)
-        integer :: st, ndims
-        allocate (dims(0))
-        if (.not. self%exists(path)) return
-        call h5dopen_f(self%id, path, did, st)
-        if (st /= 0) return
-        call h5dget_space_f(did, sid, st)
-        call h5sget_simple_extent_ndims_f(sid, ndims, st)
-        call h5sget_simple_extent_dims_f(sid, d(1:ndims), maxd(1:ndims), st)
-        dims = int(d(1:ndims))
-        call h5sclose_f(sid, st)
-        call h5dclose_f(did, st)
-    end function dataset_shape
-
-    subroutine read_r1(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        real(dp), allocatable, intent(out) :: array(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did
-        integer(hsize_t) :: dims(1)
-        integer :: st
-        call open_dataset(self, path, 1, did, dims, error)
-        if (allocated(error)) return
-        allocate (array(dims(1)))
-        call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        if (st /= 0) call read_failed(self, path, error)
-    end subroutine read_r1
-
-    subroutine read_r2(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        real(dp), allocatable, intent(out) :: array(:, :)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did
-        integer(hsize_t) :: dims(2)
-        integer :: st
-        call open_dataset(self, path, 2, did, dims, error)
-        if (allocated(error)) return
-        allocate (array(dims(1), dims(2)))
-        call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        if (st /= 0) call read_failed(self, path, error)
-    end subroutine read_r2
-
-    subroutine read_r3(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        real(dp), allocatable, intent(out) :: array(:, :, :)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did
-        integer(hsize_t) :: dims(3)
-        integer :: st
-        call open_dataset(self, path, 3, did, dims, error)
-        if (allocated(error)) return
-        allocate (array(dims(1), dims(2), dims(3)))
-        call h5dread_f(did, H5T_NATIVE_DOUBLE, array, dims, st)
-        call h5dclose_f(did, st)
-        if (st /= 0) call read_failed(self, path, error)
-    end subroutine read_r3
-
-    subroutine read_i1(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, allocatable, intent(out) :: array(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did
-        integer(hsize_t) :: dims(1)
-        integer :: st
-        call open_dataset(self, path, 1, did, dims, error)
-        if (allocated(error)) return
-        allocate (array(dims(1)))
-        call h5dread_f(did, H5T_NATIVE_INTEGER, array, dims, st)
-        call h5dclose_f(did, st)
-        if (st /= 0) call read_failed(self, path, error)
-    end subroutine read_i1
-
-    subroutine read_failed(self, path, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: error
-        call fatal_error(error, self%path//": cannot read dataset '"//path// &
-                         "' as numbers", error_code%input)
-    end subroutine read_failed
-
-    !> Open the object `path` ('/' for the root) for attribute work.
-    subroutine open_object(self, path, oid, st)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        integer(hid_t), intent(out) :: oid
-        integer, intent(out) :: st
-        if (path /= '/') then
-            if (.not. self%exists(path)) call self%create_group(path)
-        end if
-        call h5oopen_f(self%id, path, oid, st)
-    end subroutine open_object
-
-    !> Write a string attribute (replacing an existing one).
-    subroutine attr_write_str(self, path, name, value)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name, value
-        integer(hid_t) :: oid, aid, sid, tid
-        integer(hsize_t) :: dims(1) = [1]
-        integer :: st
-        call open_object(self, path, oid, st)
-        if (st /= 0) return
-        call delete_attr(oid, name)
-        call h5screate_f(H5S_SCALAR_F, sid, st)
-        call h5tcopy_f(H5T_FORTRAN_S1, tid, st)
-        call h5tset_size_f(tid, int(max(len(value), 1), size_t), st)
-        call h5acreate_f(oid, name, tid, sid, aid, st)
-        if (len(value) > 0) then
-            call h5awrite_f(aid, tid, value, dims, st)
-        else
-            call h5awrite_f(aid, tid, ' ', dims, st)
-        end if
-        call h5aclose_f(aid, st)
-        call h5tclose_f(tid, st)
-        call h5sclose_f(sid, st)
-        call h5oclose_f(oid, st)
-    end subroutine attr_write_str
-
-    subroutine attr_write_int(self, path, name, value)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        integer, intent(in) :: value
-        integer(hid_t) :: oid, aid, sid
-        integer(hsize_t) :: dims(1) = [1]
-        integer :: st
-        call open_object(self, path, oid, st)
-        if (st /= 0) return
-        call delete_attr(oid, name)
-        call h5screate_f(H5S_SCALAR_F, sid, st)
-        call h5acreate_f(oid, name, H5T_NATIVE_INTEGER, sid, aid, st)
-        call h5awrite_f(aid, H5T_NATIVE_INTEGER, value, dims, st)
-        call h5aclose_f(aid, st)
-        call h5sclose_f(sid, st)
-        call h5oclose_f(oid, st)
-    end subroutine attr_write_int
-
-    subroutine attr_write_real(self, path, name, value)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        real(dp), intent(in) :: value
-        integer(hid_t) :: oid, aid, sid
-        integer(hsize_t) :: dims(1) = [1]
-        integer :: st
-        call open_object(self, path, oid, st)
-        if (st /= 0) return
-        call delete_attr(oid, name)
-        call h5screate_f(H5S_SCALAR_F, sid, st)
-        call h5acreate_f(oid, name, H5T_NATIVE_DOUBLE, sid, aid, st)
-        call h5awrite_f(aid, H5T_NATIVE_DOUBLE, value, dims, st)
-        call h5aclose_f(aid, st)
-        call h5sclose_f(sid, st)
-        call h5oclose_f(oid, st)
-    end subroutine attr_write_real
-
-    !> Remove attribute `name` of object `oid` if it exists (attributes are overwritten).
-    subroutine delete_attr(oid, name)
-        integer(hid_t), intent(in) :: oid
-        character(len=*), intent(in) :: name
-        logical :: exists
-        integer :: st
-        call h5aexists_f(oid, name, exists, st)
-        if (st == 0 .and. exists) call h5adelete_f(oid, name, st)
-    end subroutine delete_attr
-
-    !> Does object `path` have attribute `name`?
-    logical function attr_exists(self, path, name)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        integer(hid_t) :: oid
-        integer :: st
-        attr_exists = .false.
-        if (path /= '/' .and. .not. self%exists(path)) return
-        call h5oopen_f(self%id, path, oid, st)
-        if (st /= 0) return
-        call h5aexists_f(oid, name, attr_exists, st)
-        if (st /= 0) attr_exists = .false.
-        call h5oclose_f(oid, st)
-    end function attr_exists
-
-    !> Read a scalar string attribute, fixed or variable length (trailing blanks
-    !> and NULs removed).
-    subroutine attr_read_str(self, path, name, value, error)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        character(len=:), allocatable, intent(out) :: value
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: oid, aid, ftid, mtid, sid
-        integer(size_t) :: n
-        integer :: st, i
-        logical :: is_vlen
-        character(len=:), allocatable, target :: buf
-        type(c_ptr), target :: vptr(1)
-        type(c_ptr) :: f_ptr
-        character(kind=c_char), pointer :: cstr(:)
-
-        if (.not. self%has_attr(path, name)) then
-            call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                             "' is missing", error_code%input)
-            return
-        end if
-        call h5oopen_f(self%id, path, oid, st)
-        call h5aopen_f(oid, name, aid, st)
-        call h5aget_type_f(aid, ftid, st)
-        call h5tis_variable_str_f(ftid, is_vlen, st)
-        if (st /= 0) then
-            call h5tclose_f(ftid, st)
-            call h5aclose_f(aid, st)
-            call h5oclose_f(oid, st)
-            call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                             "' is not a string", error_code%input)
-            return
-        end if
-        if (is_vlen) then
-            ! read with the file's own (variable-length string) type
-            call h5tcopy_f(ftid, mtid, st)
-            f_ptr = c_loc(vptr(1))
-            call h5aread_f(aid, mtid, f_ptr, st)
-            value = ''
-            if (st == 0) then
-                call c_f_pointer(vptr(1), cstr, [4096])
-                do i = 1, 4096
-                    if (cstr(i) == c_null_char) exit
-                    value = value//cstr(i)
-                end do
-                call h5aget_space_f(aid, sid, st)
-                call h5dvlen_reclaim_f(mtid, sid, H5P_DEFAULT_F, f_ptr, st)
-                call h5sclose_f(sid, st)
-            end if
-            call h5tclose_f(mtid, st)
-        else
-            call h5tget_size_f(ftid, n, st)
-            allocate (character(len=n) :: buf)
-            call h5tcopy_f(H5T_FORTRAN_S1, mtid, st)
-            call h5tset_size_f(mtid, n, st)
-            f_ptr = c_loc(buf)
-            call h5aread_f(aid, mtid, f_ptr, st)
-            call h5tclose_f(mtid, st)
-            do i = 1, len(buf)
-                if (buf(i:i) == c_null_char) buf(i:i) = ' '
-            end do
-            value = trim(buf)
-        end if
-        call h5tclose_f(ftid, st)
-        call h5aclose_f(aid, st)
-        call h5oclose_f(oid, st)
-    end subroutine attr_read_str
-
-    !> Read a scalar integer attribute.
-    subroutine attr_read_int(self, path, name, value, error)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        integer, intent(out) :: value
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: oid, aid
-        integer(hsize_t) :: dims(1) = [1]
-        integer :: st
-        value = 0
-        if (.not. self%has_attr(path, name)) then
-            call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                             "' is missing", error_code%input)
-            return
-        end if
-        call h5oopen_f(self%id, path, oid, st)
-        call h5aopen_f(oid, name, aid, st)
-        call h5aread_f(aid, H5T_NATIVE_INTEGER, value, dims, st)
-        call h5aclose_f(aid, st)
-        call h5oclose_f(oid, st)
-        if (st /= 0) call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                                      "' is not an integer", error_code%input)
-    end subroutine attr_read_int
-
-    !> Read a scalar real attribute.
-    subroutine attr_read_real(self, path, name, value, error)
-        class(h5file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name
-        real(dp), intent(out) :: value
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: oid, aid
-        integer(hsize_t) :: dims(1) = [1]
-        integer :: st
-        value = 0.0_dp
-        if (.not. self%has_attr(path, name)) then
-            call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                             "' is missing", error_code%input)
-            return
-        end if
-        call h5oopen_f(self%id, path, oid, st)
-        call h5aopen_f(oid, name, aid, st)
-        call h5aread_f(aid, H5T_NATIVE_DOUBLE, value, dims, st)
-        call h5aclose_f(aid, st)
-        call h5oclose_f(oid, st)
-        if (st /= 0) call fatal_error(error, self%path//": attribute '"//name//"' of '"//path// &
-                                      "' is not an integer", error_code%input)
-    end subroutine attr_read_real
 
 end module voiga_io_hdf5

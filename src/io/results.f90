@@ -48,69 +48,118 @@ contains
         integer :: i, k
         character(len=:), allocatable :: g
         character(len=16) :: buf
-        integer, allocatable :: ptr(:), conn(:), vo(:)
-        real(dp), allocatable :: ranges(:, :)
 
         call self%h5%open(case%output, 'w', error)
         if (allocated(error)) return
-        call self%h5%write_attr('/', 'voiga_version', voiga_version_string)
-        call self%h5%write_attr('/', 'title', case%title)
-        call self%h5%write_attr('/', 'scene', case%scene)
-        call self%h5%write_attr('/', 'mesh', case%mesh)
-        call self%h5%write_attr('/', 'layout', case%layout)
-        call self%h5%write_attr('/', 'case_file', case%path)
-        call self%h5%write_attr('/', 'status', 'running')
-        call self%h5%write_attr('/', 'n_dofs', model%ndof)
-        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver))
-        call self%h5%write_attr('/', 'damping', trim(case%solver%damping))
-        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps())
-        call self%h5%write_attr('/', 'n_steps_done', 0)
-        call self%h5%write_attr('/', 'n_cuts', 0)
-        call self%h5%write_attr('/', 'wall_time', 0.0_dp)
+        call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'title', case%title, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'scene', case%scene, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'mesh', case%mesh, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'layout', case%layout, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'case_file', case%path, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'status', 'running', error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'n_dofs', model%ndof, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver), error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'damping', trim(case%solver%damping), error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps(), error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'n_steps_done', 0, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'n_cuts', 0, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'wall_time', 0.0_dp, error)
+        if (allocated(error)) return
         do i = 1, size(model%bodies)
-            associate (b => model%bodies(i))
-                g = '/bodies/'//trim(b%name)
-                call write_discretization(self%h5, g, b%disc)
-                call self%h5%write_attr(g, 'material', trim(case%bodies(i)%material))
-                call self%h5%write_attr(g, 'youngs_modulus', b%mat%youngs_modulus)
-                call self%h5%write_attr(g, 'poisson_ratio', b%mat%poisson_ratio)
-                call self%h5%write_attr(g, 'dof_offset', b%dof0)
-                call self%h5%write(g//'/control_points', b%disc%x)
-                call self%h5%write(g//'/weights', b%disc%w)
-                allocate (ptr(b%disc%nel + 1), vo(b%disc%nel), ranges(4, b%disc%nel))
-                ptr(1) = 1
-                do k = 1, b%disc%nel
-                    ptr(k + 1) = ptr(k) + size(b%disc%elements(k)%conn)
-                    vo(k) = merge(1, 0, b%disc%elements(k)%span_layer > 0)
-                    ranges(:, k) = [b%disc%elements(k)%xi, b%disc%elements(k)%eta]
-                end do
-                allocate (conn(ptr(b%disc%nel + 1) - 1))
-                do k = 1, b%disc%nel
-                    conn(ptr(k):ptr(k + 1) - 1) = b%disc%elements(k)%conn
-                end do
-                call self%h5%write(g//'/elements/ptr', ptr)
-                call self%h5%write(g//'/elements/conn', conn)
-                call self%h5%write(g//'/elements/vo', vo)
-                call self%h5%write(g//'/elements/range', ranges)
-                do k = 1, 4
-                    call self%h5%write(g//'/edges/'//trim(b%disc%edges(k)%name), b%disc%edges(k)%cps)
-                end do
-                deallocate (ptr, vo, ranges, conn)
-            end associate
+            call write_body(self%h5, model, i, trim(case%bodies(i)%material), error)
+            if (allocated(error)) return
         end do
         do k = 1, size(model%dirichlet)
             write (buf, '(i0)') k
             g = '/dirichlet/'//trim(buf)
-            call self%h5%create_group(g)
-            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name))
-            call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge))
-            call self%h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)))
-            call self%h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)))
-            call self%h5%write(g//'/values', model%dirichlet(k)%values)
+            call self%h5%create_group(g, error)
+            if (allocated(error)) return
+            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), &
+                                    error)
+            if (allocated(error)) return
+            call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge), error)
+            if (allocated(error)) return
+            call self%h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)), error)
+            if (allocated(error)) return
+            call self%h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)), error)
+            if (allocated(error)) return
+            call self%h5%write(g//'/values', model%dirichlet(k)%values, error)
+            if (allocated(error)) return
         end do
-        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)')
-        call self%h5%flush()
+        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)', error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
     end subroutine results_open
+
+    !> The discretization, material and element layout of body `i` of `model` under
+    !> /bodies/<name>.
+    subroutine write_body(h5, model, i, material, error)
+        type(h5file_t), intent(inout) :: h5
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: i
+        !> Name of the body's material law.
+        character(len=*), intent(in) :: material
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        character(len=:), allocatable :: g
+        integer, allocatable :: ptr(:), conn(:), vo(:)
+        real(dp), allocatable :: ranges(:, :)
+
+        associate (b => model%bodies(i))
+            g = '/bodies/'//trim(b%name)
+            call write_discretization(h5, g, b%disc, error)
+            if (allocated(error)) return
+            call h5%write_attr(g, 'material', material, error)
+            if (allocated(error)) return
+            call h5%write_attr(g, 'youngs_modulus', b%mat%youngs_modulus, error)
+            if (allocated(error)) return
+            call h5%write_attr(g, 'poisson_ratio', b%mat%poisson_ratio, error)
+            if (allocated(error)) return
+            call h5%write_attr(g, 'dof_offset', b%dof0, error)
+            if (allocated(error)) return
+            call h5%write(g//'/control_points', b%disc%x, error)
+            if (allocated(error)) return
+            call h5%write(g//'/weights', b%disc%w, error)
+            if (allocated(error)) return
+            allocate (ptr(b%disc%nel + 1), vo(b%disc%nel), ranges(4, b%disc%nel))
+            ptr(1) = 1
+            do k = 1, b%disc%nel
+                ptr(k + 1) = ptr(k) + size(b%disc%elements(k)%conn)
+                vo(k) = merge(1, 0, b%disc%elements(k)%span_layer > 0)
+                ranges(:, k) = [b%disc%elements(k)%xi, b%disc%elements(k)%eta]
+            end do
+            allocate (conn(ptr(b%disc%nel + 1) - 1))
+            do k = 1, b%disc%nel
+                conn(ptr(k):ptr(k + 1) - 1) = b%disc%elements(k)%conn
+            end do
+            call h5%write(g//'/elements/ptr', ptr, error)
+            if (allocated(error)) return
+            call h5%write(g//'/elements/conn', conn, error)
+            if (allocated(error)) return
+            call h5%write(g//'/elements/vo', vo, error)
+            if (allocated(error)) return
+            call h5%write(g//'/elements/range', ranges, error)
+            if (allocated(error)) return
+            do k = 1, 4
+                call h5%write(g//'/edges/'//trim(b%disc%edges(k)%name), b%disc%edges(k)%cps, error)
+                if (allocated(error)) return
+            end do
+        end associate
+    end subroutine write_body
 
     !> Reopen the result file of an earlier run to continue it: status 'running',
     !> the steps it holds counted as written.
@@ -122,12 +171,14 @@ contains
         if (allocated(error)) return
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
         if (allocated(error)) return
-        call self%h5%write_attr('/', 'status', 'running')
-        call self%h5%flush()
+        call self%h5%write_attr('/', 'status', 'running', error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
     end subroutine results_reopen
 
     !> Write one converged step and the current displacement; flush.
-    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max)
+    subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
+                                  error)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -142,6 +193,7 @@ contains
         !> Solver state needed to restart after this step: the substep fraction carried
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
+        type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -150,46 +202,71 @@ contains
         call system_clock(c0, rate)
         write (buf, '(i6.6)') rec%step
         g = '/steps/'//trim(buf)
-        call self%h5%create_group(g)
-        call self%h5%write_attr(g, 'step', rec%step)
-        call self%h5%write_attr(g, 'time', rec%time)
-        call self%h5%write_attr(g, 'iterations', rec%iterations)
-        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
-        call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign)
-        call self%h5%write_attr(g, 'linear_iterations', rec%linear_iterations)
-        call self%h5%write_attr(g, 'substeps', rec%substeps)
-        call self%h5%write_attr(g, 'cuts', rec%cuts)
-        if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction)
-        if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max)
+        call self%h5%create_group(g, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'step', rec%step, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'time', rec%time, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'iterations', rec%iterations, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations), &
+                                error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'linear_iterations', rec%linear_iterations, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'substeps', rec%substeps, error)
+        if (allocated(error)) return
+        call self%h5%write_attr(g, 'cuts', rec%cuts, error)
+        if (allocated(error)) return
+        if (present(next_fraction)) &
+            call self%h5%write_attr(g, 'next_fraction', next_fraction, error)
+        if (allocated(error)) return
+        if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max, error)
+        if (allocated(error)) return
         if (present(cuts)) then
-            if (size(cuts) > 0) call write_cuts(self%h5, g, cuts)
+            if (size(cuts) > 0) call write_cuts(self%h5, g, cuts, error)
+            if (allocated(error)) return
         end if
         do k = 1, size(stage_names)
-            call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k))
+            call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k), error)
+            if (allocated(error)) return
         end do
-        call self%h5%write(g//'/residual_norms', rec%residual_norms)
-        call self%h5%write(g//'/energy_norms', rec%energy_norms)
-        if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
-        call self%h5%write(g//'/displacement', u)
+        call self%h5%write(g//'/residual_norms', rec%residual_norms, error)
+        if (allocated(error)) return
+        call self%h5%write(g//'/energy_norms', rec%energy_norms, error)
+        if (allocated(error)) return
+        if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions, error)
+        if (allocated(error)) return
+        call self%h5%write(g//'/displacement', u, error)
+        if (allocated(error)) return
         do k = 1, size(pairs)
-            call write_contact(self%h5, g, k, pairs(k)%pair)
+            call write_contact(self%h5, g, k, pairs(k)%pair, error)
+            if (allocated(error)) return
         end do
         self%n_written = self%n_written + 1
-        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts)
+        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
+        if (allocated(error)) return
         ! this step's own output time (the record was made before it was written)
         call system_clock(c1)
-        call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp))
-        call self%h5%write_attr('/', 'n_steps_done', self%n_written)
-        call self%h5%write_attr('/', 'wall_time', wall)
-        call self%h5%flush()
+        call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp), error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'n_steps_done', self%n_written, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'wall_time', wall, error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
     end subroutine results_write_step
 
     !> Per-slave-point contact output of pair `k` under step group `g`.
-    subroutine write_contact(h5, g, k, pair)
+    subroutine write_contact(h5, g, k, pair, error)
         type(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         integer, intent(in) :: k
         class(contact_pair_t), intent(in) :: pair
+        type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: c
         character(len=8) :: buf
         integer :: i, n
@@ -200,58 +277,78 @@ contains
         write (buf, '(i0)') k
         c = g//'/contact/'//trim(buf)
         n = size(pair%out)
-        call h5%create_group(c)
-        call h5%write_attr(c, 'slave', trim(pair%slave_name))
-        call h5%write_attr(c, 'master', trim(pair%master_name))
-        call h5%write_attr(c, 'penalty_normal', pair%law%eps_n)
-        call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t)
-        call h5%write_attr(c, 'friction', pair%law%mu)
-        call h5%write_attr(c, 'method', pair%method_name())
+        call h5%create_group(c, error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'slave', trim(pair%slave_name), error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'master', trim(pair%master_name), error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'penalty_normal', pair%law%eps_n, error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t, error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'friction', pair%law%mu, error)
+        if (allocated(error)) return
+        call h5%write_attr(c, 'method', pair%method_name(), error)
+        if (allocated(error)) return
         select type (m => pair%master)
         type is (rigid_line_t)
-            call h5%write(c//'/rigid_point', m%p0)
-            call h5%write(c//'/rigid_normal', m%n)
+            call h5%write(c//'/rigid_point', m%p0, error)
+            if (allocated(error)) return
+            call h5%write(c//'/rigid_normal', m%n, error)
+            if (allocated(error)) return
         end select
-        call h5%write(c//'/force', pair%force)
+        call h5%write(c//'/force', pair%force, error)
+        if (allocated(error)) return
         allocate (a2(2, n), a1(n), st(n))
         do i = 1, n
             a2(:, i) = pair%out(i)%x0
         end do
-        call h5%write(c//'/x_ref', a2)
+        call h5%write(c//'/x_ref', a2, error)
+        if (allocated(error)) return
         do i = 1, n
             a2(:, i) = pair%out(i)%x
         end do
-        call h5%write(c//'/x', a2)
+        call h5%write(c//'/x', a2, error)
+        if (allocated(error)) return
         a1 = pair%out%gap
         ! no orthogonal projection onto the master: NaN
         where (a1 > 1.0e300_dp) a1 = ieee_value(1.0_dp, ieee_quiet_nan)
-        call h5%write(c//'/gap', a1)
+        call h5%write(c//'/gap', a1, error)
+        if (allocated(error)) return
         a1 = pair%out%pn
-        call h5%write(c//'/p_n', a1)
+        call h5%write(c//'/p_n', a1, error)
+        if (allocated(error)) return
         a1 = pair%out%pt
-        call h5%write(c//'/p_t', a1)
+        call h5%write(c//'/p_t', a1, error)
+        if (allocated(error)) return
         a1 = pair%out%xi_m
-        call h5%write(c//'/xi_master', a1)
+        call h5%write(c//'/xi_master', a1, error)
+        if (allocated(error)) return
         st = pair%out%state
-        call h5%write(c//'/state', st)
-        call h5%write(c//'/xi_slave', pair%xi)
+        call h5%write(c//'/state', st, error)
+        if (allocated(error)) return
+        call h5%write(c//'/xi_slave', pair%xi, error)
+        if (allocated(error)) return
         ! committed friction history: what a restart needs
         history = pair%history()
         do i = 1, size(history)
             if (allocated(history(i)%values)) then
-                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%values)
+                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%values, error)
             else
-                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%flags)
+                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%flags, error)
             end if
+            if (allocated(error)) return
         end do
     end subroutine write_contact
 
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,
     !> fraction, new fraction), with their reasons as its attribute `reasons` (one line each).
-    subroutine write_cuts(h5, g, cuts)
+    subroutine write_cuts(h5, g, cuts, error)
         type(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(cut_record_t), intent(in) :: cuts(:)
+        type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: rows(:, :)
         character(len=:), allocatable :: reasons
         integer :: i
@@ -262,33 +359,45 @@ contains
             if (i > 1) reasons = reasons//new_line('a')
             reasons = reasons//trim(cuts(i)%reason)
         end do
-        call h5%write(g//'/cuts', rows)
-        call h5%write_attr(g//'/cuts', 'reasons', reasons)
+        call h5%write(g//'/cuts', rows, error)
+        if (allocated(error)) return
+        call h5%write_attr(g//'/cuts', 'reasons', reasons, error)
     end subroutine write_cuts
 
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and close;
     !> `cuts`: every cut of the run (written as /cuts when there is one); `tresca`:
     !> the run's Tresca fixed-point counters [retried substeps, accepted, fixed-point
-    !> iterations].
-    subroutine results_finish(self, status, wall, cuts, tresca)
+    !> iterations]. The file is closed whatever fails (the first error is returned).
+    subroutine results_finish(self, status, wall, cuts, tresca, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
         real(dp), intent(in) :: wall
         type(cut_record_t), intent(in), optional :: cuts(:)
         integer, intent(in), optional :: tresca(3)
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: close_error
         if (.not. self%h5%is_open()) return
-        if (present(cuts)) then
-            call self%h5%write_attr('/', 'n_cuts', size(cuts))
-            if (size(cuts) > 0) call write_cuts(self%h5, '', cuts)
-        end if
-        if (present(tresca)) then
-            call self%h5%write_attr('/', 'tresca_retries', tresca(1))
-            call self%h5%write_attr('/', 'tresca_accepted', tresca(2))
-            call self%h5%write_attr('/', 'fixed_point_iterations', tresca(3))
-        end if
-        call self%h5%write_attr('/', 'status', status)
-        call self%h5%write_attr('/', 'wall_time', wall)
-        call self%h5%close()
+        records: block
+            if (present(cuts)) then
+                call self%h5%write_attr('/', 'n_cuts', size(cuts), error)
+                if (allocated(error)) exit records
+                if (size(cuts) > 0) call write_cuts(self%h5, '', cuts, error)
+                if (allocated(error)) exit records
+            end if
+            if (present(tresca)) then
+                call self%h5%write_attr('/', 'tresca_retries', tresca(1), error)
+                if (allocated(error)) exit records
+                call self%h5%write_attr('/', 'tresca_accepted', tresca(2), error)
+                if (allocated(error)) exit records
+                call self%h5%write_attr('/', 'fixed_point_iterations', tresca(3), error)
+                if (allocated(error)) exit records
+            end if
+            call self%h5%write_attr('/', 'status', status, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'wall_time', wall, error)
+        end block records
+        call self%h5%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine results_finish
 
     !> The solver is set up: the levels of its multigrid hierarchy.
@@ -296,7 +405,7 @@ contains
         class(results_t), intent(inout) :: self
         integer, intent(in) :: level_dofs(:)
         type(error_t), allocatable, intent(out) :: error
-        call self%write_multigrid(level_dofs)
+        call self%write_multigrid(level_dofs, error)
     end subroutine results_set_up
 
     !> A converged step: written with the contact output of `model`'s pairs.
@@ -307,17 +416,19 @@ contains
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         call self%write_step(report%record, u, report%wall, model%pairs, report%cuts, report%n_cuts, &
-                             report%next_fraction, report%r0_max)
+                             report%next_fraction, report%r0_max, error)
     end subroutine results_step_done
 
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
-    subroutine results_write_multigrid(self, level_dofs)
+    subroutine results_write_multigrid(self, level_dofs, error)
         class(results_t), intent(inout) :: self
         integer, intent(in) :: level_dofs(:)
+        type(error_t), allocatable, intent(out) :: error
         if (.not. self%h5%is_open()) return
         if (self%h5%exists('/multigrid_level_dofs')) return
-        call self%h5%write('/multigrid_level_dofs', level_dofs)
-        call self%h5%flush()
+        call self%h5%write('/multigrid_level_dofs', level_dofs, error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
     end subroutine results_write_multigrid
 
     !> The case file recorded in the result file `path`.
@@ -329,7 +440,7 @@ contains
         call f%open(path, 'r', error)
         if (allocated(error)) return
         call f%read_attr_str('/', 'case_file', case_file, error)
-        call f%close()
+        call close_read(f, error)
         if (allocated(error)) error%message = '--restart: '//error%message
     end subroutine restart_case
 
@@ -346,8 +457,17 @@ contains
         call h5%open(path, 'r', error)
         if (allocated(error)) return
         call read_state(h5, model, state, error)
-        call h5%close()
+        call close_read(h5, error)
     end subroutine read_restart
+
+    !> Close a file that was only read; `error` keeps the first error.
+    subroutine close_read(h5, error)
+        type(h5file_t), intent(inout) :: h5
+        type(error_t), allocatable, intent(inout) :: error
+        type(error_t), allocatable :: close_error
+        call h5%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
+    end subroutine close_read
 
     subroutine read_state(h5, model, state, error)
         type(h5file_t), intent(inout) :: h5

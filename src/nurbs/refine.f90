@@ -97,24 +97,27 @@ contains
 
     !> Raise the degree of a B-spline curve from `p` to `p + t` (A5.9): every
     !> distinct knot gains multiplicity `t`, so the continuity is unchanged.
+    !> Segment by segment: knot insertion makes the segment a Bezier curve
+    !> (`to_bezier`), its degree is raised (`elevate_bezier`), and the knots inserted
+    !> at its left end are removed again (`remove_left_knot`).
     pure subroutine elevate_degree(p, knots, pw, t)
         !> Degree on entry; `p + t` on exit.
         integer, intent(inout) :: p
+        !> Knot vector, shape [n+p+1] on entry, longer on exit.
         real(dp), allocatable, intent(inout) :: knots(:)
+        !> Homogeneous control points, shape [ndim, n] on entry, [ndim, n_new] on exit.
         real(dp), allocatable, intent(inout) :: pw(:, :)
         integer, intent(in) :: t
         real(dp), allocatable :: uh(:), qw(:, :), bezalfs(:, :), bpts(:, :), ebpts(:, :), &
-                                 nextbpts(:, :), alfs(:)
-        real(dp) :: ua, ub, inv, numer, den, bet, alf, gam
-        integer :: nd, n, m, ph, ph2, i, j, k, mpi, mh, kind, r, a, b, cind, mul, oldr, &
-                   lbz, rbz, save, s, first, last, tr, kj, nbreak
+                                 nextbpts(:, :)
+        real(dp) :: ua, ub
+        integer :: nd, n, m, ph, i, j, mh, kind, r, a, b, cind, mul, oldr, lbz, rbz, nbreak
 
         if (t <= 0) return
         nd = size(pw, 1)
         n = size(pw, 2) - 1          ! book's n: last control point index (0-based)
         m = n + p + 1                ! book's m: last knot index
         ph = p + t
-        ph2 = ph/2
         nbreak = 0
         do i = 2, size(knots)
             if (knots(i) > knots(i - 1)) nbreak = nbreak + 1
@@ -122,24 +125,8 @@ contains
         ! Result sizes: each distinct knot gains t copies.
         allocate (uh(0:size(knots) + t*(nbreak + 1) - 1))
         allocate (qw(nd, 0:size(uh) - ph - 2))
-        allocate (bezalfs(0:ph, 0:p), bpts(nd, 0:p), ebpts(nd, 0:ph), nextbpts(nd, 0:max(p - 2, 0)), &
-                  alfs(0:max(p - 2, 0)))
-        bezalfs = 0.0_dp
-        bezalfs(0, 0) = 1.0_dp
-        bezalfs(ph, p) = 1.0_dp
-        do i = 1, ph2
-            inv = 1.0_dp/binomial(ph, i)
-            mpi = min(p, i)
-            do j = max(0, i - t), mpi
-                bezalfs(i, j) = inv*binomial(p, j)*binomial(t, i - j)
-            end do
-        end do
-        do i = ph2 + 1, ph - 1
-            mpi = min(p, i)
-            do j = max(0, i - t), mpi
-                bezalfs(i, j) = bezalfs(ph - i, p - j)
-            end do
-        end do
+        allocate (bezalfs(0:ph, 0:p), bpts(nd, 0:p), ebpts(nd, 0:ph), nextbpts(nd, 0:max(p - 2, 0)))
+        call elevation_coefficients(p, t, bezalfs)
         mh = ph
         kind = ph + 1
         r = -1
@@ -173,60 +160,9 @@ contains
             else
                 rbz = ph
             end if
-            if (r > 0) then
-                ! insert ub r times to get the Bezier segment
-                numer = ub - ua
-                do k = p, mul + 1, -1
-                    alfs(k - mul - 1) = numer/(knots(a + k + 1) - ua)
-                end do
-                do j = 1, r
-                    save = r - j
-                    s = mul + j
-                    do k = p, s, -1
-                        bpts(:, k) = alfs(k - s)*bpts(:, k) + (1.0_dp - alfs(k - s))*bpts(:, k - 1)
-                    end do
-                    nextbpts(:, save) = bpts(:, p)
-                end do
-            end if
-            ! degree-elevate the Bezier segment
-            do i = lbz, ph
-                ebpts(:, i) = 0.0_dp
-                mpi = min(p, i)
-                do j = max(0, i - t), mpi
-                    ebpts(:, i) = ebpts(:, i) + bezalfs(i, j)*bpts(:, j)
-                end do
-            end do
-            if (oldr > 1) then
-                ! remove the knot ua oldr times
-                first = kind - 2
-                last = kind
-                den = ub - ua
-                bet = (ub - uh(kind - 1))/den
-                do tr = 1, oldr - 1
-                    i = first
-                    j = last
-                    kj = j - kind + 1
-                    do while (j - i > tr)
-                        if (i < cind) then
-                            alf = (ub - uh(i))/(ua - uh(i))
-                            qw(:, i) = alf*qw(:, i) + (1.0_dp - alf)*qw(:, i - 1)
-                        end if
-                        if (j >= lbz) then
-                            if (j - tr <= kind - ph + oldr) then
-                                gam = (ub - uh(j - tr))/den
-                                ebpts(:, kj) = gam*ebpts(:, kj) + (1.0_dp - gam)*ebpts(:, kj + 1)
-                            else
-                                ebpts(:, kj) = bet*ebpts(:, kj) + (1.0_dp - bet)*ebpts(:, kj + 1)
-                            end if
-                        end if
-                        i = i + 1
-                        j = j - 1
-                        kj = kj - 1
-                    end do
-                    first = first - 1
-                    last = last + 1
-                end do
-            end if
+            if (r > 0) call to_bezier(p, knots, a, mul, r, ua, ub, bpts, nextbpts)
+            call elevate_bezier(p, t, lbz, bezalfs, bpts, ebpts)
+            if (oldr > 1) call remove_left_knot(ph, oldr, kind, cind, lbz, ua, ub, uh, qw, ebpts)
             if (a /= p) then
                 do i = 0, ph - oldr - 1
                     uh(kind) = ua
@@ -257,6 +193,127 @@ contains
         knots = uh(0:mh)
         pw = qw(:, 0:mh - ph - 1)
     end subroutine elevate_degree
+
+    !> Coefficients of degree elevation of a Bezier segment from degree `p` to
+    !> `p + t`: elevated point i = sum_j bezalfs(i, j) * point j. Shape [0:p+t, 0:p];
+    !> the lower half from binomials, the upper half by symmetry.
+    pure subroutine elevation_coefficients(p, t, bezalfs)
+        integer, intent(in) :: p, t
+        real(dp), intent(out) :: bezalfs(0:, 0:)
+        real(dp) :: inv
+        integer :: ph, i, j, mpi
+
+        ph = p + t
+        bezalfs = 0.0_dp
+        bezalfs(0, 0) = 1.0_dp
+        bezalfs(ph, p) = 1.0_dp
+        do i = 1, ph/2
+            inv = 1.0_dp/binomial(ph, i)
+            mpi = min(p, i)
+            do j = max(0, i - t), mpi
+                bezalfs(i, j) = inv*binomial(p, j)*binomial(t, i - j)
+            end do
+        end do
+        do i = ph/2 + 1, ph - 1
+            mpi = min(p, i)
+            do j = max(0, i - t), mpi
+                bezalfs(i, j) = bezalfs(ph - i, p - j)
+            end do
+        end do
+    end subroutine elevation_coefficients
+
+    !> Insert the knot `ub` (multiplicity `mul`) `r` times into the segment [ua, ub]
+    !> that starts at knot index `a` (book's, 0-based), turning `bpts` into its
+    !> Bezier points; `nextbpts` gets the leading points of the next segment.
+    pure subroutine to_bezier(p, knots, a, mul, r, ua, ub, bpts, nextbpts)
+        integer, intent(in) :: p
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: a, mul, r
+        real(dp), intent(in) :: ua, ub
+        !> shape: [ndim, 0:p]
+        real(dp), intent(inout) :: bpts(:, 0:)
+        !> shape: [ndim, 0:max(p-2, 0)]
+        real(dp), intent(inout) :: nextbpts(:, 0:)
+        real(dp) :: alfs(0:max(p - 2, 0)), numer
+        integer :: j, k, s
+
+        numer = ub - ua
+        do k = p, mul + 1, -1
+            alfs(k - mul - 1) = numer/(knots(a + k + 1) - ua)
+        end do
+        do j = 1, r
+            s = mul + j
+            do k = p, s, -1
+                bpts(:, k) = alfs(k - s)*bpts(:, k) + (1.0_dp - alfs(k - s))*bpts(:, k - 1)
+            end do
+            nextbpts(:, r - j) = bpts(:, p)
+        end do
+    end subroutine to_bezier
+
+    !> Degree-elevate the Bezier points `bpts` (degree p) into `ebpts(:, lbz:)` (degree
+    !> p + t); `ebpts(:, :lbz-1)` is left as it is.
+    pure subroutine elevate_bezier(p, t, lbz, bezalfs, bpts, ebpts)
+        integer, intent(in) :: p, t, lbz
+        !> shape: [0:p+t, 0:p]
+        real(dp), intent(in) :: bezalfs(0:, 0:)
+        !> shape: [ndim, 0:p]
+        real(dp), intent(in) :: bpts(:, 0:)
+        !> shape: [ndim, 0:p+t]
+        real(dp), intent(inout) :: ebpts(:, 0:)
+        integer :: i, j, mpi
+
+        do i = lbz, p + t
+            ebpts(:, i) = 0.0_dp
+            mpi = min(p, i)
+            do j = max(0, i - t), mpi
+                ebpts(:, i) = ebpts(:, i) + bezalfs(i, j)*bpts(:, j)
+            end do
+        end do
+    end subroutine elevate_bezier
+
+    !> Remove the knot `ua` `oldr - 1` times, where the last elevated segment (in `qw`,
+    !> up to `cind - 1`, and `uh` up to `kind - 1`) meets the new one (`ebpts`).
+    pure subroutine remove_left_knot(ph, oldr, kind, cind, lbz, ua, ub, uh, qw, ebpts)
+        integer, intent(in) :: ph, oldr, kind, cind, lbz
+        real(dp), intent(in) :: ua, ub
+        !> The elevated knots so far; shape: [0:mh_final]
+        real(dp), intent(in) :: uh(0:)
+        !> The elevated control points so far; shape: [ndim, 0:n_final]
+        real(dp), intent(inout) :: qw(:, 0:)
+        !> shape: [ndim, 0:ph]
+        real(dp), intent(inout) :: ebpts(:, 0:)
+        real(dp) :: den, bet, alf, gam
+        integer :: i, j, kj, tr, first, last
+
+        first = kind - 2
+        last = kind
+        den = ub - ua
+        bet = (ub - uh(kind - 1))/den
+        do tr = 1, oldr - 1
+            i = first
+            j = last
+            kj = j - kind + 1
+            do while (j - i > tr)
+                if (i < cind) then
+                    alf = (ub - uh(i))/(ua - uh(i))
+                    qw(:, i) = alf*qw(:, i) + (1.0_dp - alf)*qw(:, i - 1)
+                end if
+                if (j >= lbz) then
+                    if (j - tr <= kind - ph + oldr) then
+                        gam = (ub - uh(j - tr))/den
+                        ebpts(:, kj) = gam*ebpts(:, kj) + (1.0_dp - gam)*ebpts(:, kj + 1)
+                    else
+                        ebpts(:, kj) = bet*ebpts(:, kj) + (1.0_dp - bet)*ebpts(:, kj + 1)
+                    end if
+                end if
+                i = i + 1
+                j = j - 1
+                kj = kj - 1
+            end do
+            first = first - 1
+            last = last + 1
+        end do
+    end subroutine remove_left_knot
 
     pure real(dp) function binomial(n, k)
         integer, intent(in) :: n, k

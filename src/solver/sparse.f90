@@ -74,11 +74,28 @@ contains
         !> shape: [elem_ptr(nelem+1) - 1] or longer.
         integer, intent(in) :: elem_dofs(:)
         type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: dof_ptr(:), dof_elems(:), rows(:)
+        integer(i8) :: sumsq
 
-        integer, allocatable :: dof_ptr(:), dof_elems(:), mark(:), next(:)
-        integer, allocatable :: tmp(:), tmp_new(:)
-        integer :: nelem, e, q, p, d, i, j, k, nentries, last
-        integer(i8) :: top, cap, bound, sumsq
+        call check_element_lists(n, elem_ptr, elem_dofs, error)
+        if (allocated(error)) return
+        call dof_element_map(n, elem_ptr, elem_dofs, dof_ptr, dof_elems, sumsq)
+        allocate (self%colptr(n + 1))
+        call collect_columns(n, elem_ptr, elem_dofs, dof_ptr, dof_elems, sumsq, self%colptr, rows, &
+                             error)
+        if (allocated(error)) return
+        deallocate (dof_elems, dof_ptr)
+        call sort_columns(n, self%colptr, rows, self%rowind)
+        allocate (self%values(size(self%rowind)), source=0.0_c_double)
+        self%n = n
+        self%missed = 0
+    end subroutine new_csc_pattern
+
+    !> The checks of `new_csc_pattern` on its arguments (see there).
+    subroutine check_element_lists(n, elem_ptr, elem_dofs, error)
+        integer, intent(in) :: n, elem_ptr(:), elem_dofs(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: nelem, e, last
         character(len=160) :: buf
 
         if (n < 0) then
@@ -117,11 +134,21 @@ contains
                 return
             end if
         end if
+    end subroutine check_element_lists
 
-        ! DOF -> element map (CSR): the elements touching each DOF
+    !> The elements touching each DOF, in CSR form: those of DOF d are
+    !> `dof_elems(dof_ptr(d) : dof_ptr(d+1)-1)` (shapes: [n+1], [number of entries > 0
+    !> in the element lists]); `sumsq` is the sum over elements of (DOFs > 0)^2.
+    pure subroutine dof_element_map(n, elem_ptr, elem_dofs, dof_ptr, dof_elems, sumsq)
+        integer, intent(in) :: n, elem_ptr(:), elem_dofs(:)
+        integer, allocatable, intent(out) :: dof_ptr(:), dof_elems(:)
+        integer(i8), intent(out) :: sumsq
+        integer, allocatable :: next(:)
+        integer :: e, q, d, k
+
         allocate (dof_ptr(n + 1), source=0)
         sumsq = 0
-        do e = 1, nelem
+        do e = 1, size(elem_ptr) - 1
             k = 0
             do q = elem_ptr(e), elem_ptr(e + 1) - 1
                 d = elem_dofs(q)
@@ -139,7 +166,7 @@ contains
         allocate (dof_elems(dof_ptr(n + 1) - 1))
         allocate (next(n))
         next = dof_ptr(1:n)
-        do e = 1, nelem
+        do e = 1, size(elem_ptr) - 1
             do q = elem_ptr(e), elem_ptr(e + 1) - 1
                 d = elem_dofs(q)
                 if (d > 0) then
@@ -148,15 +175,30 @@ contains
                 end if
             end do
         end do
+    end subroutine dof_element_map
 
-        ! Unsorted rows of each column, deduplicated with a marker. Element
-        ! overlaps make sum(size^2) a few times nnz, hence the initial guess.
-        allocate (self%colptr(n + 1))
+    !> The rows of every column, unsorted: column j (the diagonal first, then the DOFs
+    !> of the elements touching j, each once by a marker) is
+    !> `rows(colptr(j)+1 : colptr(j+1))`. Element overlaps make sum(size^2) a few
+    !> times nnz, hence the initial guess of the buffer size; it grows when needed.
+    subroutine collect_columns(n, elem_ptr, elem_dofs, dof_ptr, dof_elems, sumsq, colptr, rows, &
+                               error)
+        integer, intent(in) :: n, elem_ptr(:), elem_dofs(:), dof_ptr(:), dof_elems(:)
+        integer(i8), intent(in) :: sumsq
+        !> 0-based column starts; shape: [n+1]
+        integer(c_int), intent(out) :: colptr(:)
+        !> 1-based rows; shape: [colptr(n+1)] or longer
+        integer, allocatable, intent(out) :: rows(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: mark(:), rows_new(:)
+        integer :: e, q, p, i, j
+        integer(i8) :: top, cap, bound
+
         cap = max(int(n, i8) + sumsq/3, 16_i8)
-        allocate (tmp(cap))
+        allocate (rows(cap))
         allocate (mark(n), source=0)
         top = 0
-        self%colptr(1) = 0
+        colptr(1) = 0
         do j = 1, n
             bound = 1
             do p = dof_ptr(j), dof_ptr(j + 1) - 1
@@ -165,12 +207,12 @@ contains
             end do
             if (top + bound > cap) then
                 cap = max(cap + cap/2, top + bound)
-                allocate (tmp_new(cap))
-                tmp_new(1:top) = tmp(1:top)
-                call move_alloc(tmp_new, tmp)
+                allocate (rows_new(cap))
+                rows_new(1:top) = rows(1:top)
+                call move_alloc(rows_new, rows)
             end if
             top = top + 1
-            tmp(top) = j
+            rows(top) = j
             mark(j) = j
             do p = dof_ptr(j), dof_ptr(j + 1) - 1
                 e = dof_elems(p)
@@ -180,7 +222,7 @@ contains
                     if (mark(i) == j) cycle
                     mark(i) = j
                     top = top + 1
-                    tmp(top) = i
+                    rows(top) = i
                 end do
             end do
             if (top > int(huge(0_c_int), i8)) then
@@ -189,30 +231,34 @@ contains
                                  error_code%numeric)
                 return
             end if
-            self%colptr(j + 1) = int(top, c_int)
+            colptr(j + 1) = int(top, c_int)
         end do
-        deallocate (mark, dof_elems, dof_ptr)
+    end subroutine collect_columns
 
-        ! Counting-sort transpose: scanning columns j in ascending order and
-        ! appending j to column i for every stored (i, j) gives each column its
-        ! rows in ascending order; by structural symmetry the pattern is the same.
-        nentries = int(top)
-        allocate (self%rowind(nentries))
+    !> Counting-sort transpose: scanning columns j in ascending order and appending j
+    !> to column i for every stored (i, j) gives each column its rows in ascending
+    !> order; by structural symmetry the pattern is the same. `rowind`: 0-based rows,
+    !> shape [colptr(n+1)].
+    pure subroutine sort_columns(n, colptr, rows, rowind)
+        integer, intent(in) :: n
+        integer(c_int), intent(in) :: colptr(:)
+        integer, intent(in) :: rows(:)
+        integer(c_int), allocatable, intent(out) :: rowind(:)
+        integer, allocatable :: next(:)
+        integer :: i, j, k
+
+        allocate (rowind(colptr(n + 1)), next(n))
         do i = 1, n
-            next(i) = self%colptr(i)
+            next(i) = colptr(i)
         end do
         do j = 1, n
-            do k = self%colptr(j) + 1, self%colptr(j + 1)
-                i = tmp(k)
+            do k = colptr(j) + 1, colptr(j + 1)
+                i = rows(k)
                 next(i) = next(i) + 1
-                self%rowind(next(i)) = int(j - 1, c_int)
+                rowind(next(i)) = int(j - 1, c_int)
             end do
         end do
-        deallocate (tmp, next)
-        allocate (self%values(nentries), source=0.0_c_double)
-        self%n = n
-        self%missed = 0
-    end subroutine new_csc_pattern
+    end subroutine sort_columns
 
     !> Where each stored entry of `old` is in `new` (same n, both patterns from
     !> `new_csc_pattern`): `old2new(p)` is the index into `new%values` of the entry
