@@ -17,6 +17,7 @@ module voiga_contact_gpts
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive, state_stick, state_slip
     use voiga_contact_kinematics, only: point_operators
+    use voiga_text, only: str, real_str
     use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
                                   pair_reset_trial, pair_history, pair_set_history
     implicit none
@@ -253,28 +254,24 @@ contains
     pure function gpts_failure_diagnosis(self) result(text)
         class(gpts_pair_t), intent(in) :: self
         character(len=:), allocatable :: text
-        character(len=600) :: buf
         integer :: n_active, n_holes, n_gaps, n_cp
 
         text = ''
         call self%zone(n_active, n_holes, n_gaps, n_cp)
         if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
             n_active <= n_cp) return
-        write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es8.1,a)') '; at the last converged state the contact '// &
-            'zone of '''//trim(self%slave_name)//''' on '''//trim(self%master_name)// &
-            ''' is broken up: ', n_holes, ' of its ', n_active + n_holes, ' slave points are open in gaps '// &
-            'shorter than a slave element, and its ', n_active, ' active points act on ', n_cp, &
-            ' control points of the slave edge: the Gauss-point-to-surface constraints outnumber '// &
-            'the edge''s degrees of freedom and, with penalty_normal = ', self%law%eps_n, &
-            ', lock (the pressure alternates between neighbouring points instead of following '// &
-            'a smooth field)'
-        text = trim(buf)
+        text = '; at the last converged state the contact zone of '''//trim(self%slave_name)//''' on '''// &
+               trim(self%master_name)//''' is broken up: '//str(n_holes)//' of its '//str(n_active + n_holes)// &
+               ' slave points are open in gaps shorter than a slave element, and its '//str(n_active)// &
+               ' active points act on '//str(n_cp)//' control points of the slave edge: the '// &
+               'Gauss-point-to-surface constraints outnumber the edge''s degrees of freedom and, with '// &
+               'penalty_normal = '//real_str(self%law%eps_n, 'es8.1')//', lock (the pressure alternates '// &
+               'between neighbouring points instead of following a smooth field)'
         if (self%law%mu > 0.0_dp) text = text//'; the slip bounds mu p_N then jump from '// &
                                          'point to point, which breaks up the stick/slip pattern as well'
-        write (buf, '(a,i0,a)') '; one constraint per slave control point (&contact method = '// &
-            '''mortar'') or fewer slave points per element (&contact n_gauss, here ', self%n_gauss, &
-            ') remove the over-constraint, a smaller penalty_normal eases it'
-        text = text//trim(buf)
+        text = text//'; one constraint per slave control point (&contact method = ''mortar'') or fewer '// &
+               'slave points per element (&contact n_gauss, here '//str(self%n_gauss)// &
+               ') remove the over-constraint, a smaller penalty_normal eases it'
     end function gpts_failure_diagnosis
 
     !> The contact zone at the last evaluation: `n_active` points in contact;

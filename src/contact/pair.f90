@@ -19,6 +19,7 @@ module voiga_contact_pair
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive
+    use voiga_text, only: str, real_str
     implicit none
     private
 
@@ -349,11 +350,10 @@ contains
         class(contact_pair_t), intent(in) :: self
         integer, intent(in) :: k
         type(error_t), allocatable, intent(out) :: error
-        character(len=96) :: buf
-        write (buf, '(a,i0,a,es10.3)') 'slave point ', k, ' at xi = ', self%xi(k)
         call fatal_error(error, "contact '"//trim(self%slave_name)//"' on '"// &
-                         trim(self%master_name)//"': the closest-point projection of "// &
-                         trim(buf)//' did not converge', error_code%numeric)
+                         trim(self%master_name)//"': the closest-point projection of slave point "// &
+                         str(k)//' at xi = '//real_str(self%xi(k), 'es10.3')//' did not converge', &
+                         error_code%numeric)
     end subroutine pair_projection_error
 
     !> `inside`: whether the master functions of slave point `k`'s projection lie in

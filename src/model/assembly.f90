@@ -6,6 +6,7 @@ module voiga_model_assembly
     use voiga_model, only: model_t
     use voiga_model_body, only: body_t
     use voiga_model_loads, only: phase_value
+    use voiga_text, only: str
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element
@@ -319,7 +320,6 @@ contains
         integer, allocatable :: dofs(:)
         integer :: ib, e, n, npts, idx
         logical :: ok
-        character(len=64) :: buf
         integer(i8) :: c0, c1, rate
 
         call system_clock(c0, rate)
@@ -337,8 +337,7 @@ contains
                     if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
                     call body_element(body, e, u, fe, ke, ok)
                     if (.not. ok) then
-                        write (buf, '(a,i0)') ' element ', e
-                        call fatal_error(error, "body '"//trim(body%name)//"'"//trim(buf)// &
+                        call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
                                          ': the deformation is inverted (J <= 0 at a quadrature point)', &
                                          error_code%numeric)
                         return

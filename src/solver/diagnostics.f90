@@ -10,6 +10,7 @@ module voiga_solver_diagnostics
     use voiga_error, only: error_t
     use voiga_model, only: model_t
     use voiga_model_assembly, only: assemble, assembly_stats_t
+    use voiga_text, only: str, real_str
     implicit none
     private
 
@@ -29,22 +30,21 @@ contains
         type(model_t), intent(in) :: model
         integer, intent(in) :: nonpositive, total
         character(len=:), allocatable :: text
-        character(len=300) :: buf
         integer :: ip
-        write (buf, '(a,i0,a,i0,a)') '; the determinant of the tangent stiffness changes sign near '// &
-            'the last converged state (det K <= 0 in ', nonpositive, ' of the ', total, &
-            ' iterations of the last attempt, > 0 in the others or at that state)'
-        text = trim(buf)//': pieces of the incremental problem with opposite orientation meet '// &
+        text = '; the determinant of the tangent stiffness changes sign near the last converged state '// &
+               '(det K <= 0 in '//str(nonpositive)//' of the '//str(total)//' iterations of the last '// &
+               'attempt, > 0 in the others or at that state)'
+        text = text//': pieces of the incremental problem with opposite orientation meet '// &
                'there, so it folds (for some increments it has no nearby solution): either the '// &
                'quasi-static path ends here (a limit point; the physical system would move '// &
                'dynamically) or it goes on only through increments below min_step_fraction'
         do ip = 1, size(model%pairs)
             associate (law => model%pairs(ip)%pair%law)
                 if (law%mu <= 0.0_dp) cycle
-                write (buf, '(a,es8.1,a,es8.1,a)') '; with Coulomb friction (mu = ', law%mu, &
-                    ', penalty_normal = ', law%eps_n, '): slipping points couple the '
+                text = text//'; with Coulomb friction (mu = '//real_str(law%mu, 'es8.1')//', penalty_normal = '// &
+                       real_str(law%eps_n, 'es8.1')//'): slipping points couple the'
             end associate
-            text = text//trim(buf)//' normal penalty into the tangential direction (mu x penalty_normal) '// &
+            text = text//' normal penalty into the tangential direction (mu x penalty_normal) '// &
                    'which can make the tangent indefinite (the friction-induced instability); a smaller '// &
                    'penalty_normal or mu keeps the path stable longer'
             exit

@@ -23,6 +23,7 @@ module voiga_solver_newton
     use voiga_solver_progress, only: progress_t, iteration_report_t
     use voiga_solver_convergence, only: convergence_t, converged, at_roundoff, residual_floor, floor_cap, &
                                         divergence_ratio
+    use voiga_text, only: str, real_str
     use voiga_solver_step_length, only: crossing_limit, backtracks, natural_reduction, natural_first_step, &
                                         creep_step
     implicit none
@@ -327,7 +328,7 @@ contains
         type(attempt_t), intent(inout) :: attempt
         logical, intent(out) :: done
         type(error_t), allocatable, intent(out) :: error
-        character(len=800) :: msg
+        character(len=:), allocatable :: msg
         integer :: flips, ip
 
         done = converged(st%c, settings%tol_residual, settings%tol_energy)
@@ -335,9 +336,8 @@ contains
         done = .true.
         associate (it => st%it, rn => st%c%residual, r0 => st%c%first, states => st%states)
             if (it > 0 .and. rn > divergence_ratio*r0) then
-                write (msg, '(a,es9.2,a,es9.2,a,i0,a)') 'the residual grew from ', r0, ' to ', rn, &
-                    ' in ', it, ' iterations'
-                call fatal_error(error, trim(msg), error_code%numeric)
+                call fatal_error(error, 'the residual grew from '//real_str(r0, 'es9.2')//' to '// &
+                                 real_str(rn, 'es9.2')//' in '//str(it)//' iterations', error_code%numeric)
                 return
             end if
             ! a limit cycle: the contact states and the residual repeat with period 2
@@ -348,36 +348,35 @@ contains
                     abs(st%norms(it) - st%norms(it - 2)) <= 1.0e-6_dp*rn) then
                     flips = count(states(:, it) /= states(:, it - 1))
                     attempt%switching = .true.
-                    write (msg, '(a,i0,a,i0,a,es9.2,a,es9.2,a)') 'Newton cycles after ', it, &
-                        ' iterations: ', flips, ' contact point(s) switch state (stick/slip or '// &
-                        'contact/separation) with every iteration and the residual repeats (', rn, &
-                        ', first ', r0, '): the friction and contact laws are not smooth where '// &
-                        'the point sits on the stick/slip or contact limit'
-                    call fatal_error(error, trim(msg), error_code%numeric)
+                    call fatal_error(error, 'Newton cycles after '//str(it)//' iterations: '//str(flips)// &
+                                     ' contact point(s) switch state (stick/slip or contact/separation) with '// &
+                                     'every iteration and the residual repeats ('//real_str(rn, 'es9.2')// &
+                                     ', first '//real_str(r0, 'es9.2')//'): the friction and contact laws '// &
+                                     'are not smooth where the point sits on the stick/slip or contact limit', &
+                                     error_code%numeric)
                     return
                 end if
             end if
             if (it == settings%max_iterations) then
-                write (msg, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', &
-                    settings%max_iterations, ' iterations (residual ', rn, ', first ', r0, ')'
+                msg = 'Newton did not converge in '//str(settings%max_iterations)//' iterations (residual '// &
+                      real_str(rn, 'es9.2')//', first '//real_str(r0, 'es9.2')//')'
                 if (rn <= st%c%floor) then
-                    write (msg, '(a,es9.2,a,es9.2,a,es9.2,a)') trim(msg)//': the residual is at its '// &
-                        'round-off level ', st%c%floor, ' (stiffness x rounding of the coordinates), above ', &
-                        floor_cap, ' of the force scale ', st%c%scale, &
-                        ': the stiffness (penalty) is too large for double precision'
+                    msg = msg//': the residual is at its round-off level '//real_str(st%c%floor, 'es9.2')// &
+                          ' (stiffness x rounding of the coordinates), above '//real_str(floor_cap, 'es9.2')// &
+                          ' of the force scale '//real_str(st%c%scale, 'es9.2')// &
+                          ': the stiffness (penalty) is too large for double precision'
                 else
                     flips = count([(any(states(:, ip) /= states(:, ip - 1)), ip=max(1, it - 9), it)])
                     attempt%switching = flips > 0
-                    if (flips > 0) write (msg, '(a,i0,a,i0,a)') trim(msg)// &
-                        ': contact states still switched in ', flips, ' of the last ', &
-                        it - max(1, it - 9) + 1, ' iterations (points on the stick/slip or contact limit)'
+                    if (flips > 0) msg = msg//': contact states still switched in '//str(flips)//' of the last '// &
+                                         str(it - max(1, it - 9) + 1)// &
+                                         ' iterations (points on the stick/slip or contact limit)'
                     if (.not. natural .and. 2*st%short_steps >= settings%max_iterations) &
-                        write (msg, '(a,i0,a)') trim(msg)//'; ', st%short_steps, ' of its iterations '// &
-                        'took steps of 1/16 or less: the residual rule creeps along the curvature of a '// &
-                        'stiff penalty, &solver damping = ''natural'' may pass it (docs/robustness.md, '// &
-                        '"Natural damping")'
+                        msg = msg//'; '//str(st%short_steps)//' of its iterations took steps of 1/16 or less: '// &
+                              'the residual rule creeps along the curvature of a stiff penalty, &solver '// &
+                              'damping = ''natural'' may pass it (docs/robustness.md, "Natural damping")'
                 end if
-                call fatal_error(error, trim(msg), error_code%numeric)
+                call fatal_error(error, msg, error_code%numeric)
                 return
             end if
         end associate

@@ -19,6 +19,7 @@ module voiga_solver_outer
     use voiga_solver_progress, only: progress_t, fixed_point_report_t
     use voiga_solver_convergence, only: convergence_t, converged, residual_floor
     use voiga_solver_newton, only: newton_t, newton_attempt, attempt_t
+    use voiga_text, only: str, real_str
     implicit none
     private
 
@@ -61,7 +62,6 @@ contains
         real(dp) :: last_change, growth, log_det
         integer :: fp, growing
         logical :: accepted
-        character(len=600) :: msg
 
         stats%tresca_retries = stats%tresca_retries + 1
         ! initial bounds: mu p_N at the last converged state (p_N depends on u only)
@@ -95,8 +95,8 @@ contains
                     call move_alloc(inner_error, error)
                     return
                 end if
-                write (msg, '(a,i0,a)') 'the Tresca problem of fixed-point iteration ', fp, ' failed: '
-                call fatal_error(error, trim(msg)//' '//inner_error%message, error_code%numeric)
+                call fatal_error(error, 'the Tresca problem of fixed-point iteration '//str(fp)//' failed: '// &
+                                 inner_error%message, error_code%numeric)
                 return
             end if
             ! the Coulomb residual and tangent at the Tresca solution, and the new bounds
@@ -151,20 +151,21 @@ contains
         logical, intent(in) :: diverging
         real(dp), intent(in) :: growth
         type(error_t), allocatable, intent(out) :: error
-        character(len=600) :: msg
-        write (msg, '(a,i0,a,es9.2,a,es9.2,a,es9.2,a,es9.2,a)') 'the fixed point did not converge in ', &
-            n, ' iterations (Coulomb residual ', rep%residual, ', reference ', rep%reference, &
-            '; last bound change ', rep%change, ' of max bound ', rep%largest, ')'
+        character(len=:), allocatable :: msg
+        msg = 'the fixed point did not converge in '//str(n)//' iterations (Coulomb residual '// &
+              real_str(rep%residual, 'es9.2')//', reference '//real_str(rep%reference, 'es9.2')// &
+              '; last bound change '//real_str(rep%change, 'es9.2')//' of max bound '// &
+              real_str(rep%largest, 'es9.2')//')'
         if (diverging) then
-            write (msg, '(a,f0.2,a)') trim(msg)//': the successive approximations diverge (the bound '// &
-                'change grew in 3 iterations in a row, by up to ', growth, ' per iteration): the map g -> '// &
-                'mu p_N(g) is not a contraction here'
-            call fatal_error(error, trim(msg)//', the condition under which the existence theory of '// &
+            msg = msg//': the successive approximations diverge (the bound change grew in 3 iterations in '// &
+                  'a row, by up to '//real_str(growth, 'f0.2')//' per iteration): the map g -> mu p_N(g) is '// &
+                  'not a contraction here'
+            call fatal_error(error, msg//', the condition under which the existence theory of '// &
                              'quasi-static Coulomb friction guarantees a unique incremental solution '// &
                              '(small mu); a Coulomb solution may not exist near this state', &
                              error_code%numeric)
         else
-            call fatal_error(error, trim(msg)//': the Coulomb incremental problem may have no '// &
+            call fatal_error(error, msg//': the Coulomb incremental problem may have no '// &
                              'solution near this state', error_code%numeric)
         end if
     end subroutine not_converged_error

@@ -9,6 +9,7 @@
 !> `clear_signal` change it).
 module voiga_solver_signals
     use, intrinsic :: iso_c_binding, only: c_int, c_funptr, c_funloc, c_null_funptr
+    use voiga_text, only: str
     implicit none
     private
 
@@ -63,15 +64,13 @@ contains
     pure function signal_name(signum) result(name)
         integer, intent(in) :: signum
         character(len=:), allocatable :: name
-        character(len=12) :: buf
         select case (signum)
         case (sigint)
             name = 'SIGINT'
         case (sigterm)
             name = 'SIGTERM'
         case default
-            write (buf, '(i0)') signum
-            name = 'signal '//trim(buf)
+            name = 'signal '//str(signum)
         end select
     end function signal_name
 

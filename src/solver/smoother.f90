@@ -11,6 +11,7 @@
 module voiga_solver_smoother
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
     use voiga_solver_csr, only: csr_t
     use voiga_linalg_lapack, only: band_factor
     implicit none
@@ -127,7 +128,6 @@ contains
         type(csr_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
         integer :: l, m, info
-        character(len=120) :: msg
 
         self%band = 0.0_dp
         self%band(self%dst) = a%val(self%src)
@@ -136,8 +136,8 @@ contains
             call band_factor(m, self%kl(l), self%ku(l), self%band(self%band_start(l)), &
                              self%ipiv(self%piv_start(l)), info)
             if (info /= 0) then
-                write (msg, '(a,i0,a)') 'multigrid smoother: the block of line ', l, ' is singular'
-                call fatal_error(error, trim(msg), error_code%numeric)
+                call fatal_error(error, 'multigrid smoother: the block of line '//str(l)//' is singular', &
+                                 error_code%numeric)
                 return
             end if
         end do

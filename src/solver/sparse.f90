@@ -10,6 +10,7 @@ module voiga_solver_sparse
     use, intrinsic :: iso_c_binding, only: c_int, c_double
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
     implicit none
     private
 
@@ -96,11 +97,9 @@ contains
         integer, intent(in) :: n, elem_ptr(:), elem_dofs(:)
         type(error_t), allocatable, intent(out) :: error
         integer :: nelem, e, last
-        character(len=160) :: buf
 
         if (n < 0) then
-            write (buf, '(a,i0)') 'new_csc_pattern: negative number of DOFs n = ', n
-            call fatal_error(error, trim(buf))
+            call fatal_error(error, 'new_csc_pattern: negative number of DOFs n = '//str(n))
             return
         end if
         nelem = size(elem_ptr) - 1
@@ -114,23 +113,20 @@ contains
         end if
         do e = 1, nelem
             if (elem_ptr(e + 1) < elem_ptr(e)) then
-                write (buf, '(a,i0)') 'new_csc_pattern: elem_ptr decreases at element ', e
-                call fatal_error(error, trim(buf))
+                call fatal_error(error, 'new_csc_pattern: elem_ptr decreases at element '//str(e))
                 return
             end if
         end do
         last = elem_ptr(nelem + 1) - 1
         if (last > size(elem_dofs)) then
-            write (buf, '(a,i0,a,i0)') 'new_csc_pattern: elem_ptr ends at ', last, &
-                ' but elem_dofs has ', size(elem_dofs)
-            call fatal_error(error, trim(buf))
+            call fatal_error(error, 'new_csc_pattern: elem_ptr ends at '//str(last)//' but elem_dofs has '// &
+                             str(size(elem_dofs)))
             return
         end if
         if (last > 0) then
             if (maxval(elem_dofs(1:last)) > n) then
-                write (buf, '(a,i0,a,i0)') 'new_csc_pattern: DOF ', maxval(elem_dofs(1:last)), &
-                    ' exceeds n = ', n
-                call fatal_error(error, trim(buf))
+                call fatal_error(error, 'new_csc_pattern: DOF '//str(maxval(elem_dofs(1:last)))// &
+                                 ' exceeds n = '//str(n))
                 return
             end if
         end if

@@ -24,6 +24,7 @@ module voiga_solver_stepping
     use voiga_solver_newton, only: newton_t, new_newton, attempt_t, newton_attempt
     use voiga_solver_outer, only: tresca_fixed_point, frictional
     use voiga_solver_diagnostics, only: fold_diagnosis, append_pair_diagnoses
+    use voiga_text, only: str, real_str
     implicit none
     private
 
@@ -140,9 +141,7 @@ contains
         type(error_t), intent(inout) :: error
         integer, intent(in) :: step
         real(dp), intent(in) :: t
-        character(len=200) :: msg
-        write (msg, '(a,i0,a,es12.5,a)') 'step ', step, ' (load time ', t, '):'
-        error%message = trim(msg)//' '//error%message
+        error%message = 'step '//str(step)//' (load time '//real_str(t, 'es12.5')//'): '//error%message
     end subroutine prefix_step
 
     !> Nominal step `step`: substeps until it is complete, cutting the increment on
@@ -326,13 +325,11 @@ contains
         type(step_record_t), intent(in) :: rec
         type(solver_stats_t), intent(inout) :: stats
         type(error_t), intent(inout) :: error
-        character(len=200) :: msg
-        if (rec%cuts > 0 .or. sp%settings%max_cuts > 0) then
-            write (msg, '(a,i0,a,es9.2,a,es9.2,a,i0,a)') ' (after ', rec%cuts, &
-                ' cuts; increment ', ds, ' of the nominal step, minimum ', &
-                sp%settings%min_step_fraction, ', max_cuts ', sp%settings%max_cuts, ')'
-            error%message = error%message//trim(msg)
-        end if
+        if (rec%cuts > 0 .or. sp%settings%max_cuts > 0) &
+            error%message = error%message//' (after '//str(rec%cuts)//' cuts; increment '// &
+                            real_str(ds, 'es9.2')//' of the nominal step, minimum '// &
+                            real_str(sp%settings%min_step_fraction, 'es9.2')//', max_cuts '// &
+                            str(sp%settings%max_cuts)//')'
         if (sp%fold_iterations > 0 .and. (sp%fold_iterations < sp%fold_total .or. sp%conv_det_sign > 0)) &
             error%message = error%message//fold_diagnosis(model, sp%fold_iterations, sp%fold_total)
         call append_pair_diagnoses(model, sp%u_conv, t_conv, stats%assembly, error%message)

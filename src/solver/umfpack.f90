@@ -14,6 +14,7 @@ module voiga_solver_umfpack
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_ptr, c_null_ptr, c_associated
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     implicit none
@@ -309,7 +310,6 @@ contains
         type(solve_accuracy_t), intent(in), optional :: accuracy
         real(c_double) :: control(umfpack_control), info(umfpack_info)
         integer(c_int) :: status
-        character(len=160) :: buf
 
         if (.not. c_associated(self%numeric)) then
             call fatal_error(error, 'umfpack solve: no numeric factorization '// &
@@ -324,9 +324,8 @@ contains
             return
         end if
         if (size(b) /= a%n .or. size(x) /= a%n) then
-            write (buf, '(a,i0,a,i0,a,i0)') 'umfpack solve: size(b) = ', size(b), &
-                ', size(x) = ', size(x), ', expected n = ', a%n
-            call fatal_error(error, trim(buf))
+            call fatal_error(error, 'umfpack solve: size(b) = '//str(size(b))//', size(x) = '// &
+                             str(size(x))//', expected n = '//str(a%n))
             return
         end if
         call umfpack_di_defaults(control)
@@ -482,9 +481,9 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=*), intent(in) :: routine
         integer(c_int), intent(in) :: status
-        character(len=16) :: num
+        character(len=:), allocatable :: num
 
-        write (num, '(i0)') status
+        num = str(int(status))
         if (status == umfpack_error_out_of_memory) then
             ! not a numerical failure: a smaller increment would not need less memory
             call fatal_error(error, routine//' failed: '//status_meaning(status)// &
