@@ -37,6 +37,8 @@ import numpy as np
 from pre.h5io import read_curve, read_patch
 from pre.nurbs import Curve, Patch
 
+from .units import Units
+
 STAGES: tuple[str, ...] = ("assembly", "contact", "factorization", "solve", "output")
 """Stages whose wall-clock seconds each step records (attrs ``seconds_<stage>``)."""
 
@@ -160,7 +162,7 @@ class ContactOutput:
 
 
 _LAZY_FIELDS: tuple[str, ...] = ("time", "substeps", "residual_norms", "energy_norms",
-                                  "displacement", "contact")
+                                  "displacement", "contact", "fields")
 """The fields of a :class:`Step` that ``read_result(..., lazy=True)`` reads on first use."""
 
 
@@ -230,6 +232,13 @@ class Step:
         """One entry per contact pair, in case-file order."""
         return self._get("contact")
 
+    @property
+    def fields(self) -> dict[str, dict[str, np.ndarray]]:
+        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,)
+        and e.g. ``stress`` (n, k)), from ``/steps/<k>/fields/<body>``; empty when the
+        file has none (voiga does not write them yet; docs/hdf5.md)."""
+        return self._get("fields")
+
 
 @dataclass(eq=False)
 class Result:
@@ -292,6 +301,12 @@ class Result:
     @property
     def wall_time(self) -> float:
         return float(self._attr("wall_time", 0.0))
+
+    @property
+    def units(self) -> Units:
+        """The length and force units the root attribute ``units`` names (generic
+        ``length`` / ``force`` when it names none; :mod:`post.units`)."""
+        return Units.parse(str(self._attr("units")))
 
     @property
     def converged(self) -> bool:
@@ -459,7 +474,10 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
             "residual_norms": vec("residual_norms"), "energy_norms": vec("energy_norms"),
             "displacement": vec("displacement"),
             "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
-            if gid.links.exists(b"contact") else []}
+            if gid.links.exists(b"contact") else [],
+            "fields": {body: {k: np.asarray(v[()], dtype=float) for k, v in fg.items()}
+                       for body, fg in g["fields"].items()}
+            if gid.links.exists(b"fields") else {}}
 
 
 def _read_contact(g: h5py.Group) -> ContactOutput:

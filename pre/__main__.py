@@ -13,9 +13,6 @@ import argparse
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-
-
 def _cmd_cases(args: argparse.Namespace) -> int:
     from .cases import write_cases
 
@@ -58,7 +55,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("cases", help="write geometry files and case namelists")
-    s.add_argument("--out", default=str(REPO / "cases"), help="output folder (default: repo cases/)")
+    s.add_argument("--out", default="cases",
+                   help="output folder (default: cases, relative to the current directory: run "
+                        "it from the repository root to refresh the committed cases)")
     s.set_defaults(func=_cmd_cases)
 
     s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
@@ -73,7 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_plot_layout)
 
     s = sub.add_parser("figures", help="write the docs figures")
-    s.add_argument("--out", default=str(REPO / "docs" / "figures"), help="output folder")
+    s.add_argument("--out", default=str(Path("docs") / "figures"),
+                   help="output folder (default: docs/figures, relative to the current directory)")
     s.set_defaults(func=_cmd_figures)
     return p
 
