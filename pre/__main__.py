@@ -1,6 +1,7 @@
 """Command line: ``python -m pre <subcommand>``.
 
 Subcommands:
+  geometry     a geometry spec (TOML) -> geometry file and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   refine       refine a case with splipy and write the discretization dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -12,6 +13,19 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+def _cmd_geometry(args: argparse.Namespace) -> int:
+    from .spec import SpecError, write_from_spec
+
+    try:
+        geometry, case, written = write_from_spec(args.spec, args.out, args.force)
+    except (SpecError, FileNotFoundError, OSError) as err:
+        print(f"python -m pre geometry: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}")
+    print(f"wrote {case}" if written else f"kept {case} (exists; --force to overwrite)")
+    return 0
+
 
 def _cmd_cases(args: argparse.Namespace) -> int:
     from .cases import write_cases
@@ -53,6 +67,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m pre", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("geometry", help="geometry spec (TOML) -> geometry file and case file")
+    s.add_argument("spec", help="spec file (.toml; docs/pre.md)")
+    s.add_argument("--out", default=None, help="output folder (default: the spec's folder)")
+    s.add_argument("--force", action="store_true", help="overwrite an existing case file")
+    s.set_defaults(func=_cmd_geometry)
 
     s = sub.add_parser("cases", help="write geometry files and case namelists")
     s.add_argument("--out", default="cases",
