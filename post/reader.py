@@ -185,6 +185,8 @@ class Step:
     """stage (``STAGES``) -> wall-clock seconds."""
     cuts: int = 0
     """Times the step was cut (halved) before it converged."""
+    iterations_total: int | None = None
+    """Newton iterations of all substeps and failed attempts (None in older files)."""
     _data: dict[str, Any] = field(default_factory=dict, repr=False)
     """The lazy fields read so far."""
     _source: tuple[Path, str, int] | None = field(default=None, repr=False)
@@ -399,7 +401,8 @@ def _read_body(name: str, g: h5py.Group) -> Body:
                 layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs)
 
 
-_STEP_SCALARS: tuple[str, ...] = ("iterations", "cuts") + tuple(f"seconds_{k}" for k in STAGES)
+_STEP_SCALARS: tuple[str, ...] = ("iterations", "iterations_total", "cuts") + \
+    tuple(f"seconds_{k}" for k in STAGES)
 """The step attributes every read needs (the sweep summary's)."""
 
 _INT_ATTRS = frozenset({"step", "iterations", "iterations_total", "cuts", "substeps"})
@@ -455,7 +458,9 @@ def _read_step(name: str, gid: h5py.h5g.GroupID, n_dirichlet: int, path: Path, n
     step = Step(step=int(name), iterations=int(a.get("iterations", 0)), reactions=reactions,
                 seconds={k[len("seconds_"):]: float(v) for k, v in a.items()
                          if k.startswith("seconds_")},
-                cuts=int(a.get("cuts", 0)), _source=(path, name, n_dofs))
+                cuts=int(a.get("cuts", 0)),
+                iterations_total=int(a["iterations_total"]) if "iterations_total" in a else None,
+                _source=(path, name, n_dofs))
     if not lazy:
         step._data = _read_step_details(h5py.Group(gid), name)
     return step

@@ -17,7 +17,7 @@ def summary_lines(result: Result) -> list[str]:
     """Human-readable lines describing ``result`` (any status)."""
     u = result.units
     steps = result.steps
-    iters = sum(s.iterations for s in steps)
+    iters = sum(s.iterations if s.iterations_total is None else s.iterations_total for s in steps)
     lines = [f"{result.title or result.path.name}: {result.status or 'no status'}, "
              f"{len(steps)} of {result.n_steps_planned} steps, {iters} Newton iterations, "
              f"{int(result.attrs.get('n_cuts', 0))} cuts, {result.n_dofs} DOFs, "
