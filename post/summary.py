@@ -6,7 +6,53 @@ from __future__ import annotations
 
 import numpy as np
 
-from .reader import Result
+from .plot import breakpoints
+from .reader import ContactOutput, Result
+
+PENETRATION_WARNING = 0.1
+"""Warn when the largest penetration exceeds this fraction of the slave element size."""
+
+
+def slave_element_size(result: Result, c: ContactOutput, xi: float) -> float:
+    """Length (reference configuration) of the slave's contact-edge element that holds
+    the edge parameter ``xi``: the polyline through its slave points, scaled from their
+    parameter range to the element's."""
+    breaks = breakpoints(result.body(c.slave))[0]
+    k = int(np.clip(np.searchsorted(breaks, xi, side="right") - 1, 0, len(breaks) - 2))
+    a, b = breaks[k], breaks[k + 1]
+    inside = np.flatnonzero((c.xi_slave >= a) & (c.xi_slave <= b))
+    inside = inside[np.argsort(c.xi_slave[inside], kind="stable")]
+    if len(inside) < 2:
+        return float("nan")
+    length = float(np.linalg.norm(np.diff(c.x_ref[inside], axis=0), axis=1).sum())
+    covered = float(c.xi_slave[inside[-1]] - c.xi_slave[inside[0]])
+    return length * (b - a) / covered if covered > 0 else float("nan")
+
+
+def warnings_for(result: Result) -> list[str]:
+    """What a result file shows that the user should know: a contact pair that was never
+    in contact at any converged step, and a penetration larger than
+    ``PENETRATION_WARNING`` of the size of the slave element where it is largest
+    (penalty too small, or a contact edge on the wrong side of a body)."""
+    out: list[str] = []
+    if not result.steps:
+        return out
+    for k, c in enumerate(result.steps[-1].contact):
+        pair = f"contact {c.slave} -> {c.master}"
+        ever = [s.contact[k] for s in result.steps if s.contact[k].active.any()]
+        if not ever:
+            out.append(f"warning: {pair} was never in contact (check the contact edges, "
+                       "the loads and the rigid line's normal)")
+            continue
+        deepest = max(ever, key=lambda cc: float(-cc.gap[cc.active].min()))
+        i = np.flatnonzero(deepest.active)[int(np.argmin(deepest.gap[deepest.active]))]
+        depth = float(-deepest.gap[i])
+        h = slave_element_size(result, deepest, float(deepest.xi_slave[i]))
+        if h > 0 and depth > PENETRATION_WARNING * h:
+            out.append(f"warning: {pair}: the largest penetration {depth:.3g} is "
+                       f"{depth / h:.0%} of the slave element size {h:.3g}: raise "
+                       "penalty_normal, or check that the contact edges face each other")
+    return out
 
 
 def _vec(v: np.ndarray) -> str:
@@ -42,6 +88,7 @@ def summary_lines(result: Result) -> list[str]:
                      f"{-gap.min():.3g} {u.length}, zone x in [{x[:, 0].min():.4g}, "
                      f"{x[:, 0].max():.4g}]")
         lines.append(line)
+    lines += warnings_for(result)
     if result.scene == "hertz" and last.contact:
         from .contact import format_hertz, hertz_comparison
         try:

@@ -86,3 +86,31 @@ def test_bad_input_exits_2(command: str, tmp_path: Path, capsys: pytest.CaptureF
     junk.write_text("not hdf5")
     assert main([command, str(junk)]) == 2
     assert "junk.h5" in capsys.readouterr().err
+
+
+def test_summary_warnings(press_h5: Path, tmp_path: Path) -> None:
+    """A pair never in contact, and a penetration beyond a tenth of the slave element,
+    are named (here made by editing copies of a real result)."""
+    import h5py
+
+    from post.summary import summary_lines, warnings_for
+
+    assert warnings_for(read_result(press_h5)) == []
+    never = tmp_path / "never.h5"
+    never.write_bytes(press_h5.read_bytes())
+    with h5py.File(never, "r+") as f:
+        for key in f["steps"]:
+            f[f"steps/{key}/contact/1/state"][...] = 0
+    (w,) = warnings_for(read_result(never))
+    assert "die -> slab was never in contact" in w
+    deep = tmp_path / "deep.h5"
+    deep.write_bytes(press_h5.read_bytes())
+    with h5py.File(deep, "r+") as f:
+        g = f["steps/000002/contact/1"]
+        k = int(np.flatnonzero(g["state"][()] > 0)[0])
+        gap = g["gap"][()]
+        gap[k] = -0.5  # the die's slave elements are about 1.57 long at m1
+        g["gap"][...] = gap
+    (w,) = warnings_for(read_result(deep))
+    assert "largest penetration 0.5 is 33% of the slave element size 1.53" in w
+    assert w in summary_lines(read_result(deep))
