@@ -2,7 +2,7 @@
 # Every target first installs what is missing (Debian packages through apt-get,
 # Python packages through pip), so a fresh Debian 12 machine needs nothing else.
 
-CASE    ?= cases/ironing/m1-NN2.2.nml
+CASE    ?= cases/hertz/m3-NN2.2.nml
 PYTHON  ?= python3
 PREFIX  := build/install
 VOIGA   := $(PREFIX)/bin/voiga
@@ -31,19 +31,26 @@ deps:
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PKGS) >/dev/null; \
 	fi
-	@if ! $(PYTHON) -c "import numpy, h5py, matplotlib, splipy, f90nml, tqdm, scipy, pytest" 2>/dev/null \
+	@if ! $(PYTHON) -c "import numpy, h5py, matplotlib, splipy, f90nml, tqdm, scipy, vtk, pytest, wheel" 2>/dev/null \
 	   || ! command -v fpm >/dev/null 2>&1; then \
 	  echo "deps: installing Python packages from requirements.txt"; \
 	  $(PYTHON) -m pip install -q -r requirements.txt; \
+	fi
+	@if ! $(PYTHON) -m pip show -q voiga >/dev/null 2>&1; then \
+	  echo "deps: installing the pre and post packages (pip install -e .: voiga-pre, voiga-post)"; \
+	  $(PYTHON) -m pip install -q --no-deps --no-build-isolation -e .; \
 	fi
 
 ## build: release build, installed to build/install/bin/voiga
 build: deps
 	fpm install --profile release --prefix $(PREFIX)
 
-## run: build and run CASE (default: the ironing m1 NN2.2 discretization check)
+## run: build, solve CASE (default: hertz m3 NN2.2, checked against analytic Hertz), print
+## what it found and write its figures and ParaView files into RUN_OUT (the case is
+## copied there; nothing is written next to it)
+RUN_OUT ?= build/run/$(notdir $(patsubst %/,%,$(dir $(abspath $(CASE)))))-$(basename $(notdir $(CASE)))
 run: build
-	$(VOIGA) $(CASE) --check
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post run $(CASE) --out $(RUN_OUT)
 
 ## test: Fortran unit tests (fpm test) and Python tests (pytest)
 test: build test-fortran test-python

@@ -1,14 +1,20 @@
 """Command line: ``python -m post <subcommand>``.
 
 Subcommands:
+  run            solve a case with voiga, print what it found, write figures and ParaView files
+  summary        what a result file says, in a few lines
   plot-deformed  draw every body deformed, coloured by |u| (PNG)
   plot-contact   p_N and p_T along the contact (PNG)
-  hertz          compare a hertz result with the analytic line contact
+  history        reactions and contact forces against the load time (CSV and PNG)
+  vtk            ParaView time series (.pvd + .vtu)
+  hertz          compare a hertz result with the analytic line contact (and draw it)
   sweep          run committed cases in parallel and write a summary (CSV, markdown)
   figures        validation figures and accuracy/cost tables from a sweep's results
 
 Steps (--step): N >= 1 is the step number, N < 0 counts converged steps from
 the end (-1: the last one), 0 is the reference configuration.
+Files are named <result stem>-<what>[-<step>].<ext> and written next to the result
+file, or into --out.
 """
 
 from __future__ import annotations
@@ -17,18 +23,74 @@ import argparse
 import sys
 
 
-def _cmd_plot_deformed(args: argparse.Namespace) -> int:
-    from .plot import plot_deformed
+def _scale(text: str) -> float | str:
+    """``--scale``: a positive number or ``auto``."""
+    if text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is neither a number nor 'auto'") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError("the scale must be positive")
+    return value
+
+
+def _result(args: argparse.Namespace):
     from .reader import read_result
 
-    result = read_result(args.result)
+    return read_result(args.result)
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .run import run_case
+
+    return run_case(args.case, out=args.out, binary=args.binary, quiet=args.quiet,
+                    figures=not args.no_figures, vtk=not args.no_vtk)
+
+
+def _cmd_summary(args: argparse.Namespace) -> int:
+    from .summary import summary_lines
+
+    for line in summary_lines(_result(args)):
+        print(line)
+    return 0
+
+
+def _cmd_history(args: argparse.Namespace) -> int:
+    from .history import plot_history, write_history_csv
+
+    result = _result(args)
+    if not result.steps:
+        print(f"python -m post: {args.result} has no converged step", file=sys.stderr)
+        return 1
+    print(write_history_csv(result, out=args.out))
+    print(plot_history(result, out=args.out))
+    return 0
+
+
+def _cmd_vtk(args: argparse.Namespace) -> int:
+    from .paraview import write_vtk
+
+    print(write_vtk(_result(args), out=args.out, samples=args.samples))
+    return 0
+
+
+def _cmd_plot_deformed(args: argparse.Namespace) -> int:
+    from .naming import output_path
+    from .plot import plot_deformed
+
+    result = _result(args)
     if not result.steps and args.step != 0:
         print(f"python -m post: {args.result} has no converged step (status "
               f"{result.status!r}); use --step 0 for the reference configuration",
               file=sys.stderr)
         return 1
     try:
-        path = plot_deformed(result, step=args.step, output=args.output, scale=args.scale,
+        s = result.select_step(args.step)
+        output = args.output or output_path(result.path, "deformed", 0 if s is None else s.step,
+                                            args.out)
+        path = plot_deformed(result, step=args.step, output=output, scale=args.scale,
                              length_unit=args.unit, reference=args.reference)
     except IndexError as err:
         print(f"python -m post: {err}", file=sys.stderr)
@@ -39,26 +101,28 @@ def _cmd_plot_deformed(args: argparse.Namespace) -> int:
 
 def _cmd_plot_contact(args: argparse.Namespace) -> int:
     from .contact import plot_contact
-    from .reader import read_result
 
-    result = read_result(args.result)
+    result = _result(args)
     if not result.steps or not result.steps[-1].contact:
         print(f"python -m post: {args.result} has no converged step with contact output",
               file=sys.stderr)
         return 1
     index = args.step if args.step < 0 else [s.step for s in result.steps].index(args.step)
-    print(plot_contact(result, step=index, output=args.output, axis=args.axis))
+    print(plot_contact(result, step=index, output=args.output, axis=args.axis, out=args.out))
     return 0
 
 
 def _cmd_hertz(args: argparse.Namespace) -> int:
-    from .contact import hertz_comparison
-    from .reader import read_result
+    from .contact import format_hertz, hertz_comparison, plot_hertz
 
-    h = hertz_comparison(read_result(args.result))
-    print(f"P = {h.force:.6g}  a = {h.a:.6g} (fit {h.a_fit:.6g}, {h.a_error:+.2%})  "
-          f"p0 = {h.p0:.6g} (fit {h.p0_fit:.6g}, {h.p0_error:+.2%}; max {h.p_max:.6g})  "
-          f"L2(p/pmax) = {h.l2_error:.4g}")
+    result = _result(args)
+    if not result.steps or not result.steps[-1].contact:
+        print(f"python -m post: {args.result} has no converged step with contact output",
+              file=sys.stderr)
+        return 1
+    print(format_hertz(hertz_comparison(result)))
+    if not args.no_figure:
+        print(plot_hertz(result, out=args.out))
     return 0
 
 
@@ -107,15 +171,48 @@ def build_parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
+    s = sub.add_parser("run", help="solve a case, print what it found, write its figures")
+    s.add_argument("case", help="case namelist (.nml)")
+    s.add_argument("--out", default=None,
+                   help="folder for the run: the case is copied there (geometry path rewritten) "
+                        "and its result and figures land there (default: the case's own folder)")
+    s.add_argument("--binary", default=None,
+                   help="voiga program (default: $VOIGA_BIN, voiga on the PATH, or build/install)")
+    s.add_argument("--quiet", action="store_true", help="no per-step lines from voiga")
+    s.add_argument("--no-figures", action="store_true", help="only solve and summarize")
+    s.add_argument("--no-vtk", action="store_true", help="no ParaView files")
+    s.set_defaults(func=_cmd_run)
+
+    s = sub.add_parser("summary", help="what a result file says, in a few lines")
+    s.add_argument("result", help="result file (.h5) written by voiga")
+    s.set_defaults(func=_cmd_summary)
+
+    s = sub.add_parser("history", help="reactions and contact forces vs load time (CSV, PNG)")
+    s.add_argument("result", help="result file (.h5) written by voiga")
+    s.add_argument("--out", default=None, help="folder (default: next to the result)")
+    s.set_defaults(func=_cmd_history)
+
+    s = sub.add_parser("vtk", help="ParaView time series (.pvd + .vtu)")
+    s.add_argument("result", help="result file (.h5) written by voiga")
+    s.add_argument("--out", default=None, help="folder (default: next to the result)")
+    s.add_argument("--samples", type=int, default=2,
+                   help="least subdivisions of each element per direction (default 2; at "
+                        "least 48 per body and direction)")
+    s.set_defaults(func=_cmd_vtk)
+
     s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|")
     s.add_argument("result", help="result file (.h5) written by voiga")
     s.add_argument("--step", type=int, default=-1,
                    help="step number (>= 1), -k for the k-th last, 0 = reference (default: -1)")
     s.add_argument("-o", "--output", default=None,
                    help="PNG file (default: <result>-deformed-<step>.png next to the result)")
-    s.add_argument("--scale", type=float, default=1.0,
-                   help="displacement magnification of the drawn shape (colours: true |u|)")
-    s.add_argument("--unit", default="mm", help="length unit for the labels (default: mm)")
+    s.add_argument("--out", default=None, help="folder for the default file name")
+    s.add_argument("--scale", type=_scale, default="auto",
+                   help="displacement magnification of the drawn shape (colours: true |u|); "
+                        "default auto: magnified when the displacements are small, the title "
+                        "says by how much")
+    s.add_argument("--unit", default=None,
+                   help="length unit for the labels (default: the result file's units)")
     s.add_argument("--reference", action="store_true", help="also draw the undeformed outlines")
     s.set_defaults(func=_cmd_plot_deformed)
 
@@ -124,6 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--step", type=int, default=-1, help="step number (>= 1) or -k (default: -1)")
     s.add_argument("--axis", type=int, default=0, help="0: plot against x, 1: against y")
     s.add_argument("-o", "--output", default=None, help="PNG file")
+    s.add_argument("--out", default=None, help="folder for the default file name")
     s.set_defaults(func=_cmd_plot_contact)
 
     s = sub.add_parser("sweep", help="run committed cases in parallel, summarize")
@@ -147,14 +245,30 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("hertz", help="hertz result against the analytic line contact")
     s.add_argument("result", help="result file (.h5) of a hertz case")
+    s.add_argument("--out", default=None, help="folder for the figure (default: next to the result)")
+    s.add_argument("--no-figure", action="store_true", help="only print the comparison")
     s.set_defaults(func=_cmd_hertz)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point."""
+    """Entry point. Bad input (a missing or unreadable file, a case the tools cannot
+    use) gives one line on stderr naming the cause and exit code 2."""
+    from .solver import InputError
+
     args = build_parser().parse_args(argv)
-    return int(args.func(args))
+    try:
+        return int(args.func(args))
+    except (InputError, FileNotFoundError) as err:
+        print(f"python -m post {args.command}: {err}", file=sys.stderr)
+        return 2
+    except OSError as err:  # h5py: not an HDF5 file, truncated, ...
+        print(f"python -m post {args.command}: {getattr(args, 'result', '')}: {err}",
+              file=sys.stderr)
+        return 2
+    except (KeyError, ValueError) as err:
+        print(f"python -m post {args.command}: {err}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ import numpy as np
 
 from pre.nurbs import Curve, curve_to_splipy
 
+from .naming import output_path
 from .reader import Body, ContactOutput, Result
 
 
@@ -153,8 +154,9 @@ def contact_profile(c: ContactOutput, axis: int = 0,
 
 
 def plot_contact(result: Result, step: int = -1, output: str | Path | None = None,
-                 axis: int = 0, unit: str = "mm") -> Path:
-    """p_N and p_T of every contact pair along the contact (current ``axis`` coordinate)."""
+                 axis: int = 0, out: str | Path | None = None) -> Path:
+    """p_N and p_T of every contact pair along the contact (current ``axis`` coordinate);
+    default file ``<result>-contact-<step>.png`` next to the result or in ``out``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -173,12 +175,63 @@ def plot_contact(result: Result, step: int = -1, output: str | Path | None = Non
         lo, hi = active.min(), active.max()
         pad = 0.25 * max(hi - lo, 1e-12)
         ax.set_xlim(lo - pad, hi + pad)
-    ax.set_xlabel(f"{'xy'[axis]} (current) [{unit}]")
-    ax.set_ylabel("contact traction [force/length]")
+    units = result.units
+    ax.set_xlabel(f"{'xy'[axis]} (current) [{units.length}]")
+    ax.set_ylabel(f"contact traction [{units.pressure}]")
     ax.set_title(f"{result.title}: step {st.step} (load time {st.time:g})")
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.legend()
-    out = Path(output) if output else result.path.with_name(f"{result.path.stem}-contact-{st.step}.png")
-    fig.savefig(out, dpi=150)
+    path = Path(output) if output else output_path(result.path, "contact", st.step, out)
+    fig.savefig(path, dpi=150)
     plt.close(fig)
-    return out
+    return path
+
+
+def format_hertz(h: HertzComparison) -> str:
+    """The one-line summary ``python -m post hertz`` prints."""
+    return (f"P = {h.force:.6g}  a = {h.a:.6g} (fit {h.a_fit:.6g}, {h.a_error:+.2%})  "
+            f"p0 = {h.p0:.6g} (fit {h.p0_fit:.6g}, {h.p0_error:+.2%}; max {h.p_max:.6g})  "
+            f"L2(p/pmax) = {h.l2_error:.4g}")
+
+
+def plot_hertz(result: Result, step: int = -1, output: str | Path | None = None,
+               out: str | Path | None = None, radius: float = 1.0) -> Path:
+    """The hertz scene's contact pressure against the analytic Hertz line contact:
+    the pressure at the slave points, the continuous penalty pressure along the slave
+    edge, the analytic ``p0 sqrt(1 - x^2/a^2)`` for the simulated force, and the fit
+    :func:`hertz_comparison` reports; default file ``<result>-hertz-<step>.png``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    st = result.steps[step]
+    h = hertz_comparison(result, step, radius=radius)
+    c = st.contact[0]
+    units = result.units
+    fig, ax = plt.subplots(figsize=(7.5, 4.5), layout="constrained")
+    s = np.linspace(0.0, 1.0, 400)
+    ax.plot(h.a * s, h.p0 * np.sqrt(1.0 - s**2), "k-", lw=1.6,
+            label=f"analytic Hertz: a = {h.a:.4g}, p0 = {h.p0:.4g}")
+    ax.plot(h.a_fit * s, h.p0_fit * np.sqrt(1.0 - s**2), ":", color="tab:green", lw=1.4,
+            label=f"fit: a {h.a_error:+.2%}, p0 {h.p0_error:+.2%}")
+    if c.rigid_point is not None:
+        xf, pf = pressure_field(result, step)
+        order = np.argsort(xf[:, 0])
+        ax.plot(xf[order, 0], pf[order], "-", color="tab:blue", lw=0.9, alpha=0.8,
+                label="penalty pressure along the slave edge")
+    x, pn, _ = contact_profile(c)
+    ax.plot(x, pn, "o", ms=3.5, mfc="white", color="tab:red",
+            label=f"slave points ({int(np.count_nonzero(c.active))} in contact)")
+    ax.set_xlim(0.0, 1.5 * max(h.a, h.a_fit))
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlabel(f"x (current) [{units.length}]")
+    ax.set_ylabel(f"contact pressure p_N [{units.pressure}]")
+    ax.set_title(f"{result.title}: step {st.step}, P = {h.force:.4g} {units.line_force}, "
+                 f"L2(p/pmax) = {h.l2_error:.3g}", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    path = Path(output) if output else output_path(result.path, "hertz", st.step, out)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path

@@ -4,7 +4,10 @@ Every body is drawn in its current configuration ``X + scale * u`` (exact
 VO map of :mod:`post.field`, sampled on a parametric grid that contains every
 element boundary), coloured by the displacement magnitude ``|u|`` with
 Gouraud shading, with the deformed element boundaries as thin lines and one
-colorbar shared by all bodies.
+colorbar shared by all bodies. The scale is chosen automatically when the
+displacements are small (:func:`auto_scale`; the title says the factor), rigid
+master lines are drawn, and when bodies are in contact a second panel shows the
+contact zone at true scale.
 """
 
 from __future__ import annotations
@@ -21,13 +24,20 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 
 from .field import displacement, evaluate_grid  # noqa: E402
-from .reader import Body, Result, body_displacement, read_result  # noqa: E402
+from .naming import output_path  # noqa: E402
+from .reader import Body, ContactOutput, Result, Step, body_displacement, read_result  # noqa: E402
 
 CMAP = "turbo"
 """Colour map of the contour plots (FE-style rainbow, perceptually ordered)."""
 
 MIN_SAMPLES = 120
 """At least this many samples along each parametric direction of a body."""
+
+VISIBLE = 0.02
+"""Displacements below this fraction of the scene's size are magnified (auto scale)."""
+
+TARGET = 0.1
+"""The auto scale magnifies the largest displacement to about this fraction of the size."""
 
 
 def breakpoints(body: Body) -> tuple[np.ndarray, np.ndarray]:
@@ -45,15 +55,21 @@ def sample_parameters(breaks: np.ndarray, minimum: int = MIN_SAMPLES) -> np.ndar
     return np.concatenate(parts + [breaks[-1:]])
 
 
+def sampled_field(body: Body, u_body: np.ndarray,
+                  minimum: int = MIN_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
+    """``(X (n_eta, n_xi, 2), u (n_eta, n_xi, 2))``: reference points and the
+    displacement field on the sampling grid (every element boundary included)."""
+    bx, be = breakpoints(body)
+    xi, eta = sample_parameters(bx, minimum), sample_parameters(be, minimum)
+    xx, ee = np.meshgrid(xi, eta)
+    return evaluate_grid(body, None, xi, eta), displacement(body, u_body, xx, ee)
+
+
 def deformed_grid(body: Body, u_body: np.ndarray, scale: float = 1.0,
                   minimum: int = MIN_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
     """``(points (n_eta, n_xi, 2), |u| (n_eta, n_xi))`` on the sampling grid:
     points are ``X + scale * u``, the magnitude is of the true ``u``."""
-    bx, be = breakpoints(body)
-    xi, eta = sample_parameters(bx, minimum), sample_parameters(be, minimum)
-    xx, ee = np.meshgrid(xi, eta)
-    ref = evaluate_grid(body, None, xi, eta)
-    u = displacement(body, u_body, xx, ee)
+    ref, u = sampled_field(body, u_body, minimum)
     return ref + scale * u, np.linalg.norm(u, axis=-1)
 
 
@@ -69,6 +85,50 @@ def element_edges(body: Body, u_body: np.ndarray, scale: float = 1.0,
     return lines
 
 
+def auto_scale(size: float, u_max: float, visible: float = VISIBLE, target: float = TARGET) -> float:
+    """Displacement magnification for a scene of extent ``size`` whose largest
+    displacement is ``u_max``: 1 when ``u_max >= visible * size`` (or no
+    displacement), else the largest of 1, 2, 5 x 10^k that keeps
+    ``scale * u_max <= target * size``."""
+    if u_max <= 0.0 or size <= 0.0 or u_max >= visible * size:
+        return 1.0
+    raw = target * size / u_max
+    k = np.floor(np.log10(raw))
+    mant = max(m for m in (1.0, 2.0, 5.0) if m * 10**k <= raw * (1 + 1e-12))
+    return float(max(1.0, mant * 10**k))
+
+
+def rigid_lines(step: Step | None) -> list[tuple[np.ndarray, np.ndarray, str]]:
+    """``(point, unit outward normal, label)`` of every rigid master line of a step
+    (from the result file's contact output; none at the reference configuration)."""
+    if step is None:
+        return []
+    out = []
+    for c in step.contact:
+        if c.rigid_point is not None and c.rigid_normal is not None:
+            n = np.asarray(c.rigid_normal, dtype=float)
+            out.append((np.asarray(c.rigid_point, dtype=float), n / np.linalg.norm(n),
+                        f"rigid master of {c.slave}"))
+    return out
+
+
+def draw_rigid_line(ax: plt.Axes, point: np.ndarray, normal: np.ndarray, depth: float,
+                    reach: float, label: str | None = None, style: str = "-") -> None:
+    """A rigid line (through ``point``, outward ``normal``) as a thick line with a
+    hatched band of ``depth`` on its solid side, ``reach`` long either way."""
+    t = np.array([-normal[1], normal[0]])
+    a, b = point - reach * t, point + reach * t
+    band = np.array([a, b, b - depth * normal, a - depth * normal])
+    ax.fill(band[:, 0], band[:, 1], facecolor="0.85", edgecolor="0.35", hatch="///", lw=0.0,
+            zorder=0.5)
+    ax.plot([a[0], b[0]], [a[1], b[1]], style, color="0.15", lw=1.6, label=label, zorder=3)
+
+
+def contact_points(step: Step | None) -> list[ContactOutput]:
+    """The contact pairs of a step that have points in contact."""
+    return [] if step is None else [c for c in step.contact if np.any(c.active)]
+
+
 def _title(result: Result, step: int, time: float | None, scale: float) -> str:
     title = result.title or result.path.name
     where = "reference configuration" if time is None else \
@@ -82,47 +142,19 @@ def _title(result: Result, step: int, time: float | None, scale: float) -> str:
     return text
 
 
-def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Path | None = None,
-                  scale: float = 1.0, length_unit: str = "mm", reference: bool = False,
-                  minimum: int = MIN_SAMPLES) -> Path:
-    """Draw every body of ``result`` deformed at ``step`` (selection as in
-    :meth:`post.reader.Result.select_step`) and write a PNG.
-
-    ``output`` defaults to ``<result>-deformed-<step>.png`` next to the
-    result file. ``reference=True`` adds the undeformed outlines (dashed).
-    Returns the path written.
-    """
-    if not isinstance(result, Result):
-        result = read_result(result)
-    if not result.bodies:
-        raise ValueError(f"{result.path}: no bodies")
-    s = result.select_step(step)
-    number = 0 if s is None else s.step
-    if output is None:
-        output = result.path.with_name(f"{result.path.stem}-deformed-{number:06d}.png")
-    output = Path(output)
-
-    grids = {}
-    for name, body in result.bodies.items():
-        u = body_displacement(result, name, number if s is not None else 0)
-        grids[name] = (body, u, *deformed_grid(body, u, scale, minimum))
-    vmax = max(float(g[3].max()) for g in grids.values())
-    norm = Normalize(vmin=0.0, vmax=vmax if vmax > 0 else 1.0)
-
-    allpts = np.concatenate([g[2].reshape(-1, 2) for g in grids.values()])
-    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
-    span = np.maximum(hi - lo, 1e-12)
-    width = 10.0
-    height = float(np.clip(width * 0.85 * span[1] / span[0] + 1.4, 3.5, 11.0))
-    fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
+def _draw_bodies(ax: plt.Axes, grids: dict, norm: Normalize, scale: float, reference: bool,
+                 minimum: int, names: bool = True):
+    """Every body on ``ax``: the coloured sampling grid, element edges, outline."""
     mesh = None
-    for name, (body, u, pts, mag) in grids.items():
+    for name, (body, u, ref_pts, u_pts) in grids.items():
+        pts = ref_pts + scale * u_pts
+        mag = np.linalg.norm(u_pts, axis=-1)
         mesh = ax.pcolormesh(pts[..., 0], pts[..., 1], mag, shading="gouraud", cmap=CMAP,
                              norm=norm, rasterized=True)
         mesh.sticky_edges.x[:] = []  # let the margins show the outline
         mesh.sticky_edges.y[:] = []
-        lines = element_edges(body, u, scale)
-        ax.add_collection(LineCollection(lines, colors="k", linewidths=0.35, alpha=0.7))
+        ax.add_collection(LineCollection(element_edges(body, u, scale), colors="k",
+                                         linewidths=0.35, alpha=0.7))
         outline = [pts[0], pts[-1], pts[:, 0], pts[:, -1]]
         ax.add_collection(LineCollection(outline, colors="k", linewidths=0.9))
         if reference:
@@ -130,17 +162,100 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
                                 sample_parameters(np.array([0.0, 1.0]), minimum))
             ax.add_collection(LineCollection([ref[0], ref[-1], ref[:, 0], ref[:, -1]],
                                              colors="0.45", linewidths=0.8, linestyles="--"))
-        centre = pts[pts.shape[0] // 2, pts.shape[1] // 2]
-        ax.annotate(name, centre, ha="center", va="center", fontsize=9,
-                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.5", alpha=0.8))
+        if names:
+            centre = pts[pts.shape[0] // 2, pts.shape[1] // 2]
+            ax.annotate(name, centre, ha="center", va="center", fontsize=9,
+                        bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.5", alpha=0.8))
+    return mesh
+
+
+def _zoom_window(pairs: list[ContactOutput], size: float) -> tuple[np.ndarray, np.ndarray]:
+    """Centre and half-extents of a window around the points in contact."""
+    pts = np.concatenate([c.x[c.active] for c in pairs])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    half = max(0.5 * float(np.max(hi - lo)) * 1.6, 0.02 * size)
+    return 0.5 * (lo + hi), np.array([half, 0.6 * half])
+
+
+def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Path | None = None,
+                  scale: float | str = "auto", length_unit: str | None = None,
+                  reference: bool = False, minimum: int = MIN_SAMPLES,
+                  zoom: bool = True) -> Path:
+    """Draw every body of ``result`` deformed at ``step`` (selection as in
+    :meth:`post.reader.Result.select_step`) and write a PNG.
+
+    ``scale``: displacement magnification, or ``'auto'`` (:func:`auto_scale`).
+    ``length_unit``: axis unit (default: the file's, :attr:`Result.units`).
+    ``output`` defaults to ``<result>-deformed-<step>.png`` next to the result
+    file. ``reference=True`` adds the undeformed outlines (dashed). ``zoom``: when
+    bodies are in contact, a second panel shows the contact zone at true scale.
+    Rigid master lines are drawn in both panels. Returns the path written.
+    """
+    if not isinstance(result, Result):
+        result = read_result(result)
+    if not result.bodies:
+        raise ValueError(f"{result.path}: no bodies")
+    s = result.select_step(step)
+    number = 0 if s is None else s.step
+    output = Path(output) if output is not None else output_path(result.path, "deformed", number)
+    unit = length_unit or result.units.length
+
+    grids = {}
+    for name, body in result.bodies.items():
+        u = body_displacement(result, name, number if s is not None else 0)
+        grids[name] = (body, u, *sampled_field(body, u, minimum))
+    vmax = max(float(np.linalg.norm(g[3], axis=-1).max()) for g in grids.values())
+    norm = Normalize(vmin=0.0, vmax=vmax if vmax > 0 else 1.0)
+    allpts = np.concatenate([(g[2] + g[3]).reshape(-1, 2) for g in grids.values()])
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    size = float(np.max(hi - lo))
+    if scale == "auto":
+        scale = auto_scale(size, vmax)
+    scale = float(scale)
+
+    pairs = contact_points(s) if zoom else []
+    span = np.maximum(hi - lo, 1e-12)
+    width = 10.0
+    height = float(np.clip(width * 0.85 * span[1] / span[0] + 1.4, 3.5, 11.0))
+    if pairs:
+        fig, (ax, axz) = plt.subplots(1, 2, figsize=(width * 1.45, max(height, 4.5)),
+                                      layout="constrained", width_ratios=[2.0, 1.0])
+    else:
+        fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
+        axz = None
+    mesh = _draw_bodies(ax, grids, norm, scale, reference, minimum)
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.03)
-    ax.set_xlabel(f"x [{length_unit}]")
-    ax.set_ylabel(f"y [{length_unit}]")
+    lines = rigid_lines(s)
+    if lines:
+        xl, yl = ax.get_xlim(), ax.get_ylim()
+        for p, n, label in lines:
+            note = label if scale == 1.0 else f"{label} (true position; bodies x {scale:g})"
+            draw_rigid_line(ax, p, n, 0.04 * size, 3.0 * size, note, "-" if scale == 1.0 else "--")
+        ax.set_xlim(min(xl[0], *(p[0] - 0.05 * size for p, _, _ in lines)),
+                    max(xl[1], *(p[0] + 0.05 * size for p, _, _ in lines)))
+        ax.set_ylim(min(yl[0], *(p[1] - 0.06 * size for p, _, _ in lines)), yl[1])
+        ax.legend(loc="upper right", fontsize=8)
+    ax.set_xlabel(f"x [{unit}]")
+    ax.set_ylabel(f"y [{unit}]")
     ax.set_title(_title(result, number, None if s is None else s.time, scale), fontsize=10)
-    cbar = fig.colorbar(mesh, ax=ax, shrink=0.9, pad=0.02)
-    cbar.set_label(f"displacement magnitude |u| [{length_unit}]")
+    if axz is not None:
+        _draw_bodies(axz, grids, norm, 1.0, False, minimum, names=False)
+        centre, half = _zoom_window(pairs, size)
+        for p, n, _ in lines:
+            draw_rigid_line(axz, p, n, 0.15 * half[1], 3.0 * size)
+        for c in pairs:
+            axz.plot(c.x[c.active, 0], c.x[c.active, 1], "o", ms=3.5, mfc="white", mec="crimson",
+                     mew=0.6, label=f"{c.slave}: points in contact")
+        axz.set_xlim(centre[0] - half[0], centre[0] + half[0])
+        axz.set_ylim(centre[1] - half[1], centre[1] + half[1])
+        axz.set_aspect("equal", adjustable="box")
+        axz.set_xlabel(f"x [{unit}]")
+        axz.set_title("contact zone, true scale", fontsize=10)
+        axz.legend(loc="upper right", fontsize=8)
+    cbar = fig.colorbar(mesh, ax=[ax] if axz is None else [ax, axz], shrink=0.9, pad=0.02)
+    cbar.set_label(f"displacement magnitude |u| [{unit}]")
     output.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(output, dpi=150)
     plt.close(fig)

@@ -37,6 +37,8 @@ import numpy as np
 from pre.h5io import read_curve, read_patch
 from pre.nurbs import Curve, Patch
 
+from .units import Units
+
 STAGES: tuple[str, ...] = ("assembly", "contact", "factorization", "solve", "output")
 """Stages whose wall-clock seconds each step records (attrs ``seconds_<stage>``)."""
 
@@ -160,7 +162,7 @@ class ContactOutput:
 
 
 _LAZY_FIELDS: tuple[str, ...] = ("time", "substeps", "residual_norms", "energy_norms",
-                                  "displacement", "contact")
+                                  "displacement", "contact", "fields")
 """The fields of a :class:`Step` that ``read_result(..., lazy=True)`` reads on first use."""
 
 
@@ -183,6 +185,8 @@ class Step:
     """stage (``STAGES``) -> wall-clock seconds."""
     cuts: int = 0
     """Times the step was cut (halved) before it converged."""
+    iterations_total: int | None = None
+    """Newton iterations of all substeps and failed attempts (None in older files)."""
     _data: dict[str, Any] = field(default_factory=dict, repr=False)
     """The lazy fields read so far."""
     _source: tuple[Path, str, int] | None = field(default=None, repr=False)
@@ -229,6 +233,13 @@ class Step:
     def contact(self) -> list[ContactOutput]:
         """One entry per contact pair, in case-file order."""
         return self._get("contact")
+
+    @property
+    def fields(self) -> dict[str, dict[str, np.ndarray]]:
+        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,)
+        and e.g. ``stress`` (n, k)), from ``/steps/<k>/fields/<body>``; empty when the
+        file has none (voiga does not write them yet; docs/hdf5.md)."""
+        return self._get("fields")
 
 
 @dataclass(eq=False)
@@ -292,6 +303,12 @@ class Result:
     @property
     def wall_time(self) -> float:
         return float(self._attr("wall_time", 0.0))
+
+    @property
+    def units(self) -> Units:
+        """The length and force units the root attribute ``units`` names (generic
+        ``length`` / ``force`` when it names none; :mod:`post.units`)."""
+        return Units.parse(str(self._attr("units")))
 
     @property
     def converged(self) -> bool:
@@ -384,7 +401,8 @@ def _read_body(name: str, g: h5py.Group) -> Body:
                 layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs)
 
 
-_STEP_SCALARS: tuple[str, ...] = ("iterations", "cuts") + tuple(f"seconds_{k}" for k in STAGES)
+_STEP_SCALARS: tuple[str, ...] = ("iterations", "iterations_total", "cuts") + \
+    tuple(f"seconds_{k}" for k in STAGES)
 """The step attributes every read needs (the sweep summary's)."""
 
 _INT_ATTRS = frozenset({"step", "iterations", "iterations_total", "cuts", "substeps"})
@@ -440,7 +458,9 @@ def _read_step(name: str, gid: h5py.h5g.GroupID, n_dirichlet: int, path: Path, n
     step = Step(step=int(name), iterations=int(a.get("iterations", 0)), reactions=reactions,
                 seconds={k[len("seconds_"):]: float(v) for k, v in a.items()
                          if k.startswith("seconds_")},
-                cuts=int(a.get("cuts", 0)), _source=(path, name, n_dofs))
+                cuts=int(a.get("cuts", 0)),
+                iterations_total=int(a["iterations_total"]) if "iterations_total" in a else None,
+                _source=(path, name, n_dofs))
     if not lazy:
         step._data = _read_step_details(h5py.Group(gid), name)
     return step
@@ -459,7 +479,10 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
             "residual_norms": vec("residual_norms"), "energy_norms": vec("energy_norms"),
             "displacement": vec("displacement"),
             "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
-            if gid.links.exists(b"contact") else []}
+            if gid.links.exists(b"contact") else [],
+            "fields": {body: {k: np.asarray(v[()], dtype=float) for k, v in fg.items()}
+                       for body, fg in g["fields"].items()}
+            if gid.links.exists(b"fields") else {}}
 
 
 def _read_contact(g: h5py.Group) -> ContactOutput:

@@ -1,6 +1,7 @@
 """Command line: ``python -m pre <subcommand>``.
 
 Subcommands:
+  geometry     a geometry spec (TOML) -> geometry file and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   refine       refine a case with splipy and write the discretization dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -13,7 +14,17 @@ import argparse
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
+def _cmd_geometry(args: argparse.Namespace) -> int:
+    from .spec import SpecError, write_from_spec
+
+    try:
+        geometry, case, written = write_from_spec(args.spec, args.out, args.force)
+    except (SpecError, FileNotFoundError, OSError) as err:
+        print(f"python -m pre geometry: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}")
+    print(f"wrote {case}" if written else f"kept {case} (exists; --force to overwrite)")
+    return 0
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
@@ -57,8 +68,16 @@ def build_parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
+    s = sub.add_parser("geometry", help="geometry spec (TOML) -> geometry file and case file")
+    s.add_argument("spec", help="spec file (.toml; docs/pre.md)")
+    s.add_argument("--out", default=None, help="output folder (default: the spec's folder)")
+    s.add_argument("--force", action="store_true", help="overwrite an existing case file")
+    s.set_defaults(func=_cmd_geometry)
+
     s = sub.add_parser("cases", help="write geometry files and case namelists")
-    s.add_argument("--out", default=str(REPO / "cases"), help="output folder (default: repo cases/)")
+    s.add_argument("--out", default="cases",
+                   help="output folder (default: cases, relative to the current directory: run "
+                        "it from the repository root to refresh the committed cases)")
     s.set_defaults(func=_cmd_cases)
 
     s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
@@ -73,7 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_plot_layout)
 
     s = sub.add_parser("figures", help="write the docs figures")
-    s.add_argument("--out", default=str(REPO / "docs" / "figures"), help="output folder")
+    s.add_argument("--out", default=str(Path("docs") / "figures"),
+                   help="output folder (default: docs/figures, relative to the current directory)")
     s.set_defaults(func=_cmd_figures)
     return p
 

@@ -109,7 +109,7 @@ def _body_group(scene: str, name: str, layout: str, *,
 
 
 # ------------------------------------------------------------ loads and contact
-# Values marked (c) in ../shared/paper/BENCHMARKS.md are ours; docs/validation.md
+# Values marked (c) in docs/benchmarks.md are ours; docs/validation.md
 # keeps the reasons.
 IRONING_PRESS = {"ironing": 0.5, "ironing-deep": 1.4}
 """Press depth of the die (c)."""

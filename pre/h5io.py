@@ -84,12 +84,13 @@ def read_curve(group: h5py.Group) -> Curve:
                  weights=group["weights"][()])
 
 
-def write_geometry(path: str | Path, scene: str, bodies: dict[str, Patch]) -> None:
+def write_geometry(path: str | Path, scene: str, bodies: dict[str, Patch], units: str = UNITS,
+                   generator: str = GENERATOR) -> None:
     """Write the coarse geometry file of a scene."""
     with h5py.File(path, "w") as f:
         f.attrs["scene"] = _str(scene)
-        f.attrs["units"] = _str(UNITS)
-        f.attrs["generator"] = _str(GENERATOR)
+        f.attrs["units"] = _str(units)
+        f.attrs["generator"] = _str(generator)
         g = f.create_group("bodies", track_order=True)
         for name, patch in bodies.items():
             write_patch(g.create_group(name), patch)

@@ -1,6 +1,6 @@
 """Layout names (``N2``, ``NN4``, ``NN2.2``, ``L1``) -> &body settings.
 
-See BENCHMARKS.md section 1 and the layout table of docs/formats.md. Bulk
+See docs/benchmarks.md section 1 and the layout table of docs/formats.md. Bulk
 degree 2 is the lowest degree that is exact for our scenes.
 """
 

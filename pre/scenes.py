@@ -6,7 +6,7 @@ Arcs are exact rational quadratic quarter arcs (middle weight ``sqrt(1/2)``);
 the radial direction of annular bodies is degree 1, so ``eta`` is the radius
 fraction ``(r - r_in) / (r_out - r_in)``.
 
-Values (``docs/pre.md`` and ``/work/shared/paper/BENCHMARKS.md`` section 3):
+Values (``docs/pre.md`` and ``docs/benchmarks.md`` section 3):
 
 * ironing: die = lower half annulus, R_out 3, R_in 2, centre (2.5, 3) so the
   lowest outer point is (2.5, 0); slab = [0, 9] x [-3, 0].

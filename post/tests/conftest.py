@@ -215,3 +215,54 @@ def synthetic_bodies() -> dict[str, Body]:
         for name, b in discretize_case(path).bodies.items():
             out[f"{case}:{name}"] = synthetic_body(name, b)
     return out
+
+
+# The ironing die pressed 0.3 into the slab and slid 0.3 (2 + 2 steps, m1 N2, friction):
+# contact with a NURBS master whose points slip in the last step.
+PRESS_SLIDE = """&case
+  title = 'die press and slide', scene = 'ironing', geometry = 'geometry.h5',
+  output = 'press.h5', n_bodies = 2
+/
+&body
+  name = 'die', material = 'neo-hookean', youngs_modulus = 10.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 6, nel_eta = 1, contact_edge = 'outer',
+  layer_degree = 0
+/
+&body
+  name = 'slab', material = 'neo-hookean', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 8, nel_eta = 2, contact_edge = 'top',
+  layer_degree = 2, layer_elevations = 2
+/
+&solver
+  n_steps = 2, 2
+/
+&dirichlet
+  body = 'die', edge = 'inner', fix_x = .true., fix_y = .true., ux = 0.0, 0.3, uy = -0.3, -0.3
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_x = .true., fix_y = .true.
+/
+&contact
+  slave = 'die', master = 'slab', penalty_normal = 100.0, penalty_tangent = 100.0,
+  friction = 0.3, n_gauss = 6
+/
+"""
+
+
+@pytest.fixture(scope="session")
+def press_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Die pressed and slid on the slab (NURBS master, friction; 4 steps)."""
+    return run_case(voiga, tmp_path_factory.mktemp("press"), PRESS_SLIDE, "press.h5")
+
+
+@pytest.fixture(scope="session")
+def hertz_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The committed hertz m1 NN2.2 case (rigid master line), run in a temporary folder."""
+    folder = tmp_path_factory.mktemp("hertz")
+    shutil.copy(CASES / "hertz" / "geometry.h5", folder / "geometry.h5")
+    shutil.copy(CASES / "hertz" / "m1-NN2.2.nml", folder / "case.nml")
+    run = subprocess.run([str(voiga), "case.nml", "--quiet"], cwd=folder, capture_output=True,
+                         text=True, timeout=TIMEOUT, stdin=subprocess.DEVNULL)
+    if run.returncode != 0:
+        pytest.fail(f"hertz m1 NN2.2: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}")
+    return folder / "m1-NN2.2.h5"

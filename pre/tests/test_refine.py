@@ -1,4 +1,4 @@
-"""splipy refinement: the DOF tables of BENCHMARKS.md, geometry invariance,
+"""splipy refinement: the DOF tables of docs/benchmarks.md, geometry invariance,
 knot structure, orientation and the dump schema."""
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def test_table2_ironing_m1(generated: Path, layout: str) -> None:
 
 
 def test_table2_n4_die_topology(generated: Path) -> None:
-    """BENCHMARKS.md: the N4 die is 13 x 3 control points."""
+    """docs/benchmarks.md: the N4 die is 13 x 3 control points."""
     die = discretize_case(generated / "ironing/m1-N4.nml").bodies["die"]
     assert die.bulk.shape == (3, 13) and die.bulk.degree == (4, 2)
 

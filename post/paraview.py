@@ -1,0 +1,278 @@
+"""ParaView export of a result (``python -m post vtk``): a ``.pvd`` time series of
+``.vtu`` files written with VTK's own XML writer (the ``vtk`` package from PyPI).
+
+Why VTK rather than meshio: it is Kitware's library, the one ParaView itself is built
+on, so the files are written (and, in the tests, read back) by the same code ParaView
+uses; it keeps string arrays as field data (units, provenance), which meshio's VTU
+writer does not; and it is actively released. The cost is a larger wheel.
+
+Per converged step (plus the reference configuration at load time 0) the series has
+up to three parts (``<DataSet part=...>`` in the ``.pvd``; ParaView shows them as
+blocks):
+
+- ``bodies``: every body finely sampled: each element split into at least
+  ``samples x samples`` bilinear quads (more on coarse meshes: at least
+  ``MIN_SAMPLES`` along each direction of a body) whose corners are the exact VO map at reference
+  coordinates; point data ``displacement`` (3 components, z = 0: use *Warp By
+  Vector* for the deformed shape); cell data ``body`` (index into the field data
+  ``body_names``) and ``element`` (0-based element of that body). Linear
+  interpolation between the samples is the only approximation.
+- ``contact``: the slave points of every contact pair at their reference
+  positions, one polyline per pair in slave-parameter order; point data
+  ``displacement`` (current minus reference position), ``p_n``, ``p_t``, ``gap``
+  (NaN where the point has no projection), ``state`` (0 open, 1 stick, 2 slip),
+  ``traction`` (the vector ``p_n n + p_t t`` on the slave, with the master's outward
+  normal ``n`` and tangent ``t``), ``pair`` (0-based, case-file order).
+- ``fields``: stress, strain and von Mises when the result file carries them
+  (``/steps/<k>/fields/<body>``; not written by voiga yet, see docs/hdf5.md): one
+  vertex per sample point at its reference position, with ``displacement`` and
+  every field of the file.
+
+Field data of every file: ``units``, ``title``, ``case_file``, ``voiga_version``,
+``status``, ``source`` (the result file), ``writer``, ``step``, ``time``.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+from .field import combine, displacement, evaluate
+from .naming import output_path
+from .plot import breakpoints
+from .reader import Body, ContactOutput, Result, Step, body_displacement
+
+SAMPLES = 2
+"""Default least subdivisions of every element in each parametric direction."""
+
+MIN_SAMPLES = 48
+"""Least subdivisions of a body in each parametric direction (coarse meshes)."""
+
+
+def element_samples(breaks: np.ndarray, samples: int, minimum: int = MIN_SAMPLES) -> np.ndarray:
+    """Parameters splitting every span of ``breaks`` into the same number of equal
+    parts: ``samples``, or more when needed for ``minimum`` in all."""
+    spans = max(len(breaks) - 1, 1)
+    n = max(samples, -(-minimum // spans))
+    parts = [np.linspace(a, b, n + 1)[:-1] for a, b in zip(breaks[:-1], breaks[1:])]
+    return np.concatenate(parts + [breaks[-1:]])
+
+
+def _string_array(name: str, values: list[str]) -> vtk.vtkStringArray:
+    arr = vtk.vtkStringArray()
+    arr.SetName(name)
+    for v in values:
+        arr.InsertNextValue(v)
+    return arr
+
+
+def _array(name: str, values: np.ndarray) -> vtk.vtkDataArray:
+    values = np.ascontiguousarray(values)
+    if values.dtype.kind in "iub":
+        arr = numpy_to_vtk(values.astype(np.int32), deep=True, array_type=vtk.VTK_INT)
+    else:
+        arr = numpy_to_vtk(values.astype(np.float64), deep=True, array_type=vtk.VTK_DOUBLE)
+    arr.SetName(name)
+    return arr
+
+
+def _vec3(v: np.ndarray) -> np.ndarray:
+    v = np.asarray(v, dtype=float).reshape(-1, 2)
+    return np.column_stack([v, np.zeros(len(v))])
+
+
+def _grid(points: np.ndarray, cells: list[np.ndarray], cell_type: int) -> vtk.vtkUnstructuredGrid:
+    """An unstructured grid of ``points (n, 2)`` and cells of one type."""
+    grid = vtk.vtkUnstructuredGrid()
+    pts = vtk.vtkPoints()
+    pts.SetData(numpy_to_vtk(_vec3(points), deep=True))
+    grid.SetPoints(pts)
+    conn = np.concatenate(cells) if cells else np.zeros(0, dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum([len(c) for c in cells])]).astype(np.int64)
+    ca = vtk.vtkCellArray()
+    ca.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True),
+               numpy_to_vtkIdTypeArray(conn.astype(np.int64), deep=True))
+    grid.SetCells(cell_type, ca)
+    return grid
+
+
+def _field_data(grid: vtk.vtkDataSet, result: Result, step: Step | None) -> None:
+    fd = grid.GetFieldData()
+    a = result.attrs
+    for key in ("units", "title", "case_file", "voiga_version", "status"):
+        fd.AddArray(_string_array(key, [str(a.get(key, ""))]))
+    fd.AddArray(_string_array("source", [str(result.path.resolve())]))
+    fd.AddArray(_string_array("writer", [f"voiga post vtk (VTK {vtk.vtkVersion.GetVTKVersion()})"]))
+    fd.AddArray(_array("step", np.array([0 if step is None else step.step])))
+    fd.AddArray(_array("time", np.array([0.0 if step is None else step.time])))
+    fd.AddArray(_string_array("body_names", list(result.bodies)))
+
+
+def body_samples(body: Body, samples: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sampling of one body: ``(xi grid, eta grid)`` (n_eta, n_xi) and the 0-based
+    element of every quad ``(n_eta - 1, n_xi - 1)``."""
+    bx, be = breakpoints(body)
+    xi, eta = element_samples(bx, samples), element_samples(be, samples)
+    xm, em = 0.5 * (xi[1:] + xi[:-1]), 0.5 * (eta[1:] + eta[:-1])
+    r = body.element_ranges
+    ix = np.searchsorted(bx, xm) - 1
+    ie = np.searchsorted(be, em) - 1
+    lookup = {}
+    for k, (xa, xb, ea, eb) in enumerate(r):
+        lookup[(int(np.searchsorted(bx, 0.5 * (xa + xb)) - 1),
+                int(np.searchsorted(be, 0.5 * (ea + eb)) - 1))] = k
+    elem = np.array([[lookup.get((int(i), int(j)), -1) for i in ix] for j in ie], dtype=np.int64)
+    xx, ee = np.meshgrid(xi, eta)
+    return xx, ee, elem
+
+
+def bodies_grid(result: Result, step: Step | None, samples: int = SAMPLES) -> vtk.vtkUnstructuredGrid:
+    """Every body sampled (see the module docstring)."""
+    points, disp, cells, body_id, elem_id = [], [], [], [], []
+    offset = 0
+    for b, (name, body) in enumerate(result.bodies.items()):
+        u = body_displacement(result, name, 0 if step is None else step.step)
+        xx, ee, elem = body_samples(body, samples)
+        x = evaluate(body, None, xx, ee)
+        n_eta, n_xi = xx.shape
+        ids = offset + np.arange(n_eta * n_xi).reshape(n_eta, n_xi)
+        quads = np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:], ids[1:, :-1]], axis=-1)
+        # keep the quads counter-clockwise (the arc scenes' patches are left-handed)
+        e1, e2 = x[0, 1] - x[0, 0], x[1, 0] - x[0, 0]
+        if e1[0] * e2[1] - e1[1] * e2[0] < 0:
+            quads = quads[..., ::-1]
+        points.append(x.reshape(-1, 2))
+        disp.append(displacement(body, u, xx, ee).reshape(-1, 2))
+        cells += list(quads.reshape(-1, 4))
+        body_id.append(np.full(elem.size, b))
+        elem_id.append(elem.reshape(-1))
+        offset += n_eta * n_xi
+    grid = _grid(np.concatenate(points), cells, vtk.VTK_QUAD)
+    grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
+    grid.GetCellData().AddArray(_array("body", np.concatenate(body_id)))
+    grid.GetCellData().AddArray(_array("element", np.concatenate(elem_id)))
+    _field_data(grid, result, step)
+    return grid
+
+
+def master_frame(result: Result, step: Step, c: ContactOutput) -> tuple[np.ndarray, np.ndarray]:
+    """Unit outward normals and tangents ``(n, 2)`` of the master at each slave point's
+    projection (the directions of ``p_n`` and ``p_t``): the rigid line's, or the
+    master body's contact edge (at eta = 1 of its oriented patch) at ``xi_master``."""
+    m = len(c.p_n)
+    if c.rigid_normal is not None:
+        n = np.asarray(c.rigid_normal, dtype=float)
+        n = n / np.linalg.norm(n)
+        return np.tile(n, (m, 1)), np.tile([n[1], -n[0]], (m, 1))
+    body = result.body(c.master)
+    u = body_displacement(result, body.name, step.step)
+    xi = np.clip(np.nan_to_num(c.xi_master, nan=0.5), 0.0, 1.0)
+    h = 1e-6
+    lo, hi = np.clip(xi - h, 0, 1), np.clip(xi + h, 0, 1)
+    tangent = evaluate(body, u, hi, 1.0) - evaluate(body, u, lo, 1.0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    inward = evaluate(body, u, xi, 1.0 - 1e-3) - evaluate(body, u, xi, 1.0)
+    normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+    flip = np.sum(normal * inward, axis=1) > 0
+    normal[flip] *= -1.0
+    return normal, tangent
+
+
+def contact_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
+    """Slave points of every pair (see the module docstring); None without contact."""
+    if not step.contact:
+        return None
+    pts, cells, data = [], [], {k: [] for k in ("displacement", "p_n", "p_t", "gap", "state",
+                                                "traction", "pair")}
+    offset = 0
+    for k, c in enumerate(step.contact):
+        order = np.argsort(c.xi_slave, kind="stable")
+        n, t = master_frame(result, step, c)
+        pts.append(c.x_ref[order])
+        cells.append(offset + np.arange(len(order)))
+        data["displacement"].append(_vec3(c.x[order] - c.x_ref[order]))
+        data["p_n"].append(c.p_n[order])
+        data["p_t"].append(c.p_t[order])
+        data["gap"].append(c.gap[order])
+        data["state"].append(c.state[order])
+        data["traction"].append(_vec3((c.p_n[:, None] * n + c.p_t[:, None] * t)[order]))
+        data["pair"].append(np.full(len(order), k))
+        offset += len(order)
+    grid = _grid(np.concatenate(pts), cells, vtk.VTK_POLY_LINE)
+    for key, values in data.items():
+        grid.GetPointData().AddArray(_array(key, np.concatenate(values)))
+    _field_data(grid, result, step)
+    pairs = [f"{c.slave}->{c.master}" for c in step.contact]
+    grid.GetFieldData().AddArray(_string_array("pair_names", pairs))
+    return grid
+
+
+def fields_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
+    """Sampled solver fields (stress, strain, von Mises) of the step, None when the
+    file has none."""
+    if not step.fields:
+        return None
+    pts, disp, values, body_id = [], [], {}, []
+    names = list(result.bodies)
+    for name, fields in step.fields.items():
+        body = result.body(name)
+        xi, eta = fields["xi"], fields["eta"]
+        u = body_displacement(result, name, step.step)
+        pts.append(evaluate(body, None, xi, eta).reshape(-1, 2))
+        disp.append(combine(body, u, xi, eta).reshape(-1, 2))
+        body_id.append(np.full(len(xi), names.index(name)))
+        for key, v in fields.items():
+            if key not in ("xi", "eta"):
+                values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
+    points = np.concatenate(pts)
+    grid = _grid(points, [np.array([i]) for i in range(len(points))], vtk.VTK_VERTEX)
+    grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
+    grid.GetPointData().AddArray(_array("body", np.concatenate(body_id)))
+    for key, parts in values.items():
+        grid.GetPointData().AddArray(_array(key, np.concatenate(parts)))
+    _field_data(grid, result, step)
+    return grid
+
+
+def _write(grid: vtk.vtkUnstructuredGrid, path: Path) -> None:
+    writer = vtk.vtkXMLUnstructuredGridWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(grid)
+    writer.SetDataModeToAppended()
+    writer.EncodeAppendedDataOff()
+    writer.SetCompressorTypeToZLib()
+    if writer.Write() != 1:
+        raise OSError(f"VTK could not write {path}")
+
+
+def write_vtk(result: Result, out: str | Path | None = None, samples: int = SAMPLES,
+              output: str | Path | None = None) -> Path:
+    """Write the ParaView series of ``result``: ``<result stem>.pvd`` (next to the
+    result, in ``out``, or at ``output``) and its ``.vtu`` files in the folder
+    ``<result stem>-vtk/`` beside it. Returns the ``.pvd`` path."""
+    if samples < 1:
+        raise ValueError("samples must be >= 1")
+    pvd = Path(output) if output else output_path(result.path, None, out=out, ext="pvd")
+    folder = pvd.with_name(f"{pvd.stem}-vtk")
+    folder.mkdir(parents=True, exist_ok=True)
+    root = ET.Element("VTKFile", type="Collection", version="0.1")
+    coll = ET.SubElement(root, "Collection")
+    for step in [None, *result.steps]:
+        number, time = (0, 0.0) if step is None else (step.step, step.time)
+        parts = [("bodies", bodies_grid(result, step, samples))]
+        if step is not None:
+            parts += [("contact", contact_grid(result, step)), ("fields", fields_grid(result, step))]
+        for index, (what, grid) in enumerate(parts):
+            if grid is None:
+                continue
+            path = folder / f"{what}-{number:06d}.vtu"
+            _write(grid, path)
+            ET.SubElement(coll, "DataSet", timestep=repr(float(time)), part=str(index),
+                          name=what, file=f"{folder.name}/{path.name}")
+    ET.indent(root)
+    pvd.write_text(ET.tostring(root, encoding="unicode") + "\n")
+    return pvd

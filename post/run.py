@@ -1,0 +1,70 @@
+"""Solve a case and show it (``python -m post run``, ``make run``).
+
+Runs ``voiga`` on the case, prints what the result says (:mod:`post.summary`),
+writes the figures that fit the case (deformed bodies, load history, contact
+tractions when it has contact, the Hertz overlay for the hertz scene) and the
+ParaView files, and says where they are. With ``--out DIR`` the case is copied
+into DIR (its geometry path rewritten to point at the original) so that the
+result and every figure land there and nothing is written next to the input.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .naming import output_path
+from .reader import Result, read_result
+from .solver import result_path, run_voiga, stage_case, voiga_binary
+from .summary import summary_lines
+
+
+def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> list[Path]:
+    """Every figure (and the ParaView series) that fits ``result``; returns the paths."""
+    from .contact import plot_contact, plot_hertz
+    from .history import plot_history, write_history_csv
+    from .plot import plot_deformed
+
+    written: list[Path] = []
+    if not result.steps:
+        return written
+    written.append(plot_deformed(result, output=output_path(result.path, "deformed",
+                                                            result.steps[-1].step, out)))
+    written += [write_history_csv(result, out=out), plot_history(result, out=out)]
+    if result.steps[-1].contact:
+        written.append(plot_contact(result, out=out))
+        if result.scene == "hertz":
+            written.append(plot_hertz(result, out=out))
+    if vtk:
+        from .paraview import write_vtk
+        written.append(write_vtk(result, out=out))
+    return written
+
+
+def run_case(case: str | Path, out: str | Path | None = None, binary: str | Path | None = None,
+             quiet: bool = False, figures: bool = True, vtk: bool = True) -> int:
+    """Solve ``case`` (staged into ``out`` when given), print the summary and write
+    the figures; returns voiga's exit code (the figures are made of whatever
+    converged, also after a failed run)."""
+    case = Path(case)
+    program = voiga_binary(binary)
+    run = stage_case(case, Path(out)) if out is not None else case
+    code = run_voiga(program, run, quiet)
+    path = result_path(run)
+    if not path.is_file():
+        print(f"voiga exited with {code} and wrote no result file {path}")
+        return code or 1
+    result = read_result(path)
+    print()
+    for line in summary_lines(result):
+        print(line)
+    if figures:
+        written = make_figures(result, vtk=vtk)
+        if written:
+            print(f"\nresult: {path}")
+            print("figures and files written:")
+            for p in written:
+                print(f"  {p}")
+            pvd = [p for p in written if p.suffix == ".pvd"]
+            if pvd:
+                print(f"open in ParaView: paraview {pvd[0]}")
+    return code

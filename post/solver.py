@@ -1,0 +1,88 @@
+"""Finding and running the ``voiga`` program from Python (``python -m post run``).
+
+The binary is, in this order: the one given, ``$VOIGA_BIN``, ``voiga`` on the
+``PATH``, and ``build/install/bin/voiga`` of the source checkout this package
+was imported from (``make build`` puts it there). An installed package has no
+checkout, so the last choice only applies when running from the repository.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import f90nml
+
+CHECKOUT_BINARY = Path(__file__).resolve().parents[1] / "build" / "install" / "bin" / "voiga"
+"""Where ``make build`` installs the program, when this package runs from a checkout."""
+
+
+class InputError(Exception):
+    """Bad input named by the message (the command line exits with 2)."""
+
+
+def voiga_binary(explicit: str | Path | None = None) -> Path:
+    """The voiga program to run (see the module docstring); InputError when none."""
+    if explicit:
+        path = Path(explicit)
+    elif os.environ.get("VOIGA_BIN"):
+        path = Path(os.environ["VOIGA_BIN"])
+    elif shutil.which("voiga"):
+        path = Path(shutil.which("voiga"))  # type: ignore[arg-type]
+    else:
+        path = CHECKOUT_BINARY
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        raise InputError(f"no voiga program at {path} (run `make build`, put voiga on the PATH "
+                         "or set VOIGA_BIN)")
+    return path
+
+
+def read_case_group(case: Path) -> dict:
+    """The ``&case`` group of a case file (f90nml), InputError when unreadable."""
+    if not case.is_file():
+        raise InputError(f"no case file {case}")
+    try:
+        nml = f90nml.read(str(case))
+    except Exception as err:  # f90nml raises several kinds on bad text
+        raise InputError(f"{case}: not a readable namelist ({err})") from None
+    if "case" not in nml:
+        raise InputError(f"{case}: no &case group")
+    return dict(nml["case"])
+
+
+def stage_case(case: Path, folder: Path) -> Path:
+    """A copy of ``case`` in ``folder`` whose geometry path points at the original
+    geometry (a relative path), so that the run writes its result into ``folder`` and the
+    input stays untouched. Returns the copy's path."""
+    group = read_case_group(case)
+    geometry = group.get("geometry")
+    if not geometry:
+        raise InputError(f"{case}: &case has no geometry")
+    geometry_path = (case.parent / str(geometry)).resolve()
+    if not geometry_path.is_file():
+        raise InputError(f"{case}: geometry file {geometry_path} does not exist")
+    folder.mkdir(parents=True, exist_ok=True)
+    copy = folder / case.name
+    if copy.resolve() == case.resolve():
+        return case
+    relative = os.path.relpath(geometry_path, folder.resolve())
+    f90nml.patch(str(case), {"case": {"geometry": relative}}, str(copy) + ".tmp")
+    os.replace(str(copy) + ".tmp", copy)
+    return copy
+
+
+def result_path(case: Path) -> Path:
+    """The result file a case writes (``&case output``, relative to the case's folder)."""
+    output = read_case_group(case).get("output")
+    if not output:
+        raise InputError(f"{case}: &case has no output")
+    return case.parent / str(output)
+
+
+def run_voiga(binary: Path, case: Path, quiet: bool = False) -> int:
+    """Run ``voiga CASE`` (its per-step lines go to the terminal unless ``quiet``);
+    returns its exit code."""
+    args = [str(binary), str(case)] + (["--quiet"] if quiet else [])
+    return subprocess.run(args, stdin=subprocess.DEVNULL).returncode

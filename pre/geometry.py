@@ -1,0 +1,267 @@
+"""Bodies for any 2D problem: exact NURBS patches from simple shapes or from splipy
+objects, checked and written as a geometry file the solver reads (``docs/formats.md``).
+
+The Python API under ``python -m pre geometry`` (``docs/pre.md``):
+
+- shapes: :func:`rectangle`, :func:`annular_sector` (any start and end angle),
+  :func:`polygon` (four sides, each a chain of straight segments and circular arcs;
+  a Coons patch, exact on its boundary);
+- :func:`body` turns any splipy surface (e.g. from ``splipy.surface_factory`` or a
+  GoTools ``.g2`` file, :func:`read_g2`) into a :class:`pre.nurbs.Patch` with named
+  edges;
+- :func:`check_patch` rejects what the solver cannot use (3D control points, a
+  patch that folds over or degenerates, unnamed or repeated edges);
+- :func:`write_bodies` writes the geometry file.
+
+Every shape names its four sides; the names map onto the patch edges ``xi0``,
+``xi1``, ``eta0``, ``eta1`` that the case file refers to by name. splipy does every
+spline operation (arcs, Coons patches, reparametrization, file reading); this module
+only chooses the inputs and checks the result.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import splipy
+from splipy import curve_factory, surface_factory
+
+from .h5io import write_geometry
+from .nurbs import EDGE_KEYS, Patch, evaluate_patch, patch_from_splipy, patch_to_splipy
+from .scenes import annular_sector as _quarter_sector
+from .scenes import rectangle as _rectangle
+
+Point = Sequence[float]
+
+RECTANGLE_SIDES = {"bottom": "eta0", "right": "xi1", "top": "eta1", "left": "xi0"}
+"""Side labels of a rectangle: xi along x, eta along y."""
+
+SECTOR_SIDES = {"start": "xi0", "end": "xi1", "inner": "eta0", "outer": "eta1"}
+"""Side labels of an annular sector: xi along the arcs (from the start angle to the
+end angle), eta from the inner to the outer arc."""
+
+
+def _named(sides: dict[str, str], names: dict[str, str] | None) -> dict[str, str]:
+    """Edge key -> name, from side label -> edge key and label -> name (default:
+    the label itself)."""
+    names = dict(names or {})
+    unknown = set(names) - set(sides)
+    if unknown:
+        raise ValueError(f"unknown side(s) {sorted(unknown)}; the sides are {list(sides)}")
+    return {key: names.get(label, label) for label, key in sides.items()}
+
+
+def rectangle(x: Sequence[float], y: Sequence[float], edges: dict[str, str] | None = None) -> Patch:
+    """The rectangle ``[x0, x1] x [y0, y1]`` (bilinear); ``edges`` names its sides
+    ``bottom``, ``right``, ``top``, ``left`` (default: those words)."""
+    (x0, x1), (y0, y1) = x, y
+    if not (x1 > x0 and y1 > y0):
+        raise ValueError(f"rectangle: need x0 < x1 and y0 < y1, got x = {list(x)}, y = {list(y)}")
+    return _rectangle(float(x0), float(x1), float(y0), float(y1), _named(RECTANGLE_SIDES, edges))
+
+
+def _arc(centre: Point, radius: float, start_deg: float, end_deg: float) -> splipy.Curve:
+    """Exact rational quadratic arc (pieces of at most 90 degrees) from ``start_deg`` to
+    ``end_deg`` (counter-clockwise when end > start), parameter on [0, 1]."""
+    sweep = math.radians(end_deg - start_deg)
+    a0 = math.radians(start_deg)
+    arc = curve_factory.circle_segment(abs(sweep), radius, center=(*centre, 0.0),
+                                       xaxis=(math.cos(a0), math.sin(a0), 0.0),
+                                       normal=(0.0, 0.0, 1.0 if sweep > 0 else -1.0))
+    arc.set_dimension(2)
+    arc.reparam()
+    return arc
+
+
+def annular_sector(centre: Point, r_in: float, r_out: float, angles: Sequence[float],
+                   edges: dict[str, str] | None = None) -> Patch:
+    """The region between two concentric arcs from ``angles[0]`` to ``angles[1]``
+    (degrees, counter-clockwise when the second is larger; at most 360 apart);
+    ``edges`` names its sides ``start``, ``end``, ``inner``, ``outer``."""
+    a0, a1 = float(angles[0]), float(angles[1])
+    if not 0 < r_in < r_out:
+        raise ValueError(f"annular sector: need 0 < r_in < r_out, got {r_in}, {r_out}")
+    if not 0 < abs(a1 - a0) <= 360:
+        raise ValueError(f"annular sector: angles {a0}, {a1} must differ by at most 360 degrees")
+    names = _named(SECTOR_SIDES, edges)
+    if a0 % 90 == 0 and a1 % 90 == 0 and a1 > a0:  # the scenes' exact construction
+        return _quarter_sector(centre, r_in, r_out, list(range(int(a0), int(a1) + 1, 90)), names)
+    surface = surface_factory.edge_curves(_arc(centre, r_in, a0, a1), _arc(centre, r_out, a0, a1))
+    surface.reparam()
+    return patch_from_splipy(surface, names)
+
+
+def _segment(p: np.ndarray, q: np.ndarray, radius: float | None) -> splipy.Curve:
+    """From ``p`` to ``q``: straight, or a circular arc of ``|radius|`` that bulges
+    to the right of the direction of travel for ``radius > 0`` (outward on a
+    counter-clockwise boundary), to the left for ``radius < 0``."""
+    if radius is None:
+        line = curve_factory.line(tuple(p), tuple(q))
+        line.raise_order(1)
+        line.reparam()
+        return line
+    chord = float(np.linalg.norm(q - p))
+    r = abs(float(radius))
+    if r < chord / 2:
+        raise ValueError(f"arc of radius {r} cannot join points {chord:g} apart")
+    mid = 0.5 * (p + q)
+    d = (q - p) / chord
+    left = np.array([-d[1], d[0]])
+    h = math.sqrt(max(r * r - chord * chord / 4, 0.0))
+    centre = mid + (h if radius > 0 else -h) * left  # bulge away from the centre
+    a0 = math.degrees(math.atan2(*(p - centre)[::-1]))
+    a1 = math.degrees(math.atan2(*(q - centre)[::-1]))
+    # the centre lies left of the travel for radius > 0: the short way round is then
+    # counter-clockwise, and clockwise for radius < 0
+    sweep = (a1 - a0) % 360.0
+    if radius < 0:
+        sweep -= 360.0
+    return _arc(centre, r, a0, a0 + sweep)
+
+
+def _chain(pieces: list[splipy.Curve]) -> splipy.Curve:
+    curve = pieces[0].clone()
+    for piece in pieces[1:]:
+        curve.append(piece.clone())
+    curve.reparam()
+    return curve
+
+
+def polygon(points: Sequence[Point], corners: Sequence[int] | None = None,
+            arcs: dict[int, float] | None = None, edges: Sequence[str] | None = None) -> Patch:
+    """A body bounded by the closed polygon ``points`` (counter-clockwise), whose
+    segment ``k`` (from point ``k`` to ``k + 1``) is a circular arc of signed radius
+    ``arcs[k]`` (> 0 bulges outward). ``corners`` are the indices of the four points
+    where the patch has its corners (default: the points, when there are four);
+    side ``i`` runs from ``corners[i]`` to ``corners[i + 1]`` and is named
+    ``edges[i]`` (default ``side0`` ... ``side3``). The interior is the Coons patch
+    of the four sides (exact on the boundary); :func:`check_patch` rejects a patch
+    that folds over."""
+    pts = np.asarray(points, dtype=float)
+    n = len(pts)
+    if pts.ndim != 2 or pts.shape[1] != 2 or n < 4:
+        raise ValueError("polygon: need at least 4 points [x, y]")
+    area = 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1]))
+    if area <= 0:
+        raise ValueError("polygon: give the points counter-clockwise")
+    corners = list(range(4)) if corners is None and n == 4 else list(corners or [])
+    if len(corners) != 4 or sorted(corners) != corners or len(set(corners)) != 4 \
+            or min(corners) < 0 or max(corners) >= n:
+        raise ValueError(f"polygon: corners must be 4 increasing point indices, got {corners}")
+    arcs = {int(k): float(r) for k, r in (arcs or {}).items()}
+    if any(not 0 <= k < n for k in arcs):
+        raise ValueError(f"polygon: arc segments must be in 0..{n - 1}")
+    names = list(edges) if edges is not None else [f"side{i}" for i in range(4)]
+    if len(names) != 4:
+        raise ValueError("polygon: give 4 edge names")
+    sides = []
+    for i in range(4):
+        a, b = corners[i], corners[(i + 1) % 4]
+        idx = list(range(a, b)) if b > a else list(range(a, n)) + list(range(0, b))
+        sides.append(_chain([_segment(pts[k], pts[(k + 1) % n], arcs.get(k)) for k in idx]))
+    surface = surface_factory.edge_curves(*sides)
+    surface.reparam()
+    patch = patch_from_splipy(surface)
+    patch.edges = _match_edges(patch, sides, names)
+    return patch
+
+
+def _edge_points(patch: Patch, key: str, t: np.ndarray) -> np.ndarray:
+    one, zero = np.ones_like(t), np.zeros_like(t)
+    xi, eta = {"xi0": (zero, t), "xi1": (one, t), "eta0": (t, zero), "eta1": (t, one)}[key]
+    return evaluate_patch(patch, xi, eta)
+
+
+def _match_edges(patch: Patch, sides: list[splipy.Curve], names: list[str]) -> dict[str, str]:
+    """Name the patch edges after the side curves they coincide with."""
+    t = np.linspace(0.0, 1.0, 7)
+    out = {}
+    for curve, name in zip(sides, names):
+        pts = np.asarray(curve(np.linspace(curve.start(0), curve.end(0), 7)))[:, :2]
+        best = min(EDGE_KEYS, key=lambda k: min(np.abs(_edge_points(patch, k, t) - pts).max(),
+                                                np.abs(_edge_points(patch, k, t)[::-1] - pts).max()))
+        out[best] = name
+    if len(out) != 4:
+        raise ValueError("polygon: could not match the four sides to the patch edges")
+    return out
+
+
+def body(surface: splipy.Surface, edges: dict[str, str]) -> Patch:
+    """A splipy surface as a body: 2D (a z coordinate must be zero), parameters
+    rescaled to [0, 1]^2, ``edges`` naming ``xi0``, ``xi1``, ``eta0``, ``eta1``."""
+    s = surface.clone()
+    if s.dimension > 2:
+        cp = np.asarray(s.controlpoints)
+        z = cp[..., 2]
+        if np.abs(z).max() > 1e-12 * max(1.0, np.abs(cp[..., :2]).max()):
+            raise ValueError("the surface is not planar in z = 0")
+        s.set_dimension(2)
+    s.reparam()
+    missing = set(EDGE_KEYS) - set(edges)
+    if missing:
+        raise ValueError(f"name every edge: missing {sorted(missing)}")
+    return patch_from_splipy(s, {k: edges[k] for k in EDGE_KEYS})
+
+
+def read_g2(path: str | Path) -> list[splipy.SplineObject]:
+    """Every spline object of a GoTools ``.g2`` file (splipy's reader)."""
+    from splipy.io import G2
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no .g2 file {path}")
+    with G2(str(path)) as f:
+        return list(f.read())
+
+
+def jacobian_signs(patch: Patch, n: int = 24) -> np.ndarray:
+    """det(dX/dxi, dX/deta) at ``n x n`` interior points (Gauss-like, off the edges)."""
+    s = patch_to_splipy(patch)
+    t = (np.arange(n) + 0.5) / n
+    du = np.asarray(s.derivative(t, t, d=(1, 0)))[..., :2]
+    dv = np.asarray(s.derivative(t, t, d=(0, 1)))[..., :2]
+    return du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0]
+
+
+def check_patch(name: str, patch: Patch) -> None:
+    """Raise ValueError naming ``name`` and the cause when the solver cannot use the
+    patch: knots not on [0, 1], non-positive weights, unnamed or repeated edge names,
+    or a map that folds over or degenerates (det J changes sign or vanishes inside)."""
+    for what, knots in (("knots_xi", patch.knots_xi), ("knots_eta", patch.knots_eta)):
+        if knots[0] != 0.0 or knots[-1] != 1.0:
+            raise ValueError(f"body {name!r}: {what} must span [0, 1]")
+    if np.any(patch.weights <= 0):
+        raise ValueError(f"body {name!r}: weights must be positive")
+    names = [patch.edges.get(k, "") for k in EDGE_KEYS]
+    if any(not e for e in names) or len(set(names)) != 4:
+        raise ValueError(f"body {name!r}: the four edges need four different names, got {names}")
+    det = jacobian_signs(patch)
+    scale = float(np.abs(det).max())
+    if scale == 0 or not (np.all(det > 1e-10 * scale) or np.all(det < -1e-10 * scale)):
+        raise ValueError(f"body {name!r}: the patch folds over or degenerates (the Jacobian "
+                         "changes sign inside); choose other corners or split the body")
+
+
+def edge_length(patch: Patch, key: str, n: int = 200) -> float:
+    """Length of one edge of a patch (polyline of ``n`` points)."""
+    pts = _edge_points(patch, key, np.linspace(0.0, 1.0, n))
+    return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+
+
+def write_bodies(path: str | Path, bodies: dict[str, Patch | splipy.Surface],
+                 scene: str = "", units: str = "mm, N",
+                 edges: dict[str, dict[str, str]] | None = None) -> Path:
+    """Check every body and write the geometry file; splipy surfaces are converted
+    with :func:`body` (their edge names from ``edges[name]``). Returns the path."""
+    patches = {}
+    for name, b in bodies.items():
+        patch = b if isinstance(b, Patch) else body(b, (edges or {}).get(name, {}))
+        check_patch(name, patch)
+        patches[name] = patch
+    path = Path(path)
+    write_geometry(path, scene or path.stem, patches, units=units,
+                   generator="voiga pre (python -m pre geometry)")
+    return path

@@ -1,0 +1,249 @@
+"""A declarative geometry spec (TOML) -> geometry file and case file
+(``python -m pre geometry SPEC.toml``; reference in ``docs/pre.md``).
+
+A spec lists bodies (``[[body]]``, one patch each: ``shape = "rectangle"``,
+``"annular_sector"``, ``"arc"``, ``"polygon"`` or ``"g2"``), the refinement and
+material defaults (``[defaults]``), and optionally the groups of the case file
+(``[case]``, ``[solver]``, ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]``),
+which are written to the case as they are. From ``name.toml`` it writes
+``name-geometry.h5`` and the case ``name.nml`` next to it (or into ``--out``).
+A case written without load groups is a template: its comments show the groups
+to add (``docs/formats.md``).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .cases import to_namelist_text
+from .geometry import (annular_sector, body, check_patch, edge_length, polygon, read_g2, rectangle,
+                       write_bodies)
+from .layouts import parse_layout
+from .nurbs import Patch
+
+DEFAULTS: dict[str, Any] = {
+    "layout": "NN2.2",
+    "elements": 8,
+    "material": "neo-hookean",
+    "youngs_modulus": 1.0,
+    "poisson_ratio": 0.3,
+}
+"""Refinement and material defaults of every body (``[defaults]`` overrides them):
+``layout`` (``Np``, ``NNp``, ``NNp.k``, ``L1``; docs/formats.md), ``elements`` along
+the longer parametric direction of a body unless ``element_size`` is given (then
+``ceil(edge length / element_size)`` in each direction) or the body sets ``nel``."""
+
+CASE_GROUPS = ("solver", "dirichlet", "pressure", "contact")
+"""Spec tables copied into the case file, in this order."""
+
+BODY_KEYS = {"name", "shape", "edges", "contact_edge", "nel", "layout", "elements",
+             "element_size", "material", "youngs_modulus", "poisson_ratio"}
+SHAPE_KEYS = {
+    "rectangle": {"x", "y"},
+    "annular_sector": {"centre", "r_in", "r_out", "angles"},
+    "arc": {"centre", "radius", "thickness", "angles"},
+    "polygon": {"points", "corners", "arcs"},
+    "g2": {"file", "index"},
+}
+
+
+class SpecError(ValueError):
+    """A spec the tools cannot use; the message names the body and the key."""
+
+
+@dataclass
+class Spec:
+    """A read spec: its file, the bodies' tables, defaults and case groups."""
+
+    path: Path
+    data: dict[str, Any]
+
+    @property
+    def bodies(self) -> list[dict[str, Any]]:
+        return list(self.data.get("body", []))
+
+    @property
+    def defaults(self) -> dict[str, Any]:
+        return {**DEFAULTS, **self.data.get("defaults", {})}
+
+
+def read_spec(path: str | Path) -> Spec:
+    """Parse a TOML spec (tomllib); SpecError names the problem."""
+    path = Path(path)
+    if not path.is_file():
+        raise SpecError(f"no spec file {path}")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise SpecError(f"{path}: not valid TOML ({err})") from None
+    unknown = set(data) - {"units", "scene", "defaults", "body", "case", *CASE_GROUPS}
+    if unknown:
+        raise SpecError(f"{path}: unknown table(s) {sorted(unknown)}")
+    if not data.get("body"):
+        raise SpecError(f"{path}: no [[body]]")
+    return Spec(path, data)
+
+
+def _need(b: dict[str, Any], key: str) -> Any:
+    if key not in b:
+        raise SpecError(f"body {b.get('name', '?')!r}: missing {key!r}")
+    return b[key]
+
+
+def build_patch(b: dict[str, Any], folder: Path) -> Patch:
+    """The patch of one ``[[body]]`` table (``folder``: where relative files are)."""
+    name = _need(b, "name")
+    shape = _need(b, "shape")
+    if shape not in SHAPE_KEYS:
+        raise SpecError(f"body {name!r}: unknown shape {shape!r} (known: {sorted(SHAPE_KEYS)})")
+    unknown = set(b) - BODY_KEYS - SHAPE_KEYS[shape]
+    if unknown:
+        raise SpecError(f"body {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
+    edges = b.get("edges")
+    try:
+        if shape == "rectangle":
+            return rectangle(_need(b, "x"), _need(b, "y"), edges)
+        if shape == "annular_sector":
+            return annular_sector(_need(b, "centre"), _need(b, "r_in"), _need(b, "r_out"),
+                                  _need(b, "angles"), edges)
+        if shape == "arc":
+            r, t = float(_need(b, "radius")), float(_need(b, "thickness"))
+            return annular_sector(_need(b, "centre"), r - t / 2, r + t / 2, _need(b, "angles"), edges)
+        if shape == "polygon":
+            arcs = {int(a["segment"]): float(a["radius"]) for a in b.get("arcs", [])}
+            return polygon(_need(b, "points"), b.get("corners"), arcs, edges)
+        objs = [o for o in read_g2(folder / _need(b, "file")) if o.pardim == 2]
+        index = int(b.get("index", 0))
+        if not 0 <= index < len(objs):
+            raise SpecError(f"body {name!r}: the .g2 file has {len(objs)} surface(s), no index {index}")
+        return body(objs[index], dict(edges or {}))
+    except (ValueError, KeyError, TypeError) as err:
+        if isinstance(err, SpecError):
+            raise
+        raise SpecError(f"body {name!r}: {err}") from None
+
+
+def _orient(patch: Patch, contact_key: str | None) -> tuple[str, str]:
+    """The patch edges along which the case's ``nel_xi`` and ``nel_eta`` count: the
+    solver turns the patch so that the contact edge is eta = 1 (docs/formats.md)."""
+    if contact_key in ("xi0", "xi1"):
+        return "xi0", "eta0"  # along the contact edge = along eta of the patch
+    return "eta0", "xi0"
+
+
+def body_group(b: dict[str, Any], patch: Patch, defaults: dict[str, Any]) -> dict[str, Any]:
+    """The ``&body`` group of one body: layout, mesh, contact edge, material."""
+    name = b["name"]
+    opt = {**defaults, **{k: v for k, v in b.items() if k in DEFAULTS or k == "element_size"}}
+    try:
+        lay = parse_layout(str(opt["layout"]))
+    except ValueError as err:
+        raise SpecError(f"body {name!r}: {err}") from None
+    contact = b.get("contact_edge", "")
+    key = None
+    if contact:
+        try:
+            key = patch.edge_key(contact)
+        except KeyError:
+            raise SpecError(f"body {name!r}: contact_edge {contact!r} is not one of its edges "
+                            f"{sorted(patch.edges.values())}") from None
+    along, across = _orient(patch, key)
+    if "nel" in b:
+        nel = [int(n) for n in b["nel"]]
+        if len(nel) != 2 or min(nel) < 1:
+            raise SpecError(f"body {name!r}: nel must be two positive integers [xi, eta]")
+        if key in ("xi0", "xi1"):  # given along the patch's xi, eta; the case counts turned
+            nel = nel[::-1]
+    else:
+        lengths = [edge_length(patch, along), edge_length(patch, across)]
+        if "element_size" in opt:
+            h = float(opt["element_size"])
+            if h <= 0:
+                raise SpecError(f"body {name!r}: element_size must be positive")
+            nel = [max(1, math.ceil(L / h - 1e-9)) for L in lengths]
+        else:
+            n = int(opt["elements"])
+            h = max(lengths) / n
+            nel = [max(1, math.ceil(L / h - 1e-9)) for L in lengths]
+    g: dict[str, Any] = {"name": name, "basis": lay.basis,
+                         "degree_xi": max(lay.degree_xi, max(patch.degree) if lay.basis == "nurbs" else 1),
+                         "degree_eta": max(lay.degree_eta, max(patch.degree) if lay.basis == "nurbs" else 1),
+                         "nel_xi": nel[0], "nel_eta": nel[1], "contact_edge": contact,
+                         "layer_degree": lay.layer_degree if contact else 0,
+                         "layer_elevations": lay.layer_elevations if contact else 0,
+                         "material": str(opt["material"]),
+                         "youngs_modulus": float(opt["youngs_modulus"]),
+                         "poisson_ratio": float(opt["poisson_ratio"])}
+    return g
+
+
+TEMPLATE_HELP = """
+! This case has no loads yet: add the groups you need (docs/formats.md), e.g.
+!
+! &solver
+!   n_steps = 10
+! /
+! &dirichlet
+!   body = '{body}', edge = '{edge}', fix_x = .true., fix_y = .true., ux = 0.0, uy = -0.1
+! /
+! &contact
+!   slave = '{body}', master = 'rigid', rigid_point = 0.0, 0.0, rigid_normal = 0.0, 1.0,
+!   penalty_normal = 100.0, friction = 0.0
+! /
+"""
+
+
+def case_groups(spec: Spec, patches: dict[str, Patch], geometry: str, stem: str) -> dict[str, Any]:
+    """The case file's groups: ``&case``, one ``&body`` per body, then the spec's
+    ``[solver]``, ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]`` as given."""
+    case = {"title": spec.data.get("scene", stem), "scene": spec.data.get("scene", stem),
+            "geometry": geometry, "output": f"{stem}.h5", "n_bodies": len(patches)}
+    case.update(spec.data.get("case", {}))
+    groups: dict[str, Any] = {"case": case,
+                              "body": [body_group(b, patches[b["name"]], spec.defaults)
+                                       for b in spec.bodies]}
+    for g in CASE_GROUPS:
+        if g in spec.data:
+            value = spec.data[g]
+            groups[g] = value if isinstance(value, dict) else list(value)
+    return groups
+
+
+def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
+                    force: bool = False) -> tuple[Path, Path, bool]:
+    """Build every body of the spec, write ``<stem>-geometry.h5`` and the case
+    ``<stem>.nml`` (into ``out``, default the spec's folder). An existing case file
+    is kept unless ``force`` (it may have been edited). Returns ``(geometry, case,
+    case written)``."""
+    spec = read_spec(spec_path)
+    folder = Path(out) if out is not None else spec.path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = spec.path.stem
+    patches: dict[str, Patch] = {}
+    for b in spec.bodies:
+        patch = build_patch(b, spec.path.parent)
+        if b["name"] in patches:
+            raise SpecError(f"two bodies are named {b['name']!r}")
+        try:
+            check_patch(b["name"], patch)
+        except ValueError as err:
+            raise SpecError(str(err)) from None
+        patches[b["name"]] = patch
+    groups = case_groups(spec, patches, f"{stem}-geometry.h5", stem)
+    geometry = write_bodies(folder / f"{stem}-geometry.h5", patches,
+                            scene=str(spec.data.get("scene", stem)),
+                            units=str(spec.data.get("units", "mm, N")))
+    case = folder / f"{stem}.nml"
+    if case.exists() and not force:
+        return geometry, case, False
+    text = to_namelist_text(groups)
+    if not any(g in spec.data for g in CASE_GROUPS):
+        first = spec.bodies[0]["name"]
+        edge = sorted(patches[first].edges.values())[0]
+        text += TEMPLATE_HELP.format(body=first, edge=edge)
+    case.write_text(text)
+    return geometry, case, True
