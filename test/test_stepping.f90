@@ -13,11 +13,23 @@ module test_stepping
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
+    use voiga_solver_progress, only: progress_t, iteration_report_t, step_report_t
+    use voiga_solver_records, only: cut_record_t
     use voiga_test_fixtures, only: rectangle, scene_t, scene_model
     implicit none
     private
 
     public :: collect_stepping
+
+    !> Counts what the solver reports.
+    type, extends(progress_t) :: tally_t
+        integer :: iterations = 0, cuts = 0, steps = 0, last_step = 0
+        real(dp), allocatable :: u_last(:)
+    contains
+        procedure :: iteration => tally_iteration
+        procedure :: cut => tally_cut
+        procedure :: step_done => tally_step_done
+    end type tally_t
 
 contains
 
@@ -28,7 +40,8 @@ contains
                     new_unittest('increment_grows_back_to_nominal', test_growth), &
                     new_unittest('minimum_increment_fails_cleanly', test_minimum), &
                     new_unittest('no_cuts_fails_at_full_step', test_no_cuts), &
-                    new_unittest('predictor_same_states_fewer_iterations', test_predictor) &
+                    new_unittest('predictor_same_states_fewer_iterations', test_predictor), &
+                    new_unittest('progress_reports_every_step', test_progress) &
                     ]
     end subroutine collect_stepping
 
@@ -208,5 +221,58 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_predictor
+
+    !> The solver reports every accepted iterate, cut and converged step through the
+    !> progress hooks, in step order, with the converged displacement.
+    subroutine test_progress(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_settings_t) :: settings
+        type(solver_stats_t) :: stats
+        type(tally_t) :: tally
+        real(dp), allocatable :: u(:)
+        call block_model([0.6_dp, 0.62_dp], [1, 4], model, settings, error)
+        if (allocated(error)) return
+        call solve_steps(model, settings, u, stats, error, tally)
+        if (allocated(error)) return
+        call check(error, tally%steps, 5, 'every step reported')
+        if (allocated(error)) return
+        call check(error, tally%last_step, 5, 'in order, the last one last')
+        if (allocated(error)) return
+        call check(error, tally%cuts, stats%cuts, 'every cut reported')
+        if (allocated(error)) return
+        call check(error, tally%cuts > 0, 'there were cuts')
+        if (allocated(error)) return
+        ! an accepted iterate is reported before its convergence test: iterations + 1
+        ! per converged attempt, iterations + 1 for a failed one that reached the cap
+        call check(error, tally%iterations >= stats%iterations, 'every iteration reported')
+        if (allocated(error)) return
+        call check(error, maxval(abs(tally%u_last - u)), 0.0_dp, 'the converged displacement reported')
+    end subroutine test_progress
+
+    subroutine tally_iteration(self, report)
+        class(tally_t), intent(inout) :: self
+        type(iteration_report_t), intent(in) :: report
+        self%iterations = self%iterations + 1
+    end subroutine tally_iteration
+
+    subroutine tally_cut(self, cut, reason)
+        class(tally_t), intent(inout) :: self
+        type(cut_record_t), intent(in) :: cut
+        character(len=*), intent(in) :: reason
+        if (len(reason) > 0 .and. cut%step > 0) self%cuts = self%cuts + 1
+    end subroutine tally_cut
+
+    subroutine tally_step_done(self, report, u, model, error)
+        class(tally_t), intent(inout) :: self
+        type(step_report_t), intent(in) :: report
+        real(dp), intent(in) :: u(:)
+        type(model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        self%steps = self%steps + 1
+        if (report%record%step /= self%last_step + 1) return
+        self%last_step = report%record%step
+        if (model%ndof == size(u)) self%u_last = u
+    end subroutine tally_step_done
 
 end module test_stepping
