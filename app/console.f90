@@ -25,6 +25,7 @@ module voiga_app_console
         procedure :: cut => console_cut
         procedure :: fixed_point => console_fixed_point
         procedure :: fixed_point_done => console_fixed_point_done
+        procedure :: multipliers_updated => console_multipliers_updated
         procedure :: step_done => console_step_done
     end type console_t
 
@@ -107,6 +108,14 @@ contains
             '); last bound change ', report%change, ' of max bound ', report%largest, '; det K sign ', &
             report%det_sign
     end subroutine console_fixed_point_done
+
+    subroutine console_multipliers_updated(self, step, update, residual)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: step, update
+        real(dp), intent(in) :: residual
+        if (self%verbose) write (*, '(a,i0,a,i0,a,es9.2,a)') '  step ', step, ' multiplier update ', update, &
+            '  constraint residual ', residual, ' of the element size'
+    end subroutine console_multipliers_updated
 
     !> The step goes to the result file, then one line: step, load time, Newton
     !> iterations, residual, seconds (the file's writing included), substeps and cuts.

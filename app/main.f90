@@ -121,9 +121,7 @@ program voiga_main
     call catch_signals()
     call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
     if (stats%signal /= 0) then
-        call results%finish('interrupted', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
-                             finish_error)
+        call results%finish('interrupted', wall_seconds() - t0, stats, finish_error)
         if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//finish_error%message
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
             ' completed steps are in '//case%output
@@ -131,9 +129,7 @@ program voiga_main
         call exit_code(128 + stats%signal)
     end if
     if (allocated(error)) then
-        call results%finish('failed: '//error%message, wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
-                             finish_error)
+        call results%finish('failed: '//error%message, wall_seconds() - t0, stats, finish_error)
         if (allocated(finish_error)) then
             write (0, '(a)') 'voiga: error: '//finish_error%message
         else
@@ -141,9 +137,7 @@ program voiga_main
         end if
         call fail(error)
     end if
-    call results%finish('converged', wall_seconds() - t0, stats%cut_records, &
-                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
-                             error)
+    call results%finish('converged', wall_seconds() - t0, stats, error)
     if (allocated(error)) call fail(error)
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &

@@ -27,7 +27,7 @@ module test_contact
     implicit none
     private
 
-    public :: collect_contact, two_body_model
+    public :: collect_contact, two_body_model, penetrating_state, contact_fd, body, bc, build_model
 
     real(dp), parameter :: pi = acos(-1.0_dp)
 

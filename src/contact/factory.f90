@@ -7,14 +7,18 @@ module voiga_contact_factory
     use voiga_contact_pair, only: contact_pair_t
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
+    use voiga_contact_alm, only: alm_pair_t, default_alm_tolerance
     implicit none
     private
 
-    public :: contact_settings_t, contact_method_names, new_contact_pair
+    public :: contact_settings_t, contact_method_names, new_contact_pair, automatic_penalty
+
+    !> The automatic normal penalty is this multiple of E* q / h (`automatic_penalty`).
+    real(dp), parameter :: penalty_factor = 10.0_dp
 
     !> The valid values of `&contact method`: Gauss-point-to-surface (the paper's),
-    !> mortar-type penalty.
-    character(len=*), parameter :: contact_method_names(2) = [character(len=6) :: 'gpts', 'mortar']
+    !> mortar-type penalty, augmented Lagrangian on the mortar-type constraints.
+    character(len=*), parameter :: contact_method_names(3) = [character(len=6) :: 'gpts', 'mortar', 'alm']
 
     !> One contact pair (`&contact`; docs/formats.md).
     type :: contact_settings_t
@@ -22,29 +26,49 @@ module voiga_contact_factory
         character(len=32) :: slave = '', master = ''
         !> Rigid line: a point on it and its outward normal.
         real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
+        !> Penalties (0: automatic, `automatic_penalty`; penalty_tangent 0: the normal
+        !> one) and the friction coefficient.
         real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
         !> Gauss points per slave contact element (0: layer degree + 1).
         integer :: n_gauss = 0
         !> One of `contact_method_names`.
         character(len=16) :: method = 'gpts'
+        !> Augmented Lagrangian: constraint tolerance relative to the slave element size.
+        real(dp) :: tolerance = default_alm_tolerance
     end type contact_settings_t
 
 contains
 
-    !> An empty pair of the method `method` (its data is set by the caller, then
-    !> `setup`).
-    subroutine new_contact_pair(pair, method, error)
+    !> An empty pair of the method `settings%method`, with the method's own
+    !> settings (its shared data is set by the caller, then `setup`).
+    subroutine new_contact_pair(pair, settings, error)
         class(contact_pair_t), allocatable, intent(out) :: pair
-        character(len=*), intent(in) :: method
+        type(contact_settings_t), intent(in) :: settings
         type(error_t), allocatable, intent(out) :: error
-        select case (trim(method))
+        select case (trim(settings%method))
         case ('gpts')
             allocate (gpts_pair_t :: pair)
         case ('mortar')
             allocate (mortar_pair_t :: pair)
+        case ('alm')
+            pair = alm_pair_t(tolerance=settings%tolerance)
         case default
-            call fatal_error(error, "unknown contact method '"//trim(method)//"'", error_code%input)
+            call fatal_error(error, "unknown contact method '"//trim(settings%method)//"'", error_code%input)
         end select
     end subroutine new_contact_pair
+
+    !> The normal penalty used when the case gives none: `penalty_factor` E* q / h,
+    !> with E* the plane-strain modulus of the pair (1/E* = sum over its deformable
+    !> bodies of (1 - nu^2)/E), q the slave edge's degree and h its smallest element
+    !> (reference length). A penalty of E* / h makes the contact as stiff as an
+    !> element of size h, and q / h is the spacing of the edge's control points;
+    !> the factor keeps the penalty's own compliance (about E* / (eps a) of the
+    !> pressure over a zone of size a) small without making the tangent stiff
+    !> (docs/theory.md, section 7.6; docs/howto.md, "Choosing contact settings").
+    pure real(dp) function automatic_penalty(e_star, degree, h) result(eps)
+        real(dp), intent(in) :: e_star, h
+        integer, intent(in) :: degree
+        eps = penalty_factor*e_star*real(degree, dp)/h
+    end function automatic_penalty
 
 end module voiga_contact_factory

@@ -134,6 +134,9 @@ contains
             self%out(k)%state = state
             self%out(k)%pn = pn
             self%out(k)%pt = pt
+            ! the point's traction acts per current length (da = |a_s| w)
+            self%out(k)%pn0 = pn*self%out(k)%stretch
+            self%out(k)%pt0 = pt*self%out(k)%stretch
             if (allocated(self%anchor)) then
                 self%trial_active(k) = .true.
                 self%trial_anchor(k) = new_anchor

@@ -61,6 +61,10 @@ module voiga_contact_mortar
         procedure :: set_history => mortar_set_history
         procedure :: accept_iterate => mortar_accept_iterate
         procedure :: step_limit => mortar_step_limit
+        !> The law at every control point from its weighted gap and slip.
+        procedure :: control_laws => mortar_control_laws
+        !> Receives the coupling vectors of each active control point (default: no use).
+        procedure :: keep_coupling => mortar_keep_coupling
     end type mortar_pair_t
 
     !> Per slave point: its derivative vectors over its local DOFs.
@@ -107,24 +111,16 @@ contains
         type(error_t), allocatable, intent(out) :: error
         procedure(add_matrix), optional :: add
         type(mortar_work_t) :: wk
-        real(dp) :: t_old
-        integer :: a
         logical :: miss
 
         self%force = 0.0_dp
         call self%master%prepare(u)
         call mortar_project(self, u, wk, error)
         if (allocated(error)) return
-        ! the law at every control point (open where no point of its support has a
-        ! projection: its weighted gap is then empty, not zero)
-        do a = 1, size(self%slave%cps)
-            if (wk%d_seen(a) <= 0.0_dp) wk%g_a(a) = huge(1.0_dp)
-            t_old = 0.0_dp
-            if (allocated(self%traction)) t_old = self%traction(a)
-            call control_point_law(self%law, wk%g_a(a), wk%d_a(a), wk%ds_a(a), t_old, self%gap_tol, wk%p_a(a), &
-                                   wk%t_a(a), wk%st_a(a), wk%t_tr(a))
-            if (allocated(self%traction)) self%trial_traction(a) = wk%t_a(a)
-        end do
+        ! open where no point of its support has a projection: its weighted gap is
+        ! then empty, not zero
+        where (wk%d_seen <= 0.0_dp) wk%g_a = huge(1.0_dp)
+        call self%control_laws(wk%g_a, wk%d_a, wk%ds_a, wk%p_a, wk%t_a, wk%st_a, wk%t_tr)
         call mortar_points(self, r, wk, miss, add)
         self%last = mortar_snapshot_t(wk%g_a, wk%d_a, wk%t_tr, wk%st_a)
         if (.not. present(add) .or. miss) return
@@ -220,8 +216,11 @@ contains
                 r(vec%dofs) = r(vec%dofs) + rl
                 self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
                 self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
-                out%pn = pbar
-                out%pt = tbar
+                ! the interpolated tractions act per reference length (w0 = |A_s| w)
+                out%pn0 = pbar
+                out%pt0 = tbar
+                out%pn = pbar/out%stretch
+                out%pt = tbar/out%stretch
                 out%state = merge(state_slip, state_stick, any(wk%st_a(sp%local) == state_slip))
                 if (present(add)) then
                     call self%fit_pattern(k, mp, inside)
@@ -288,9 +287,42 @@ contains
                 end if
             end if
             call add(blk, kc)
+            call self%keep_coupling(a, blk, v, q, mm)
             deallocate (v, q, mm, pos, kc)
         end do
     end subroutine mortar_coupling
+
+    !> The law at every control point (`control_point_law`), the committed traction
+    !> as the tangential reference; the trial traction is kept for the commit.
+    !> `g_a`: weighted gaps (huge where nothing projects), `d_a` weights, `ds_a`
+    !> weighted slips; out: pressures, tractions, states, trial tractions.
+    !> [slave edge control points] each. An extension may shift the gaps (the
+    !> snapshot of the step control sees `g_a` as returned).
+    pure subroutine mortar_control_laws(self, g_a, d_a, ds_a, p_a, t_a, st_a, t_tr)
+        class(mortar_pair_t), intent(inout) :: self
+        real(dp), intent(inout) :: g_a(:)
+        real(dp), intent(in) :: d_a(:), ds_a(:)
+        real(dp), intent(out) :: p_a(:), t_a(:), t_tr(:)
+        integer, intent(out) :: st_a(:)
+        real(dp) :: t_old
+        integer :: a
+        do a = 1, size(g_a)
+            t_old = 0.0_dp
+            if (allocated(self%traction)) t_old = self%traction(a)
+            call control_point_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), &
+                                   st_a(a), t_tr(a))
+            if (allocated(self%traction)) self%trial_traction(a) = t_a(a)
+        end do
+    end subroutine mortar_control_laws
+
+    !> The coupling vectors of active control point `a` on the DOFs `blk`: the
+    !> derivatives of its weighted gap `v` and weighted slip `m`, and `q`, the
+    !> derivative of the residual by its tangential traction (with a minus sign).
+    pure subroutine mortar_keep_coupling(self, a, blk, v, q, m)
+        class(mortar_pair_t), intent(inout) :: self
+        integer, intent(in) :: a, blk(:)
+        real(dp), intent(in) :: v(:), q(:), m(:)
+    end subroutine mortar_keep_coupling
 
     !> One pattern block per slave control point.
     pure integer function mortar_n_blocks(self) result(n)

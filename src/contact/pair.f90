@@ -23,7 +23,8 @@ module voiga_contact_pair
     implicit none
     private
 
-    public :: contact_pair_t, pair_slot_t, contact_point_out_t, history_item_t, add_matrix
+    public :: contact_pair_t, pair_slot_t, contact_point_out_t, history_item_t, add_matrix, &
+              sparse_vector_t, constraint_set_t
     !> The shared parts of the history operations, for extensions that add their own
     !> (gfortran does not call a binding of an abstract parent through the parent component).
     public :: pair_setup_history, pair_commit, pair_reset_trial, pair_history, pair_set_history
@@ -32,7 +33,11 @@ module voiga_contact_pair
     type :: contact_point_out_t
         !> Reference and current position of the slave point.
         real(dp) :: x0(2) = 0.0_dp, x(2) = 0.0_dp
-        real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp
+        !> Normal gap; contact pressure and tangential traction per current length of
+        !> the slave edge, and per reference length (nominal: `pn0` = `pn` x `stretch`).
+        real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp, pn0 = 0.0_dp, pt0 = 0.0_dp
+        !> Current over reference length of the slave edge at the point, |a_s| / |A_s|.
+        real(dp) :: stretch = 1.0_dp
         !> Master convective coordinate of the projection, and the range of master
         !> control points its functions belong to (empty for a rigid master).
         real(dp) :: xi_m = 0.0_dp
@@ -47,6 +52,21 @@ module voiga_contact_pair
         real(dp), allocatable :: values(:)
         integer, allocatable :: flags(:)
     end type history_item_t
+
+    !> A vector on a few global DOFs.
+    type :: sparse_vector_t
+        integer, allocatable :: dofs(:)
+        real(dp), allocatable :: values(:)
+    end type sparse_vector_t
+
+    !> The active constraints of a pair with multipliers at its last evaluation, for
+    !> a Newton update of the multipliers (`voiga_solver_outer`): per constraint j,
+    !> its residual c_j, the derivative of c_j by the DOFs (`rows(j)`), and the
+    !> derivative of the residual vector by its multiplier (`cols(j)`).
+    type :: constraint_set_t
+        real(dp), allocatable :: c(:)
+        type(sparse_vector_t), allocatable :: rows(:), cols(:)
+    end type constraint_set_t
 
     abstract interface
         !> Receives a local stiffness matrix `k` on the global DOFs `dofs`.
@@ -117,12 +137,19 @@ module voiga_contact_pair
         !> Step control inside a Newton iteration (default: none).
         procedure :: accept_iterate => pair_accept_iterate
         procedure :: step_limit => pair_step_limit
-        !> Outer loop around Newton on variables the method fixes for a Newton
-        !> solve (the Tresca fixed point on the slip limits; default: none).
+        !> The Tresca fixed point on the slip limits, an outer loop around Newton on
+        !> variables the method fixes for a Newton solve (default: not taking part).
         procedure :: takes_outer => pair_takes_outer
         procedure :: outer_capture => pair_outer_capture
         procedure :: outer_apply => pair_no_op
         procedure :: outer_release => pair_no_op
+        !> Multipliers updated between Newton solves (augmented Lagrangian; default:
+        !> none): whether the pair has them; the constraint test at the last
+        !> evaluation; its active constraints; an update of their multipliers.
+        procedure :: has_multipliers => pair_has_multipliers
+        procedure :: constraint_test => pair_constraint_test
+        procedure :: constraints => pair_constraints
+        procedure :: update_multipliers => pair_update_multipliers
         !> What the pair's state says about a failed step (default: nothing).
         procedure :: failure_diagnosis => pair_failure_diagnosis
         !> Helpers of the methods.
@@ -309,6 +336,35 @@ contains
         largest = 0.0_dp
     end subroutine pair_outer_capture
 
+    pure logical function pair_has_multipliers(self)
+        class(contact_pair_t), intent(in) :: self
+        pair_has_multipliers = .false.
+    end function pair_has_multipliers
+
+    !> Whether the constraints hold to the pair's tolerance at the last evaluation;
+    !> `residual`: how far they are off (relative to the slave element size).
+    pure subroutine pair_constraint_test(self, satisfied, residual)
+        class(contact_pair_t), intent(in) :: self
+        logical, intent(out) :: satisfied
+        real(dp), intent(out) :: residual
+        satisfied = .true.
+        residual = 0.0_dp
+    end subroutine pair_constraint_test
+
+    !> The active constraints at the last evaluation (with a tangent).
+    pure function pair_constraints(self) result(set)
+        class(contact_pair_t), intent(in) :: self
+        type(constraint_set_t) :: set
+        allocate (set%c(0), set%rows(0), set%cols(0))
+    end function pair_constraints
+
+    !> Update the multipliers: those of the active constraints (in the order of
+    !> `constraints`) by `delta`, the others from the last evaluation.
+    pure subroutine pair_update_multipliers(self, delta)
+        class(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: delta(:)
+    end subroutine pair_update_multipliers
+
     pure subroutine pair_no_op(self)
         class(contact_pair_t), intent(inout) :: self
     end subroutine pair_no_op
@@ -333,9 +389,12 @@ contains
         associate (out => self%out(k))
             out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
             out%x = sp%x
+            out%stretch = norm2(sp%a)/norm2(matmul(self%slave%x0(:, sp%local), sp%dr))
             out%state = state_inactive
             out%pn = 0.0_dp
             out%pt = 0.0_dp
+            out%pn0 = 0.0_dp
+            out%pt0 = 0.0_dp
             call self%master%project(u, sp%x, mp, found, converged)
             out%xi_m = mp%xi
             out%first = mp%first

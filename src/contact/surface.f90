@@ -10,7 +10,7 @@ module voiga_contact_surface
     implicit none
     private
 
-    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point
+    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point, element_lengths
 
     !> The contact edge of one body.
     type :: contact_surface_t
@@ -134,5 +134,21 @@ contains
             allocate (a(n))
         end subroutine reuse_int
     end subroutine surface_point
+
+    !> The reference length of every element of the edge, as the chord between its
+    !> ends; shape: [elements along the edge].
+    pure function element_lengths(self) result(h)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), allocatable :: h(:), u0(:)
+        type(surface_point_t) :: pa, pb
+        integer :: e
+        allocate (h(size(self%spans)), u0(maxval(self%dofs)))
+        u0 = 0.0_dp
+        do e = 1, size(self%spans)
+            call surface_point(self, u0, self%breaks(e), pa, self%spans(e))
+            call surface_point(self, u0, self%breaks(e + 1), pb, self%spans(e))
+            h(e) = norm2(pb%x - pa%x)
+        end do
+    end function element_lengths
 
 end module voiga_contact_surface

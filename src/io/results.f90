@@ -13,7 +13,7 @@ module voiga_io_results
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
-    use voiga_solver_records, only: step_record_t, cut_record_t, stage_names
+    use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t
     use voiga_solver_progress, only: progress_t, step_report_t
     use voiga_solver_stepping, only: resume_t
     implicit none
@@ -322,6 +322,15 @@ contains
         a1 = pair%out%pt
         call h5%write(c//'/p_t', a1, error)
         if (allocated(error)) return
+        a1 = pair%out%pn0
+        call h5%write(c//'/p_n_nominal', a1, error)
+        if (allocated(error)) return
+        a1 = pair%out%pt0
+        call h5%write(c//'/p_t_nominal', a1, error)
+        if (allocated(error)) return
+        a1 = pair%out%stretch
+        call h5%write(c//'/stretch', a1, error)
+        if (allocated(error)) return
         a1 = pair%out%xi_m
         call h5%write(c//'/xi_master', a1, error)
         if (allocated(error)) return
@@ -364,34 +373,30 @@ contains
         call h5%write_attr(g//'/cuts', 'reasons', reasons, error)
     end subroutine write_cuts
 
-    !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and close;
-    !> `cuts`: every cut of the run (written as /cuts when there is one); `tresca`:
-    !> the run's Tresca fixed-point counters [retried substeps, accepted, fixed-point
-    !> iterations]. The file is closed whatever fails (the first error is returned).
-    subroutine results_finish(self, status, wall, cuts, tresca, error)
+    !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and the
+    !> run's counters of `stats` (every cut as /cuts when there is one, the Tresca
+    !> fixed point's, the multiplier updates), and close.
+    subroutine results_finish(self, status, wall, stats, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
         real(dp), intent(in) :: wall
-        type(cut_record_t), intent(in), optional :: cuts(:)
-        integer, intent(in), optional :: tresca(3)
+        type(solver_stats_t), intent(in) :: stats
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: close_error
         if (.not. self%h5%is_open()) return
         records: block
-            if (present(cuts)) then
-                call self%h5%write_attr('/', 'n_cuts', size(cuts), error)
-                if (allocated(error)) exit records
-                if (size(cuts) > 0) call write_cuts(self%h5, '', cuts, error)
-                if (allocated(error)) exit records
-            end if
-            if (present(tresca)) then
-                call self%h5%write_attr('/', 'tresca_retries', tresca(1), error)
-                if (allocated(error)) exit records
-                call self%h5%write_attr('/', 'tresca_accepted', tresca(2), error)
-                if (allocated(error)) exit records
-                call self%h5%write_attr('/', 'fixed_point_iterations', tresca(3), error)
-                if (allocated(error)) exit records
-            end if
+            call self%h5%write_attr('/', 'n_cuts', size(stats%cut_records), error)
+            if (allocated(error)) exit records
+            if (size(stats%cut_records) > 0) call write_cuts(self%h5, '', stats%cut_records, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'tresca_retries', stats%tresca_retries, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'tresca_accepted', stats%tresca_accepted, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'fixed_point_iterations', stats%fixed_point_iterations, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates, error)
+            if (allocated(error)) exit records
             call self%h5%write_attr('/', 'status', status, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'wall_time', wall, error)

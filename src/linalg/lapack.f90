@@ -4,7 +4,7 @@ module voiga_linalg_lapack
     implicit none
     private
 
-    public :: solve_spd, band_factor
+    public :: solve_spd, solve_general, band_factor
 
     interface
         pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
@@ -14,6 +14,12 @@ module voiga_linalg_lapack
             real(dp), intent(inout) :: a(lda, *), b(ldb, *)
             integer, intent(out) :: info
         end subroutine dposv
+        pure subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            integer, intent(in) :: n, nrhs, lda, ldb
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgesv
         pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
             import :: dp
             integer, intent(in) :: m, n, kl, ku, ldab
@@ -35,6 +41,19 @@ contains
         integer, intent(out) :: info
         call dposv('L', size(a, 1), size(b, 2), a, size(a, 1), b, size(b, 1), info)
     end subroutine solve_spd
+
+    !> Solve a x = b for a general square `a` (LU with partial pivoting, LAPACK
+    !> dgesv). On exit `b` holds x; `a` is overwritten by its factors. `info` > 0:
+    !> `a` is singular, `b` is then undefined.
+    pure subroutine solve_general(a, b, info)
+        !> shape: [n, n]
+        real(dp), intent(inout) :: a(:, :)
+        !> shape: [n, nrhs]
+        real(dp), intent(inout) :: b(:, :)
+        integer, intent(out) :: info
+        integer :: ipiv(size(a, 1))
+        call dgesv(size(a, 1), size(b, 2), a, size(a, 1), ipiv, b, size(b, 1), info)
+    end subroutine solve_general
 
     !> LU factorization with partial pivoting of an n x n band matrix with `kl`
     !> sub- and `ku` superdiagonals (LAPACK dgbtrf). `ab` has shape [2 kl + ku + 1, n]

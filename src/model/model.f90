@@ -8,8 +8,8 @@ module voiga_model
     use voiga_model_body, only: body_t, body_settings_t, new_body
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
     use voiga_contact_pair, only: pair_slot_t
-    use voiga_contact_factory, only: contact_settings_t, new_contact_pair
-    use voiga_contact_surface, only: new_contact_surface
+    use voiga_contact_factory, only: contact_settings_t, new_contact_pair, automatic_penalty
+    use voiga_contact_surface, only: new_contact_surface, element_lengths
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
     implicit none
@@ -134,7 +134,7 @@ contains
         real(dp), allocatable :: u0(:), r0(:)
         integer :: ib
 
-        call new_contact_pair(slot%pair, inp%method, error)
+        call new_contact_pair(slot%pair, inp, error)
         if (allocated(error)) return
         associate (pair => slot%pair)
             pair%slave_name = inp%slave
@@ -152,7 +152,12 @@ contains
                 allocate (pair%master, source=master)
             end if
             pair%law%eps_n = inp%penalty_normal
+            if (pair%law%eps_n <= 0.0_dp) pair%law%eps_n = automatic_penalty(plane_modulus(self, pair%slave_body, &
+                                                                                    pair%master_body), &
+                                                                       pair%slave%degree, &
+                                                                       minval(element_lengths(pair%slave)))
             pair%law%eps_t = inp%penalty_tangent
+            if (pair%law%eps_t <= 0.0_dp) pair%law%eps_t = pair%law%eps_n
             pair%law%mu = inp%friction
             pair%n_gauss = inp%n_gauss
             call pair%setup()
@@ -166,6 +171,24 @@ contains
             pair%n_friction = 0
         end associate
     end subroutine new_pair
+
+    !> The plane-strain modulus E* of a pair: 1/E* = sum over its deformable bodies
+    !> (the master 0: rigid) of (1 - nu^2)/E.
+    pure real(dp) function plane_modulus(self, slave, master) result(e_star)
+        type(model_t), intent(in) :: self
+        integer, intent(in) :: slave, master
+        real(dp) :: compliance
+        integer :: ib, k
+        compliance = 0.0_dp
+        do k = 1, 2
+            ib = merge(slave, master, k == 1)
+            if (ib == 0) cycle
+            associate (mat => self%bodies(ib)%mat)
+                compliance = compliance + (1.0_dp - mat%poisson_ratio**2)/mat%youngs_modulus
+            end associate
+        end do
+        e_star = 1.0_dp/compliance
+    end function plane_modulus
 
     pure integer function find_body(self, name) result(ib)
         type(model_t), intent(in) :: self

@@ -1,4 +1,12 @@
-!> Outer loops around Newton. The Tresca fixed point (docs/robustness.md, "Tresca
+!> Outer loops around Newton.
+!>
+!> The augmented Lagrangian (Uzawa, docs/theory.md section 7.5): with the contact
+!> multipliers fixed Newton solves the substep, then every pair with multipliers
+!> updates them from the solution and tests its constraints; repeated until every
+!> pair's constraints hold to its tolerance. `substep_attempt` runs it when a pair
+!> has multipliers, a plain Newton attempt otherwise.
+!>
+!> The Tresca fixed point (docs/robustness.md, "Tresca
 !> fixed point"): a frictional substep whose Newton attempt from the last
 !> converged state failed with contact states switching is retried at the same
 !> increment by successive approximations on the slip bounds, the fixed point of
@@ -19,16 +27,205 @@ module voiga_solver_outer
     use voiga_solver_progress, only: progress_t, fixed_point_report_t
     use voiga_solver_convergence, only: convergence_t, converged, residual_floor
     use voiga_solver_newton, only: newton_t, newton_attempt, attempt_t
+    use voiga_solver_records, only: wall_seconds
+    use voiga_contact_pair, only: constraint_set_t
+    use voiga_linalg_lapack, only: solve_general
     use voiga_text, only: str, real_str
     implicit none
     private
 
-    public :: tresca_fixed_point, frictional
+    public :: tresca_fixed_point, frictional, substep_attempt
 
     !> Most Tresca solves (fixed-point iterations) of one retried substep.
     integer, parameter :: max_fixed_point = 40
 
+    !> Most multiplier updates of one substep (augmented Lagrangian); the constraint
+    !> error falls by a roughly constant factor per update, small for stiff penalties
+    !> (docs/theory.md, section 7.5).
+    integer, parameter :: max_updates = 100
+    !> The smallest fraction of a multiplier step, and the updates without a new
+    !> smallest constraint residual after which the step is halved
+    !> (`substep_attempt`).
+    real(dp), parameter :: min_damping = 1.0_dp/64.0_dp
+    integer, parameter :: stall = 3
+
 contains
+
+    !> Solve the substep at load time `t` from `u` (prescribed values set): Newton,
+    !> inside the augmented Lagrangian's multiplier updates when a pair has
+    !> multipliers: after each Newton solve, if a pair's constraints do not hold to its
+    !> tolerance, the multipliers take a Newton step on the constraints
+    !> (`multiplier_step`) and Newton solves again from the predicted state. A
+    !> control point on the stick/slip limit can make full steps cycle between active
+    !> sets: after `stall` updates without a new smallest constraint residual the
+    !> steps are halved. Fails like a Newton attempt, or when `max_updates` updates do
+    !> not satisfy the constraints.
+    subroutine substep_attempt(newton, model, step, t, u, stats, rec, progress, attempt, error)
+        type(newton_t), intent(inout) :: newton
+        type(model_t), intent(inout) :: model
+        integer, intent(in) :: step
+        real(dp), intent(in) :: t
+        real(dp), intent(inout) :: u(:)
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        class(progress_t), intent(inout) :: progress
+        type(attempt_t), intent(out) :: attempt
+        type(error_t), allocatable, intent(out) :: error
+        type(attempt_t) :: inner
+        real(dp) :: r0, worst, best, damping
+        integer :: k, stalled
+        logical :: satisfied
+
+        if (.not. any([(model%pairs(k)%pair%has_multipliers(), k=1, size(model%pairs))])) then
+            call newton_attempt(newton, model, step, t, u, stats, rec, progress, attempt, error)
+            return
+        end if
+        best = huge(1.0_dp)
+        stalled = 0
+        damping = 1.0_dp
+        do k = 1, max_updates
+            ! after the first solve, Newton's tolerance is relative to the substep's
+            ! first residual (a multiplier update leaves a small one)
+            if (k == 1) then
+                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error)
+            else
+                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, r0)
+            end if
+            attempt%iterations = attempt%iterations + inner%iterations
+            attempt%residual = inner%residual
+            attempt%det_sign = inner%det_sign
+            attempt%nonpositive_det = attempt%nonpositive_det + inner%nonpositive_det
+            attempt%switching = inner%switching
+            if (allocated(error)) return
+            if (k == 1) r0 = rec%residual_norms(1)
+            call constraint_test(model, satisfied, worst)
+            call progress%multipliers_updated(step, k, worst)
+            if (satisfied) return
+            ! full steps (a semi-smooth Newton step may raise the residual while the
+            ! active set settles); halved after `stall` updates without a new
+            ! smallest residual (the active set cycles), doubled back with each one
+            if (worst < best) then
+                best = worst
+                stalled = 0
+                damping = min(1.0_dp, 2.0_dp*damping)
+            else
+                stalled = stalled + 1
+                if (stalled >= stall) then
+                    damping = max(0.5_dp*damping, min_damping)
+                    stalled = 0
+                end if
+            end if
+            call multiplier_step(newton, model, damping, u, rec, error)
+            stats%multiplier_updates = stats%multiplier_updates + 1
+            if (allocated(error)) return
+        end do
+        call fatal_error(error, 'the augmented Lagrangian did not satisfy the contact constraints in '// &
+                         str(max_updates)//' multiplier updates (largest gap or stick slip '// &
+                         real_str(worst, 'es9.2')//' of the slave element size)', error_code%numeric)
+    end subroutine substep_attempt
+
+    !> Whether every pair's constraints hold at its last evaluation, and the largest
+    !> constraint residual (relative to the slave element size).
+    pure subroutine constraint_test(model, satisfied, worst)
+        type(model_t), intent(in) :: model
+        logical, intent(out) :: satisfied
+        real(dp), intent(out) :: worst
+        real(dp) :: residual
+        logical :: ok
+        integer :: ip
+        satisfied = .true.
+        worst = 0.0_dp
+        do ip = 1, size(model%pairs)
+            call model%pairs(ip)%pair%constraint_test(ok, residual)
+            satisfied = satisfied .and. ok
+            worst = max(worst, residual)
+        end do
+    end subroutine constraint_test
+
+    !> A Newton step on the active constraints c(u(mu)) = 0 of every pair with
+    !> multipliers mu, at the converged state `u` of fixed multipliers: with the
+    !> tangent K there, a change dmu moves the equilibrium by du = -K^-1 C dmu (C: the
+    !> columns d r / d mu) and the constraints by R du (R: their rows), so
+    !> (R K^-1 C) dmu = c; `u` moves by du (the next Newton solve starts at the
+    !> predicted equilibrium). Exact for a linear problem with a fixed active set,
+    !> whatever the penalty. Costs one factorization and one solve per constraint.
+    !> `damping` < 1 takes that fraction of the step.
+    subroutine multiplier_step(newton, model, damping, u, rec, error)
+        type(newton_t), intent(inout) :: newton
+        type(model_t), intent(inout) :: model
+        !> The fraction of the step taken.
+        real(dp), intent(in) :: damping
+        real(dp), intent(inout) :: u(:)
+        type(step_record_t), intent(inout) :: rec
+        type(error_t), allocatable, intent(out) :: error
+        type(constraint_set_t), allocatable :: sets(:)
+        real(dp), allocatable :: w(:, :), s(:, :), delta(:, :)
+        real(dp) :: tic
+        integer :: ip, j, n, first, info
+
+        allocate (sets(size(model%pairs)))
+        do ip = 1, size(model%pairs)
+            sets(ip) = model%pairs(ip)%pair%constraints()
+        end do
+        n = sum([(size(sets(ip)%c), ip=1, size(sets))])
+        allocate (w(model%ndof, n), s(n, n), delta(n, 1))
+        if (n > 0) then
+            tic = wall_seconds()
+            call newton%k%fix_dofs(model%fixed)
+            call newton%linear%factor(newton%k, error)
+            rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
+            if (allocated(error)) return
+            tic = wall_seconds()
+            call schur_complement(newton, model%fixed, sets, w, s, delta(:, 1), error)
+            rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
+            if (allocated(error)) return
+            call solve_general(s, delta, info)
+            if (info /= 0) then
+                call fatal_error(error, 'the augmented Lagrangian''s active constraints are dependent (their '// &
+                                 'Schur complement is singular)', error_code%numeric)
+                return
+            end if
+            delta = damping*delta
+            u = u - matmul(w, delta(:, 1))
+        end if
+        first = 0
+        do ip = 1, size(sets)
+            call model%pairs(ip)%pair%update_multipliers(delta(first + 1:first + size(sets(ip)%c), 1))
+            first = first + size(sets(ip)%c)
+        end do
+    end subroutine multiplier_step
+
+    !> The constraints of `sets` in order: w(:, j) = K^-1 C_j (the factorized tangent),
+    !> the Schur complement s = R K^-1 C and the residuals c.
+    subroutine schur_complement(newton, fixed, sets, w, s, c, error)
+        type(newton_t), intent(inout) :: newton
+        logical, intent(in) :: fixed(:)
+        type(constraint_set_t), intent(in) :: sets(:)
+        real(dp), intent(out) :: w(:, :), s(:, :), c(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: rhs(:)
+        integer :: ip, i, j
+        allocate (rhs(size(fixed)))
+        j = 0
+        do ip = 1, size(sets)
+            do i = 1, size(sets(ip)%c)
+                j = j + 1
+                c(j) = sets(ip)%c(i)
+                rhs = 0.0_dp
+                rhs(sets(ip)%cols(i)%dofs) = rhs(sets(ip)%cols(i)%dofs) + sets(ip)%cols(i)%values
+                rhs = merge(0.0_dp, rhs, fixed)
+                call newton%linear%solve(newton%k, rhs, w(:, j), error)
+                if (allocated(error)) return
+            end do
+        end do
+        i = 0
+        do ip = 1, size(sets)
+            do j = 1, size(sets(ip)%c)
+                i = i + 1
+                s(i, :) = matmul(sets(ip)%rows(j)%values, w(sets(ip)%rows(j)%dofs, :))
+            end do
+        end do
+    end subroutine schur_complement
 
     !> Whether any contact pair takes part in the Tresca fixed point (frictional GPTS).
     pure logical function frictional(model)

@@ -58,6 +58,7 @@ module voiga_solver_progress
         procedure :: cut => progress_cut
         procedure :: fixed_point => progress_fixed_point
         procedure :: fixed_point_done => progress_fixed_point
+        procedure :: multipliers_updated => progress_multipliers_updated
         procedure :: step_done => progress_step_done
     end type progress_t
 
@@ -111,6 +112,14 @@ contains
         class(progress_t), intent(inout) :: self
         type(fixed_point_report_t), intent(in) :: report
     end subroutine progress_fixed_point
+
+    !> The `update`-th multiplier update of the augmented Lagrangian at `step`; the
+    !> largest constraint residual before it (relative to the slave element size).
+    subroutine progress_multipliers_updated(self, step, update, residual)
+        class(progress_t), intent(inout) :: self
+        integer, intent(in) :: step, update
+        real(dp), intent(in) :: residual
+    end subroutine progress_multipliers_updated
 
     !> A nominal step converged with displacement `u`; `model` holds the contact
     !> pairs' output of its last evaluation. A failure (the result file cannot be

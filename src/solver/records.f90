@@ -70,6 +70,8 @@ module voiga_solver_records
         !> Substeps retried with the Tresca fixed point, of them accepted, and the
         !> fixed-point iterations (Tresca solves) of all retries.
         integer :: tresca_retries = 0, tresca_accepted = 0, fixed_point_iterations = 0
+        !> Multiplier updates of the augmented Lagrangian (every substep's, failed ones too).
+        integer :: multiplier_updates = 0
         !> Largest first residual of a step so far: the force scale of the round-off floor.
         real(dp) :: r0_max = 0.0_dp
         !> Converged substeps and cuts of the load increment.

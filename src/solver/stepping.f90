@@ -21,8 +21,8 @@ module voiga_solver_stepping
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, step_record_t, cut_record_t, append_cut, wall_seconds
     use voiga_solver_progress, only: progress_t, step_report_t
-    use voiga_solver_newton, only: newton_t, new_newton, attempt_t, newton_attempt
-    use voiga_solver_outer, only: tresca_fixed_point, frictional
+    use voiga_solver_newton, only: newton_t, new_newton, attempt_t
+    use voiga_solver_outer, only: tresca_fixed_point, frictional, substep_attempt
     use voiga_solver_diagnostics, only: fold_diagnosis, append_pair_diagnoses
     use voiga_text, only: str, real_str
     implicit none
@@ -222,7 +222,7 @@ contains
             return
         end if
         call set_prescribed(model, t, u)
-        call newton_attempt(sp%newton, model, step, t, u, stats, rec, progress, attempt, error)
+        call substep_attempt(sp%newton, model, step, t, u, stats, rec, progress, attempt, error)
         if (.not. allocated(error) .or. predicted) return
         sp%fold_iterations = attempt%nonpositive_det
         sp%fold_total = attempt%iterations

@@ -7,6 +7,7 @@ module voiga_io_case_contact
     use voiga_io_case_values, only: unset, body_index, quoted
     use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t, contact_method_names
+    use voiga_contact_alm, only: default_alm_tolerance
     implicit none
     private
 
@@ -24,11 +25,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=32) :: slave, master
         character(len=16) :: method
-        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction
+        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, tolerance
         integer :: n_gauss, ios
         character(len=512) :: msg
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss, method
+            friction, n_gauss, method, tolerance
 
         slave = ''
         master = ''
@@ -39,18 +40,22 @@ contains
         friction = 0.0_dp
         n_gauss = 0
         method = 'gpts'
+        tolerance = default_alm_tolerance
         read (u, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call group_error(path, 'contact', k, ios, msg, try_contact, error)
             return
         end if
-        if (penalty_tangent == unset) penalty_tangent = penalty_normal
         entry = contact_settings_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-                                   friction, n_gauss, method)
+                                   friction, n_gauss, method, tolerance)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         call check_law(entry, bodies, path//trim(msg)//' ', error)
+        if (allocated(error)) return
+        ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
+        if (entry%penalty_normal == unset) entry%penalty_normal = 0.0_dp
+        if (entry%penalty_tangent == unset) entry%penalty_tangent = entry%penalty_normal
     contains
         subroutine try_contact(text, ios, msg)
             character(len=*), intent(in) :: text
@@ -104,15 +109,17 @@ contains
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: e_max
-        if (c%penalty_normal == unset) then
-            call fatal_error(error, where//'penalty_normal is required', error_code%input)
-        else if (.not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
-            call fatal_error(error, where//'penalty_normal must be finite and > 0', error_code%input)
+        if (c%penalty_normal /= unset .and. .not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
+            call fatal_error(error, where//'penalty_normal must be finite and > 0 (or not given: automatic)', &
+                             error_code%input)
         else if (.not. (c%friction >= 0.0_dp .and. ieee_is_finite(c%friction))) then
             call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
-        else if (c%friction > 0.0_dp .and. .not. (c%penalty_tangent > 0.0_dp .and. &
-                                                  ieee_is_finite(c%penalty_tangent))) then
-            call fatal_error(error, where//'penalty_tangent must be finite and > 0', error_code%input)
+        else if (c%friction > 0.0_dp .and. c%penalty_tangent /= unset .and. &
+                 .not. (c%penalty_tangent > 0.0_dp .and. ieee_is_finite(c%penalty_tangent))) then
+            call fatal_error(error, where//'penalty_tangent must be finite and > 0 (or not given)', &
+                             error_code%input)
+        else if (.not. (c%tolerance > 0.0_dp .and. c%tolerance < 1.0_dp)) then
+            call fatal_error(error, where//'tolerance must lie in (0, 1)', error_code%input)
         else if (c%n_gauss < 0 .or. c%n_gauss > 30) then
             call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
         else if (.not. any(contact_method_names == c%method)) then
