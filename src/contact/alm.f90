@@ -131,9 +131,9 @@ contains
     pure subroutine alm_setup_history(self)
         class(alm_pair_t), intent(inout) :: self
         real(dp), allocatable :: lengths(:)
-        integer :: n, e, p, s
+        integer :: n, i
         call self%mortar_pair_t%setup_history()
-        n = size(self%slave%cps)
+        n = size(self%node_first)
         allocate (self%lambda(n), self%lambda_last(n), self%g(n), self%d(n), self%ds(n), self%state(n), &
                   self%p_last(n), self%t_last(n), self%v(n), self%m(n), self%q(n), self%h(n))
         self%lambda = 0.0_dp
@@ -148,12 +148,9 @@ contains
             allocate (self%tau(n))
             self%tau = 0.0_dp
         end if
-        self%h = 0.0_dp
-        p = self%slave%degree
         lengths = element_lengths(self%slave)
-        do e = 1, size(self%slave%spans)
-            s = self%slave%spans(e)
-            self%h(s - p:s) = max(self%h(s - p:s), lengths(e))
+        do i = 1, n
+            self%h(i) = maxval(lengths(self%node_first(i):self%node_last(i)))
         end do
     end subroutine alm_setup_history
 

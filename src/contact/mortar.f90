@@ -19,7 +19,7 @@
 module voiga_contact_mortar
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_contact_surface, only: surface_point_t
+    use voiga_contact_surface, only: surface_point_t, surface_point
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_kinematics, only: point_operators
@@ -41,10 +41,21 @@ module voiga_contact_mortar
         integer, allocatable :: state(:)
     end type mortar_snapshot_t
 
-    !> A mortar-type penalty pair.
+    !> A mortar-type penalty pair. Its constraints are weighted with a multiplier
+    !> basis on the slave edge, one constraint per basis function ("node"): the
+    !> slave edge's own functions (one node per slave control point, the default),
+    !> or, with `linear_multipliers`, the piecewise-linear hat functions on its
+    !> breakpoints (one node per element end).
     type, extends(contact_pair_t) :: mortar_pair_t
-        !> Friction history (mu > 0) [slave edge control points]: committed and
-        !> trial tangential traction t_A (along the master tangent).
+        !> Use the hat functions on the breakpoints as the multiplier basis.
+        logical :: linear_multipliers = .false.
+        !> The multiplier basis: the nodes whose functions are nonzero at each slave
+        !> point and their values there [basis functions per point, points]; the
+        !> first and last slave element of each node's support [nodes].
+        integer, allocatable :: point_nodes(:, :), node_first(:), node_last(:)
+        real(dp), allocatable :: point_values(:, :)
+        !> Friction history (mu > 0) [nodes]: committed and trial tangential traction
+        !> t_A (along the master tangent).
         real(dp), allocatable :: traction(:), trial_traction(:)
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
@@ -83,7 +94,7 @@ module voiga_contact_mortar
         !> the last converged state, has a converged projection, had one then.
         real(dp), allocatable :: w0(:), dxi(:)
         logical, allocatable :: valid(:), slip(:)
-        !> Per control point [ncp]: weights, weighted gaps, weighted slips, pressures,
+        !> Per node [nodes]: weights, weighted gaps, weighted slips, pressures,
         !> tangential tractions, their trial values, the weight of the points with a
         !> projection in its support, states.
         real(dp), allocatable :: d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), t_tr(:), d_seen(:)
@@ -139,7 +150,7 @@ contains
         logical :: found, converged
 
         npts = size(self%xi)
-        ncp = size(self%slave%cps)
+        ncp = size(self%node_first)
         allocate (wk%sps(npts), wk%mps(npts), wk%vec(npts), wk%w0(npts), wk%dxi(npts), wk%valid(npts), &
                   wk%slip(npts))
         allocate (wk%d_a(ncp), wk%g_a(ncp), wk%ds_a(ncp), wk%p_a(ncp), wk%t_a(ncp), wk%st_a(ncp), &
@@ -153,10 +164,11 @@ contains
         wk%slip = .false.
         do k = 1, npts
             call self%project_point(u, k, wk%sps(k), wk%mps(k), found, converged)
-            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k))
+            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k), nodes => self%point_nodes(:, k), &
+                       phi => self%point_values(:, k))
                 a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
                 wk%w0(k) = norm2(a0)*self%w(k)
-                wk%d_a(sp%local) = wk%d_a(sp%local) + wk%w0(k)*sp%r
+                wk%d_a(nodes) = wk%d_a(nodes) + wk%w0(k)*phi
                 if (allocated(self%xi_last)) then
                     self%trial_xi(k) = mp%xi
                     self%trial_active(k) = .false.
@@ -168,14 +180,14 @@ contains
                     return
                 end if
                 wk%valid(k) = .true.
-                wk%d_seen(sp%local) = wk%d_seen(sp%local) + wk%w0(k)*sp%r
-                wk%g_a(sp%local) = wk%g_a(sp%local) + wk%w0(k)*sp%r*out%gap
+                wk%d_seen(nodes) = wk%d_seen(nodes) + wk%w0(k)*phi
+                wk%g_a(nodes) = wk%g_a(nodes) + wk%w0(k)*phi*out%gap
                 if (allocated(self%xi_last)) then
                     self%trial_active(k) = .true.
                     if (self%active_last(k)) then
                         wk%slip(k) = .true.
                         wk%dxi(k) = mp%xi - self%xi_last(k)
-                        wk%ds_a(sp%local) = wk%ds_a(sp%local) + wk%w0(k)*sp%r*wk%dxi(k)*norm2(mp%a)
+                        wk%ds_a(nodes) = wk%ds_a(nodes) + wk%w0(k)*phi*wk%dxi(k)*norm2(mp%a)
                     end if
                 end if
             end associate
@@ -198,10 +210,11 @@ contains
         miss = .false.
         do k = 1, size(self%xi)
             if (.not. wk%valid(k)) cycle
-            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k), vec => wk%vec(k))
-                if (all(wk%st_a(sp%local) == state_inactive)) cycle
-                pbar = dot_product(sp%r, wk%p_a(sp%local))
-                tbar = dot_product(sp%r, wk%t_a(sp%local))
+            associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k), vec => wk%vec(k), &
+                       nodes => self%point_nodes(:, k), phi => self%point_values(:, k))
+                if (all(wk%st_a(nodes) == state_inactive)) cycle
+                pbar = dot_product(phi, wk%p_a(nodes))
+                tbar = dot_product(phi, wk%t_a(nodes))
                 nd = size(sp%dofs) + size(mp%dofs)
                 if (allocated(rl)) then
                     if (size(rl) /= nd) deallocate (rl, kl)
@@ -221,7 +234,7 @@ contains
                 out%pt0 = tbar
                 out%pn = pbar/out%stretch
                 out%pt = tbar/out%stretch
-                out%state = merge(state_slip, state_stick, any(wk%st_a(sp%local) == state_slip))
+                out%state = merge(state_slip, state_stick, any(wk%st_a(nodes) == state_slip))
                 if (present(add)) then
                     call self%fit_pattern(k, mp, inside)
                     if (inside) then
@@ -250,19 +263,18 @@ contains
 
         ng = self%n_gauss
         mdofs = self%master%all_dofs()
-        do a = 1, size(self%slave%cps)
+        do a = 1, size(self%node_first)
             if (wk%st_a(a) == state_inactive) cycle
             blk = self%block_dofs(a, mdofs)
             allocate (v(size(blk)), q(size(blk)), mm(size(blk)), pos(0))
             v = 0.0_dp
             q = 0.0_dp
             mm = 0.0_dp
-            do e = 1, size(self%slave%spans)
-                if (a < self%slave%spans(e) - self%slave%degree .or. a > self%slave%spans(e)) cycle
+            do e = self%node_first(a), self%node_last(a)
                 do k = (e - 1)*ng + 1, e*ng
                     if (.not. allocated(wk%vec(k)%dofs)) cycle
-                    i = findloc(wk%sps(k)%local, a, dim=1)
-                    c = wk%w0(k)*wk%sps(k)%r(i)
+                    i = findloc(self%point_nodes(:, k), a, dim=1)
+                    c = wk%w0(k)*self%point_values(i, k)
                     pos = [(findloc(blk, wk%vec(k)%dofs(j), dim=1), j=1, size(wk%vec(k)%dofs))]
                     v(pos) = v(pos) + c*wk%vec(k)%gn
                     if (self%law%mu > 0.0_dp) then
@@ -327,12 +339,12 @@ contains
     !> One pattern block per slave control point.
     pure integer function mortar_n_blocks(self) result(n)
         class(mortar_pair_t), intent(in) :: self
-        n = size(self%slave%cps)
+        n = size(self%node_first)
     end function mortar_n_blocks
 
-    !> Slave control point b couples every DOF of every point in its support with
-    !> every other, so its block is the edge DOFs and master ranges of all the slave
-    !> elements its function is nonzero on (each once).
+    !> Node b couples every DOF of every point in its support with every other, so
+    !> its block is the edge DOFs and master ranges of all the slave elements its
+    !> function is nonzero on (each once).
     pure function mortar_block_dofs(self, b, mdofs) result(dofs)
         class(mortar_pair_t), intent(in) :: self
         integer, intent(in) :: b
@@ -345,8 +357,7 @@ contains
         lo = huge(1)
         hi = 0
         allocate (used(size(mdofs)/2), source=.false.)
-        do e = 1, size(self%slave%spans)
-            if (b < self%slave%spans(e) - p .or. b > self%slave%spans(e)) cycle
+        do e = self%node_first(b), self%node_last(b)
             lo = min(lo, self%slave%spans(e) - p)
             hi = max(hi, self%slave%spans(e))
             if (self%mlo(e) <= self%mhi(e)) used(self%mlo(e):self%mhi(e)) = .true.
@@ -355,15 +366,63 @@ contains
         dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
     end function mortar_block_dofs
 
-    !> With friction: the shared history and a tangential traction per control point.
+    !> The multiplier basis; with friction the shared history and a tangential
+    !> traction per node.
     pure subroutine mortar_setup_history(self)
         class(mortar_pair_t), intent(inout) :: self
         call pair_setup_history(self)
+        call setup_multipliers(self)
         if (self%law%mu <= 0.0_dp) return
-        allocate (self%traction(size(self%slave%cps)), self%trial_traction(size(self%slave%cps)))
+        allocate (self%traction(size(self%node_first)), self%trial_traction(size(self%node_first)))
         self%traction = 0.0_dp
         self%trial_traction = 0.0_dp
     end subroutine mortar_setup_history
+
+    !> The multiplier basis at the slave points and the supports of its nodes: the
+    !> slave edge's functions (`surface_point`, as the evaluation computes them), or
+    !> the hat functions on the breakpoints, linear in the parameter within an element.
+    pure subroutine setup_multipliers(self)
+        class(mortar_pair_t), intent(inout) :: self
+        type(surface_point_t) :: sp
+        real(dp), allocatable :: u0(:)
+        real(dp) :: s
+        integer :: e, i, k, p, ne, ng, a
+
+        ne = size(self%slave%spans)
+        ng = self%n_gauss
+        p = self%slave%degree
+        if (self%linear_multipliers) then
+            allocate (self%point_nodes(2, ne*ng), self%point_values(2, ne*ng), self%node_first(ne + 1), &
+                      self%node_last(ne + 1))
+            do e = 1, ne
+                do i = 1, ng
+                    k = (e - 1)*ng + i
+                    s = (self%xi(k) - self%slave%breaks(e))/(self%slave%breaks(e + 1) - self%slave%breaks(e))
+                    self%point_nodes(:, k) = [e, e + 1]
+                    self%point_values(:, k) = [1.0_dp - s, s]
+                end do
+            end do
+            self%node_first = [(max(1, a - 1), a=1, ne + 1)]
+            self%node_last = [(min(ne, a), a=1, ne + 1)]
+            return
+        end if
+        allocate (self%point_nodes(p + 1, ne*ng), self%point_values(p + 1, ne*ng), &
+                  self%node_first(size(self%slave%cps)), self%node_last(size(self%slave%cps)))
+        allocate (u0(maxval(self%slave%dofs)), source=0.0_dp)
+        do k = 1, ne*ng
+            call surface_point(self%slave, u0, self%xi(k), sp, self%span(k))
+            self%point_nodes(:, k) = sp%local
+            self%point_values(:, k) = sp%r
+        end do
+        self%node_first = huge(1)
+        self%node_last = 0
+        do e = 1, ne
+            do a = self%slave%spans(e) - p, self%slave%spans(e)
+                self%node_first(a) = min(self%node_first(a), e)
+                self%node_last(a) = max(self%node_last(a), e)
+            end do
+        end do
+    end subroutine setup_multipliers
 
     pure subroutine mortar_commit(self)
         class(mortar_pair_t), intent(inout) :: self
