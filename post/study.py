@@ -153,11 +153,11 @@ def value_text(value: Any) -> str:
 
 def case_stem(base: str, changes: Changes) -> str:
     """``<base stem>+<path>=<value>+...`` (characters other than letters, digits and
-    ``._,=[]-`` become ``_``)."""
+    ``._,=+[]-`` become ``_``)."""
     if not changes:
         return base
     slug = "+".join(f"{path}={value_text(v)}" for path, v in changes)
-    return base + "+" + re.sub(r"[^A-Za-z0-9._,=\[\]-]", "_", slug)
+    return base + "+" + re.sub(r"[^A-Za-z0-9._,=+\[\]-]", "_", slug)
 
 
 def parse_case(text: str, where: str) -> f90nml.Namelist:
