@@ -14,6 +14,7 @@ docs/studies.md is the how-to.
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import re
 import tomllib
@@ -151,13 +152,21 @@ def value_text(value: Any) -> str:
     return str(value)
 
 
+MAX_STEM = 150
+"""Longest case name from the changes; a longer one is replaced by a hash of it."""
+
+
 def case_stem(base: str, changes: Changes) -> str:
     """``<base stem>+<path>=<value>+...`` (characters other than letters, digits and
-    ``._,=+[]-`` become ``_``)."""
+    ``._,=+[]-`` become ``_``; a name longer than MAX_STEM becomes ``<base
+    stem>+<12 hex digits of its SHA-1>``: the table's columns still say the values)."""
     if not changes:
         return base
     slug = "+".join(f"{path}={value_text(v)}" for path, v in changes)
-    return base + "+" + re.sub(r"[^A-Za-z0-9._,=+\[\]-]", "_", slug)
+    stem = base + "+" + re.sub(r"[^A-Za-z0-9._,=+\[\]-]", "_", slug)
+    if len(stem) > MAX_STEM:
+        stem = base + "+" + hashlib.sha1(slug.encode()).hexdigest()[:12]
+    return stem
 
 
 def parse_case(text: str, where: str) -> f90nml.Namelist:

@@ -13,7 +13,7 @@ import pytest
 from post.__main__ import main
 from post.measures import file_measure, parse_file_measure
 from post.reader import read_result
-from post.study import NAMELISTS, load_study
+from post.study import NAMELISTS, case_stem, load_study
 
 REPO = Path(__file__).resolve().parents[2]
 HERTZ = REPO / "cases" / "hertz" / "m1-N2.nml"
@@ -71,6 +71,14 @@ solver = {n_steps = 2, max_cuts = 3}
     # the rest of the case is the base's, value for value
     base = f90nml.read(str(HERTZ))
     assert nml["body"]["knots_xi"] == base["body"]["knots_xi"]
+
+
+def test_long_case_names_are_hashed() -> None:
+    short = case_stem("m1-N2", (("contact.friction", 0.1), ("body[slab].youngs_modulus", 2.0)))
+    assert short == "m1-N2+contact.friction=0.1+body[slab].youngs_modulus=2.0"
+    long = case_stem("m1-N2", (("body[slab].knots_xi", tuple(i / 100 for i in range(1, 100))),))
+    other = case_stem("m1-N2", (("body[slab].knots_xi", tuple(i / 100 for i in range(2, 100))),))
+    assert re.fullmatch(r"m1-N2\+[0-9a-f]{12}", long) and long != other
 
 
 @pytest.mark.parametrize("text, cause", [
