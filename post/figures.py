@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .reader import read_result
+from .sweep import SUMMARY_COLUMNS
 
 LAYOUT_ORDER = ["L1", "N2", "N4", "N6", "NN4", "NN6", "NN2.1", "NN2.2", "NN2.3", "NN3.2"]
 
@@ -214,10 +215,6 @@ def make_all(results: Path, out: Path) -> list[Path]:
     return [p for p in made if p is not None]
 
 
-BOOKKEEPING = {"scene", "mesh", "layout", "case", "dofs", "interface_dofs", "steps", "iterations", "cuts",
-               "wall_s", "status", "exit_code", "error", "measure_error", "time_norm", "assembly_s",
-               "contact_s", "factorization_s", "solve_s", "output_s"}
-"""Summary columns that are not measures (figures of a study plot the others)."""
 
 
 def _cell(row: dict[str, object], key: str) -> object:
@@ -238,7 +235,7 @@ def _safe(name: str) -> str:
 
 
 def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -> list[Path]:
-    """For every measure (a numeric column other than BOOKKEEPING and ``params``): the
+    """For every measure (a numeric column other than SUMMARY_COLUMNS and ``params``): the
     measure against each parameter that takes more than one value (one line per
     combination of the other parameters; ``scene``, ``mesh`` and ``layout`` count as
     parameters when they vary) and against the wall time of the run (one point per
@@ -250,7 +247,7 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
     keys: list[str] = []
     for row in ok:
         keys += [k for k in row if k not in keys]
-    measures = [k for k in keys if k not in BOOKKEEPING and k not in params
+    measures = [k for k in keys if k not in SUMMARY_COLUMNS and k not in params
                 and any(np.isfinite(_num(r, k)) for r in ok)]
     if not ok or not measures:
         return []

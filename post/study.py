@@ -25,7 +25,7 @@ from typing import Any
 import f90nml
 
 from .measures import parse_file_measure
-from .sweep import REPO, Run, find_cases
+from .sweep import REPO, SUMMARY_COLUMNS, Run, find_cases
 
 NAMELISTS: dict[str, frozenset[str]] = {
     "case": frozenset({"title", "scene", "mesh", "layout", "geometry", "output", "n_bodies"}),
@@ -409,6 +409,9 @@ def load_study(path: Path, out: Path | None = None) -> Study:
     if not isinstance(measures, dict) or not all(isinstance(v, str) for v in measures.values()):
         raise StudyError(f"{where}: measures must be a list of measures or a table name = measure")
     for name, expr in measures.items():
+        if name in SUMMARY_COLUMNS or name in study.parameters():
+            raise StudyError(f"{where}: measure name {name!r} is a column of the table already; "
+                             f"name it otherwise (measures = {{ my_name = {expr!r} }})")
         try:
             parse_file_measure(expr)
         except ValueError as err:

@@ -157,6 +157,11 @@ def longest_first(runs: list[Run], times: dict[str, float] | None = None) -> lis
     return sorted(runs, key=expected, reverse=True)
 
 
+SUMMARY_COLUMNS = frozenset({"scene", "mesh", "layout", "case", "dofs", "interface_dofs", "steps", "iterations",
+                             "cuts", "wall_s", *(f"{s}_s" for s in STAGES), "status", "exit_code", "error",
+                             "measure_error", "time_norm"})
+"""The summary's columns that are not measures."""
+
 REFERENCES = {"hertz": "m6-N2", "rings": "ref-N2"}
 """Reference run of each scene for the error measures."""
 

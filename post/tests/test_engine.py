@@ -22,7 +22,7 @@ HERTZ = REPO / "cases" / "hertz" / "m1-N2.nml"
 
 STUDY = """# six hertz m1 cases; the last one fails (one Newton iteration, no cuts)
 base = "{hertz}"
-measures = {{ force_y = "steps/last/contact/1/force[1]", cuts = "n_cuts" }}
+measures = {{ force_y = "steps/last/contact/1/force[1]", run_cuts = "n_cuts" }}
 [[list]]
 contact.penalty_normal = 1000.0
 [[list]]

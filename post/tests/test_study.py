@@ -91,6 +91,7 @@ def test_long_case_names_are_hashed() -> None:
     ('base = "{hertz}"\n[grid]\ncontact.friction = 0.1\n', "must be a non-empty list"),
     ('base = "{hertz}"\nmeasures = ["median(n_dofs)"]\n', "unknown reduction"),
     ('base = "{hertz}"\nbogus = 1\n', "unknown key 'bogus'"),
+    ('base = "{hertz}"\nmeasures = { cuts = "n_cuts" }\n', "is a column of the table already"),
     ('cases = "../.."\nscenes = ["nosuch"]\n', "no committed case"),
     ('base = "{hertz}"\n[grid\n', "not a TOML file"),
 ])
