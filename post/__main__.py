@@ -68,7 +68,7 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_study(study: "Study", args: argparse.Namespace, prog: str) -> int:
+def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
     """Run ``study`` as the command line asks (shared by ``study`` and ``sweep``):
     derive the cases, solve those not up to date on Dask, write the table (and the
     figures); 2 for bad input, 1 if a case failed, else 0."""
