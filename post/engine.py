@@ -138,14 +138,14 @@ def connect(scheduler: str | None = None, jobs: int = 0) -> Iterator[object]:
     """A ``distributed.Client``: of the cluster at ``scheduler``, else of a new
     ``LocalCluster`` (``jobs`` single-threaded workers, default one per core) in this
     process (the work is in the voiga subprocesses). OSError when the scheduler does
-    not answer."""
+    not answer or the address is malformed."""
     import dask
     from distributed import Client, LocalCluster
 
     if scheduler:
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as err:
+        except (OSError, TimeoutError, ValueError) as err:  # ValueError: a malformed address
             raise OSError(f"no Dask scheduler answers at {scheduler} ({err})") from None
         try:
             yield client

@@ -103,6 +103,15 @@ def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.Capture
     assert err.count("\n") == 1 and cause in err and "Traceback" not in err, err
 
 
+def test_malformed_scheduler_address(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    fake = tmp_path / "voiga"
+    fake.write_text("")
+    assert main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(tmp_path / "out"),
+                 "--binary", str(fake), "--scheduler", "foo"]) == 2
+    err = capsys.readouterr().err
+    assert "no Dask scheduler answers at foo" in err and "Traceback" not in err
+
+
 def test_missing_study_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     assert main(["study", str(tmp_path / "none.toml")]) == 2
     assert "no study file" in capsys.readouterr().err
