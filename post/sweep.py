@@ -64,7 +64,7 @@ def find_cases(cases: Path, out: Path, scenes: list[str] | None = None,
     runs = []
     for path in sorted(cases.glob("*/*.nml")):
         scene = path.parent.name
-        mesh, layout = path.stem.split("-", 1)
+        mesh, _, layout = path.stem.partition("-")
         if scenes and scene not in scenes:
             continue
         if meshes and mesh not in meshes:
