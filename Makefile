@@ -31,7 +31,7 @@ deps:
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PKGS) >/dev/null; \
 	fi
-	@if ! $(PYTHON) -c "import numpy, h5py, matplotlib, splipy, f90nml, tqdm, scipy, vtk, pytest, wheel" 2>/dev/null \
+	@if ! $(PYTHON) -c "import numpy, h5py, matplotlib, splipy, f90nml, tqdm, scipy, vtk, pytest, wheel, dask, distributed, pyarrow" 2>/dev/null \
 	   || ! command -v fpm >/dev/null 2>&1; then \
 	  echo "deps: installing Python packages from requirements.txt"; \
 	  $(PYTHON) -m pip install -q -r requirements.txt; \
@@ -76,12 +76,13 @@ stress: build
 bench: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m bench $(BENCH_ARGS)
 
-## paper: run the paper's studies (PAPER_ARGS, e.g. --scenes hertz --meshes m1 m2) into
-## PAPER_OUT and regenerate the figures and tables in docs/validation; fails if a case fails
+## paper: run the paper's studies (the study cases/studies/paper.toml: every committed case;
+## PAPER_ARGS, e.g. --scenes hertz --meshes m1 m2) into PAPER_OUT and regenerate the
+## figures and tables in docs/validation; fails if a case fails
 PAPER_OUT ?= results
 paper: build
 	@status=0; \
-	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post sweep --out $(PAPER_OUT) $(PAPER_ARGS) || status=$$?; \
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post study cases/studies/paper.toml --out $(PAPER_OUT) $(PAPER_ARGS) || status=$$?; \
 	$(PYTHON) -m post figures --results $(PAPER_OUT) --out docs/validation || status=$$?; \
 	exit $$status
 

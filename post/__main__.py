@@ -8,7 +8,9 @@ Subcommands:
   history        reactions and contact forces against the load time (CSV and PNG)
   vtk            ParaView time series (.pvd + .vtu)
   hertz          compare a hertz result with the analytic line contact (and draw it)
-  sweep          run committed cases in parallel and write a summary (CSV, markdown)
+  study          a parameter study from a study file (docs/studies.md): derived cases
+                 run on Dask, one table (CSV, markdown, Parquet) and figures
+  sweep          the committed cases as a study without changes (the same engine)
   figures        validation figures and accuracy/cost tables from a sweep's results
 
 Steps (--step): N >= 1 is the step number, N < 0 counts converged steps from
@@ -21,6 +23,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .study import Study
 
 
 def _scale(text: str) -> float | str:
@@ -126,33 +132,85 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    import os
+def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
+    """Run ``study`` as the command line asks (shared by ``study`` and ``sweep``):
+    derive the cases, solve those not up to date on Dask, write the table (and the
+    figures); 2 for bad input, 1 if a case failed, else 0."""
     from pathlib import Path
 
-    from .sweep import default_binary, find_cases, previous_times, summarize, sweep, write_summary
+    from .engine import connect, run_all
+    from .study import StudyError
+    from .sweep import default_binary, previous_times, summarize, write_summary
 
     binary = Path(args.binary) if args.binary else default_binary()
-    if not binary.exists():
-        print(f"python -m post sweep: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
+    if not binary.exists() and not (args.list or args.summary_only):
+        print(f"{prog}: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
         return 2
-    runs = find_cases(Path(args.cases), Path(args.out), args.scenes, args.meshes, args.layouts)
-    if not runs:
-        print("python -m post sweep: no case matches", file=sys.stderr)
+    try:
+        runs = study.runs()
+    except StudyError as err:
+        print(f"{prog}: {err}", file=sys.stderr)
         return 2
-    failed = 0
+    if args.list:
+        for run in runs:
+            print(run.work)
+        return 0
+    failures: dict[str, tuple[int, str]] = {}
     if not args.summary_only:
-        # the previous sweep's wall times order the runs longest first
-        outcome = sweep(runs, binary, args.jobs or os.cpu_count() or 1, args.timeout, args.force,
-                        progress=not args.no_progress,
-                        times=previous_times(Path(args.out) / "summary.csv"))
-        for label, (code, message) in sorted(outcome.items()):
-            if code != 0:
-                failed += 1
-                print(f"{label}: exit {code}: {message}", file=sys.stderr)
-    csv_path, md_path = write_summary(summarize(runs), Path(args.out))
-    print(f"{len(runs)} cases, {failed} failed; summary in {csv_path} and {md_path}")
-    return 1 if failed else 0
+        try:
+            # the previous summary's wall times order the runs longest first
+            with connect(args.scheduler, args.jobs) as client:
+                outcome = run_all(runs, binary, client, args.timeout or study.timeout, args.force,
+                                  progress=not args.no_progress,
+                                  times=previous_times(study.out / "summary.csv"),
+                                  shared=not args.no_shared_fs)
+        except OSError as err:
+            print(f"{prog}: {err}", file=sys.stderr)
+            return 2
+        failures = {label: (o.code, o.message) for label, o in outcome.items() if o.code != 0}
+        for label, (code, message) in sorted(failures.items()):
+            print(f"{label}: exit {code}: {message}", file=sys.stderr)
+    rows = summarize(runs, study.measures, failures)
+    csv_path, md_path = write_summary(rows, study.out)
+    if study.figures and not getattr(args, "no_figures", False):
+        from .figures import study_figures
+
+        made = study_figures(rows, study.parameters(), study.out / "figures")
+        if made:
+            print(f"{len(made)} figures in {study.out / 'figures'}")
+    print(f"{len(runs)} cases, {len(failures)} failed; summary in {csv_path} and {md_path}")
+    return 1 if failures else 0
+
+
+def _cmd_study(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .study import StudyError, load_study
+
+    prog = "python -m post study"
+    try:
+        study = load_study(Path(args.study), Path(args.out) if args.out else None)
+    except StudyError as err:
+        print(f"{prog}: {err}", file=sys.stderr)
+        return 2
+    for key in ("scenes", "meshes", "layouts"):
+        if getattr(args, key) is not None:
+            if study.base is not None:
+                print(f"{prog}: --{key} selects committed cases; {args.study} has a base case",
+                      file=sys.stderr)
+                return 2
+            setattr(study, key, getattr(args, key))
+    return _run_study(study, args, prog)
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .study import Study
+
+    study = Study(out=Path(args.out), cases=Path(args.cases), scenes=args.scenes, meshes=args.meshes,
+                  layouts=args.layouts, figures=False)
+    return _run_study(study, args, "python -m post sweep")
 
 
 def _cmd_figures(args: argparse.Namespace) -> int:
@@ -163,6 +221,28 @@ def _cmd_figures(args: argparse.Namespace) -> int:
     for path in make_all(Path(args.results), Path(args.out)):
         print(path)
     return 0
+
+
+def _engine_options(s: argparse.ArgumentParser, timeout_default: float) -> None:
+    """The options ``study`` and ``sweep`` share."""
+    s.add_argument("--scenes", nargs="*", help="scenes to run (default: all)")
+    s.add_argument("--meshes", nargs="*", help="meshes to run, e.g. m1 m2 (default: all)")
+    s.add_argument("--layouts", nargs="*", help="layouts to run, e.g. N2 NN2.2 (default: all)")
+    s.add_argument("--jobs", type=int, default=0,
+                   help="workers of the local cluster (default: number of cores)")
+    s.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786 "
+                        "(default: a local cluster)")
+    s.add_argument("--no-shared-fs", action="store_true",
+                   help="the workers do not see --out: results come back through the scheduler")
+    s.add_argument("--timeout", type=float, default=timeout_default,
+                   help="seconds per case (default: " + ("the study file's, else 3600)"
+                                                          if not timeout_default else "3600)"))
+    s.add_argument("--force", action="store_true", help="rerun up-to-date cases too")
+    s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
+    s.add_argument("--list", action="store_true", help="only list the cases (their case files)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.add_argument("--binary", default=None, help="voiga binary (default: $VOIGA_BIN or build/install)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -224,18 +304,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default=None, help="folder for the default file name")
     s.set_defaults(func=_cmd_plot_contact)
 
-    s = sub.add_parser("sweep", help="run committed cases in parallel, summarize")
+    s = sub.add_parser("study", help="a parameter study from a study file (docs/studies.md)")
+    s.add_argument("study", help="study file (TOML)")
+    s.add_argument("--out", default=None,
+                   help="folder of the cases, results, table and figures (default: the file's "
+                        "out, else results/<study name>)")
+    _engine_options(s, timeout_default=0.0)
+    s.add_argument("--no-figures", action="store_true", help="no figures")
+    s.set_defaults(func=_cmd_study)
+
+    s = sub.add_parser("sweep", help="run committed cases in parallel, summarize (a study without changes)")
     s.add_argument("--cases", default="cases", help="folder of committed cases (default: cases)")
     s.add_argument("--out", default="results", help="work and summary folder (default: results)")
-    s.add_argument("--scenes", nargs="*", help="scenes to run (default: all)")
-    s.add_argument("--meshes", nargs="*", help="meshes to run, e.g. m1 m2 (default: all)")
-    s.add_argument("--layouts", nargs="*", help="layouts to run, e.g. N2 NN2.2 (default: all)")
-    s.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores)")
-    s.add_argument("--timeout", type=float, default=3600.0, help="seconds per case (default 3600)")
-    s.add_argument("--force", action="store_true", help="rerun up-to-date cases too")
-    s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
-    s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--binary", default=None, help="voiga binary (default: $VOIGA_BIN or build/install)")
+    _engine_options(s, timeout_default=3600.0)
     s.set_defaults(func=_cmd_sweep)
 
     s = sub.add_parser("figures", help="validation figures and tables from a sweep")

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .reader import read_result
+from .sweep import SUMMARY_COLUMNS
 
 LAYOUT_ORDER = ["L1", "N2", "N4", "N6", "NN4", "NN6", "NN2.1", "NN2.2", "NN2.3", "NN3.2"]
 
@@ -29,10 +30,12 @@ def read_summary(results: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
-def _num(row: dict[str, str], key: str) -> float:
+def _num(row: dict[str, str] | dict[str, object], key: str) -> float:
+    """The cell as a number (NaN when empty or not a number)."""
+    value = row.get(key)
     try:
-        return float(row.get(key, "") or "nan")
-    except ValueError:
+        return float(value) if value not in (None, "") else float("nan")
+    except (TypeError, ValueError):
         return float("nan")
 
 
@@ -210,3 +213,93 @@ def make_all(results: Path, out: Path) -> list[Path]:
         text += [f"\n## {scene}: {error}\n\n", accuracy_cost(rows, scene, error)]
     (out / "accuracy-cost.md").write_text("".join(text))
     return [p for p in made if p is not None]
+
+
+
+
+def _cell(row: dict[str, object], key: str) -> object:
+    value = row.get(key)
+    return "" if value is None else value
+
+
+def _numeric(values: list[object]) -> bool:
+    try:
+        [float(v) for v in values]
+        return True
+    except (TypeError, ValueError):
+        return False
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "._-" else "_" for c in name)
+
+
+def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -> list[Path]:
+    """For every measure (a numeric column other than SUMMARY_COLUMNS and ``params``): the
+    measure against each parameter that takes more than one value (one line per
+    combination of the other parameters; ``scene``, ``mesh`` and ``layout`` count as
+    parameters when they vary) and against the wall time of the run (one point per
+    case, labelled with its parameters). PNG files ``<measure>-vs-<parameter>.png`` and
+    ``<measure>-vs-time.png`` in ``out``; the converged runs only."""
+    ok = [r for r in rows if r.get("status") == "converged"]
+    axes = [p for p in ["scene", "mesh", "layout", *params]
+            if len({str(_cell(r, p)) for r in ok}) > 1]
+    keys: list[str] = []
+    for row in ok:
+        keys += [k for k in row if k not in keys]
+    measures = [k for k in keys if k not in SUMMARY_COLUMNS and k not in params
+                and any(np.isfinite(_num(r, k)) for r in ok)]
+    if not ok or not measures:
+        return []
+    out.mkdir(parents=True, exist_ok=True)
+    plt = _plt()
+    paths = []
+
+    def label(row: dict[str, object], names: list[str]) -> str:
+        return ", ".join(f"{n.rsplit('.', 1)[-1]}={_cell(row, n)}" for n in names)
+
+    for m in measures:
+        for x in axes:
+            others = [p for p in axes if p != x]
+            fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+            xs_all = [_cell(r, x) for r in ok]
+            numeric = _numeric(xs_all)
+            order = list(dict.fromkeys(str(v) for v in xs_all))
+            groups: dict[str, list[dict[str, object]]] = {}
+            for r in ok:
+                groups.setdefault(label(r, others), []).append(r)
+            for name, pts in groups.items():
+                if numeric:
+                    pts = sorted(pts, key=lambda r: float(_cell(r, x)))
+                    xs = [float(_cell(r, x)) for r in pts]
+                else:
+                    pts = sorted(pts, key=lambda r: order.index(str(_cell(r, x))))
+                    xs = [order.index(str(_cell(r, x))) for r in pts]
+                ax.plot(xs, [_num(r, m) for r in pts], "o-", ms=4, label=name or None)
+            if not numeric:
+                ax.set_xticks(range(len(order)), order)
+            ax.set_xlabel(x)
+            ax.set_ylabel(m)
+            ax.set_title(f"{m} against {x}")
+            if others:
+                ax.legend(fontsize=7)
+            path = out / f"{_safe(m)}-vs-{_safe(x)}.png"
+            fig.savefig(path, dpi=110)
+            plt.close(fig)
+            paths.append(path)
+        fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+        walls = [_num(r, "wall_s") for r in ok]
+        values = [_num(r, m) for r in ok]
+        ax.plot(walls, values, "o", ms=5)
+        for r, w, v in zip(ok, walls, values):
+            ax.annotate(label(r, axes), (w, v), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        if min(walls) > 0 and max(walls) > 10 * min(walls):
+            ax.set_xscale("log")
+        ax.set_xlabel("wall time of the run, s")
+        ax.set_ylabel(m)
+        ax.set_title(f"{m} against the run's wall time")
+        path = out / f"{_safe(m)}-vs-time.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths

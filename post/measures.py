@@ -7,11 +7,15 @@
   normalised pressure p/p_max against analytic Hertz and against the reference run
   (N2 on m6).
 - rings: relative L2 errors of p_N and p_T against the reference run (N2, finer mesh).
+
+A study may also name measures read from the result file (:func:`file_measure`).
 """
 
 from __future__ import annotations
 
+import re
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -153,5 +157,67 @@ def measures_for(scene: str, res: Result, ref: Result | None = None) -> dict[str
     return {}
 
 
-__all__ = ["detrended_amplitude", "fit_hertz", "hertz_measures", "ironing_measures",
-           "measures_for", "profile_error", "rings_measures"]
+REDUCTIONS = {"max": np.max, "min": np.min, "mean": np.mean, "sum": np.sum,
+              "absmax": lambda a: np.max(np.abs(a)), "norm": np.linalg.norm}
+"""The reductions a file measure may apply to an array."""
+
+_FILE_MEASURE = re.compile(r"^(?:(?P<fn>\w+)\((?P<inner>.*)\)|(?P<plain>.*))$")
+_INDEXED = re.compile(r"^(?P<path>[\w/.-]+?)(?:\[(?P<index>[-\d\s,]+)\])?$")
+
+
+def parse_file_measure(expr: str) -> tuple[str | None, str, tuple[int, ...]]:
+    """``'max(steps/last/contact/1/p_n)'`` -> (reduction, HDF5 path, index); ValueError
+    for a malformed one. See :func:`file_measure`."""
+    m = _FILE_MEASURE.match(expr.strip())
+    fn = m.group("fn") if m else None
+    body = (m.group("inner") if fn else m.group("plain")).strip() if m else ""
+    if fn is not None and fn not in REDUCTIONS:
+        raise ValueError(f"unknown reduction {fn!r} in {expr!r} (known: {', '.join(REDUCTIONS)})")
+    k = _INDEXED.match(body)
+    if not k or not k.group("path").strip("/"):
+        raise ValueError(f"{expr!r} is not [reduction(]path[index][)], e.g. "
+                         f"'steps/last/contact/1/force[1]' or 'max(steps/last/contact/1/p_n)'")
+    index = tuple(int(i) for i in k.group("index").split(",")) if k.group("index") else ()
+    return fn, k.group("path").strip("/"), index
+
+
+def file_measure(path: Path, expr: str) -> float:
+    """A number read from a result file (docs/hdf5.md): ``[reduction(]path[index][)]``.
+    ``path`` is an HDF5 dataset or attribute (the last component may name an attribute
+    of the group before it), from the root; ``steps/last`` (or ``steps/-k``) is the
+    last (k-th last) converged step's group. ``index`` picks an element (0-based, in
+    h5py's shape: ``steps/last/reactions[0,1]`` is y of the first Dirichlet condition);
+    ``reduction`` (max, min, mean, sum, absmax, norm) turns an array into a number.
+    KeyError when the file has no such path, ValueError when the value is not one
+    number."""
+    import h5py
+
+    fn, hpath, index = parse_file_measure(expr)
+    parts = hpath.split("/")
+    with h5py.File(path, "r") as f:
+        if parts[0] == "steps" and len(parts) > 1 and (parts[1] == "last" or parts[1].startswith("-")):
+            names = sorted(f["steps"]) if "steps" in f else []
+            back = 1 if parts[1] == "last" else -int(parts[1])
+            if not names or back > len(names):
+                raise KeyError("no such converged step")
+            parts[1] = names[-back]
+        group, last = "/".join(parts[:-1]) or "/", parts[-1]
+        if "/".join(parts) in f:
+            value = np.asarray(f["/".join(parts)][()])
+        elif group in f and last in f[group].attrs:
+            value = np.asarray(f[group].attrs[last])
+        else:
+            raise KeyError(f"no {hpath!r} in the result")
+    if value.dtype.kind in "SUO":
+        raise ValueError(f"{hpath!r} is not a number")
+    if index:
+        value = value[index]
+    if fn is not None:
+        value = np.asarray(REDUCTIONS[fn](value))
+    if value.size != 1:
+        raise ValueError(f"{expr!r} is an array of shape {value.shape}: index or reduce it")
+    return float(value.reshape(()))
+
+
+__all__ = ["detrended_amplitude", "file_measure", "fit_hertz", "hertz_measures", "ironing_measures",
+           "measures_for", "parse_file_measure", "profile_error", "rings_measures"]

@@ -1,9 +1,10 @@
-"""Run a set of cases in parallel and summarize them (``python -m post sweep``).
+"""The cases of a sweep or study and their summary table (``python -m post sweep``).
 
-Each case is copied with its scene's geometry into ``<out>/<scene>/`` and solved there by
-``voiga``; a case whose result is converged and newer than the case file, the geometry
-and the binary is skipped. The summary (CSV and markdown) lists DOFs, Newton
-iterations, load-step cuts, wall time per stage, status and the scene's error measures
+A :class:`Run` is one case: a committed case file copied into ``<out>/<scene>/``, or a
+case derived from one by a study (``post/study.py``). The engine (``post/engine.py``)
+solves them; a case whose result is converged and newer than its inputs and the binary
+is skipped. The summary (CSV, markdown, Parquet) lists DOFs, Newton iterations,
+load-step cuts, wall time per stage, status and the scene's error measures
 (``post/measures.py``).
 """
 
@@ -11,14 +12,9 @@ from __future__ import annotations
 
 import csv
 import os
-import shutil
-import subprocess
-import sys
-from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-
-from tqdm import tqdm
+from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 STAGES = ("assembly", "contact", "factorization", "solve", "output")
@@ -26,15 +22,23 @@ STAGES = ("assembly", "contact", "factorization", "solve", "output")
 
 @dataclass
 class Run:
-    """One case of a sweep."""
+    """One case of a sweep or study."""
 
     scene: str
     mesh: str
     layout: str
     case: Path
-    """The committed case file."""
+    """The committed (or base) case file it comes from."""
     work: Path
     """The copy that is solved (its result is written beside it)."""
+    text: str | None = None
+    """The case text to solve, when it differs from ``case``'s (a derived or generated case)."""
+    changes: tuple[tuple[str, Any], ...] = ()
+    """The study's changes: (variable path, value)."""
+    params: dict[str, Any] = field(default_factory=dict)
+    """Every variable the study changes -> its value in this case."""
+    geometry_file: Path | None = None
+    """The geometry file, if not ``geometry.h5`` next to ``case``."""
 
     @property
     def result(self) -> Path:
@@ -42,7 +46,16 @@ class Run:
 
     @property
     def label(self) -> str:
-        return f"{self.scene}/{self.mesh}-{self.layout}"
+        return f"{self.scene}/{self.work.stem}"
+
+    @property
+    def geometry(self) -> Path:
+        """The geometry file (``&case geometry``)."""
+        return self.geometry_file or self.case.parent / "geometry.h5"
+
+    def case_text(self) -> str:
+        """The text of the case to solve."""
+        return self.text if self.text is not None else self.case.read_text()
 
 
 def find_cases(cases: Path, out: Path, scenes: list[str] | None = None,
@@ -51,7 +64,7 @@ def find_cases(cases: Path, out: Path, scenes: list[str] | None = None,
     runs = []
     for path in sorted(cases.glob("*/*.nml")):
         scene = path.parent.name
-        mesh, layout = path.stem.split("-", 1)
+        mesh, _, layout = path.stem.partition("-")
         if scenes and scene not in scenes:
             continue
         if meshes and mesh not in meshes:
@@ -77,55 +90,20 @@ def up_to_date(run: Run, binary: Path) -> bool:
     if status != "converged":
         return False
     stamp = run.result.stat().st_mtime
-    inputs = [run.case, run.case.parent / "geometry.h5", binary]
+    inputs = [run.case, run.geometry, run.work, binary]
     return all(stamp > p.stat().st_mtime for p in inputs if p.exists())
 
 
-def prepare(run: Run) -> None:
-    """Copy the case and its geometry into the work folder."""
-    run.work.parent.mkdir(parents=True, exist_ok=True)
-    geo = run.case.parent / "geometry.h5"
-    target = run.work.parent / "geometry.h5"
-    if not target.exists() or target.stat().st_mtime < geo.stat().st_mtime:
-        shutil.copy2(geo, target)
-    text = run.case.read_text()
-    # the result goes next to the work copy, named after it
-    run.work.write_text(text)
-
-
-def single_thread_env() -> dict[str, str]:
-    """The environment with one BLAS thread per run (unless the caller set one).
-
-    The sweep runs one case per core; OpenBLAS threads on top of that only spin
-    (measured: 1.5x the CPU time on ironing m3 N6 with two threads).
-    """
-    env = dict(os.environ)
-    env.setdefault("OPENBLAS_NUM_THREADS", "1")
-    return env
-
-
-def solve(run: Run, binary: Path, timeout: float) -> tuple[Run, int, str]:
-    """Run voiga on one case; (run, exit code, last stderr line)."""
-    prepare(run)
-    try:
-        proc = subprocess.run([str(binary), str(run.work), "--quiet"], capture_output=True,
-                              text=True, timeout=timeout, env=single_thread_env())
-    except subprocess.TimeoutExpired:
-        return run, -1, f"timed out after {timeout:g} s"
-    lines = (proc.stderr or "").strip().splitlines()
-    return run, proc.returncode, lines[-1] if lines else ""
-
-
-def estimated_cost(case: Path) -> float:
+def estimated_cost(case: Path, text: str | None = None) -> float:
     """Relative cost of solving a case, from its case file alone: for every body its
     control points (nel_xi + p)(nel_eta + q) times the stencil (2p + 1)(2q + 1) of a
     matrix column (p, q the bulk degrees; an explicit knot vector gives nel), times
     the load steps of all phases. Within a factor of about 2 of the measured wall
     times of ``make paper`` (ironing m4 N6 / N2: 2.8 estimated, 2.7 measured); it
-    only has to order the runs."""
+    only has to order the runs. ``text``: the case's text, if not the file's."""
     import f90nml
 
-    nml = f90nml.read(str(case))
+    nml = f90nml.reads(text) if text is not None else f90nml.read(str(case))
     bodies = nml.get("body", [])
     bodies = [bodies] if isinstance(bodies, dict) else list(bodies)
     work = 0.0
@@ -144,7 +122,7 @@ def estimated_cost(case: Path) -> float:
 
 
 def previous_times(summary: Path) -> dict[str, float]:
-    """label (``scene/mesh-layout``) -> wall seconds of a previous sweep's
+    """label (``scene/<case>``) -> wall seconds of a previous sweep's
     ``summary.csv`` (empty when there is none)."""
     times: dict[str, float] = {}
     if not summary.is_file():
@@ -156,7 +134,7 @@ def previous_times(summary: Path) -> dict[str, float]:
             except ValueError:
                 continue
             if wall == wall and wall > 0 and row.get("status") == "converged":
-                times[f"{row['scene']}/{row['mesh']}-{row['layout']}"] = wall
+                times[f"{row['scene']}/{row.get('case') or row['mesh'] + '-' + row['layout']}"] = wall
     return times
 
 
@@ -169,7 +147,7 @@ def longest_first(runs: list[Run], times: dict[str, float] | None = None) -> lis
     first too: replayed with the times of the make paper run, both orders give the
     same 679 s on 2 cores, half the 1357 s of the runs.)"""
     times = times or {}
-    cost = {r.label: estimated_cost(r.case) for r in runs}
+    cost = {r.label: estimated_cost(r.case, r.text) for r in runs}
     ratios = sorted(times[r.label] / cost[r.label] for r in runs if r.label in times and cost[r.label] > 0)
     scale = ratios[len(ratios) // 2] if ratios else 1.0
 
@@ -179,46 +157,41 @@ def longest_first(runs: list[Run], times: dict[str, float] | None = None) -> lis
     return sorted(runs, key=expected, reverse=True)
 
 
-def sweep(runs: list[Run], binary: Path, jobs: int, timeout: float, force: bool = False,
-          progress: bool = True, times: dict[str, float] | None = None) -> dict[str, tuple[int, str]]:
-    """Solve every run not up to date, ``jobs`` at a time, longest first
-    (:func:`longest_first`; ``times``: wall seconds of a previous sweep, label ->
-    seconds); label -> (exit code, message)."""
-    todo = [r for r in runs if force or not up_to_date(r, binary)]
-    outcome: dict[str, tuple[int, str]] = {r.label: (0, "up to date") for r in runs if r not in todo}
-    # longest first keeps both cores busy until the end
-    todo = longest_first(todo, times)
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(solve, r, binary, timeout) for r in todo]
-        bar = tqdm(total=len(futures), desc="sweep", unit="case", disable=not progress, file=sys.stderr)
-        for fut in as_completed(futures):
-            run, code, message = fut.result()
-            outcome[run.label] = (code, message)
-            bar.set_postfix_str(run.label)
-            bar.update()
-        bar.close()
-    return outcome
-
+SUMMARY_COLUMNS = frozenset({"scene", "mesh", "layout", "case", "dofs", "interface_dofs", "steps", "iterations",
+                             "cuts", "wall_s", *(f"{s}_s" for s in STAGES), "status", "exit_code", "error",
+                             "measure_error", "time_norm"})
+"""The summary's columns that are not measures."""
 
 REFERENCES = {"hertz": "m6-N2", "rings": "ref-N2"}
 """Reference run of each scene for the error measures."""
 
 
-def summarize(runs: list[Run]) -> list[dict[str, object]]:
-    """One row per run with a result file: DOFs, iterations, cuts, seconds, status,
-    measures; ironing amplitudes as % of N2 on the same mesh; time normalised by the
-    scene's most expensive run (the paper's Eq. 36)."""
-    from .measures import measures_for
+def summarize(runs: list[Run], measures: dict[str, str] | None = None,
+              failures: dict[str, tuple[int, str]] | None = None) -> list[dict[str, object]]:
+    """One row per run: scene, mesh, layout (and for a study's derived cases the case
+    name and the value of every variable the study changes), DOFs, iterations, cuts,
+    seconds, status, the scene's measures and the ``measures`` named by the study
+    (column -> :func:`post.measures.file_measure`); ironing amplitudes as % of N2 on the
+    same mesh with the same changes; time normalised by the scene's most expensive run
+    (the paper's Eq. 36). ``failures``: label -> (exit code, message) of the runs that
+    failed in this study, recorded in ``exit_code`` and ``error``. The error measures
+    compare with the scene's reference run (REFERENCES) with the same changes."""
+    from .measures import file_measure, measures_for
     from .reader import read_result
 
     refs = {}
-    for scene, stem in REFERENCES.items():
-        for run in runs:
-            if run.scene == scene and f"{run.mesh}-{run.layout}" == stem and run.result.exists():
-                refs[scene] = read_result(run.result, lazy=True)
+    for run in runs:
+        if REFERENCES.get(run.scene) == f"{run.mesh}-{run.layout}" and run.result.exists():
+            refs[(run.scene, run.changes)] = read_result(run.result, lazy=True)
     rows = []
     for run in runs:
         row: dict[str, object] = {"scene": run.scene, "mesh": run.mesh, "layout": run.layout}
+        if run.changes:
+            row["case"] = run.work.stem
+        row.update({k: value_cell(v) for k, v in run.params.items()})
+        code, message = (failures or {}).get(run.label, (0, ""))
+        if code:
+            row["exit_code"], row["error"] = code, message
         if not run.result.exists():
             row["status"] = "no result"
             rows.append(row)
@@ -233,12 +206,18 @@ def summarize(runs: list[Run]) -> list[dict[str, object]]:
         for stage in STAGES:
             row[f"{stage}_s"] = round(sum(s.seconds.get(stage, 0.0) for s in res.steps), 4)
         row["status"] = res.status
-        row.update(measures_for(run.scene, res, refs.get(run.scene)))
+        row.update(measures_for(run.scene, res, refs.get((run.scene, run.changes))))
+        for name, expr in (measures or {}).items():
+            try:
+                row[name] = file_measure(run.result, expr)
+            except (KeyError, ValueError, IndexError, TypeError) as err:
+                row[name] = float("nan")
+                row["measure_error"] = f"{name}: {err}"
         rows.append(row)
-    for row in rows:
+    for run, row in zip(runs, rows):
         if str(row["scene"]).startswith("ironing") and "amp_px" in row:
-            n2 = [r for r in rows if r["scene"] == row["scene"] and r["mesh"] == row["mesh"]
-                  and r["layout"] == "N2" and "amp_px" in r]
+            n2 = [r for u, r in zip(runs, rows) if u.scene == run.scene and u.mesh == run.mesh
+                  and u.layout == "N2" and u.changes == run.changes and "amp_px" in r]
             if n2:
                 row["px_pct_n2"] = 100.0 * float(row["amp_px"]) / float(n2[0]["amp_px"])
                 row["py_pct_n2"] = 100.0 * float(row["amp_py"]) / float(n2[0]["amp_py"])
@@ -250,8 +229,16 @@ def summarize(runs: list[Run]) -> list[dict[str, object]]:
     return rows
 
 
+def value_cell(value: Any) -> object:
+    """A namelist value as a table cell: scalars as they are, arrays space-separated."""
+    if isinstance(value, (list, tuple)):
+        return " ".join(str(v) for v in value)
+    return value
+
+
 def write_summary(rows: list[dict[str, object]], out: Path) -> tuple[Path, Path]:
-    """``summary.csv`` and ``summary.md`` in ``out``."""
+    """``summary.csv`` and ``summary.md`` in ``out``, and ``summary.parquet`` when
+    pyarrow is installed (:func:`write_parquet`)."""
     keys: list[str] = []
     for row in rows:
         keys += [k for k in row if k not in keys]
@@ -270,7 +257,30 @@ def write_summary(rows: list[dict[str, object]], out: Path) -> tuple[Path, Path]
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
     lines += ["| " + " | ".join(fmt(row.get(k)) for k in keys) + " |" for row in rows]
     md_path.write_text("\n".join(lines) + "\n")
+    write_parquet(rows, keys, out / "summary.parquet")
     return csv_path, md_path
+
+
+def write_parquet(rows: list[dict[str, object]], keys: list[str], path: Path) -> Path | None:
+    """The table as Parquet (pyarrow): a column whose values are all numbers (or
+    missing) is float64 or int64, any other a string column. None without pyarrow."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return None
+    columns = {}
+    for key in keys:
+        values = [None if row.get(key) == "" else row.get(key) for row in rows]
+        present = [v for v in values if v is not None]
+        if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
+            columns[key] = pa.array(values, type=pa.int64())
+        elif present and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in present):
+            columns[key] = pa.array([None if v is None else float(v) for v in values], type=pa.float64())
+        else:
+            columns[key] = pa.array([None if v is None else str(v) for v in values], type=pa.string())
+    pq.write_table(pa.table(columns), path)
+    return path
 
 
 def default_binary() -> Path:

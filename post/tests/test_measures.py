@@ -10,8 +10,9 @@ import pytest
 
 from post.figures import accuracy_cost
 from post.measures import detrended_amplitude, profile_error
-from post.sweep import (estimated_cost, find_cases, longest_first, previous_times, summarize, sweep,
-                        up_to_date, write_summary)
+from post.engine import connect, run_all
+from post.sweep import (estimated_cost, find_cases, longest_first, previous_times, summarize, up_to_date,
+                        write_summary)
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -55,11 +56,12 @@ def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
         pytest.skip(f"no voiga binary at {binary}")
     runs = find_cases(REPO / "cases", tmp_path, ["hertz"], ["m1"], ["L1", "N2"])
     assert [r.label for r in runs] == ["hertz/m1-L1", "hertz/m1-N2"]
-    outcome = sweep(runs, binary, jobs=2, timeout=300, progress=False)
-    assert all(code == 0 for code, _ in outcome.values()), outcome
-    assert all(up_to_date(r, binary) for r in runs)
-    again = sweep(runs, binary, jobs=2, timeout=300, progress=False)
-    assert all(msg == "up to date" for _, msg in again.values())
+    with connect(jobs=2) as client:
+        outcome = run_all(runs, binary, client, timeout=300, progress=False)
+        assert all(o.code == 0 for o in outcome.values()), outcome
+        assert all(up_to_date(r, binary) for r in runs)
+        again = run_all(runs, binary, client, timeout=300, progress=False)
+    assert all(o.message == "up to date" for o in again.values())
     csv_path, md_path = write_summary(summarize(runs), tmp_path)
     rows = list(csv.DictReader(csv_path.open()))
     assert [int(r["dofs"]) for r in rows] == [980, 1078]
