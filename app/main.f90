@@ -6,7 +6,7 @@ program voiga_main
     use voiga_version, only: voiga_version_string
     use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_dump, only: write_dump
-    use voiga_io_bodies, only: discretize_bodies
+    use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
     use voiga_io_results, only: restart_case, read_restart
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
@@ -81,6 +81,8 @@ program voiga_main
     call read_case(case_path, case, error)
     if (allocated(error)) call fail(error)
     call discretize_bodies(case, discs, error)
+    if (allocated(error)) call fail(error)
+    call read_rigid_curves(case, error)
     if (allocated(error)) call fail(error)
 
     total = 0

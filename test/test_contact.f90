@@ -23,11 +23,12 @@ module test_contact
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t, mortar_snapshot_t
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model
     implicit none
     private
 
-    public :: collect_contact, two_body_model
+    public :: collect_contact, two_body_model, penetrating_state, run_fd
 
     real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -65,8 +66,9 @@ contains
 
 
     !> Die (half annulus, outer radius 3, lowest point (2.5, 0)) over a 9 x 3 slab,
-    !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0).
-    subroutine two_body_model(layout, mu, rigid, model, error, method)
+    !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0, or with
+    !> `curve` the rigid obstacle it bounds).
+    subroutine two_body_model(layout, mu, rigid, model, error, method, curve)
         character(len=*), intent(in) :: layout
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -74,6 +76,8 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Contact method ('gpts' when absent).
         character(len=*), intent(in), optional :: method
+        !> A rigid master bounded by this curve instead of the line (with `rigid`).
+        type(nurbs_curve_t), intent(in), optional :: curve
         type(scene_t) :: c
         type(discretization_t) :: discs(2)
         character(len=8), parameter :: names(2) = [character(len=8) :: 'die', 'slab']
@@ -98,6 +102,10 @@ contains
         c%contact(1)%penalty_tangent = 70.0_dp
         c%contact(1)%friction = mu
         if (present(method)) c%contact(1)%method = method
+        if (present(curve)) then
+            c%contact(1)%rigid_curve = 'curve'
+            c%contact(1)%curve = curve
+        end if
         call new_discretization(discs(1), annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
                                 c%bodies(1)%layout, '', error)
         if (allocated(error)) return
@@ -186,7 +194,7 @@ contains
         end subroutine add_dense
     end subroutine contact_fd
 
-    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method)
+    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method, curve)
         character(len=*), intent(in) :: layouts(:)
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -199,12 +207,14 @@ contains
         !> Contact method ('gpts' when absent); mortar: the shift is that of the last
         !> converged projections, the committed tractions are zero.
         character(len=*), intent(in), optional :: method
+        !> A rigid master bounded by this curve (with `rigid`).
+        type(nurbs_curve_t), intent(in), optional :: curve
         type(model_t) :: model
         real(dp), allocatable :: u(:), r(:)
         integer :: il
 
         do il = 1, size(layouts)
-            call two_body_model(trim(layouts(il)), mu, rigid, model, error, method)
+            call two_body_model(trim(layouts(il)), mu, rigid, model, error, method, curve)
             if (allocated(error)) return
             call penetrating_state(model, u)
             if (mu > 0.0_dp) then

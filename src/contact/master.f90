@@ -1,6 +1,8 @@
-!> The master side of a contact pair: a deformable body's contact edge (NURBS)
-!> or a rigid straight line without DOFs. Both answer the closest-point projection
-!> of a slave point with a `master_point_t`.
+!> The master side of a contact pair: a deformable body's contact edge (NURBS),
+!> or a rigid obstacle without DOFs (a straight line, or any NURBS curve of the
+!> geometry file). Each answers the closest-point projection of a slave point
+!> with a `master_point_t`; a rigid one is moved by its prescribed motion
+!> (`move`, called by the model at the load time before every assembly).
 module voiga_contact_master
     use voiga_kinds, only: dp
     implicit none
@@ -31,6 +33,7 @@ module voiga_contact_master
         procedure(project_interface), deferred :: project
         procedure(all_dofs_interface), deferred :: all_dofs
         procedure :: prepare => master_prepare
+        procedure :: move => master_move
     end type contact_master_t
 
     abstract interface
@@ -64,5 +67,13 @@ contains
         real(dp), intent(in) :: u(:)
         ! a rigid master has nothing to update
     end subroutine master_prepare
+
+    !> Put a rigid master at its reference position translated by `offset`
+    !> (its prescribed motion at the current load time). Default: nothing (a
+    !> deformable master moves with its body's DOFs).
+    pure subroutine master_move(self, offset)
+        class(contact_master_t), intent(inout) :: self
+        real(dp), intent(in) :: offset(2)
+    end subroutine master_move
 
 end module voiga_contact_master

@@ -115,7 +115,7 @@ contains
         end do
         rewind (u)
         do i = 1, size(self%contact)
-            call read_contact(u, self%path, i, self%bodies, self%contact(i), error)
+            call read_contact(u, self%path, i, nph, self%bodies, self%contact(i), error)
             if (allocated(error)) return
         end do
     end subroutine read_groups

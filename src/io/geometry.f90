@@ -1,15 +1,17 @@
-!> Reading the coarse exact patches of a scene from its geometry HDF5 file
-!> (schema in docs/formats.md), with every value validated.
+!> Reading the coarse exact patches of a scene and the curves of its rigid
+!> obstacles from its geometry HDF5 file (schema in docs/formats.md), with every
+!> value validated.
 module voiga_io_geometry
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5, only: h5file_t
     use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels
+    use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
 
-    public :: read_patch, validate_knots
+    public :: read_patch, read_curve, validate_knots
 
 contains
 
@@ -104,6 +106,56 @@ contains
             end do
         end do
     end subroutine read_patch
+
+    !> Read the curve `name` (/curves/<name>: a rigid obstacle's boundary) from the
+    !> open geometry file `h5`.
+    subroutine read_curve(h5, name, curve, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        type(nurbs_curve_t), intent(out) :: curve
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: g, where
+        integer, allocatable :: degree(:)
+        real(dp), allocatable :: cp(:, :)
+
+        g = '/curves/'//trim(name)
+        where = h5%path//": curve '"//trim(name)//"': "
+        if (.not. h5%exists(g)) then
+            call fatal_error(error, h5%path//": no curve '"//trim(name)//"' (group "//g// &
+                             " is missing)", error_code%input)
+            return
+        end if
+        call h5%read(g//'/degree', degree, error)
+        if (allocated(error)) return
+        if (size(degree) /= 1) then
+            call fatal_error(error, where//'degree must have 1 entry', error_code%input)
+            return
+        end if
+        if (degree(1) < 1 .or. degree(1) > 20) then
+            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
+            return
+        end if
+        curve%degree = degree(1)
+        call h5%read(g//'/knots', curve%knots, error)
+        if (allocated(error)) return
+        call h5%read(g//'/control_points', cp, error)
+        if (allocated(error)) return
+        call h5%read(g//'/weights', curve%w, error)
+        if (allocated(error)) return
+        if (size(cp, 1) /= 2 .or. size(curve%w) /= size(cp, 2)) then
+            call fatal_error(error, where//'control_points must have shape (n, 2) and weights (n,)', &
+                             error_code%input)
+            return
+        end if
+        call validate_knots(curve%knots, curve%degree, size(cp, 2), where//'knots', error)
+        if (allocated(error)) return
+        if (.not. all(ieee_is_finite(cp))) then
+            call fatal_error(error, where//'control_points must be finite', error_code%input)
+        else if (.not. all(curve%w > 0.0_dp .and. ieee_is_finite(curve%w))) then
+            call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
+        end if
+        curve%cp = cp
+    end subroutine read_curve
 
     !> A knot vector of `n` functions of degree `p`: length n+p+1, finite,
     !> non-decreasing, open (end multiplicity p+1) on [0, 1], interior

@@ -9,9 +9,11 @@ module voiga_io_results
     use voiga_version, only: voiga_version_string
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
-    use voiga_io_dump, only: write_discretization
+    use voiga_io_dump, only: write_discretization, write_curve
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
+    use voiga_contact_master_curve, only: rigid_curve_t
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
     use voiga_solver_records, only: step_record_t, cut_record_t, stage_names
     use voiga_solver_progress, only: progress_t, step_report_t
@@ -296,6 +298,13 @@ contains
             call h5%write(c//'/rigid_point', m%p0, error)
             if (allocated(error)) return
             call h5%write(c//'/rigid_normal', m%n, error)
+            if (allocated(error)) return
+        type is (rigid_curve_t)
+            ! where the obstacle is at this step, and its translation from time 0
+            call write_curve(h5, c//'/rigid_curve', nurbs_curve_t(m%surf%degree, m%surf%knots, m%surf%x0, &
+                                                                  m%surf%w), error)
+            if (allocated(error)) return
+            call h5%write(c//'/rigid_offset', m%offset, error)
             if (allocated(error)) return
         end select
         call h5%write(c//'/force', pair%force, error)
