@@ -7,7 +7,7 @@ uses; it keeps string arrays as field data (units, provenance), which meshio's V
 writer does not; and it is actively released. The cost is a larger wheel.
 
 Per converged step (plus the reference configuration at load time 0) the series has
-up to three parts (``<DataSet part=...>`` in the ``.pvd``; ParaView shows them as
+up to four parts (``<DataSet part=...>`` in the ``.pvd``; ParaView shows them as
 blocks):
 
 - ``bodies``: every body finely sampled: each element split into at least
@@ -23,6 +23,10 @@ blocks):
   (NaN where the point has no projection), ``state`` (0 open, 1 stick, 2 slip),
   ``traction`` (the vector ``p_n n + p_t t`` on the slave, with the master's outward
   normal ``n`` and tangent ``t``), ``pair`` (0-based, case-file order).
+- ``rigid``: the rigid masters, one polyline each at its position at load time 0
+  (a curve sampled finely; a line as a segment across the bodies), with point data
+  ``displacement`` (its prescribed translation at the step: *Warp By Vector* puts it
+  where it is) and ``normal`` (outward), cell data ``pair``.
 - ``fields``: stress, strain and von Mises when the result file carries them
   (``/steps/<k>/fields/<body>``; not written by voiga yet, see docs/hdf5.md): one
   vertex per sample point at its reference position, with ``displacement`` and
@@ -40,6 +44,8 @@ from pathlib import Path
 import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+from pre.nurbs import curve_to_splipy
 
 from .field import combine, displacement, evaluate
 from .naming import output_path
@@ -161,9 +167,16 @@ def bodies_grid(result: Result, step: Step | None, samples: int = SAMPLES) -> vt
 
 def master_frame(result: Result, step: Step, c: ContactOutput) -> tuple[np.ndarray, np.ndarray]:
     """Unit outward normals and tangents ``(n, 2)`` of the master at each slave point's
-    projection (the directions of ``p_n`` and ``p_t``): the rigid line's, or the
-    master body's contact edge (at eta = 1 of its oriented patch) at ``xi_master``."""
+    projection (the directions of ``p_n`` and ``p_t``): the rigid line's, the rigid
+    curve's at ``xi_master``, or the master body's contact edge (at eta = 1 of its
+    oriented patch) at ``xi_master``."""
     m = len(c.p_n)
+    if c.rigid_curve is not None:
+        spline = curve_to_splipy(c.rigid_curve)
+        xi = np.clip(np.nan_to_num(c.xi_master, nan=0.5), 0.0, 1.0)
+        tangent = np.asarray(spline.derivative(xi))[:, :2].reshape(m, 2)
+        tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+        return np.column_stack([tangent[:, 1], -tangent[:, 0]]), tangent
     if c.rigid_normal is not None:
         n = np.asarray(c.rigid_normal, dtype=float)
         n = n / np.linalg.norm(n)
@@ -208,6 +221,42 @@ def contact_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
     _field_data(grid, result, step)
     pairs = [f"{c.slave}->{c.master}" for c in step.contact]
     grid.GetFieldData().AddArray(_string_array("pair_names", pairs))
+    return grid
+
+
+def rigid_grid(result: Result, step: Step, samples: int = 400) -> vtk.vtkUnstructuredGrid | None:
+    """The rigid masters of the step (see the module docstring); None without any."""
+    size = max(float(np.ptp(b.control_points, axis=0).max()) for b in result.bodies.values())
+    pts, disp, normals, cells, pair = [], [], [], [], []
+    offset = 0
+    for k, c in enumerate(step.contact):
+        shift = np.zeros(2) if c.rigid_offset is None else np.asarray(c.rigid_offset, dtype=float)
+        if c.rigid_curve is not None:
+            spline = curve_to_splipy(c.rigid_curve)
+            t = np.linspace(0.0, 1.0, samples)
+            x = np.asarray(spline(t))[:, :2]
+            a = np.asarray(spline.derivative(t))[:, :2]
+            n = np.column_stack([a[:, 1], -a[:, 0]]) / np.linalg.norm(a, axis=1)[:, None]
+        elif c.rigid_point is not None and c.rigid_normal is not None:
+            n1 = np.asarray(c.rigid_normal, dtype=float) / np.linalg.norm(c.rigid_normal)
+            reach = 1.5 * size * np.linspace(-1.0, 1.0, 2)[:, None]
+            x = np.asarray(c.rigid_point, dtype=float) + reach * np.array([n1[1], -n1[0]])
+            n = np.tile(n1, (2, 1))
+        else:
+            continue
+        pts.append(x - shift)
+        disp.append(np.tile(shift, (len(x), 1)))
+        normals.append(n)
+        cells.append(offset + np.arange(len(x)))
+        pair.append(k)
+        offset += len(x)
+    if not pts:
+        return None
+    grid = _grid(np.concatenate(pts), cells, vtk.VTK_POLY_LINE)
+    grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
+    grid.GetPointData().AddArray(_array("normal", _vec3(np.concatenate(normals))))
+    grid.GetCellData().AddArray(_array("pair", np.array(pair)))
+    _field_data(grid, result, step)
     return grid
 
 
@@ -265,7 +314,8 @@ def write_vtk(result: Result, out: str | Path | None = None, samples: int = SAMP
         number, time = (0, 0.0) if step is None else (step.step, step.time)
         parts = [("bodies", bodies_grid(result, step, samples))]
         if step is not None:
-            parts += [("contact", contact_grid(result, step)), ("fields", fields_grid(result, step))]
+            parts += [("contact", contact_grid(result, step)), ("rigid", rigid_grid(result, step)),
+                      ("fields", fields_grid(result, step))]
         for index, (what, grid) in enumerate(parts):
             if grid is None:
                 continue

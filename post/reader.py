@@ -154,6 +154,11 @@ class ContactOutput:
     """(2,) a point of a rigid master line (None for a deformable master)."""
     rigid_normal: np.ndarray | None = None
     """(2,) the rigid master line's unit outward normal."""
+    rigid_curve: Curve | None = None
+    """A rigid master bounded by a curve: the curve where it is at this step (the
+    obstacle on its left, outward normal ``(a_y, -a_x)/|a|``; None otherwise)."""
+    rigid_offset: np.ndarray | None = None
+    """(2,) that curve's translation from its position at load time 0."""
 
     @property
     def active(self) -> np.ndarray:
@@ -500,7 +505,9 @@ def _read_contact(g: h5py.Group) -> ContactOutput:
                          xi_master=vec("xi_master"),
                          state=np.asarray(g["state"][()], dtype=int).reshape(-1), attrs=a,
                          rigid_point=vec("rigid_point") if "rigid_point" in g else None,
-                         rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None)
+                         rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None,
+                         rigid_curve=read_curve(g["rigid_curve"]) if "rigid_curve" in g else None,
+                         rigid_offset=vec("rigid_offset") if "rigid_offset" in g else None)
 
 
 def read_result(path: str | Path, lazy: bool = False) -> Result:

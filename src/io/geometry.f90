@@ -11,7 +11,7 @@ module voiga_io_geometry
     implicit none
     private
 
-    public :: read_patch, read_curve, validate_knots
+    public :: read_patch, read_curve, validate_knots, geometry_units
 
 contains
 
@@ -106,6 +106,22 @@ contains
             end do
         end do
     end subroutine read_patch
+
+    !> The root attribute `units` of the geometry file `path` ('<length>, <force>'
+    !> when `pre` wrote it), or `default` when the file has none or cannot be read
+    !> (a label only: nothing else depends on it).
+    function geometry_units(path, default) result(units)
+        character(len=*), intent(in) :: path, default
+        character(len=:), allocatable :: units
+        type(h5file_t) :: h5
+        type(error_t), allocatable :: error, close_error
+        units = default
+        call h5%open(path, 'r', error)
+        if (allocated(error)) return
+        if (h5%has_attr('/', 'units')) call h5%read_attr_str('/', 'units', units, error)
+        if (allocated(error)) units = default
+        call h5%close(close_error)
+    end function geometry_units
 
     !> Read the curve `name` (/curves/<name>: a rigid obstacle's boundary) from the
     !> open geometry file `h5`.

@@ -10,6 +10,7 @@ module voiga_io_results
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization, write_curve
+    use voiga_io_geometry, only: geometry_units
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_master_curve, only: rigid_curve_t
@@ -102,7 +103,8 @@ contains
             call self%h5%write(g//'/values', model%dirichlet(k)%values, error)
             if (allocated(error)) return
         end do
-        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)', error)
+        ! the geometry's units ('mm, N' from pre), else just consistent ones
+        call self%h5%write_attr('/', 'units', geometry_units(case%geometry, 'consistent'), error)
         if (allocated(error)) return
         call self%h5%flush(error)
     end subroutine results_open
@@ -298,6 +300,8 @@ contains
             call h5%write(c//'/rigid_point', m%p0, error)
             if (allocated(error)) return
             call h5%write(c//'/rigid_normal', m%n, error)
+            if (allocated(error)) return
+            call h5%write(c//'/rigid_offset', m%p0 - m%p_ref, error)
             if (allocated(error)) return
         type is (rigid_curve_t)
             ! where the obstacle is at this step, and its translation from time 0

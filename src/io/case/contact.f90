@@ -91,8 +91,8 @@ contains
         if (trim(c%master) /= 'rigid') then
             ib = body_index(bodies, c%master)
             if (len_trim(c%rigid_curve) > 0) then
-                call fatal_error(error, where//"rigid_curve names the curve of a rigid master: master = '"// &
-                                 trim(c%master)//"' is a body (set master = 'rigid')", error_code%input)
+                call fatal_error(error, where//"rigid_curve names the curve of a rigid master, but master = '"// &
+                                 trim(c%master)//"' (set master = 'rigid')", error_code%input)
             else if (ib == 0) then
                 call fatal_error(error, where//"master = '"//trim(c%master)// &
                                  "' is neither a body of the case nor 'rigid'", error_code%input)
