@@ -112,7 +112,7 @@ program voiga_main
         call read_restart(restart_path, model, resume, error)
         if (allocated(error)) call fail(error)
         case%output = restart_path
-        call results%reopen(restart_path, error)
+        call results%reopen(restart_path, case, error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
     else

@@ -27,10 +27,13 @@ blocks):
   (a curve sampled finely; a line as a segment across the bodies), with point data
   ``displacement`` (its prescribed translation at the step: *Warp By Vector* puts it
   where it is) and ``normal`` (outward), cell data ``pair``.
-- ``fields``: stress, strain and von Mises when the result file carries them
-  (``/steps/<k>/fields/<body>``; not written by voiga yet, see docs/hdf5.md): one
-  vertex per sample point at its reference position, with ``displacement`` and
-  every field of the file.
+- ``fields``: stress, strain and von Mises at the steps the result file has them
+  (``/steps/<k>/fields/<body>``, written by voiga as ``&output`` asks; docs/hdf5.md):
+  the sample points at their reference positions with ``displacement``, joined
+  into quads within each element (one vertex per point with one sample per
+  element), with ``stress`` and ``strain`` as symmetric tensors (``XX YY ZZ XY YZ
+  XZ``, z out of plane), ``von_mises``, ``element`` and ``body``; the stress and
+  strain measures as field data.
 
 Field data of every file: ``units``, ``title``, ``case_file``, ``voiga_version``,
 ``status``, ``source`` (the result file), ``writer``, ``step``, ``time``.
@@ -260,30 +263,76 @@ def rigid_grid(result: Result, step: Step, samples: int = 400) -> vtk.vtkUnstruc
     return grid
 
 
+TENSOR_COMPONENTS = ("XX", "YY", "ZZ", "XY", "YZ", "XZ")
+"""ParaView's order of a symmetric tensor's six components."""
+
+
+def symmetric_tensor(values: np.ndarray) -> np.ndarray:
+    """(n, 4) [xx, yy, zz, xy] (the result file's plane-strain components) as (n, 6) in
+    ParaView's symmetric-tensor order (yz = xz = 0)."""
+    v = np.asarray(values, dtype=float).reshape(-1, 4)
+    return np.column_stack([v[:, 0], v[:, 1], v[:, 2], v[:, 3], np.zeros(len(v)), np.zeros(len(v))])
+
+
+def _sample_cells(fields: dict[str, np.ndarray], samples: int, offset: int) -> list[np.ndarray]:
+    """Quads joining each element's ``samples x samples`` grid of points (xi fastest),
+    or one vertex per point (one sample, or no element numbers)."""
+    n = len(fields["xi"])
+    if samples < 2 or "element" not in fields or n % samples**2:
+        return [np.array([offset + i]) for i in range(n)]
+    k = samples
+    grid = np.arange(k * k).reshape(k, k)
+    quad = np.stack([grid[:-1, :-1], grid[:-1, 1:], grid[1:, 1:], grid[1:, :-1]], axis=-1).reshape(-1, 4)
+    # counter-clockwise in the patch's parameters; left-handed patches are fine for VTK
+    return [offset + e * k * k + q for e in range(n // (k * k)) for q in quad]
+
+
 def fields_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
     """Sampled solver fields (stress, strain, von Mises) of the step, None when the
-    file has none."""
+    file has none: the sample points at their reference positions with
+    ``displacement``, joined into quads per element when the solver sampled a grid
+    (``&output samples >= 2``); ``stress`` and ``strain`` as symmetric tensors
+    (``XX YY ZZ XY YZ XZ``) when the file gives their plane-strain components."""
     if not step.fields:
         return None
-    pts, disp, values, body_id = [], [], {}, []
+    pts, disp, values, body_id, cells = [], [], {}, [], []
+    tensors = set()
     names = list(result.bodies)
+    offset = 0
     for name, fields in step.fields.items():
         body = result.body(name)
+        info = step.field_info.get(name, {})
         xi, eta = fields["xi"], fields["eta"]
         u = body_displacement(result, name, step.step)
         pts.append(evaluate(body, None, xi, eta).reshape(-1, 2))
         disp.append(combine(body, u, xi, eta).reshape(-1, 2))
         body_id.append(np.full(len(xi), names.index(name)))
+        cells += _sample_cells(fields, int(info.get("samples", 1)), offset)
+        offset += len(xi)
+        plane = info.get("components") == "xx yy zz xy"
         for key, v in fields.items():
-            if key not in ("xi", "eta"):
-                values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
+            if key in ("xi", "eta"):
+                continue
+            if plane and key in ("stress", "strain"):
+                v = symmetric_tensor(v)
+                tensors.add(key)
+            values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
     points = np.concatenate(pts)
-    grid = _grid(points, [np.array([i]) for i in range(len(points))], vtk.VTK_VERTEX)
+    kind = vtk.VTK_QUAD if cells and len(cells[0]) == 4 else vtk.VTK_VERTEX
+    grid = _grid(points, cells, kind)
     grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
     grid.GetPointData().AddArray(_array("body", np.concatenate(body_id)))
     for key, parts in values.items():
-        grid.GetPointData().AddArray(_array(key, np.concatenate(parts)))
+        arr = _array(key, np.concatenate(parts))
+        if key in tensors:
+            for i, c in enumerate(TENSOR_COMPONENTS):
+                arr.SetComponentName(i, c)
+        grid.GetPointData().AddArray(arr)
     _field_data(grid, result, step)
+    for name, info in step.field_info.items():
+        for key in ("stress_measure", "strain_measure"):
+            if key in info:
+                grid.GetFieldData().AddArray(_string_array(f"{name}: {key}", [str(info[key])]))
     return grid
 
 

@@ -167,7 +167,7 @@ class ContactOutput:
 
 
 _LAZY_FIELDS: tuple[str, ...] = ("time", "substeps", "residual_norms", "energy_norms",
-                                  "displacement", "contact", "fields")
+                                  "displacement", "contact", "fields", "field_info")
 """The fields of a :class:`Step` that ``read_result(..., lazy=True)`` reads on first use."""
 
 
@@ -241,10 +241,17 @@ class Step:
 
     @property
     def fields(self) -> dict[str, dict[str, np.ndarray]]:
-        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,)
-        and e.g. ``stress`` (n, k)), from ``/steps/<k>/fields/<body>``; empty when the
-        file has none (voiga does not write them yet; docs/hdf5.md)."""
+        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,),
+        ``element`` (n,) 0-based, ``stress`` and ``strain`` (n, 4) as [xx, yy, zz, xy],
+        ``von_mises`` (n,)), from ``/steps/<k>/fields/<body>``; empty at the steps
+        without (``&output``; docs/hdf5.md)."""
         return self._get("fields")
+
+    @property
+    def field_info(self) -> dict[str, dict[str, Any]]:
+        """The attributes of each body's sampled fields (``samples``, ``components``,
+        ``stress_measure``, ``strain_measure``); empty at steps without fields."""
+        return self._get("field_info")
 
 
 @dataclass(eq=False)
@@ -485,9 +492,18 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
             "displacement": vec("displacement"),
             "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
             if gid.links.exists(b"contact") else [],
-            "fields": {body: {k: np.asarray(v[()], dtype=float) for k, v in fg.items()}
+            "fields": {body: {k: _field_array(v) for k, v in fg.items()}
                        for body, fg in g["fields"].items()}
+            if gid.links.exists(b"fields") else {},
+            "field_info": {body: _attrs(fg) for body, fg in g["fields"].items()}
             if gid.links.exists(b"fields") else {}}
+
+
+def _field_array(d: h5py.Dataset) -> np.ndarray:
+    """A sampled-field dataset: ``element`` as 0-based ints, the rest as floats."""
+    if d.name.rsplit("/", 1)[-1] == "element":
+        return np.asarray(d[()], dtype=np.int64) - 1
+    return np.asarray(d[()], dtype=float)
 
 
 def _read_contact(g: h5py.Group) -> ContactOutput:

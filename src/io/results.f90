@@ -12,6 +12,8 @@ module voiga_io_results
     use voiga_io_dump, only: write_discretization, write_curve
     use voiga_io_geometry, only: geometry_units
     use voiga_model, only: model_t
+    use voiga_model_fields, only: output_settings_t
+    use voiga_io_fields, only: write_fields
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_nurbs_curve, only: nurbs_curve_t
@@ -29,6 +31,9 @@ module voiga_io_results
     type, extends(progress_t) :: results_t
         type(h5file_t) :: h5
         integer :: n_written = 0
+        !> The sampled fields the case asks for (`&output`) and the run's last step.
+        type(output_settings_t) :: fields
+        integer :: last_step = 0
     contains
         procedure :: open => results_open
         procedure :: reopen => results_reopen
@@ -52,6 +57,8 @@ contains
         character(len=:), allocatable :: g
         character(len=16) :: buf
 
+        self%fields = case%field_output
+        self%last_step = case%solver%total_steps()
         call self%h5%open(case%output, 'w', error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
@@ -165,12 +172,15 @@ contains
         end associate
     end subroutine write_body
 
-    !> Reopen the result file of an earlier run to continue it: status 'running',
-    !> the steps it holds counted as written.
-    subroutine results_reopen(self, path, error)
+    !> Reopen the result file of an earlier run of `case` to continue it: status
+    !> 'running', the steps it holds counted as written.
+    subroutine results_reopen(self, path, case, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: case
         type(error_t), allocatable, intent(out) :: error
+        self%fields = case%field_output
+        self%last_step = case%solver%total_steps()
         call self%h5%open(path, 'rw', error)
         if (allocated(error)) return
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
@@ -182,7 +192,7 @@ contains
 
     !> Write one converged step and the current displacement; flush.
     subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
-                                  error)
+                                  error, model)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -198,6 +208,9 @@ contains
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
         type(error_t), allocatable, intent(out) :: error
+        !> The model of `u`: its bodies' sampled fields are written when `&output`
+        !> asks for them at this step.
+        type(model_t), intent(in), optional :: model
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -250,6 +263,10 @@ contains
             call write_contact(self%h5, g, k, pairs(k)%pair, error)
             if (allocated(error)) return
         end do
+        if (present(model)) then
+            if (self%fields%wants(rec%step, self%last_step)) call write_fields(self%h5, g, self%fields, model, u, error)
+            if (allocated(error)) return
+        end if
         self%n_written = self%n_written + 1
         if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
         if (allocated(error)) return
@@ -429,7 +446,7 @@ contains
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         call self%write_step(report%record, u, report%wall, model%pairs, report%cuts, report%n_cuts, &
-                             report%next_fraction, report%r0_max, error)
+                             report%next_fraction, report%r0_max, error, model)
     end subroutine results_step_done
 
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
