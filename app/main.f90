@@ -10,6 +10,7 @@ program voiga_main
     use voiga_io_results, only: restart_case, read_restart
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
+    use voiga_model_checks, only: setup_warnings, warning_t
     use voiga_solver_records, only: solver_stats_t, wall_seconds
     use voiga_solver_stepping, only: solve_steps, resume_t
     use voiga_solver_signals, only: catch_signals, signal_name
@@ -27,6 +28,7 @@ program voiga_main
     type(resume_t) :: resume
     type(console_t) :: results
     type(solver_stats_t) :: stats
+    type(warning_t), allocatable :: warnings(:)
     real(dp), allocatable :: u(:)
     real(dp) :: t0
     integer :: i, n, total
@@ -101,11 +103,18 @@ program voiga_main
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
-    if (check) stop
 
     call new_model(model, case%bodies, discs, case%solver%n_gauss, case%dirichlet, case%pressure, &
                    case%contact, error)
     if (allocated(error)) call fail(error)
+    if (check) then
+        ! what a run would warn about at its start (a run reports them itself)
+        warnings = setup_warnings(model)
+        do i = 1, size(warnings)
+            write (0, '(a)') 'voiga: warning: '//trim(warnings(i)%text)
+        end do
+        stop
+    end if
     results%quiet = quiet
     results%verbose = verbose
     if (allocated(restart_path)) then

@@ -43,6 +43,7 @@ module voiga_io_results
         procedure :: write_multigrid => results_write_multigrid
         procedure :: set_up => results_set_up
         procedure :: step_done => results_step_done
+        procedure :: warning => results_warning
     end type results_t
 
 contains
@@ -448,6 +449,25 @@ contains
         call self%write_step(report%record, u, report%wall, model%pairs, report%cuts, report%n_cuts, &
                              report%next_fraction, report%r0_max, error, model)
     end subroutine results_step_done
+
+    !> A warning: one more line of the root attribute `warnings` (a line the file
+    !> has already, e.g. a set-up warning repeated by a restart, is not repeated).
+    !> Written and flushed at once; a failure to write it is not the run's.
+    subroutine results_warning(self, text)
+        class(results_t), intent(inout) :: self
+        character(len=*), intent(in) :: text
+        type(error_t), allocatable :: error
+        character(len=:), allocatable :: lines
+        if (.not. self%h5%is_open()) return
+        lines = ''
+        if (self%h5%has_attr('/', 'warnings')) call self%h5%read_attr_str('/', 'warnings', lines, error)
+        if (allocated(error)) return
+        if (index(new_line('a')//lines//new_line('a'), new_line('a')//text//new_line('a')) > 0) return
+        if (len(lines) > 0) lines = lines//new_line('a')
+        call self%h5%write_attr('/', 'warnings', lines//text, error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
+    end subroutine results_warning
 
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
     subroutine results_write_multigrid(self, level_dofs, error)
