@@ -90,6 +90,9 @@ contains
         if (allocated(error)) return
         call self%h5%write_attr('/', 'wall_time', 0.0_dp, error)
         if (allocated(error)) return
+        ! the run's warnings, one per line (results_warning); none yet
+        call self%h5%write_attr('/', 'warnings', '', error)
+        if (allocated(error)) return
         do i = 1, size(model%bodies)
             call write_body(self%h5, model, i, trim(case%bodies(i)%material), error)
             if (allocated(error)) return

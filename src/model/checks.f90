@@ -36,10 +36,17 @@ module voiga_model_checks
         character(len=512) :: text = ''
     end type warning_t
 
+    !> The reference lengths of a pair's slave elements [nel].
+    type :: lengths_t
+        real(dp), allocatable :: h(:)
+    end type lengths_t
+
     !> What the warnings after steps and at the end need to remember per pair.
     type :: contact_watch_t
         !> Has the pair had a point in contact; has its deep penetration been reported?
         logical, allocatable :: ever_active(:), deep_reported(:)
+        !> Each pair's slave element lengths (computed once).
+        type(lengths_t), allocatable :: slave(:)
     contains
         procedure :: after_step => watch_after_step
         procedure :: at_end => watch_at_end
@@ -51,8 +58,13 @@ contains
     pure subroutine new_contact_watch(self, model)
         type(contact_watch_t), intent(out) :: self
         type(model_t), intent(in) :: model
+        integer :: ip
         allocate (self%ever_active(size(model%pairs)), source=.false.)
         allocate (self%deep_reported(size(model%pairs)), source=.false.)
+        allocate (self%slave(size(model%pairs)))
+        do ip = 1, size(model%pairs)
+            self%slave(ip)%h = element_lengths(model%pairs(ip)%pair%slave)
+        end do
     end subroutine new_contact_watch
 
     !> "contact 'slave' on 'master': "
@@ -84,12 +96,13 @@ contains
 
     !> The depth of each slave point inside the master (-gap) over the reference
     !> length of its slave element, for the points `use` selects (0 for the others).
-    pure function depth_ratios(pair, use) result(ratio)
+    pure function depth_ratios(pair, h, use) result(ratio)
         class(contact_pair_t), intent(in) :: pair
+        !> The reference lengths of the slave elements.
+        real(dp), intent(in) :: h(:)
         logical, intent(in) :: use(:)
-        real(dp), allocatable :: ratio(:), h(:)
+        real(dp), allocatable :: ratio(:)
         integer :: k
-        h = element_lengths(pair%slave)
         allocate (ratio(size(pair%out)), source=0.0_dp)
         do k = 1, size(ratio)
             if (use(k)) ratio(k) = -pair%out(k)%gap/h((k - 1)/pair%n_gauss + 1)
@@ -125,7 +138,7 @@ contains
         type(warning_t), allocatable, intent(inout) :: list(:)
         real(dp), allocatable :: depth(:)
         integer :: k, n
-        depth = depth_ratios(pair, pair%out%gap < 1.0e300_dp)
+        depth = depth_ratios(pair, element_lengths(pair%slave), pair%out%gap < 1.0e300_dp)
         n = count(depth > overlap_fraction)
         if (n == 0) return
         k = maxloc(depth, dim=1)
@@ -214,7 +227,7 @@ contains
             associate (pair => model%pairs(ip)%pair)
                 if (any(pair%out%state /= state_inactive)) self%ever_active(ip) = .true.
                 if (self%deep_reported(ip)) cycle
-                ratio = depth_ratios(pair, pair%out%state /= state_inactive)
+                ratio = depth_ratios(pair, self%slave(ip)%h, pair%out%state /= state_inactive)
                 if (maxval(ratio) <= deep_fraction) cycle
                 self%deep_reported(ip) = .true.
                 k = maxloc(ratio, dim=1)
