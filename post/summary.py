@@ -31,7 +31,7 @@ def slave_element_size(result: Result, c: ContactOutput, xi: float) -> float:
 
 def warnings_for(result: Result) -> list[str]:
     """What a result file shows that the user should know. voiga records its own
-    warnings in the root attribute ``warnings`` (docs/robustness.md, "Warnings"):
+    warnings in the root attribute ``warnings`` (docs/warnings.md):
     those, when the file has the attribute. Files written before it: a contact pair
     that was never in contact at any converged step, and a penetration larger than
     ``PENETRATION_WARNING`` of the size of the slave element where it is largest

@@ -269,25 +269,18 @@ def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
     folder.mkdir(parents=True, exist_ok=True)
     stem = spec.path.stem
     patches: dict[str, Patch] = {}
-    for b in spec.bodies:
-        patch = build_patch(b, spec.path.parent)
-        if b["name"] in patches:
-            raise SpecError(f"two bodies are named {b['name']!r}")
-        try:
-            check_patch(b["name"], patch)
-        except ValueError as err:
-            raise SpecError(str(err)) from None
-        patches[b["name"]] = patch
     curves: dict[str, Curve] = {}
-    for c in spec.curves:
-        curve = build_curve(c, spec.path.parent)
-        if c["name"] in curves or c["name"] in patches:
-            raise SpecError(f"two bodies or curves are named {c['name']!r}")
-        try:
-            check_curve(c["name"], curve)
-        except ValueError as err:
-            raise SpecError(str(err)) from None
-        curves[c["name"]] = curve
+    for tables, build, check, into in ((spec.bodies, build_patch, check_patch, patches),
+                                       (spec.curves, build_curve, check_curve, curves)):
+        for t in tables:
+            obj = build(t, spec.path.parent)
+            if t["name"] in patches or t["name"] in curves:
+                raise SpecError(f"two bodies or curves are named {t['name']!r}")
+            try:
+                check(t["name"], obj)
+            except ValueError as err:
+                raise SpecError(str(err)) from None
+            into[t["name"]] = obj
     groups = case_groups(spec, patches, f"{stem}-geometry.h5", stem)
     geometry = write_bodies(folder / f"{stem}-geometry.h5", patches,
                             scene=str(spec.data.get("scene", stem)),

@@ -5,10 +5,8 @@ module test_contact
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_surface, only: nurbs_surface_t
-    use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_model, only: model_t
-    use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
                                     new_assembly_map
@@ -24,7 +22,8 @@ module test_contact
     use voiga_contact_mortar, only: mortar_pair_t, mortar_snapshot_t
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
     use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model, &
+                                   body_settings
     implicit none
     private
 
@@ -415,19 +414,6 @@ contains
         end select
     end subroutine test_mortar_unprojected_open
 
-    !> A body entry of a test case.
-    function body(name, material, e, layout) result(b)
-        character(len=*), intent(in) :: name, material
-        real(dp), intent(in) :: e
-        type(layout_t), intent(in) :: layout
-        type(body_settings_t) :: b
-        b%name = name
-        b%material = material
-        b%youngs_modulus = e
-        b%poisson_ratio = 0.3_dp
-        b%layout = layout
-    end function body
-
     function bc(b, edge, fix, values) result(d)
         character(len=*), intent(in) :: b, edge
         logical, intent(in) :: fix(2)
@@ -495,8 +481,8 @@ contains
         real(dp), allocatable :: u(:)
         real(dp), parameter :: p = 0.01_dp
 
-        c%bodies = [body('upper', 'linear', 1.0_dp, paper_layout('N2', [nel_upper, 2], 'bottom')), &
-                    body('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
+        c%bodies = [body_settings('upper', 'linear', 1.0_dp, paper_layout('N2', [nel_upper, 2], 'bottom')), &
+                    body_settings('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
         c%solver%n_steps = [1]
         c%dirichlet = [bc('lower', 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
                        bc('lower', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
@@ -533,7 +519,7 @@ contains
         character(len=*), intent(in), optional :: method
         type(scene_t) :: c
         type(solver_stats_t) :: stats
-        c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
+        c%bodies = [body_settings('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
@@ -738,8 +724,8 @@ contains
         real(dp) :: floor
         integer :: i
 
-        c%bodies = [body('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
-                    body('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
+        c%bodies = [body_settings('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
+                    body_settings('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
         ! press 0.5 in 10 steps, then 5 of the 200 sliding steps of 0.02
         c%solver%n_steps = [10, 5]
         c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &

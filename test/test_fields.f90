@@ -11,7 +11,7 @@ module test_fields
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t
     use voiga_model_fields, only: output_settings_t, field_samples_t, sample_fields
-    use voiga_test_fixtures, only: annulus_sector, paper_layout, scene_t, scene_model, lcg_t
+    use voiga_test_fixtures, only: annulus_sector, paper_layout, scene_t, scene_model, lcg_t, body_settings
     use voiga_discretization_patch, only: new_discretization
     implicit none
     private
@@ -107,12 +107,7 @@ contains
         real(dp), parameter :: g(2, 2) = reshape([2.0e-3_dp, -1.0e-3_dp, 3.0e-3_dp, -4.0e-3_dp], [2, 2])
         real(dp), allocatable :: u(:)
         integer :: a
-        allocate (c%bodies(1))
-        c%bodies(1)%name = 'ring'
-        c%bodies(1)%material = 'linear'
-        c%bodies(1)%youngs_modulus = 1.0_dp
-        c%bodies(1)%poisson_ratio = 0.3_dp
-        c%bodies(1)%layout = paper_layout('NN2.2', [4, 2], 'outer')
+        c%bodies = [body_settings('ring', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'outer'))]
         call new_discretization(disc(1), annulus_sector([0.0_dp, 0.0_dp], 1.0_dp, 2.0_dp, 0.0_dp, 2), &
                                 c%bodies(1)%layout, '', error)
         if (allocated(error)) return

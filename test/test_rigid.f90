@@ -18,7 +18,8 @@ module test_rigid
     use voiga_model_loads, only: dirichlet_settings_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
-    use voiga_test_fixtures, only: annulus_sector, rectangle, lcg_t, paper_layout, scene_t, scene_model
+    use voiga_test_fixtures, only: annulus_sector, rectangle, lcg_t, paper_layout, scene_t, scene_model, &
+                                   body_settings
     use test_contact, only: run_fd
     implicit none
     private
@@ -203,12 +204,7 @@ contains
             type(scene_t) :: c
             type(discretization_t) :: disc(1)
             type(solver_stats_t) :: stats
-            allocate (c%bodies(1))
-            c%bodies(1)%name = 'block'
-            c%bodies(1)%material = 'linear'
-            c%bodies(1)%youngs_modulus = 1.0_dp
-            c%bodies(1)%poisson_ratio = 0.3_dp
-            c%bodies(1)%layout = paper_layout('NN2.2', [16, 6], 'top')
+            c%bodies = [body_settings('block', 'linear', 1.0_dp, paper_layout('NN2.2', [16, 6], 'top'))]
             c%solver%n_steps = [3]
             c%contact = [contact_settings_t(slave='block', master='rigid', rigid_curve='punch', &
                                             penalty_normal=1000.0_dp)]

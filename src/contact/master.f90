@@ -8,7 +8,7 @@ module voiga_contact_master
     implicit none
     private
 
-    public :: contact_master_t, master_point_t
+    public :: contact_master_t, master_point_t, master_no_dofs
 
     !> The master at the projection of a slave point.
     type :: master_point_t
@@ -31,7 +31,8 @@ module voiga_contact_master
         logical :: deformable = .false.
     contains
         procedure(project_interface), deferred :: project
-        procedure(all_dofs_interface), deferred :: all_dofs
+        !> Every DOF the master may couple to (for the stiffness pattern); default: none.
+        procedure :: all_dofs => master_no_dofs
         procedure :: prepare => master_prepare
         procedure :: move => master_move
     end type contact_master_t
@@ -49,16 +50,17 @@ module voiga_contact_master
             !> False if the local Newton iteration did not converge.
             logical, intent(out) :: converged
         end subroutine project_interface
-
-        !> Every DOF the master may couple to (for the stiffness pattern).
-        pure function all_dofs_interface(self) result(dofs)
-            import :: contact_master_t
-            class(contact_master_t), intent(in) :: self
-            integer, allocatable :: dofs(:)
-        end function all_dofs_interface
     end interface
 
 contains
+
+    !> No DOFs: a rigid master.
+    pure function master_no_dofs(self) result(dofs)
+        class(contact_master_t), intent(in) :: self
+        integer, allocatable :: dofs(:)
+        allocate (dofs(0))
+        if (self%deformable) dofs = [integer ::]   ! (a deformable master overrides this)
+    end function master_no_dofs
 
     !> Update whatever the master's search needs for the configuration `u` (called
     !> once per evaluation of a pair, before its projections). Default: nothing.

@@ -12,7 +12,7 @@
 module voiga_contact_master_curve
     use voiga_kinds, only: dp
     use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_contact_master, only: master_point_t
+    use voiga_contact_master, only: master_point_t, master_no_dofs
     use voiga_contact_master_nurbs, only: nurbs_master_t, nurbs_prepare, nurbs_project
     use voiga_contact_surface, only: new_curve_surface
     implicit none
@@ -75,11 +75,11 @@ contains
         mp%last = 0
     end subroutine curve_project
 
+    !> None (the NURBS master's would be the curve's own control points).
     pure function curve_all_dofs(self) result(dofs)
         class(rigid_curve_t), intent(in) :: self
         integer, allocatable :: dofs(:)
-        allocate (dofs(0))
-        if (self%deformable) dofs = [integer ::]
+        dofs = master_no_dofs(self)
     end function curve_all_dofs
 
     !> Translate the curve to its reference position plus `offset`.

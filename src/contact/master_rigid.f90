@@ -16,7 +16,6 @@ module voiga_contact_master_rigid
         real(dp) :: p_ref(2) = 0.0_dp
     contains
         procedure :: project => rigid_project
-        procedure :: all_dofs => rigid_all_dofs
         procedure :: move => rigid_move
     end type rigid_line_t
 
@@ -54,12 +53,5 @@ contains
         real(dp), intent(in) :: offset(2)
         self%p0 = self%p_ref + offset
     end subroutine rigid_move
-
-    pure function rigid_all_dofs(self) result(dofs)
-        class(rigid_line_t), intent(in) :: self
-        integer, allocatable :: dofs(:)
-        allocate (dofs(0))
-        if (self%deformable) dofs = [integer ::]
-    end function rigid_all_dofs
 
 end module voiga_contact_master_rigid

@@ -1,5 +1,5 @@
 !> What a run should warn about instead of running silently into a wrong answer
-!> (docs/robustness.md, "Warnings"): at set-up, bodies that overlap (or a contact
+!> (docs/warnings.md): at set-up, bodies that overlap (or a contact
 !> edge on the wrong side of a body, whose master normal then points into the
 !> slave), a slave contact edge that faces away from its master, a slave stiffer
 !> or coarser than its master; after each converged step, a penetration deeper than
