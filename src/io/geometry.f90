@@ -27,22 +27,8 @@ contains
         integer :: i, j, k
 
         g = '/bodies/'//trim(name)
-        where = h5%path//": body '"//trim(name)//"': "
-        if (.not. h5%exists(g)) then
-            call fatal_error(error, h5%path//": no body '"//trim(name)//"' (group "//g// &
-                             " is missing)", error_code%input)
-            return
-        end if
-        call h5%read(g//'/degree', degree, error)
+        call read_degree(h5, 'body', name, g, 2, degree, where, error)
         if (allocated(error)) return
-        if (size(degree) /= 2) then
-            call fatal_error(error, where//'degree must have 2 entries', error_code%input)
-            return
-        end if
-        if (any(degree < 1) .or. any(degree > 20)) then
-            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
-            return
-        end if
         surf%degree = degree
         call h5%read(g//'/knots_xi', surf%knots_xi, error)
         if (allocated(error)) return
@@ -135,22 +121,8 @@ contains
         real(dp), allocatable :: cp(:, :)
 
         g = '/curves/'//trim(name)
-        where = h5%path//": curve '"//trim(name)//"': "
-        if (.not. h5%exists(g)) then
-            call fatal_error(error, h5%path//": no curve '"//trim(name)//"' (group "//g// &
-                             " is missing)", error_code%input)
-            return
-        end if
-        call h5%read(g//'/degree', degree, error)
+        call read_degree(h5, 'curve', name, g, 1, degree, where, error)
         if (allocated(error)) return
-        if (size(degree) /= 1) then
-            call fatal_error(error, where//'degree must have 1 entry', error_code%input)
-            return
-        end if
-        if (degree(1) < 1 .or. degree(1) > 20) then
-            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
-            return
-        end if
         curve%degree = degree(1)
         call h5%read(g//'/knots', curve%knots, error)
         if (allocated(error)) return
@@ -172,6 +144,31 @@ contains
         end if
         curve%cp = cp
     end subroutine read_curve
+
+    !> The `n` degrees of the spline in group `g` (a `what` called `name`: 'body' or
+    !> 'curve'), each in 1..20; `where` begins the messages about it.
+    subroutine read_degree(h5, what, name, g, n, degree, where, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: what, name, g
+        integer, intent(in) :: n
+        integer, allocatable, intent(out) :: degree(:)
+        character(len=:), allocatable, intent(out) :: where
+        type(error_t), allocatable, intent(out) :: error
+        where = h5%path//': '//what//" '"//trim(name)//"': "
+        if (.not. h5%exists(g)) then
+            call fatal_error(error, h5%path//': no '//what//" '"//trim(name)//"' (group "//g// &
+                             " is missing)", error_code%input)
+            return
+        end if
+        call h5%read(g//'/degree', degree, error)
+        if (allocated(error)) return
+        if (size(degree) /= n) then
+            call fatal_error(error, where//'degree must have '//trim(merge('2 entries', '1 entry  ', n == 2)), &
+                             error_code%input)
+        else if (any(degree < 1) .or. any(degree > 20)) then
+            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
+        end if
+    end subroutine read_degree
 
     !> A knot vector of `n` functions of degree `p`: length n+p+1, finite,
     !> non-decreasing, open (end multiplicity p+1) on [0, 1], interior
