@@ -1,6 +1,7 @@
 !> The terminal side of a run: the result file's progress hooks (`results_t`)
 !> plus one line per converged step, cut and retry (none with --quiet), and with
-!> --verbose one per Newton iteration and linear solve.
+!> --verbose one per Newton iteration and linear solve; warnings go to stderr
+!> (also with --quiet).
 module voiga_app_console
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
@@ -27,6 +28,7 @@ module voiga_app_console
         procedure :: fixed_point_done => console_fixed_point_done
         procedure :: multipliers_updated => console_multipliers_updated
         procedure :: step_done => console_step_done
+        procedure :: warning => console_warning
     end type console_t
 
 contains
@@ -141,5 +143,13 @@ contains
             end if
         end associate
     end subroutine console_step_done
+
+    !> `voiga: warning: <text>` on stderr, and into the result file.
+    subroutine console_warning(self, text)
+        class(console_t), intent(inout) :: self
+        character(len=*), intent(in) :: text
+        call self%results_t%warning(text)
+        write (0, '(a)') 'voiga: warning: '//text
+    end subroutine console_warning
 
 end module voiga_app_console

@@ -6,10 +6,11 @@ program voiga_main
     use voiga_version, only: voiga_version_string
     use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_dump, only: write_dump
-    use voiga_io_bodies, only: discretize_bodies
+    use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
     use voiga_io_results, only: restart_case, read_restart
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
+    use voiga_model_checks, only: setup_warnings, warning_t
     use voiga_solver_records, only: solver_stats_t, wall_seconds
     use voiga_solver_stepping, only: solve_steps, resume_t
     use voiga_solver_signals, only: catch_signals, signal_name
@@ -27,6 +28,7 @@ program voiga_main
     type(resume_t) :: resume
     type(console_t) :: results
     type(solver_stats_t) :: stats
+    type(warning_t), allocatable :: warnings(:)
     real(dp), allocatable :: u(:)
     real(dp) :: t0
     integer :: i, n, total
@@ -82,6 +84,8 @@ program voiga_main
     if (allocated(error)) call fail(error)
     call discretize_bodies(case, discs, error)
     if (allocated(error)) call fail(error)
+    call read_rigid_curves(case, error)
+    if (allocated(error)) call fail(error)
 
     total = 0
     do i = 1, size(discs)
@@ -99,18 +103,25 @@ program voiga_main
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
-    if (check) stop
 
     call new_model(model, case%bodies, discs, case%solver%n_gauss, case%dirichlet, case%pressure, &
                    case%contact, error)
     if (allocated(error)) call fail(error)
+    if (check) then
+        ! what a run would warn about at its start (a run reports them itself)
+        warnings = setup_warnings(model)
+        do i = 1, size(warnings)
+            write (0, '(a)') 'voiga: warning: '//trim(warnings(i)%text)
+        end do
+        stop
+    end if
     results%quiet = quiet
     results%verbose = verbose
     if (allocated(restart_path)) then
         call read_restart(restart_path, model, resume, error)
         if (allocated(error)) call fail(error)
         case%output = restart_path
-        call results%reopen(restart_path, error)
+        call results%reopen(restart_path, case, error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
     else

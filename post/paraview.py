@@ -7,7 +7,7 @@ uses; it keeps string arrays as field data (units, provenance), which meshio's V
 writer does not; and it is actively released. The cost is a larger wheel.
 
 Per converged step (plus the reference configuration at load time 0) the series has
-up to three parts (``<DataSet part=...>`` in the ``.pvd``; ParaView shows them as
+up to four parts (``<DataSet part=...>`` in the ``.pvd``; ParaView shows them as
 blocks):
 
 - ``bodies``: every body finely sampled: each element split into at least
@@ -23,10 +23,17 @@ blocks):
   (NaN where the point has no projection), ``state`` (0 open, 1 stick, 2 slip),
   ``traction`` (the vector ``p_n n + p_t t`` on the slave, with the master's outward
   normal ``n`` and tangent ``t``), ``pair`` (0-based, case-file order).
-- ``fields``: stress, strain and von Mises when the result file carries them
-  (``/steps/<k>/fields/<body>``; not written by voiga yet, see docs/hdf5.md): one
-  vertex per sample point at its reference position, with ``displacement`` and
-  every field of the file.
+- ``rigid``: the rigid masters, one polyline each at its position at load time 0
+  (a curve sampled finely; a line as a segment across the bodies), with point data
+  ``displacement`` (its prescribed translation at the step: *Warp By Vector* puts it
+  where it is) and ``normal`` (outward), cell data ``pair``.
+- ``fields``: stress, strain and von Mises at the steps the result file has them
+  (``/steps/<k>/fields/<body>``, written by voiga as ``&output`` asks; docs/hdf5.md):
+  the sample points at their reference positions with ``displacement``, joined
+  into quads within each element (one vertex per point with one sample per
+  element), with ``stress`` and ``strain`` as symmetric tensors (``XX YY ZZ XY YZ
+  XZ``, z out of plane), ``von_mises``, ``element`` and ``body``; the stress and
+  strain measures as field data.
 
 Field data of every file: ``units``, ``title``, ``case_file``, ``voiga_version``,
 ``status``, ``source`` (the result file), ``writer``, ``step``, ``time``.
@@ -40,6 +47,8 @@ from pathlib import Path
 import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+from pre.nurbs import curve_to_splipy
 
 from .field import combine, displacement, evaluate
 from .naming import output_path
@@ -161,9 +170,16 @@ def bodies_grid(result: Result, step: Step | None, samples: int = SAMPLES) -> vt
 
 def master_frame(result: Result, step: Step, c: ContactOutput) -> tuple[np.ndarray, np.ndarray]:
     """Unit outward normals and tangents ``(n, 2)`` of the master at each slave point's
-    projection (the directions of ``p_n`` and ``p_t``): the rigid line's, or the
-    master body's contact edge (at eta = 1 of its oriented patch) at ``xi_master``."""
+    projection (the directions of ``p_n`` and ``p_t``): the rigid line's, the rigid
+    curve's at ``xi_master``, or the master body's contact edge (at eta = 1 of its
+    oriented patch) at ``xi_master``."""
     m = len(c.p_n)
+    if c.rigid_curve is not None:
+        spline = curve_to_splipy(c.rigid_curve)
+        xi = np.clip(np.nan_to_num(c.xi_master, nan=0.5), 0.0, 1.0)
+        tangent = np.asarray(spline.derivative(xi))[:, :2].reshape(m, 2)
+        tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+        return np.column_stack([tangent[:, 1], -tangent[:, 0]]), tangent
     if c.rigid_normal is not None:
         n = np.asarray(c.rigid_normal, dtype=float)
         n = n / np.linalg.norm(n)
@@ -211,30 +227,112 @@ def contact_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
     return grid
 
 
+def rigid_grid(result: Result, step: Step, samples: int = 400) -> vtk.vtkUnstructuredGrid | None:
+    """The rigid masters of the step (see the module docstring); None without any."""
+    size = max(float(np.ptp(b.control_points, axis=0).max()) for b in result.bodies.values())
+    pts, disp, normals, cells, pair = [], [], [], [], []
+    offset = 0
+    for k, c in enumerate(step.contact):
+        shift = np.zeros(2) if c.rigid_offset is None else np.asarray(c.rigid_offset, dtype=float)
+        if c.rigid_curve is not None:
+            spline = curve_to_splipy(c.rigid_curve)
+            t = np.linspace(0.0, 1.0, samples)
+            x = np.asarray(spline(t))[:, :2]
+            a = np.asarray(spline.derivative(t))[:, :2]
+            n = np.column_stack([a[:, 1], -a[:, 0]]) / np.linalg.norm(a, axis=1)[:, None]
+        elif c.rigid_point is not None and c.rigid_normal is not None:
+            n1 = np.asarray(c.rigid_normal, dtype=float) / np.linalg.norm(c.rigid_normal)
+            reach = 1.5 * size * np.linspace(-1.0, 1.0, 2)[:, None]
+            x = np.asarray(c.rigid_point, dtype=float) + reach * np.array([n1[1], -n1[0]])
+            n = np.tile(n1, (2, 1))
+        else:
+            continue
+        pts.append(x - shift)
+        disp.append(np.tile(shift, (len(x), 1)))
+        normals.append(n)
+        cells.append(offset + np.arange(len(x)))
+        pair.append(k)
+        offset += len(x)
+    if not pts:
+        return None
+    grid = _grid(np.concatenate(pts), cells, vtk.VTK_POLY_LINE)
+    grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
+    grid.GetPointData().AddArray(_array("normal", _vec3(np.concatenate(normals))))
+    grid.GetCellData().AddArray(_array("pair", np.array(pair)))
+    _field_data(grid, result, step)
+    return grid
+
+
+TENSOR_COMPONENTS = ("XX", "YY", "ZZ", "XY", "YZ", "XZ")
+"""ParaView's order of a symmetric tensor's six components."""
+
+
+def symmetric_tensor(values: np.ndarray) -> np.ndarray:
+    """(n, 4) [xx, yy, zz, xy] (the result file's plane-strain components) as (n, 6) in
+    ParaView's symmetric-tensor order (yz = xz = 0)."""
+    v = np.asarray(values, dtype=float).reshape(-1, 4)
+    return np.column_stack([v[:, 0], v[:, 1], v[:, 2], v[:, 3], np.zeros(len(v)), np.zeros(len(v))])
+
+
+def _sample_cells(fields: dict[str, np.ndarray], samples: int, offset: int) -> list[np.ndarray]:
+    """Quads joining each element's ``samples x samples`` grid of points (xi fastest),
+    or one vertex per point (one sample, or no element numbers)."""
+    n = len(fields["xi"])
+    if samples < 2 or "element" not in fields or n % samples**2:
+        return [np.array([offset + i]) for i in range(n)]
+    k = samples
+    grid = np.arange(k * k).reshape(k, k)
+    quad = np.stack([grid[:-1, :-1], grid[:-1, 1:], grid[1:, 1:], grid[1:, :-1]], axis=-1).reshape(-1, 4)
+    # counter-clockwise in the patch's parameters; left-handed patches are fine for VTK
+    return [offset + e * k * k + q for e in range(n // (k * k)) for q in quad]
+
+
 def fields_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
     """Sampled solver fields (stress, strain, von Mises) of the step, None when the
-    file has none."""
+    file has none: the sample points at their reference positions with
+    ``displacement``, joined into quads per element when the solver sampled a grid
+    (``&output samples >= 2``); ``stress`` and ``strain`` as symmetric tensors
+    (``XX YY ZZ XY YZ XZ``) when the file gives their plane-strain components."""
     if not step.fields:
         return None
-    pts, disp, values, body_id = [], [], {}, []
+    pts, disp, values, body_id, cells = [], [], {}, [], []
+    tensors = set()
     names = list(result.bodies)
+    offset = 0
     for name, fields in step.fields.items():
         body = result.body(name)
+        info = step.field_info.get(name, {})
         xi, eta = fields["xi"], fields["eta"]
         u = body_displacement(result, name, step.step)
         pts.append(evaluate(body, None, xi, eta).reshape(-1, 2))
         disp.append(combine(body, u, xi, eta).reshape(-1, 2))
         body_id.append(np.full(len(xi), names.index(name)))
+        cells += _sample_cells(fields, int(info.get("samples", 1)), offset)
+        offset += len(xi)
+        plane = info.get("components") == "xx yy zz xy"
         for key, v in fields.items():
-            if key not in ("xi", "eta"):
-                values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
+            if key in ("xi", "eta"):
+                continue
+            if plane and key in ("stress", "strain"):
+                v = symmetric_tensor(v)
+                tensors.add(key)
+            values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
     points = np.concatenate(pts)
-    grid = _grid(points, [np.array([i]) for i in range(len(points))], vtk.VTK_VERTEX)
+    kind = vtk.VTK_QUAD if cells and len(cells[0]) == 4 else vtk.VTK_VERTEX
+    grid = _grid(points, cells, kind)
     grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
     grid.GetPointData().AddArray(_array("body", np.concatenate(body_id)))
     for key, parts in values.items():
-        grid.GetPointData().AddArray(_array(key, np.concatenate(parts)))
+        arr = _array(key, np.concatenate(parts))
+        if key in tensors:
+            for i, c in enumerate(TENSOR_COMPONENTS):
+                arr.SetComponentName(i, c)
+        grid.GetPointData().AddArray(arr)
     _field_data(grid, result, step)
+    for name, info in step.field_info.items():
+        for key in ("stress_measure", "strain_measure"):
+            if key in info:
+                grid.GetFieldData().AddArray(_string_array(f"{name}: {key}", [str(info[key])]))
     return grid
 
 
@@ -265,7 +363,8 @@ def write_vtk(result: Result, out: str | Path | None = None, samples: int = SAMP
         number, time = (0, 0.0) if step is None else (step.step, step.time)
         parts = [("bodies", bodies_grid(result, step, samples))]
         if step is not None:
-            parts += [("contact", contact_grid(result, step)), ("fields", fields_grid(result, step))]
+            parts += [("contact", contact_grid(result, step)), ("rigid", rigid_grid(result, step)),
+                      ("fields", fields_grid(result, step))]
         for index, (what, grid) in enumerate(parts):
             if grid is None:
                 continue

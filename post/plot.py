@@ -6,8 +6,8 @@ element boundary), coloured by the displacement magnitude ``|u|`` with
 Gouraud shading, with the deformed element boundaries as thin lines and one
 colorbar shared by all bodies. The scale is chosen automatically when the
 displacements are small (:func:`auto_scale`; the title says the factor), rigid
-master lines are drawn, and when bodies are in contact a second panel shows the
-contact zone at true scale.
+masters (lines and curves) are drawn where they are, and when bodies are in
+contact a second panel shows the contact zone at true scale.
 """
 
 from __future__ import annotations
@@ -22,6 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
+
+from pre.nurbs import curve_to_splipy  # noqa: E402
 
 from .field import displacement, evaluate_grid  # noqa: E402
 from .naming import output_path  # noqa: E402
@@ -124,6 +126,35 @@ def draw_rigid_line(ax: plt.Axes, point: np.ndarray, normal: np.ndarray, depth: 
     ax.plot([a[0], b[0]], [a[1], b[1]], style, color="0.15", lw=1.6, label=label, zorder=3)
 
 
+def rigid_curves(step: Step | None, n: int = 400) -> list[tuple[np.ndarray, np.ndarray, str]]:
+    """``(points (n, 2), unit outward normals (n, 2), label)`` of every rigid master
+    curve of a step, where it is at that step (none at the reference configuration)."""
+    if step is None:
+        return []
+    out = []
+    for c in step.contact:
+        if c.rigid_curve is None:
+            continue
+        spline = curve_to_splipy(c.rigid_curve)
+        t = np.linspace(0.0, 1.0, n)
+        pts = np.asarray(spline(t))[:, :2]
+        a = np.asarray(spline.derivative(t))[:, :2]
+        normal = np.column_stack([a[:, 1], -a[:, 0]]) / np.linalg.norm(a, axis=1)[:, None]
+        out.append((pts, normal, f"rigid master of {c.slave}"))
+    return out
+
+
+def draw_rigid_curve(ax: plt.Axes, points: np.ndarray, normals: np.ndarray, depth: float,
+                     label: str | None = None, style: str = "-") -> None:
+    """A rigid obstacle's boundary as a thick curve with a hatched band of ``depth``
+    on the obstacle's side (opposite its outward ``normals``)."""
+    inner = points - depth * normals
+    band = np.concatenate([points, inner[::-1]])
+    ax.fill(band[:, 0], band[:, 1], facecolor="0.85", edgecolor="0.35", hatch="///", lw=0.0,
+            zorder=0.5)
+    ax.plot(points[:, 0], points[:, 1], style, color="0.15", lw=1.6, label=label, zorder=3)
+
+
 def contact_points(step: Step | None) -> list[ContactOutput]:
     """The contact pairs of a step that have points in contact."""
     return [] if step is None else [c for c in step.contact if np.any(c.active)]
@@ -189,7 +220,7 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
     ``output`` defaults to ``<result>-deformed-<step>.png`` next to the result
     file. ``reference=True`` adds the undeformed outlines (dashed). ``zoom``: when
     bodies are in contact, a second panel shows the contact zone at true scale.
-    Rigid master lines are drawn in both panels. Returns the path written.
+    Rigid masters (lines, curves) are drawn in both panels. Returns the path written.
     """
     if not isinstance(result, Result):
         result = read_result(result)
@@ -236,6 +267,12 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
         ax.set_xlim(min(xl[0], *(p[0] - 0.05 * size for p, _, _ in lines)),
                     max(xl[1], *(p[0] + 0.05 * size for p, _, _ in lines)))
         ax.set_ylim(min(yl[0], *(p[1] - 0.06 * size for p, _, _ in lines)), yl[1])
+    curves = rigid_curves(s)
+    for pts, n, label in curves:
+        note = label if scale == 1.0 else f"{label} (true position; bodies x {scale:g})"
+        draw_rigid_curve(ax, pts, n, 0.04 * size, note, "-" if scale == 1.0 else "--")
+    if lines or curves:
+        ax.autoscale_view()
         ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel(f"x [{unit}]")
     ax.set_ylabel(f"y [{unit}]")
@@ -245,6 +282,8 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
         centre, half = _zoom_window(pairs, size)
         for p, n, _ in lines:
             draw_rigid_line(axz, p, n, 0.15 * half[1], 3.0 * size)
+        for pts, n, _ in curves:
+            draw_rigid_curve(axz, pts, n, 0.15 * half[1])
         for c in pairs:
             axz.plot(c.x[c.active, 0], c.x[c.active, 1], "o", ms=3.5, mfc="white", mec="crimson",
                      mew=0.6, label=f"{c.slave}: points in contact")

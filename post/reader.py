@@ -154,6 +154,11 @@ class ContactOutput:
     """(2,) a point of a rigid master line (None for a deformable master)."""
     rigid_normal: np.ndarray | None = None
     """(2,) the rigid master line's unit outward normal."""
+    rigid_curve: Curve | None = None
+    """A rigid master bounded by a curve: the curve where it is at this step (the
+    obstacle on its left, outward normal ``(a_y, -a_x)/|a|``; None otherwise)."""
+    rigid_offset: np.ndarray | None = None
+    """(2,) that curve's translation from its position at load time 0."""
 
     @property
     def active(self) -> np.ndarray:
@@ -162,7 +167,7 @@ class ContactOutput:
 
 
 _LAZY_FIELDS: tuple[str, ...] = ("time", "substeps", "residual_norms", "energy_norms",
-                                  "displacement", "contact", "fields")
+                                  "displacement", "contact", "fields", "field_info")
 """The fields of a :class:`Step` that ``read_result(..., lazy=True)`` reads on first use."""
 
 
@@ -236,10 +241,17 @@ class Step:
 
     @property
     def fields(self) -> dict[str, dict[str, np.ndarray]]:
-        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,)
-        and e.g. ``stress`` (n, k)), from ``/steps/<k>/fields/<body>``; empty when the
-        file has none (voiga does not write them yet; docs/hdf5.md)."""
+        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,),
+        ``element`` (n,) 0-based, ``stress`` and ``strain`` (n, 4) as [xx, yy, zz, xy],
+        ``von_mises`` (n,)), from ``/steps/<k>/fields/<body>``; empty at the steps
+        without (``&output``; docs/hdf5.md)."""
         return self._get("fields")
+
+    @property
+    def field_info(self) -> dict[str, dict[str, Any]]:
+        """The attributes of each body's sampled fields (``samples``, ``components``,
+        ``stress_measure``, ``strain_measure``); empty at steps without fields."""
+        return self._get("field_info")
 
 
 @dataclass(eq=False)
@@ -480,9 +492,18 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
             "displacement": vec("displacement"),
             "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
             if gid.links.exists(b"contact") else [],
-            "fields": {body: {k: np.asarray(v[()], dtype=float) for k, v in fg.items()}
+            "fields": {body: {k: _field_array(v) for k, v in fg.items()}
                        for body, fg in g["fields"].items()}
+            if gid.links.exists(b"fields") else {},
+            "field_info": {body: _attrs(fg) for body, fg in g["fields"].items()}
             if gid.links.exists(b"fields") else {}}
+
+
+def _field_array(d: h5py.Dataset) -> np.ndarray:
+    """A sampled-field dataset: ``element`` as 0-based ints, the rest as floats."""
+    if d.name.rsplit("/", 1)[-1] == "element":
+        return np.asarray(d[()], dtype=np.int64) - 1
+    return np.asarray(d[()], dtype=float)
 
 
 def _read_contact(g: h5py.Group) -> ContactOutput:
@@ -500,7 +521,9 @@ def _read_contact(g: h5py.Group) -> ContactOutput:
                          xi_master=vec("xi_master"),
                          state=np.asarray(g["state"][()], dtype=int).reshape(-1), attrs=a,
                          rigid_point=vec("rigid_point") if "rigid_point" in g else None,
-                         rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None)
+                         rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None,
+                         rigid_curve=read_curve(g["rigid_curve"]) if "rigid_curve" in g else None,
+                         rigid_offset=vec("rigid_offset") if "rigid_offset" in g else None)
 
 
 def read_result(path: str | Path, lazy: bool = False) -> Result:

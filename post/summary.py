@@ -30,10 +30,15 @@ def slave_element_size(result: Result, c: ContactOutput, xi: float) -> float:
 
 
 def warnings_for(result: Result) -> list[str]:
-    """What a result file shows that the user should know: a contact pair that was never
-    in contact at any converged step, and a penetration larger than
+    """What a result file shows that the user should know. voiga records its own
+    warnings in the root attribute ``warnings`` (docs/warnings.md):
+    those, when the file has the attribute. Files written before it: a contact pair
+    that was never in contact at any converged step, and a penetration larger than
     ``PENETRATION_WARNING`` of the size of the slave element where it is largest
     (penalty too small, or a contact edge on the wrong side of a body)."""
+    if "warnings" in result.attrs:
+        text = result.attrs["warnings"]
+        return [f"warning: {line}" for line in str(text).split("\n") if line.strip()]
     out: list[str] = []
     if not result.steps:
         return out

@@ -11,7 +11,12 @@ The Python API under ``python -m pre geometry`` (``docs/pre.md``):
   edges;
 - :func:`check_patch` rejects what the solver cannot use (3D control points, a
   patch that folds over or degenerates, unnamed or repeated edges);
-- :func:`write_bodies` writes the geometry file.
+- rigid obstacles (``&contact master = 'rigid'``, ``rigid_curve``): curves without
+  DOFs from :func:`obstacle_arc` (a cylinder or a round seat),
+  :func:`obstacle_polyline` (a flat punch with rounded corners, a die profile) or
+  :func:`obstacle` (any splipy curve), oriented counter-clockwise around the
+  obstacle as the solver expects (the obstacle on the left of the curve);
+- :func:`write_bodies` writes the geometry file (bodies and obstacle curves).
 
 Every shape names its four sides; the names map onto the patch edges ``xi0``,
 ``xi1``, ``eta0``, ``eta1`` that the case file refers to by name. splipy does every
@@ -30,7 +35,8 @@ import splipy
 from splipy import curve_factory, surface_factory
 
 from .h5io import write_geometry
-from .nurbs import EDGE_KEYS, Patch, evaluate_patch, patch_from_splipy, patch_to_splipy
+from .nurbs import (EDGE_KEYS, Curve, Patch, curve_from_splipy, curve_to_splipy, evaluate_patch,
+                    patch_from_splipy, patch_to_splipy)
 from .scenes import annular_sector as _quarter_sector
 from .scenes import rectangle as _rectangle
 
@@ -251,17 +257,95 @@ def edge_length(patch: Patch, key: str, n: int = 200) -> float:
     return float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
 
 
+SIDES = ("left", "right")
+"""Which side of a polyline (in the order of its points) the obstacle lies on."""
+
+
+def obstacle(spline: splipy.Curve, side: str = "left") -> Curve:
+    """A splipy curve (planar, any parametrization) as the boundary of a rigid
+    obstacle lying on its ``side`` ("left" or "right" of the direction of travel):
+    parameter rescaled to [0, 1] and the direction reversed when needed, so that the
+    obstacle is on the left as the solver expects (its outward normal is then
+    ``(a_y, -a_x)/|a|``, ``a = dx/dxi``; docs/formats.md)."""
+    if side not in SIDES:
+        raise ValueError(f"side must be one of {SIDES}, got {side!r}")
+    c = spline.clone()
+    if c.dimension > 2:
+        cp = np.asarray(c.controlpoints)
+        if np.abs(cp[:, 2]).max() > 1e-12 * max(1.0, np.abs(cp[:, :2]).max()):
+            raise ValueError("the curve is not planar in z = 0")
+        c.set_dimension(2)
+    if side == "right":
+        c.reverse()
+    c.reparam()
+    return curve_from_splipy(c)
+
+
+def obstacle_arc(centre: Point, radius: float, angles: Sequence[float], side: str = "inside") -> Curve:
+    """A circular arc from ``angles[0]`` to ``angles[1]`` (degrees, at most 360
+    apart) bounding a rigid obstacle: the disc (``side = "inside"``: a cylinder or a
+    round punch) or what surrounds the circle (``"outside"``: a round seat or groove).
+    The contact zone should not include the ends of the arc."""
+    a0, a1 = float(angles[0]), float(angles[1])
+    if radius <= 0 or not 0 < abs(a1 - a0) <= 360:
+        raise ValueError(f"obstacle arc: need radius > 0 and angles at most 360 degrees apart, "
+                         f"got {radius}, {list(angles)}")
+    if side not in ("inside", "outside"):
+        raise ValueError(f"obstacle arc: side must be 'inside' or 'outside', got {side!r}")
+    lo, hi = min(a0, a1), max(a0, a1)
+    # counter-clockwise with the disc on the left
+    return obstacle(_arc(centre, radius, lo, hi), "left" if side == "inside" else "right")
+
+
+def obstacle_polyline(points: Sequence[Point], side: str, arcs: dict[int, float] | None = None) -> Curve:
+    """An open chain of straight segments through ``points`` (segment ``k`` from point
+    ``k`` to ``k + 1``), segment ``k`` a circular arc of signed radius ``arcs[k]``
+    (> 0 bulges to the right of the direction of travel, < 0 to the left; as for
+    :func:`polygon`), bounding a rigid obstacle on its ``side`` ("left" or "right" of
+    the direction of travel). Corners between straight segments are kinks (C0 knots)."""
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2:
+        raise ValueError("obstacle polyline: need at least 2 points [x, y]")
+    arcs = {int(k): float(r) for k, r in (arcs or {}).items()}
+    if any(not 0 <= k < len(pts) - 1 for k in arcs):
+        raise ValueError(f"obstacle polyline: arc segments must be in 0..{len(pts) - 2}")
+    if np.any(np.linalg.norm(np.diff(pts, axis=0), axis=1) == 0):
+        raise ValueError("obstacle polyline: two consecutive points coincide")
+    pieces = [_segment(pts[k], pts[k + 1], arcs.get(k)) for k in range(len(pts) - 1)]
+    return obstacle(_chain(pieces), side)
+
+
+def check_curve(name: str, curve: Curve) -> None:
+    """Raise ValueError naming ``name`` and the cause when the solver cannot use the
+    obstacle curve: knots not on [0, 1], non-positive weights, or a curve that stops
+    (dx/dxi vanishing: no normal)."""
+    if curve.knots[0] != 0.0 or curve.knots[-1] != 1.0:
+        raise ValueError(f"curve {name!r}: knots must span [0, 1]")
+    if np.any(curve.weights <= 0):
+        raise ValueError(f"curve {name!r}: weights must be positive")
+    spline = curve_to_splipy(curve)
+    t = np.linspace(0.0, 1.0, 200)
+    speed = np.linalg.norm(np.asarray(spline.derivative(t))[:, :2], axis=1)
+    size = float(np.ptp(curve.control_points, axis=0).max())
+    if size == 0 or speed.min() <= 1e-10 * size:
+        raise ValueError(f"curve {name!r}: the curve stops somewhere (dx/dxi = 0): no normal there")
+
+
 def write_bodies(path: str | Path, bodies: dict[str, Patch | splipy.Surface],
                  scene: str = "", units: str = "mm, N",
-                 edges: dict[str, dict[str, str]] | None = None) -> Path:
-    """Check every body and write the geometry file; splipy surfaces are converted
-    with :func:`body` (their edge names from ``edges[name]``). Returns the path."""
+                 edges: dict[str, dict[str, str]] | None = None,
+                 curves: dict[str, Curve] | None = None) -> Path:
+    """Check every body and obstacle curve and write the geometry file; splipy
+    surfaces are converted with :func:`body` (their edge names from
+    ``edges[name]``). Returns the path."""
     patches = {}
     for name, b in bodies.items():
         patch = b if isinstance(b, Patch) else body(b, (edges or {}).get(name, {}))
         check_patch(name, patch)
         patches[name] = patch
+    for name, c in (curves or {}).items():
+        check_curve(name, c)
     path = Path(path)
     write_geometry(path, scene or path.stem, patches, units=units,
-                   generator="voiga pre (python -m pre geometry)")
+                   generator="voiga pre (python -m pre geometry)", curves=curves)
     return path

@@ -85,8 +85,9 @@ def read_curve(group: h5py.Group) -> Curve:
 
 
 def write_geometry(path: str | Path, scene: str, bodies: dict[str, Patch], units: str = UNITS,
-                   generator: str = GENERATOR) -> None:
-    """Write the coarse geometry file of a scene."""
+                   generator: str = GENERATOR, curves: dict[str, Curve] | None = None) -> None:
+    """Write the coarse geometry file of a scene: its bodies and (``/curves``, only
+    when there are any) the curves of its rigid obstacles."""
     with h5py.File(path, "w") as f:
         f.attrs["scene"] = _str(scene)
         f.attrs["units"] = _str(units)
@@ -94,12 +95,22 @@ def write_geometry(path: str | Path, scene: str, bodies: dict[str, Patch], units
         g = f.create_group("bodies", track_order=True)
         for name, patch in bodies.items():
             write_patch(g.create_group(name), patch)
+        if curves:
+            g = f.create_group("curves", track_order=True)
+            for name, curve in curves.items():
+                write_curve(g.create_group(name), curve)
 
 
 def read_geometry(path: str | Path) -> tuple[dict[str, Any], dict[str, Patch]]:
     """``(root attrs, {body name: coarse patch})`` of a geometry file."""
     with h5py.File(path, "r") as f:
         return attrs_dict(f), {name: read_patch(g) for name, g in f["bodies"].items()}
+
+
+def read_curves(path: str | Path) -> dict[str, Curve]:
+    """``{name: curve}`` of the rigid obstacles of a geometry file (empty if none)."""
+    with h5py.File(path, "r") as f:
+        return {name: read_curve(g) for name, g in f["curves"].items()} if "curves" in f else {}
 
 
 def h5_contents(path: str | Path) -> dict[str, Any]:

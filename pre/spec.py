@@ -2,7 +2,8 @@
 (``python -m pre geometry SPEC.toml``; reference in ``docs/pre.md``).
 
 A spec lists bodies (``[[body]]``, one patch each: ``shape = "rectangle"``,
-``"annular_sector"``, ``"arc"``, ``"polygon"`` or ``"g2"``), the refinement and
+``"annular_sector"``, ``"arc"``, ``"polygon"`` or ``"g2"``), rigid obstacles
+(``[[curve]]``: ``shape = "arc"``, ``"polyline"`` or ``"g2"``), the refinement and
 material defaults (``[defaults]``), and optionally the groups of the case file
 (``[case]``, ``[solver]``, ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]``),
 which are written to the case as they are. From ``name.toml`` it writes
@@ -20,10 +21,10 @@ from pathlib import Path
 from typing import Any
 
 from .cases import to_namelist_text
-from .geometry import (annular_sector, body, check_patch, edge_length, polygon, read_g2, rectangle,
-                       write_bodies)
+from .geometry import (annular_sector, body, check_curve, check_patch, edge_length, obstacle,
+                       obstacle_arc, obstacle_polyline, polygon, read_g2, rectangle, write_bodies)
 from .layouts import parse_layout
-from .nurbs import Patch
+from .nurbs import Curve, Patch
 
 DEFAULTS: dict[str, Any] = {
     "layout": "NN2.2",
@@ -51,6 +52,15 @@ SHAPE_KEYS = {
 }
 
 
+CURVE_KEYS = {"name", "shape", "side"}
+CURVE_SHAPE_KEYS = {
+    "arc": {"centre", "radius", "angles"},
+    "polyline": {"points", "arcs"},
+    "g2": {"file", "index"},
+}
+"""Keys of a ``[[curve]]`` table (a rigid obstacle's boundary), per shape."""
+
+
 class SpecError(ValueError):
     """A spec the tools cannot use; the message names the body and the key."""
 
@@ -67,6 +77,10 @@ class Spec:
         return list(self.data.get("body", []))
 
     @property
+    def curves(self) -> list[dict[str, Any]]:
+        return list(self.data.get("curve", []))
+
+    @property
     def defaults(self) -> dict[str, Any]:
         return {**DEFAULTS, **self.data.get("defaults", {})}
 
@@ -80,7 +94,7 @@ def read_spec(path: str | Path) -> Spec:
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise SpecError(f"{path}: not valid TOML ({err})") from None
-    unknown = set(data) - {"units", "scene", "defaults", "body", "case", *CASE_GROUPS}
+    unknown = set(data) - {"units", "scene", "defaults", "body", "curve", "case", *CASE_GROUPS}
     if unknown:
         raise SpecError(f"{path}: unknown table(s) {sorted(unknown)}")
     if not data.get("body"):
@@ -88,9 +102,9 @@ def read_spec(path: str | Path) -> Spec:
     return Spec(path, data)
 
 
-def _need(b: dict[str, Any], key: str) -> Any:
+def _need(b: dict[str, Any], key: str, what: str = "body") -> Any:
     if key not in b:
-        raise SpecError(f"body {b.get('name', '?')!r}: missing {key!r}")
+        raise SpecError(f"{what} {b.get('name', '?')!r}: missing {key!r}")
     return b[key]
 
 
@@ -125,6 +139,37 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
         if isinstance(err, SpecError):
             raise
         raise SpecError(f"body {name!r}: {err}") from None
+
+
+def build_curve(c: dict[str, Any], folder: Path) -> Curve:
+    """The obstacle curve of one ``[[curve]]`` table (``folder``: where relative files
+    are): an ``arc`` (``side`` "inside", the default: the disc is the obstacle, or
+    "outside"), a ``polyline`` or the ``index``-th curve of a ``.g2`` file (``side``
+    "left" or "right" of the direction of travel: required)."""
+    name = _need(c, "name", "curve")
+    shape = _need(c, "shape", "curve")
+    if shape not in CURVE_SHAPE_KEYS:
+        raise SpecError(f"curve {name!r}: unknown shape {shape!r} (known: {sorted(CURVE_SHAPE_KEYS)})")
+    unknown = set(c) - CURVE_KEYS - CURVE_SHAPE_KEYS[shape]
+    if unknown:
+        raise SpecError(f"curve {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
+    try:
+        if shape == "arc":
+            return obstacle_arc(_need(c, "centre", "curve"), float(_need(c, "radius", "curve")),
+                                _need(c, "angles", "curve"), str(c.get("side", "inside")))
+        side = str(_need(c, "side", "curve"))
+        if shape == "polyline":
+            arcs = {int(a["segment"]): float(a["radius"]) for a in c.get("arcs", [])}
+            return obstacle_polyline(_need(c, "points", "curve"), side, arcs)
+        objs = [o for o in read_g2(folder / _need(c, "file", "curve")) if o.pardim == 1]
+        index = int(c.get("index", 0))
+        if not 0 <= index < len(objs):
+            raise SpecError(f"curve {name!r}: the .g2 file has {len(objs)} curve(s), no index {index}")
+        return obstacle(objs[index], side)
+    except (ValueError, KeyError, TypeError) as err:
+        if isinstance(err, SpecError):
+            raise
+        raise SpecError(f"curve {name!r}: {err}") from None
 
 
 def _orient(patch: Patch, contact_key: str | None) -> tuple[str, str]:
@@ -224,19 +269,22 @@ def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
     folder.mkdir(parents=True, exist_ok=True)
     stem = spec.path.stem
     patches: dict[str, Patch] = {}
-    for b in spec.bodies:
-        patch = build_patch(b, spec.path.parent)
-        if b["name"] in patches:
-            raise SpecError(f"two bodies are named {b['name']!r}")
-        try:
-            check_patch(b["name"], patch)
-        except ValueError as err:
-            raise SpecError(str(err)) from None
-        patches[b["name"]] = patch
+    curves: dict[str, Curve] = {}
+    for tables, build, check, into in ((spec.bodies, build_patch, check_patch, patches),
+                                       (spec.curves, build_curve, check_curve, curves)):
+        for t in tables:
+            obj = build(t, spec.path.parent)
+            if t["name"] in patches or t["name"] in curves:
+                raise SpecError(f"two bodies or curves are named {t['name']!r}")
+            try:
+                check(t["name"], obj)
+            except ValueError as err:
+                raise SpecError(str(err)) from None
+            into[t["name"]] = obj
     groups = case_groups(spec, patches, f"{stem}-geometry.h5", stem)
     geometry = write_bodies(folder / f"{stem}-geometry.h5", patches,
                             scene=str(spec.data.get("scene", stem)),
-                            units=str(spec.data.get("units", "mm, N")))
+                            units=str(spec.data.get("units", "mm, N")), curves=curves)
     case = folder / f"{stem}.nml"
     if case.exists() and not force:
         return geometry, case, False

@@ -15,7 +15,7 @@ module voiga_test_fixtures
     implicit none
     private
 
-    public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model
+    public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model, body_settings
 
     !> The settings of a test scene, as a case file would give them.
     type :: scene_t
@@ -48,6 +48,19 @@ contains
         if (.not. allocated(c%solver%n_steps)) c%solver%n_steps = [1]
         call new_model(model, c%bodies, discs, c%solver%n_gauss, c%dirichlet, c%pressure, c%contact, error)
     end subroutine scene_model
+
+    !> A body entry of a test case (Poisson's ratio 0.3).
+    function body_settings(name, material, e, layout) result(b)
+        character(len=*), intent(in) :: name, material
+        real(dp), intent(in) :: e
+        type(layout_t), intent(in) :: layout
+        type(body_settings_t) :: b
+        b%name = name
+        b%material = material
+        b%youngs_modulus = e
+        b%poisson_ratio = 0.3_dp
+        b%layout = layout
+    end function body_settings
 
     !> A layout in the paper's notation: 'L1', 'Np' (degree p along the contact edge,
     !> 2 across), 'NNq' (bulk 2 x 2, layer of degree q), 'NNq.k' (k more elevations).

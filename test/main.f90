@@ -14,6 +14,8 @@ program voiga_tests
     use test_multigrid, only: collect_multigrid
     use test_hdf5, only: collect_hdf5
     use test_alm, only: collect_alm
+    use test_rigid, only: collect_rigid
+    use test_fields, only: collect_fields
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -30,7 +32,9 @@ program voiga_tests
              new_testsuite('stepping', collect_stepping), &
              new_testsuite('multigrid', collect_multigrid), &
              new_testsuite('hdf5', collect_hdf5), &
-             new_testsuite('alm', collect_alm) &
+             new_testsuite('alm', collect_alm), &
+             new_testsuite('rigid', collect_rigid), &
+             new_testsuite('fields', collect_fields) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

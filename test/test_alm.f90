@@ -15,8 +15,8 @@ module test_alm
     use voiga_contact_surface, only: element_lengths
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
-    use voiga_test_fixtures, only: paper_layout, rectangle, scene_t
-    use test_contact, only: two_body_model, penetrating_state, contact_fd, body, bc, build_model
+    use voiga_test_fixtures, only: paper_layout, rectangle, scene_t, body => body_settings
+    use test_contact, only: two_body_model, penetrating_state, contact_fd, bc, build_model
     implicit none
     private
 

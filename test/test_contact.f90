@@ -5,10 +5,8 @@ module test_contact
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_surface, only: nurbs_surface_t
-    use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_model, only: model_t
-    use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
                                     new_assembly_map
@@ -23,11 +21,13 @@ module test_contact
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t, mortar_snapshot_t
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
-    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model
+    use voiga_nurbs_curve, only: nurbs_curve_t
+    use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model, &
+                                   body_settings
     implicit none
     private
 
-    public :: collect_contact, two_body_model, penetrating_state, contact_fd, body, bc, build_model
+    public :: collect_contact, two_body_model, penetrating_state, contact_fd, bc, build_model, run_fd
 
     real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -65,8 +65,9 @@ contains
 
 
     !> Die (half annulus, outer radius 3, lowest point (2.5, 0)) over a 9 x 3 slab,
-    !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0).
-    subroutine two_body_model(layout, mu, rigid, model, error, method)
+    !> both with `layout`; the pair die -> slab (or -> a rigid line y = 0, or with
+    !> `curve` the rigid obstacle it bounds).
+    subroutine two_body_model(layout, mu, rigid, model, error, method, curve)
         character(len=*), intent(in) :: layout
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -74,6 +75,8 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Contact method ('gpts' when absent).
         character(len=*), intent(in), optional :: method
+        !> A rigid master bounded by this curve instead of the line (with `rigid`).
+        type(nurbs_curve_t), intent(in), optional :: curve
         type(scene_t) :: c
         type(discretization_t) :: discs(2)
         character(len=8), parameter :: names(2) = [character(len=8) :: 'die', 'slab']
@@ -98,6 +101,10 @@ contains
         c%contact(1)%penalty_tangent = 70.0_dp
         c%contact(1)%friction = mu
         if (present(method)) c%contact(1)%method = method
+        if (present(curve)) then
+            c%contact(1)%rigid_curve = 'curve'
+            c%contact(1)%curve = curve
+        end if
         call new_discretization(discs(1), annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
                                 c%bodies(1)%layout, '', error)
         if (allocated(error)) return
@@ -186,7 +193,7 @@ contains
         end subroutine add_dense
     end subroutine contact_fd
 
-    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method)
+    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method, curve)
         character(len=*), intent(in) :: layouts(:)
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -199,12 +206,14 @@ contains
         !> Contact method ('gpts' when absent); mortar: the shift is that of the last
         !> converged projections, the committed tractions are zero.
         character(len=*), intent(in), optional :: method
+        !> A rigid master bounded by this curve (with `rigid`).
+        type(nurbs_curve_t), intent(in), optional :: curve
         type(model_t) :: model
         real(dp), allocatable :: u(:), r(:)
         integer :: il
 
         do il = 1, size(layouts)
-            call two_body_model(trim(layouts(il)), mu, rigid, model, error, method)
+            call two_body_model(trim(layouts(il)), mu, rigid, model, error, method, curve)
             if (allocated(error)) return
             call penetrating_state(model, u)
             if (mu > 0.0_dp) then
@@ -405,19 +414,6 @@ contains
         end select
     end subroutine test_mortar_unprojected_open
 
-    !> A body entry of a test case.
-    function body(name, material, e, layout) result(b)
-        character(len=*), intent(in) :: name, material
-        real(dp), intent(in) :: e
-        type(layout_t), intent(in) :: layout
-        type(body_settings_t) :: b
-        b%name = name
-        b%material = material
-        b%youngs_modulus = e
-        b%poisson_ratio = 0.3_dp
-        b%layout = layout
-    end function body
-
     function bc(b, edge, fix, values) result(d)
         character(len=*), intent(in) :: b, edge
         logical, intent(in) :: fix(2)
@@ -485,8 +481,8 @@ contains
         real(dp), allocatable :: u(:)
         real(dp), parameter :: p = 0.01_dp
 
-        c%bodies = [body('upper', 'linear', 1.0_dp, paper_layout('N2', [nel_upper, 2], 'bottom')), &
-                    body('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
+        c%bodies = [body_settings('upper', 'linear', 1.0_dp, paper_layout('N2', [nel_upper, 2], 'bottom')), &
+                    body_settings('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
         c%solver%n_steps = [1]
         c%dirichlet = [bc('lower', 'bottom', [.false., .true.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
                        bc('lower', 'left', [.true., .false.], reshape([0.0_dp, 0.0_dp], [2, 1])), &
@@ -523,7 +519,7 @@ contains
         character(len=*), intent(in), optional :: method
         type(scene_t) :: c
         type(solver_stats_t) :: stats
-        c%bodies = [body('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
+        c%bodies = [body_settings('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
@@ -728,8 +724,8 @@ contains
         real(dp) :: floor
         integer :: i
 
-        c%bodies = [body('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
-                    body('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
+        c%bodies = [body_settings('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
+                    body_settings('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
         ! press 0.5 in 10 steps, then 5 of the 200 sliding steps of 0.02
         c%solver%n_steps = [10, 5]
         c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &

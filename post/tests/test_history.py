@@ -89,16 +89,21 @@ def test_bad_input_exits_2(command: str, tmp_path: Path, capsys: pytest.CaptureF
 
 
 def test_summary_warnings(press_h5: Path, tmp_path: Path) -> None:
-    """A pair never in contact, and a penetration beyond a tenth of the slave element,
-    are named (here made by editing copies of a real result)."""
+    """The solver's warnings recorded in the file are shown (here: the die, the slave,
+    is stiffer than the slab). A file without that record (written before voiga made
+    one): a pair never in contact, and a penetration beyond a tenth of the slave
+    element, are named (here made by editing copies of a real result)."""
     import h5py
 
     from post.summary import summary_lines, warnings_for
 
-    assert warnings_for(read_result(press_h5)) == []
+    (w,) = warnings_for(read_result(press_h5))
+    assert w.startswith("warning: contact 'die' on 'slab': the slave is stiffer")
+    assert w in summary_lines(read_result(press_h5))
     never = tmp_path / "never.h5"
     never.write_bytes(press_h5.read_bytes())
     with h5py.File(never, "r+") as f:
+        del f.attrs["warnings"]
         for key in f["steps"]:
             f[f"steps/{key}/contact/1/state"][...] = 0
     (w,) = warnings_for(read_result(never))
@@ -106,6 +111,7 @@ def test_summary_warnings(press_h5: Path, tmp_path: Path) -> None:
     deep = tmp_path / "deep.h5"
     deep.write_bytes(press_h5.read_bytes())
     with h5py.File(deep, "r+") as f:
+        del f.attrs["warnings"]
         g = f["steps/000002/contact/1"]
         k = int(np.flatnonzero(g["state"][()] > 0)[0])
         gap = g["gap"][()]

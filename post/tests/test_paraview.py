@@ -132,8 +132,9 @@ def test_contact_edge_fields(which: str, request: pytest.FixtureRequest, tmp_pat
 
 
 def test_solver_fields_are_exported_when_present(two_h5: Path, tmp_path: Path) -> None:
-    """Stress fields are not written by voiga yet (issue 18 item 4); a file that has
-    them (here added by hand, layout of docs/hdf5.md) gets a ``fields`` part."""
+    """Any field a file has under ``/steps/<k>/fields/<body>`` (here added by hand,
+    without the solver's attributes: one vertex per point, arrays as they are) gets a
+    ``fields`` part (the solver's own fields: test/python/test_fields.py)."""
     path = tmp_path / "two.h5"
     path.write_bytes(two_h5.read_bytes())
     xi = np.array([0.1, 0.5, 0.9])

@@ -4,6 +4,7 @@
 module voiga_contact_factory
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_contact_pair, only: contact_pair_t
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
@@ -22,10 +23,17 @@ module voiga_contact_factory
 
     !> One contact pair (`&contact`; docs/formats.md).
     type :: contact_settings_t
-        !> Slave body; master body, or 'rigid' for a fixed rigid line.
+        !> Slave body; master body, or 'rigid' for a rigid obstacle.
         character(len=32) :: slave = '', master = ''
         !> Rigid line: a point on it and its outward normal.
         real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
+        !> Rigid obstacle bounded by a curve of the geometry file instead of the line:
+        !> its name ('' for the line) and the curve (read by `voiga_io_bodies`).
+        character(len=32) :: rigid_curve = ''
+        type(nurbs_curve_t) :: curve
+        !> The rigid master's translation at the end of each load phase, shape
+        !> [2, n_phases] (linear within a phase, zero at time 0); unallocated: fixed.
+        real(dp), allocatable :: rigid_motion(:, :)
         !> Penalties (0: automatic, `automatic_penalty`; penalty_tangent 0: the normal
         !> one) and the friction coefficient.
         real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp

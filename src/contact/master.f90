@@ -1,12 +1,14 @@
-!> The master side of a contact pair: a deformable body's contact edge (NURBS)
-!> or a rigid straight line without DOFs. Both answer the closest-point projection
-!> of a slave point with a `master_point_t`.
+!> The master side of a contact pair: a deformable body's contact edge (NURBS),
+!> or a rigid obstacle without DOFs (a straight line, or any NURBS curve of the
+!> geometry file). Each answers the closest-point projection of a slave point
+!> with a `master_point_t`; a rigid one is moved by its prescribed motion
+!> (`move`, called by the model at the load time before every assembly).
 module voiga_contact_master
     use voiga_kinds, only: dp
     implicit none
     private
 
-    public :: contact_master_t, master_point_t
+    public :: contact_master_t, master_point_t, master_no_dofs
 
     !> The master at the projection of a slave point.
     type :: master_point_t
@@ -29,8 +31,10 @@ module voiga_contact_master
         logical :: deformable = .false.
     contains
         procedure(project_interface), deferred :: project
-        procedure(all_dofs_interface), deferred :: all_dofs
+        !> Every DOF the master may couple to (for the stiffness pattern); default: none.
+        procedure :: all_dofs => master_no_dofs
         procedure :: prepare => master_prepare
+        procedure :: move => master_move
     end type contact_master_t
 
     abstract interface
@@ -46,16 +50,17 @@ module voiga_contact_master
             !> False if the local Newton iteration did not converge.
             logical, intent(out) :: converged
         end subroutine project_interface
-
-        !> Every DOF the master may couple to (for the stiffness pattern).
-        pure function all_dofs_interface(self) result(dofs)
-            import :: contact_master_t
-            class(contact_master_t), intent(in) :: self
-            integer, allocatable :: dofs(:)
-        end function all_dofs_interface
     end interface
 
 contains
+
+    !> No DOFs: a rigid master.
+    pure function master_no_dofs(self) result(dofs)
+        class(contact_master_t), intent(in) :: self
+        integer, allocatable :: dofs(:)
+        allocate (dofs(0))
+        if (self%deformable) dofs = [integer ::]   ! (a deformable master overrides this)
+    end function master_no_dofs
 
     !> Update whatever the master's search needs for the configuration `u` (called
     !> once per evaluation of a pair, before its projections). Default: nothing.
@@ -64,5 +69,13 @@ contains
         real(dp), intent(in) :: u(:)
         ! a rigid master has nothing to update
     end subroutine master_prepare
+
+    !> Put a rigid master at its reference position translated by `offset`
+    !> (its prescribed motion at the current load time). Default: nothing (a
+    !> deformable master moves with its body's DOFs).
+    pure subroutine master_move(self, offset)
+        class(contact_master_t), intent(inout) :: self
+        real(dp), intent(in) :: offset(2)
+    end subroutine master_move
 
 end module voiga_contact_master

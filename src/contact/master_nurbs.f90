@@ -18,6 +18,9 @@ module voiga_contact_master_nurbs
     private
 
     public :: nurbs_master_t, new_nurbs_master, outward_sign
+    !> The search and projection on the curve, for extensions with another
+    !> displacement vector (a rigid curve's, `voiga_contact_master_curve`).
+    public :: nurbs_prepare, nurbs_project
 
     !> Newton iterations of the projection.
     integer, parameter :: max_newton = 50

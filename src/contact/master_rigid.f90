@@ -1,5 +1,6 @@
 !> A rigid straight master line (an obstacle without DOFs): the points
 !> x = p0 + xi t with outward unit normal n; xi is the arc length along t = (n_y, -n_x).
+!> A prescribed motion translates it (`move`: p0 = p_ref + offset).
 module voiga_contact_master_rigid
     use voiga_kinds, only: dp
     use voiga_contact_master, only: contact_master_t, master_point_t
@@ -11,9 +12,11 @@ module voiga_contact_master_rigid
     !> A fixed rigid line.
     type, extends(contact_master_t) :: rigid_line_t
         real(dp) :: p0(2) = 0.0_dp, n(2) = [0.0_dp, 1.0_dp], t(2) = [1.0_dp, 0.0_dp]
+        !> The point p0 at load time 0.
+        real(dp) :: p_ref(2) = 0.0_dp
     contains
         procedure :: project => rigid_project
-        procedure :: all_dofs => rigid_all_dofs
+        procedure :: move => rigid_move
     end type rigid_line_t
 
 contains
@@ -24,6 +27,7 @@ contains
         real(dp), intent(in) :: p0(2), normal(2)
         self%deformable = .false.
         self%p0 = p0
+        self%p_ref = p0
         self%n = normal/norm2(normal)
         self%t = [self%n(2), -self%n(1)]
     end subroutine new_rigid_line
@@ -44,11 +48,10 @@ contains
         converged = .true.
     end subroutine rigid_project
 
-    pure function rigid_all_dofs(self) result(dofs)
-        class(rigid_line_t), intent(in) :: self
-        integer, allocatable :: dofs(:)
-        allocate (dofs(0))
-        if (self%deformable) dofs = [integer ::]
-    end function rigid_all_dofs
+    pure subroutine rigid_move(self, offset)
+        class(rigid_line_t), intent(inout) :: self
+        real(dp), intent(in) :: offset(2)
+        self%p0 = self%p_ref + offset
+    end subroutine rigid_move
 
 end module voiga_contact_master_rigid

@@ -6,11 +6,13 @@ module voiga_contact_surface
     use voiga_kinds, only: dp
     use voiga_nurbs_basis, only: find_span, basis_ders, distinct_knots
     use voiga_nurbs_rational, only: rationalize
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_discretization_patch, only: discretization_t
     implicit none
     private
 
-    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point, element_lengths
+    public :: contact_surface_t, new_contact_surface, new_curve_surface, surface_point_t, surface_point, &
+              element_lengths
 
     !> The contact edge of one body.
     type :: contact_surface_t
@@ -47,7 +49,7 @@ contains
         type(contact_surface_t), intent(out) :: self
         type(discretization_t), intent(in) :: disc
         integer, intent(in) :: dof0
-        integer :: ny, k
+        integer :: ny
         if (disc%has_layer) then
             self%degree = disc%layer%degree
             self%knots = disc%layer%knots
@@ -64,12 +66,36 @@ contains
         self%dofs(1, :) = dof0 + 2*self%cps - 1
         self%dofs(2, :) = dof0 + 2*self%cps
         self%x0 = disc%x(:, self%cps)
+        call set_spans(self)
+    end subroutine new_contact_surface
+
+    !> A curve that belongs to no body (a rigid obstacle's), as a surface over a
+    !> displacement vector of its own: control point k has the DOFs 2k - 1, 2k.
+    pure subroutine new_curve_surface(self, curve)
+        type(contact_surface_t), intent(out) :: self
+        type(nurbs_curve_t), intent(in) :: curve
+        integer :: k
+        self%degree = curve%degree
+        self%knots = curve%knots
+        self%w = curve%w
+        self%cps = [(k, k=1, size(curve%w))]
+        allocate (self%dofs(2, size(self%cps)))
+        self%dofs(1, :) = 2*self%cps - 1
+        self%dofs(2, :) = 2*self%cps
+        self%x0 = curve%cp
+        call set_spans(self)
+    end subroutine new_curve_surface
+
+    !> The breakpoints and the knot span of each element, from the knots.
+    pure subroutine set_spans(self)
+        type(contact_surface_t), intent(inout) :: self
+        integer :: k
         self%breaks = distinct_knots(self%knots)
         allocate (self%spans(size(self%breaks) - 1))
         do k = 1, size(self%spans)
             self%spans(k) = find_span(self%knots, self%degree, 0.5_dp*(self%breaks(k) + self%breaks(k + 1)))
         end do
-    end subroutine new_contact_surface
+    end subroutine set_spans
 
     !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
     !> forces the knot span (0: found from xi), so that a point on an element

@@ -1,16 +1,17 @@
 !> From a case to the discretized bodies: read each body's coarse patch from the
-!> geometry file and build its discretization with the case's layout.
+!> geometry file and build its discretization with the case's layout; and the
+!> curves of the rigid obstacles the contact pairs name.
 module voiga_io_bodies
     use voiga_error, only: error_t
     use voiga_io_case, only: case_t
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_geometry, only: read_patch
+    use voiga_io_geometry, only: read_patch, read_curve
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     implicit none
     private
 
-    public :: discretize_bodies
+    public :: discretize_bodies, read_rigid_curves
 
 contains
 
@@ -44,5 +45,34 @@ contains
         call geo%close(close_error)
         if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine discretize_bodies
+
+    !> Read the curve of every contact pair whose rigid master is one
+    !> (`&contact rigid_curve`) from the geometry file into `case%contact(k)%curve`.
+    subroutine read_rigid_curves(case, error)
+        type(case_t), intent(inout) :: case
+        type(error_t), allocatable, intent(out) :: error
+        type(h5file_t) :: geo
+        type(error_t), allocatable :: close_error
+        character(len=16) :: buf
+        integer :: k
+
+        if (all([(len_trim(case%contact(k)%rigid_curve) == 0, k=1, size(case%contact))])) return
+        call geo%open(case%geometry, 'r', error)
+        if (allocated(error)) then
+            error%message = case%path//': &case: geometry: '//error%message
+            return
+        end if
+        do k = 1, size(case%contact)
+            if (len_trim(case%contact(k)%rigid_curve) == 0) cycle
+            call read_curve(geo, case%contact(k)%rigid_curve, case%contact(k)%curve, error)
+            if (allocated(error)) then
+                write (buf, '(i0)') k
+                error%message = case%path//': &contact ('//trim(buf)//'): rigid_curve: '//error%message
+                exit
+            end if
+        end do
+        call geo%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
+    end subroutine read_rigid_curves
 
 end module voiga_io_bodies

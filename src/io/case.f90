@@ -13,6 +13,8 @@ module voiga_io_case
     use voiga_io_case_dirichlet, only: read_dirichlet
     use voiga_io_case_pressure, only: read_pressure
     use voiga_io_case_contact, only: read_contact
+    use voiga_io_case_output, only: read_output
+    use voiga_model_fields, only: output_settings_t
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
     use voiga_contact_factory, only: contact_settings_t
@@ -24,8 +26,8 @@ module voiga_io_case
     public :: case_t, read_case, resolve_path, known_groups, check_edges
 
     !> The namelist groups a case file may contain.
-    character(len=*), parameter :: known_groups(6) = [character(len=9) :: 'case', 'body', 'solver', &
-                                                      'dirichlet', 'pressure', 'contact']
+    character(len=*), parameter :: known_groups(7) = [character(len=9) :: 'case', 'body', 'solver', &
+                                                      'dirichlet', 'pressure', 'contact', 'output']
 
     !> A case: its `&case` group and the settings of every other group.
     type, extends(case_settings_t) :: case_t
@@ -36,6 +38,8 @@ module voiga_io_case
         type(dirichlet_settings_t), allocatable :: dirichlet(:)
         type(pressure_settings_t), allocatable :: pressure(:)
         type(contact_settings_t), allocatable :: contact(:)
+        !> The sampled fields the result file gets (`&output`).
+        type(output_settings_t) :: field_output
     end type case_t
 
 contains
@@ -115,9 +119,11 @@ contains
         end do
         rewind (u)
         do i = 1, size(self%contact)
-            call read_contact(u, self%path, i, self%bodies, self%contact(i), error)
+            call read_contact(u, self%path, i, nph, self%bodies, self%contact(i), error)
             if (allocated(error)) return
         end do
+        if (any(names == 'output')) call read_output(u, self%path, self%solver%total_steps(), self%field_output, &
+                                                     error)
     end subroutine read_groups
 
     !> Every group in the file is known, and there are exactly n_bodies &body groups.
@@ -131,7 +137,7 @@ contains
         do i = 1, size(names)
             if (.not. any(known_groups == names(i))) then
                 call fatal_error(error, path//': unknown namelist group &'//trim(names(i))// &
-                                 ' (known: &case, &body, &solver, &dirichlet, &pressure, &contact)', &
+                                 ' (known: &case, &body, &solver, &dirichlet, &pressure, &contact, &output)', &
                                  error_code%input)
                 return
             end if
@@ -142,8 +148,8 @@ contains
             call fatal_error(error, path//trim(msg), error_code%input)
             return
         end if
-        if (count(names == 'case') /= 1 .or. count(names == 'solver') > 1) then
-            call fatal_error(error, path//': groups &case and &solver may appear once each', &
+        if (count(names == 'case') /= 1 .or. count(names == 'solver') > 1 .or. count(names == 'output') > 1) then
+            call fatal_error(error, path//': groups &case, &solver and &output may appear once each', &
                              error_code%input)
             return
         end if

@@ -4,12 +4,13 @@ module voiga_io_dump
     use voiga_error, only: error_t
     use voiga_io_hdf5, only: h5file_t
     use voiga_discretization_patch, only: discretization_t
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_io_case, only: case_t
     use voiga_version, only: voiga_version_string
     implicit none
     private
 
-    public :: write_discretization, write_dump
+    public :: write_discretization, write_dump, write_curve
 
 contains
 
@@ -68,15 +69,23 @@ contains
         if (allocated(error)) return
         call h5%write(group//'/bulk/weights', disc%bulk%w, error)
         if (allocated(error)) return
-        if (disc%has_layer) then
-            call h5%write(group//'/layer/degree', [disc%layer%degree], error)
-            if (allocated(error)) return
-            call h5%write(group//'/layer/knots', disc%layer%knots, error)
-            if (allocated(error)) return
-            call h5%write(group//'/layer/control_points', disc%layer%cp, error)
-            if (allocated(error)) return
-            call h5%write(group//'/layer/weights', disc%layer%w, error)
-        end if
+        if (disc%has_layer) call write_curve(h5, group//'/layer', disc%layer, error)
     end subroutine write_discretization
+
+    !> Write `curve` as the group `group` (degree (1,), knots, control_points (n, 2)
+    !> and weights in h5py's shapes; the schema of the VO layer in docs/formats.md).
+    subroutine write_curve(h5, group, curve, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: group
+        type(nurbs_curve_t), intent(in) :: curve
+        type(error_t), allocatable, intent(out) :: error
+        call h5%write(group//'/degree', [curve%degree], error)
+        if (allocated(error)) return
+        call h5%write(group//'/knots', curve%knots, error)
+        if (allocated(error)) return
+        call h5%write(group//'/control_points', curve%cp, error)
+        if (allocated(error)) return
+        call h5%write(group//'/weights', curve%w, error)
+    end subroutine write_curve
 
 end module voiga_io_dump

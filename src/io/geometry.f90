@@ -1,15 +1,17 @@
-!> Reading the coarse exact patches of a scene from its geometry HDF5 file
-!> (schema in docs/formats.md), with every value validated.
+!> Reading the coarse exact patches of a scene and the curves of its rigid
+!> obstacles from its geometry HDF5 file (schema in docs/formats.md), with every
+!> value validated.
 module voiga_io_geometry
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5, only: h5file_t
     use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels
+    use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
 
-    public :: read_patch, validate_knots
+    public :: read_patch, read_curve, validate_knots, geometry_units
 
 contains
 
@@ -25,22 +27,8 @@ contains
         integer :: i, j, k
 
         g = '/bodies/'//trim(name)
-        where = h5%path//": body '"//trim(name)//"': "
-        if (.not. h5%exists(g)) then
-            call fatal_error(error, h5%path//": no body '"//trim(name)//"' (group "//g// &
-                             " is missing)", error_code%input)
-            return
-        end if
-        call h5%read(g//'/degree', degree, error)
+        call read_degree(h5, 'body', name, g, 2, degree, where, error)
         if (allocated(error)) return
-        if (size(degree) /= 2) then
-            call fatal_error(error, where//'degree must have 2 entries', error_code%input)
-            return
-        end if
-        if (any(degree < 1) .or. any(degree > 20)) then
-            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
-            return
-        end if
         surf%degree = degree
         call h5%read(g//'/knots_xi', surf%knots_xi, error)
         if (allocated(error)) return
@@ -104,6 +92,83 @@ contains
             end do
         end do
     end subroutine read_patch
+
+    !> The root attribute `units` of the geometry file `path` ('<length>, <force>'
+    !> when `pre` wrote it), or `default` when the file has none or cannot be read
+    !> (a label only: nothing else depends on it).
+    function geometry_units(path, default) result(units)
+        character(len=*), intent(in) :: path, default
+        character(len=:), allocatable :: units
+        type(h5file_t) :: h5
+        type(error_t), allocatable :: error, close_error
+        units = default
+        call h5%open(path, 'r', error)
+        if (allocated(error)) return
+        if (h5%has_attr('/', 'units')) call h5%read_attr_str('/', 'units', units, error)
+        if (allocated(error)) units = default
+        call h5%close(close_error)
+    end function geometry_units
+
+    !> Read the curve `name` (/curves/<name>: a rigid obstacle's boundary) from the
+    !> open geometry file `h5`.
+    subroutine read_curve(h5, name, curve, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        type(nurbs_curve_t), intent(out) :: curve
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: g, where
+        integer, allocatable :: degree(:)
+        real(dp), allocatable :: cp(:, :)
+
+        g = '/curves/'//trim(name)
+        call read_degree(h5, 'curve', name, g, 1, degree, where, error)
+        if (allocated(error)) return
+        curve%degree = degree(1)
+        call h5%read(g//'/knots', curve%knots, error)
+        if (allocated(error)) return
+        call h5%read(g//'/control_points', cp, error)
+        if (allocated(error)) return
+        call h5%read(g//'/weights', curve%w, error)
+        if (allocated(error)) return
+        if (size(cp, 1) /= 2 .or. size(curve%w) /= size(cp, 2)) then
+            call fatal_error(error, where//'control_points must have shape (n, 2) and weights (n,)', &
+                             error_code%input)
+            return
+        end if
+        call validate_knots(curve%knots, curve%degree, size(cp, 2), where//'knots', error)
+        if (allocated(error)) return
+        if (.not. all(ieee_is_finite(cp))) then
+            call fatal_error(error, where//'control_points must be finite', error_code%input)
+        else if (.not. all(curve%w > 0.0_dp .and. ieee_is_finite(curve%w))) then
+            call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
+        end if
+        curve%cp = cp
+    end subroutine read_curve
+
+    !> The `n` degrees of the spline in group `g` (a `what` called `name`: 'body' or
+    !> 'curve'), each in 1..20; `where` begins the messages about it.
+    subroutine read_degree(h5, what, name, g, n, degree, where, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: what, name, g
+        integer, intent(in) :: n
+        integer, allocatable, intent(out) :: degree(:)
+        character(len=:), allocatable, intent(out) :: where
+        type(error_t), allocatable, intent(out) :: error
+        where = h5%path//': '//what//" '"//trim(name)//"': "
+        if (.not. h5%exists(g)) then
+            call fatal_error(error, h5%path//': no '//what//" '"//trim(name)//"' (group "//g// &
+                             " is missing)", error_code%input)
+            return
+        end if
+        call h5%read(g//'/degree', degree, error)
+        if (allocated(error)) return
+        if (size(degree) /= n) then
+            call fatal_error(error, where//'degree must have '//trim(merge('2 entries', '1 entry  ', n == 2)), &
+                             error_code%input)
+        else if (any(degree < 1) .or. any(degree > 20)) then
+            call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
+        end if
+    end subroutine read_degree
 
     !> A knot vector of `n` functions of degree `p`: length n+p+1, finite,
     !> non-decreasing, open (end multiplicity p+1) on [0, 1], interior

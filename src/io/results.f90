@@ -9,9 +9,14 @@ module voiga_io_results
     use voiga_version, only: voiga_version_string
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
-    use voiga_io_dump, only: write_discretization
+    use voiga_io_dump, only: write_discretization, write_curve
+    use voiga_io_geometry, only: geometry_units
     use voiga_model, only: model_t
+    use voiga_model_fields, only: output_settings_t
+    use voiga_io_fields, only: write_fields
     use voiga_contact_master_rigid, only: rigid_line_t
+    use voiga_contact_master_curve, only: rigid_curve_t
+    use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
     use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t
     use voiga_solver_progress, only: progress_t, step_report_t
@@ -26,6 +31,9 @@ module voiga_io_results
     type, extends(progress_t) :: results_t
         type(h5file_t) :: h5
         integer :: n_written = 0
+        !> The sampled fields the case asks for (`&output`) and the run's last step.
+        type(output_settings_t) :: fields
+        integer :: last_step = 0
     contains
         procedure :: open => results_open
         procedure :: reopen => results_reopen
@@ -35,6 +43,7 @@ module voiga_io_results
         procedure :: write_multigrid => results_write_multigrid
         procedure :: set_up => results_set_up
         procedure :: step_done => results_step_done
+        procedure :: warning => results_warning
     end type results_t
 
 contains
@@ -49,6 +58,8 @@ contains
         character(len=:), allocatable :: g
         character(len=16) :: buf
 
+        self%fields = case%field_output
+        self%last_step = case%solver%total_steps()
         call self%h5%open(case%output, 'w', error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
@@ -79,6 +90,9 @@ contains
         if (allocated(error)) return
         call self%h5%write_attr('/', 'wall_time', 0.0_dp, error)
         if (allocated(error)) return
+        ! the run's warnings, one per line (results_warning); none yet
+        call self%h5%write_attr('/', 'warnings', '', error)
+        if (allocated(error)) return
         do i = 1, size(model%bodies)
             call write_body(self%h5, model, i, trim(case%bodies(i)%material), error)
             if (allocated(error)) return
@@ -100,7 +114,8 @@ contains
             call self%h5%write(g//'/values', model%dirichlet(k)%values, error)
             if (allocated(error)) return
         end do
-        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)', error)
+        ! the geometry's units ('mm, N' from pre), else just consistent ones
+        call self%h5%write_attr('/', 'units', geometry_units(case%geometry, 'consistent'), error)
         if (allocated(error)) return
         call self%h5%flush(error)
     end subroutine results_open
@@ -161,12 +176,15 @@ contains
         end associate
     end subroutine write_body
 
-    !> Reopen the result file of an earlier run to continue it: status 'running',
-    !> the steps it holds counted as written.
-    subroutine results_reopen(self, path, error)
+    !> Reopen the result file of an earlier run of `case` to continue it: status
+    !> 'running', the steps it holds counted as written.
+    subroutine results_reopen(self, path, case, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: path
+        type(case_t), intent(in) :: case
         type(error_t), allocatable, intent(out) :: error
+        self%fields = case%field_output
+        self%last_step = case%solver%total_steps()
         call self%h5%open(path, 'rw', error)
         if (allocated(error)) return
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
@@ -178,7 +196,7 @@ contains
 
     !> Write one converged step and the current displacement; flush.
     subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
-                                  error)
+                                  error, model)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -194,6 +212,9 @@ contains
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
         type(error_t), allocatable, intent(out) :: error
+        !> The model of `u`: its bodies' sampled fields are written when `&output`
+        !> asks for them at this step.
+        type(model_t), intent(in), optional :: model
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -246,6 +267,10 @@ contains
             call write_contact(self%h5, g, k, pairs(k)%pair, error)
             if (allocated(error)) return
         end do
+        if (present(model)) then
+            if (self%fields%wants(rec%step, self%last_step)) call write_fields(self%h5, g, self%fields, model, u, error)
+            if (allocated(error)) return
+        end if
         self%n_written = self%n_written + 1
         if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
         if (allocated(error)) return
@@ -296,6 +321,15 @@ contains
             call h5%write(c//'/rigid_point', m%p0, error)
             if (allocated(error)) return
             call h5%write(c//'/rigid_normal', m%n, error)
+            if (allocated(error)) return
+            call h5%write(c//'/rigid_offset', m%p0 - m%p_ref, error)
+            if (allocated(error)) return
+        type is (rigid_curve_t)
+            ! where the obstacle is at this step, and its translation from time 0
+            call write_curve(h5, c//'/rigid_curve', nurbs_curve_t(m%surf%degree, m%surf%knots, m%surf%x0, &
+                                                                  m%surf%w), error)
+            if (allocated(error)) return
+            call h5%write(c//'/rigid_offset', m%offset, error)
             if (allocated(error)) return
         end select
         call h5%write(c//'/force', pair%force, error)
@@ -421,8 +455,27 @@ contains
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         call self%write_step(report%record, u, report%wall, model%pairs, report%cuts, report%n_cuts, &
-                             report%next_fraction, report%r0_max, error)
+                             report%next_fraction, report%r0_max, error, model)
     end subroutine results_step_done
+
+    !> A warning: one more line of the root attribute `warnings` (a line the file
+    !> has already, e.g. a set-up warning repeated by a restart, is not repeated).
+    !> Written and flushed at once; a failure to write it is not the run's.
+    subroutine results_warning(self, text)
+        class(results_t), intent(inout) :: self
+        character(len=*), intent(in) :: text
+        type(error_t), allocatable :: error
+        character(len=:), allocatable :: lines
+        if (.not. self%h5%is_open()) return
+        lines = ''
+        if (self%h5%has_attr('/', 'warnings')) call self%h5%read_attr_str('/', 'warnings', lines, error)
+        if (allocated(error)) return
+        if (index(new_line('a')//lines//new_line('a'), new_line('a')//text//new_line('a')) > 0) return
+        if (len(lines) > 0) lines = lines//new_line('a')
+        call self%h5%write_attr('/', 'warnings', lines//text, error)
+        if (allocated(error)) return
+        call self%h5%flush(error)
+    end subroutine results_warning
 
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
     subroutine results_write_multigrid(self, level_dofs, error)

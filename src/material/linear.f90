@@ -12,6 +12,8 @@ module voiga_material_linear
     type, extends(material_t) :: linear_elastic_t
     contains
         procedure :: stress => linear_stress
+        procedure :: fields => linear_fields
+        procedure, nopass :: strain_name => linear_strain_name
     end type linear_elastic_t
 
 contains
@@ -39,6 +41,24 @@ contains
         end do
         ok = .true.
     end subroutine linear_stress
+
+    !> The small-strain stress (plane strain: sigma_zz = lambda tr(eps)) and eps =
+    !> sym(grad u), in the reference configuration (the law's own assumption).
+    pure subroutine linear_fields(self, grad_u, stress, strain, ok)
+        class(linear_elastic_t), intent(in) :: self
+        real(dp), intent(in) :: grad_u(2, 2)
+        real(dp), intent(out) :: stress(4), strain(4)
+        logical, intent(out) :: ok
+        real(dp) :: s(2, 2), c(2, 2, 2, 2)
+        call self%stress(grad_u, s, c, ok)
+        strain = [grad_u(1, 1), grad_u(2, 2), 0.0_dp, 0.5_dp*(grad_u(1, 2) + grad_u(2, 1))]
+        stress = [s(1, 1), s(2, 2), self%lambda*(strain(1) + strain(2)), s(1, 2)]
+    end subroutine linear_fields
+
+    pure function linear_strain_name() result(name)
+        character(len=:), allocatable :: name
+        name = 'small strain sym(grad u)'
+    end function linear_strain_name
 
 
 end module voiga_material_linear

@@ -5,12 +5,14 @@
 !> L_v tau = c_tau : d (d the rate of deformation), so that the tangent
 !> stiffness is int (grad_x N_a . c_tau . grad_x N_b + grad_x N_a . tau grad_x N_b I) dV.
 !> All in-plane: 2 x 2 stresses, 2 x 2 x 2 x 2 moduli; plane strain means F33 = 1.
+!> For output (`fields`), each law also gives the Cauchy stress with its
+!> out-of-plane component and its own strain measure, as [xx, yy, zz, xy].
 module voiga_material
     use voiga_kinds, only: dp
     implicit none
     private
 
-    public :: material_t, lame_from_young, delta, identity2
+    public :: material_t, lame_from_young, delta, identity2, von_mises
 
     !> The 2 x 2 identity: delta(i, j) as a constant array, for the inner loops of
     !> the laws (a lookup instead of a call; same values as `delta`).
@@ -25,6 +27,8 @@ module voiga_material
         logical :: finite_strain = .false.
     contains
         procedure(stress_interface), deferred :: stress
+        procedure(fields_interface), deferred :: fields
+        procedure(strain_name_interface), deferred, nopass :: strain_name
     end type material_t
 
     abstract interface
@@ -39,6 +43,24 @@ module voiga_material
             real(dp), intent(out) :: s(2, 2), c(2, 2, 2, 2)
             logical, intent(out) :: ok
         end subroutine stress_interface
+
+        !> What a result file shows at a point with displacement gradient `grad_u` =
+        !> du/dX: the Cauchy stress (current configuration, plane strain: with its
+        !> out-of-plane sigma_zz) and the law's strain measure (`strain_name`), each
+        !> [xx, yy, zz, xy] (tensor components: eps_xy, not the engineering shear).
+        !> `ok` is false when the state is inadmissible (J <= 0).
+        pure subroutine fields_interface(self, grad_u, stress, strain, ok)
+            import :: material_t, dp
+            class(material_t), intent(in) :: self
+            real(dp), intent(in) :: grad_u(2, 2)
+            real(dp), intent(out) :: stress(4), strain(4)
+            logical, intent(out) :: ok
+        end subroutine fields_interface
+
+        !> The strain measure `fields` gives, as the result file names it.
+        pure function strain_name_interface() result(name)
+            character(len=:), allocatable :: name
+        end function strain_name_interface
     end interface
 
 contains
@@ -54,6 +76,13 @@ contains
         self%lambda = youngs_modulus*poisson_ratio/((1.0_dp + poisson_ratio)*(1.0_dp - 2.0_dp*poisson_ratio))
         self%kappa = youngs_modulus/(3.0_dp*(1.0_dp - 2.0_dp*poisson_ratio))
     end subroutine lame_from_young
+
+    !> The von Mises stress of the stress `s` [xx, yy, zz, xy] (plane strain: the
+    !> out-of-plane component counts).
+    pure real(dp) function von_mises(s)
+        real(dp), intent(in) :: s(4)
+        von_mises = sqrt(0.5_dp*((s(1) - s(2))**2 + (s(2) - s(3))**2 + (s(3) - s(1))**2) + 3.0_dp*s(4)**2)
+    end function von_mises
 
     !> Kronecker delta as a real, for building elasticity tensors.
     pure elemental real(dp) function delta(i, j)

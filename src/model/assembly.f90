@@ -3,7 +3,7 @@
 module voiga_model_assembly
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t
+    use voiga_model, only: model_t, move_obstacles
     use voiga_model_body, only: body_t
     use voiga_model_loads, only: phase_value
     use voiga_text, only: str
@@ -173,7 +173,7 @@ contains
     subroutine assemble(model, u, t, r, stats, error, k, map, refit)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
-        !> Load time (for the external forces).
+        !> Load time (for the external forces and the rigid masters' motions).
         real(dp), intent(in) :: t
         real(dp), intent(out) :: r(:)
         type(assembly_stats_t), intent(inout) :: stats
@@ -190,6 +190,7 @@ contains
         real(dp), allocatable :: r_bulk(:), k_bulk(:)
         integer :: pass, ip
         logical :: fit, keep
+        call move_obstacles(model, t)
         fit = .false.
         if (present(refit)) fit = refit .and. present(k)
         keep = .false.

@@ -8,6 +8,7 @@ module voiga_model_loads
     private
 
     public :: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
+    public :: obstacle_motion_t
 
     !> A prescribed displacement on a named edge (docs/formats.md, `&dirichlet`).
     type :: dirichlet_settings_t
@@ -44,6 +45,15 @@ module voiga_model_loads
         integer :: edge = 0
         real(dp), allocatable :: values(:)
     end type pressure_t
+
+    !> The prescribed translation of a rigid contact master (`&contact rigid_ux`,
+    !> `rigid_uy`).
+    type :: obstacle_motion_t
+        !> The contact pair whose master moves.
+        integer :: pair = 0
+        !> Translation at the end of each phase [2, n_phases].
+        real(dp), allocatable :: values(:, :)
+    end type obstacle_motion_t
 
 contains
 

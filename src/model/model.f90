@@ -6,16 +6,18 @@ module voiga_model
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_discretization_patch, only: discretization_t, edge_cps
     use voiga_model_body, only: body_t, body_settings_t, new_body
-    use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
+    use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
+                                 obstacle_motion_t
     use voiga_contact_pair, only: pair_slot_t
     use voiga_contact_factory, only: contact_settings_t, new_contact_pair, automatic_penalty
     use voiga_contact_surface, only: new_contact_surface, element_lengths
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
+    use voiga_contact_master_curve, only: rigid_curve_t, new_rigid_curve
     implicit none
     private
 
-    public :: model_t, new_model, set_prescribed, reference_coordinates
+    public :: model_t, new_model, set_prescribed, reference_coordinates, move_obstacles
 
     !> Everything the solver needs to know of the physics.
     type :: model_t
@@ -30,6 +32,8 @@ module voiga_model
         !> Contact pairs, each of its method's type (their friction history changes
         !> as steps converge).
         type(pair_slot_t), allocatable :: pairs(:)
+        !> The prescribed motions of rigid masters (only those that move).
+        type(obstacle_motion_t), allocatable :: motions(:)
     end type model_t
 
 contains
@@ -73,6 +77,14 @@ contains
         do k = 1, size(contact)
             call new_pair(self, contact(k), self%pairs(k), error)
             if (allocated(error)) return
+        end do
+        allocate (self%motions(count([(allocated(contact(k)%rigid_motion), k=1, size(contact))])))
+        i = 0
+        do k = 1, size(contact)
+            if (.not. allocated(contact(k)%rigid_motion)) cycle
+            i = i + 1
+            self%motions(i)%pair = k
+            self%motions(i)%values = contact(k)%rigid_motion
         end do
     end subroutine new_model
 
@@ -130,6 +142,7 @@ contains
         type(pair_slot_t), intent(out) :: slot
         type(error_t), allocatable, intent(out) :: error
         type(rigid_line_t) :: rigid
+        type(rigid_curve_t) :: curve
         type(nurbs_master_t) :: master
         real(dp), allocatable :: u0(:), r0(:)
         integer :: ib
@@ -142,7 +155,15 @@ contains
             ib = find_body(self, inp%slave)
             pair%slave_body = ib
             call new_contact_surface(pair%slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
-            if (trim(inp%master) == 'rigid') then
+            if (trim(inp%master) == 'rigid' .and. len_trim(inp%rigid_curve) > 0) then
+                if (.not. allocated(inp%curve%w)) then
+                    call fatal_error(error, "contact: the rigid curve '"//trim(inp%rigid_curve)// &
+                                     "' was not read", error_code%input)
+                    return
+                end if
+                call new_rigid_curve(curve, inp%curve)
+                allocate (pair%master, source=curve)
+            else if (trim(inp%master) == 'rigid') then
                 call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
                 allocate (pair%master, source=rigid)
             else
@@ -214,6 +235,20 @@ contains
             end do
         end do
     end subroutine set_prescribed
+
+    !> Put every moving rigid master where its prescribed motion has it at load
+    !> time `t` (before the contact pairs are evaluated at `t`).
+    pure subroutine move_obstacles(model, t)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: t
+        integer :: k
+        do k = 1, size(model%motions)
+            associate (m => model%motions(k))
+                call model%pairs(m%pair)%pair%master%move([phase_value(m%values(1, :), t), &
+                                                           phase_value(m%values(2, :), t)])
+            end associate
+        end do
+    end subroutine move_obstacles
 
     !> Reference coordinates of the control point of every DOF; shape: [ndof]
     !> (2(a-1)+i of body b at dof0 + 2(a-1) + i, as the displacement).

@@ -4,7 +4,8 @@
 !> The hooks a run calls, in order: `set_up` once (a hierarchical linear solver's
 !> levels), then per Newton iteration `iteration`, `factorized`, `linear_solved`;
 !> per failed attempt `retried` or `cut`; per Tresca fixed point `fixed_point`
-!> and `fixed_point_done`; per converged step `step_done`.
+!> and `fixed_point_done`; per converged step `step_done`; `warning` whenever the
+!> run finds something the user should know (`voiga_model_checks`).
 module voiga_solver_progress
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
@@ -60,6 +61,7 @@ module voiga_solver_progress
         procedure :: fixed_point_done => progress_fixed_point
         procedure :: multipliers_updated => progress_multipliers_updated
         procedure :: step_done => progress_step_done
+        procedure :: warning => progress_warning
     end type progress_t
 
 contains
@@ -131,5 +133,12 @@ contains
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
     end subroutine progress_step_done
+
+    !> Something the user should know that does not stop the run (`text`: one line,
+    !> naming the pair or body, the cause and the remedy).
+    subroutine progress_warning(self, text)
+        class(progress_t), intent(inout) :: self
+        character(len=*), intent(in) :: text
+    end subroutine progress_warning
 
 end module voiga_solver_progress

@@ -24,6 +24,7 @@ module voiga_solver_stepping
     use voiga_solver_newton, only: newton_t, new_newton, attempt_t
     use voiga_solver_outer, only: tresca_fixed_point, frictional, substep_attempt
     use voiga_solver_diagnostics, only: fold_diagnosis, append_pair_diagnoses
+    use voiga_model_checks, only: contact_watch_t, new_contact_watch, setup_warnings, warning_t
     use voiga_text, only: str, real_str
     implicit none
     private
@@ -59,6 +60,8 @@ module voiga_solver_stepping
         integer :: conv_det_sign = 0, fold_iterations = 0, fold_total = 0
         !> Wall time origin of the run.
         real(dp) :: start = 0.0_dp
+        !> What the warnings after each step and at the end remember.
+        type(contact_watch_t) :: watch
     end type stepper_t
 
 contains
@@ -82,6 +85,7 @@ contains
         type(progress_t), target :: silent
         class(progress_t), pointer :: out
         type(stepper_t) :: sp
+        type(warning_t), allocatable :: warnings(:)
         integer :: step, first
         real(dp) :: t
 
@@ -103,6 +107,8 @@ contains
         allocate (stats%records(0), stats%cut_records(0))
         first = 1
         if (present(resume)) call resume_from(sp, resume, u, stats, first)
+        call new_contact_watch(sp%watch, model)
+        call report_warnings(out, setup_warnings(model))
         t = 0.0_dp
         do step = first, sp%settings%total_steps()
             call solve_step(sp, model, step, u, stats, out, t, error)
@@ -114,6 +120,10 @@ contains
                 exit
             end if
         end do
+        if (.not. allocated(error)) then
+            call sp%watch%at_end(model, sp%settings%total_steps() - first + 1, warnings)
+            call report_warnings(out, warnings)
+        end if
         if (allocated(error) .and. stats%signal == 0) call prefix_step(error, step, t)
         call sp%newton%linear%factorizations(stats%symbolic_factorizations, stats%numeric_factorizations)
     end subroutine solve_steps
@@ -135,6 +145,16 @@ contains
         sp%conv_det_sign = resume%det_sign
         first = resume%step + 1
     end subroutine resume_from
+
+    !> Every warning of `list` to `progress`.
+    subroutine report_warnings(progress, list)
+        class(progress_t), intent(inout) :: progress
+        type(warning_t), intent(in) :: list(:)
+        integer :: i
+        do i = 1, size(list)
+            call progress%warning(trim(list(i)%text))
+        end do
+    end subroutine report_warnings
 
     !> "step N (load time t): " before the reason of a failed run.
     pure subroutine prefix_step(error, step, t)
@@ -349,6 +369,7 @@ contains
         class(progress_t), intent(inout) :: progress
         type(error_t), allocatable, intent(out) :: error
         type(step_report_t) :: report
+        type(warning_t), allocatable :: warnings(:)
         real(dp) :: tic
         integer :: j, c
 
@@ -368,6 +389,8 @@ contains
                                wall=tic - sp%start, cuts=stats%cut_records(first_cut:), n_cuts=stats%cuts, &
                                next_fraction=sp%frac, r0_max=stats%r0_max)
         call progress%step_done(report, u, model, error)
+        call sp%watch%after_step(model, step, warnings)
+        call report_warnings(progress, warnings)
         rec%seconds(5) = wall_seconds() - tic
         stats%records = [stats%records, rec]
     end subroutine finish_step

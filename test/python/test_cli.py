@@ -128,6 +128,16 @@ BAD_CASES = [
     ("friction = 0.3", "friction = 0.3, method = 'mortal'", ["&contact", "method = 'mortal'", "'gpts', 'mortar'"]),
     # an edge a load names is checked against the body's edges by --check too
     ("edge = 'bottom'", "edge = 'floor'", ["&dirichlet (2)", "no edge named 'floor'", "'slab'", "'bottom'"]),
+    # every group is validated by --check (issue 18, item 8)
+    ("&contact", "&pressure\n  body = 'slab', edge = 'side', p = 0.1, 0.1\n/\n&contact",
+     ["&pressure (1)", "no edge named 'side'", "'slab'"]),
+    ("slave = 'die'", "slave = 'punch'", ["&contact (1)", "slave = 'punch'", "not a body"]),
+    ("master = 'slab'", "master = 'anvil2'", ["&contact (1)", "master = 'anvil2'"]),
+    ("master = 'slab'", "master = 'rigid', rigid_curve = 'roller'", ["&contact (1)", "rigid_curve", "no curve 'roller'"]),
+    ("master = 'slab'", "master = 'slab', rigid_uy = -1.0, -1.0", ["&contact (1)", "rigid_ux and rigid_uy"]),
+    ("master = 'slab'", "master = 'rigid', rigid_uy = -1.0", ["&contact (1)", "rigid_uy", "one value per load phase"]),
+    ("n_steps = 10, 200", "n_steps = 10, 0", ["&solver", "n_steps"]),
+    ("&contact", "&output\n  fields = 'stresses'\n/\n&contact", ["&output", "'stresses'", "'von_mises'"]),
 ]
 
 

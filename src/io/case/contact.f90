@@ -4,7 +4,7 @@ module voiga_io_case_contact
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: unset, body_index, quoted
+    use voiga_io_case_values, only: unset, max_phases, body_index, quoted, phase_values
     use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t, contact_method_names
     use voiga_contact_alm, only: default_alm_tolerance
@@ -16,20 +16,22 @@ module voiga_io_case_contact
 contains
 
     !> Read the next (the `k`-th) `&contact` group from unit `u` for a case with
-    !> `bodies`, and validate it. penalty_tangent defaults to penalty_normal.
-    subroutine read_contact(u, path, k, bodies, entry, error)
-        integer, intent(in) :: u, k
+    !> `bodies` and `nph` load phases, and validate it. penalty_tangent defaults to
+    !> penalty_normal.
+    subroutine read_contact(u, path, k, nph, bodies, entry, error)
+        integer, intent(in) :: u, k, nph
         character(len=*), intent(in) :: path
         type(body_settings_t), intent(in) :: bodies(:)
         type(contact_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=32) :: slave, master
+        character(len=32) :: slave, master, rigid_curve
         character(len=16) :: method
         real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, tolerance
+        real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases)
         integer :: n_gauss, ios
         character(len=512) :: msg
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss, method, tolerance
+            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy
 
         slave = ''
         master = ''
@@ -41,13 +43,18 @@ contains
         n_gauss = 0
         method = 'gpts'
         tolerance = default_alm_tolerance
+        rigid_curve = ''
+        rigid_ux = unset
+        rigid_uy = unset
         read (u, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call group_error(path, 'contact', k, ios, msg, try_contact, error)
             return
         end if
-        entry = contact_settings_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-                                   friction, n_gauss, method, tolerance)
+        entry = contact_settings_t(slave=slave, master=master, rigid_point=rigid_point, rigid_normal=rigid_normal, &
+                                   rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
+                                   penalty_tangent=penalty_tangent, friction=friction, n_gauss=n_gauss, &
+                                   method=method, tolerance=tolerance)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
@@ -56,6 +63,7 @@ contains
         ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
         if (entry%penalty_normal == unset) entry%penalty_normal = 0.0_dp
         if (entry%penalty_tangent == unset) entry%penalty_tangent = entry%penalty_normal
+        call rigid_motion(entry, rigid_ux, rigid_uy, nph, path//trim(msg)//' ', error)
     contains
         subroutine try_contact(text, ios, msg)
             character(len=*), intent(in) :: text
@@ -66,7 +74,7 @@ contains
     end subroutine read_contact
 
     !> The slave and master are bodies of the case with a contact edge (or the
-    !> master is a valid rigid line).
+    !> master is a valid rigid line, or a rigid curve).
     subroutine check_pair(c, bodies, where, error)
         type(contact_settings_t), intent(in) :: c
         type(body_settings_t), intent(in) :: bodies(:)
@@ -86,7 +94,10 @@ contains
         end if
         if (trim(c%master) /= 'rigid') then
             ib = body_index(bodies, c%master)
-            if (ib == 0) then
+            if (len_trim(c%rigid_curve) > 0) then
+                call fatal_error(error, where//"rigid_curve names the curve of a rigid master, but master = '"// &
+                                 trim(c%master)//"' (set master = 'rigid')", error_code%input)
+            else if (ib == 0) then
                 call fatal_error(error, where//"master = '"//trim(c%master)// &
                                  "' is neither a body of the case nor 'rigid'", error_code%input)
             else if (trim(c%master) == trim(c%slave)) then
@@ -95,12 +106,34 @@ contains
                 call fatal_error(error, where//"master = '"//trim(c%master)// &
                                  "' has no contact_edge in its &body", error_code%input)
             end if
+        else if (len_trim(c%rigid_curve) > 0) then
+            return   ! the geometry file must have it (checked when it is read)
         else if (.not. all(ieee_is_finite(c%rigid_point)) .or. .not. all(ieee_is_finite(c%rigid_normal)) .or. &
                  norm2(c%rigid_normal) <= 0.0_dp) then
             call fatal_error(error, where//'rigid_point must be finite and rigid_normal finite and '// &
                              'nonzero', error_code%input)
         end if
     end subroutine check_pair
+
+    !> The rigid master's translation per phase (`rigid_ux`, `rigid_uy`; only for a
+    !> rigid master; none given: fixed).
+    subroutine rigid_motion(c, ux, uy, nph, where, error)
+        type(contact_settings_t), intent(inout) :: c
+        real(dp), intent(in) :: ux(:), uy(:)
+        integer, intent(in) :: nph
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        if (all(ux == unset) .and. all(uy == unset)) return
+        if (trim(c%master) /= 'rigid') then
+            call fatal_error(error, where//"rigid_ux and rigid_uy move a rigid master: master = '"// &
+                             trim(c%master)//"' is a body (move it by its &dirichlet)", error_code%input)
+            return
+        end if
+        allocate (c%rigid_motion(2, nph))
+        call phase_values(ux, .true., 'rigid_ux', where, nph, c%rigid_motion(1, :), error)
+        if (allocated(error)) return
+        call phase_values(uy, .true., 'rigid_uy', where, nph, c%rigid_motion(2, :), error)
+    end subroutine rigid_motion
 
     !> Penalties, friction, points and method in range.
     subroutine check_law(c, bodies, where, error)

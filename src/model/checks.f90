@@ -1,0 +1,260 @@
+!> What a run should warn about instead of running silently into a wrong answer
+!> (docs/warnings.md): at set-up, bodies that overlap (or a contact
+!> edge on the wrong side of a body, whose master normal then points into the
+!> slave), a slave contact edge that faces away from its master, a slave stiffer
+!> or coarser than its master; after each converged step, a penetration deeper than
+!> `deep_fraction` of the slave element; at the end, a pair that never came into
+!> contact. Only messages are made here; the solver reports them through
+!> `progress_t%warning`, `--check` prints the set-up ones.
+module voiga_model_checks
+    use voiga_kinds, only: dp
+    use voiga_text, only: str, real_str
+    use voiga_model, only: model_t
+    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
+    use voiga_contact_master, only: master_point_t
+    use voiga_contact_master_nurbs, only: nurbs_master_t, outward_sign
+    use voiga_contact_law, only: state_inactive
+    use voiga_element_quadrature, only: gauss_legendre
+    implicit none
+    private
+
+    public :: warning_t, contact_watch_t, new_contact_watch, setup_warnings, deep_fraction
+
+    !> A penetration deeper than this fraction of its slave element is reported.
+    real(dp), parameter :: deep_fraction = 0.1_dp
+    !> Bodies overlap at the start when a slave point lies deeper than this fraction
+    !> of its slave element inside the master (below: round-off of touching bodies,
+    !> or a faceted L1 edge on a curved master).
+    real(dp), parameter :: overlap_fraction = 1.0e-3_dp
+    !> A slave is coarser than its master when its elements along the contact edge
+    !> are longer by this factor on average.
+    real(dp), parameter :: coarser_factor = 1.25_dp
+
+    !> One warning (fixed length: arrays of them grow by constructor).
+    type :: warning_t
+        character(len=512) :: text = ''
+    end type warning_t
+
+    !> The reference lengths of a pair's slave elements [nel].
+    type :: lengths_t
+        real(dp), allocatable :: h(:)
+    end type lengths_t
+
+    !> What the warnings after steps and at the end need to remember per pair.
+    type :: contact_watch_t
+        !> Has the pair had a point in contact; has its deep penetration been reported?
+        logical, allocatable :: ever_active(:), deep_reported(:)
+        !> Each pair's slave element lengths (computed once).
+        type(lengths_t), allocatable :: slave(:)
+    contains
+        procedure :: after_step => watch_after_step
+        procedure :: at_end => watch_at_end
+    end type contact_watch_t
+
+contains
+
+    !> A watch over the pairs of `model`.
+    pure subroutine new_contact_watch(self, model)
+        type(contact_watch_t), intent(out) :: self
+        type(model_t), intent(in) :: model
+        integer :: ip
+        allocate (self%ever_active(size(model%pairs)), source=.false.)
+        allocate (self%deep_reported(size(model%pairs)), source=.false.)
+        allocate (self%slave(size(model%pairs)))
+        do ip = 1, size(model%pairs)
+            self%slave(ip)%h = element_lengths(model%pairs(ip)%pair%slave)
+        end do
+    end subroutine new_contact_watch
+
+    !> "contact 'slave' on 'master': "
+    pure function pair_label(pair) result(label)
+        class(contact_pair_t), intent(in) :: pair
+        character(len=:), allocatable :: label
+        label = "contact '"//trim(pair%slave_name)//"' on '"//trim(pair%master_name)//"': "
+    end function pair_label
+
+    !> Reference lengths of the elements of a contact edge [nel] (Gauss, 6 points).
+    pure function element_lengths(surf) result(h)
+        type(contact_surface_t), intent(in) :: surf
+        real(dp), allocatable :: h(:)
+        real(dp) :: gx(6), gw(6), u(maxval(surf%dofs))
+        type(surface_point_t) :: pt
+        integer :: e, i
+        call gauss_legendre(6, gx, gw)
+        u = 0.0_dp
+        allocate (h(size(surf%spans)), source=0.0_dp)
+        do e = 1, size(h)
+            associate (a => surf%breaks(e), b => surf%breaks(e + 1))
+                do i = 1, 6
+                    call surface_point(surf, u, a + 0.5_dp*(b - a)*(gx(i) + 1.0_dp), pt, surf%spans(e))
+                    h(e) = h(e) + 0.5_dp*(b - a)*gw(i)*norm2(pt%a)
+                end do
+            end associate
+        end do
+    end function element_lengths
+
+    !> The depth of each slave point inside the master (-gap) over the reference
+    !> length of its slave element, for the points `use` selects (0 for the others).
+    pure function depth_ratios(pair, h, use) result(ratio)
+        class(contact_pair_t), intent(in) :: pair
+        !> The reference lengths of the slave elements.
+        real(dp), intent(in) :: h(:)
+        logical, intent(in) :: use(:)
+        real(dp), allocatable :: ratio(:)
+        integer :: k
+        allocate (ratio(size(pair%out)), source=0.0_dp)
+        do k = 1, size(ratio)
+            if (use(k)) ratio(k) = -pair%out(k)%gap/h((k - 1)/pair%n_gauss + 1)
+        end do
+    end function depth_ratios
+
+    !> "(x, y)"
+    pure function point_str(x) result(text)
+        real(dp), intent(in) :: x(2)
+        character(len=:), allocatable :: text
+        text = '('//trim(adjustl(real_str(x(1), 'es11.4')))//', '//trim(adjustl(real_str(x(2), 'es11.4')))//')'
+    end function point_str
+
+    !> The checks of the reference configuration, from each pair's evaluation there
+    !> (`new_model` evaluates every pair at u = 0).
+    function setup_warnings(model) result(list)
+        type(model_t), intent(in) :: model
+        type(warning_t), allocatable :: list(:)
+        integer :: ip
+        allocate (list(0))
+        do ip = 1, size(model%pairs)
+            associate (pair => model%pairs(ip)%pair)
+                call overlap_warning(pair, list)
+                call facing_warning(model, pair, list)
+                call slave_choice_warning(model, pair, list)
+            end associate
+        end do
+    end function setup_warnings
+
+    !> Slave points inside the master at the start.
+    subroutine overlap_warning(pair, list)
+        class(contact_pair_t), intent(in) :: pair
+        type(warning_t), allocatable, intent(inout) :: list(:)
+        real(dp), allocatable :: depth(:)
+        integer :: k, n
+        depth = depth_ratios(pair, element_lengths(pair%slave), pair%out%gap < 1.0e300_dp)
+        n = count(depth > overlap_fraction)
+        if (n == 0) return
+        k = maxloc(depth, dim=1)
+        list = [list, warning_t(pair_label(pair)//'the bodies overlap at the start: '//str(n)//' of '// &
+                                str(size(depth))//' slave points lie inside the master, the deepest by '// &
+                                trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
+                                point_str(pair%out(k)%x0)//' ('//trim(adjustl(real_str(depth(k), 'f6.2')))// &
+                                ' slave elements). If the bodies do not overlap, a contact edge is on the '// &
+                                "wrong side of its body (the master's outward normal points into the slave): "// &
+                                'check contact_edge of both bodies')]
+    end subroutine overlap_warning
+
+    !> The slave point closest to the master (outside it) must face it: its outward
+    !> normal against the master's. Else the slave's contact edge is on the wrong side.
+    subroutine facing_warning(model, pair, list)
+        type(model_t), intent(in) :: model
+        class(contact_pair_t), intent(in) :: pair
+        type(warning_t), allocatable, intent(inout) :: list(:)
+        type(surface_point_t) :: sp
+        type(master_point_t) :: mp
+        real(dp), allocatable :: u(:), gap(:)
+        real(dp) :: ns(2), s
+        integer :: k
+        logical :: found, converged
+        gap = pair%out%gap
+        where (gap < 0.0_dp) gap = huge(1.0_dp)
+        if (all(gap > 1.0e300_dp)) return
+        k = minloc(gap, dim=1)
+        allocate (u(model%ndof), source=0.0_dp)
+        call surface_point(pair%slave, u, pair%xi(k), sp, pair%span(k))
+        call pair%master%project(u, sp%x, mp, found, converged)
+        if (.not. found) return
+        s = outward_sign(model%bodies(pair%slave_body)%disc)
+        ns = s*[sp%a(2), -sp%a(1)]/norm2(sp%a)
+        if (dot_product(ns, mp%n) <= 0.0_dp) return
+        list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '//point_str(sp%x)// &
+                                ", faces away from it: the slave's contact_edge = '"// &
+                                trim(model%bodies(pair%slave_body)%disc%edges(4)%name)// &
+                                "' is on the side of its body away from the master; choose the edge that faces it")]
+    end subroutine facing_warning
+
+    !> A deformable master softer or finer than its slave: GPTS enforces the contact
+    !> at the slave's points, so the usual choice is the softer, finer body as slave.
+    subroutine slave_choice_warning(model, pair, list)
+        type(model_t), intent(in) :: model
+        class(contact_pair_t), intent(in) :: pair
+        type(warning_t), allocatable, intent(inout) :: list(:)
+        character(len=:), allocatable :: why
+        real(dp) :: es, em, hs, hm
+        if (pair%master_body == 0) return
+        select type (m => pair%master)
+        class is (nurbs_master_t)
+            hs = sum(element_lengths(pair%slave))/size(pair%slave%spans)
+            hm = sum(element_lengths(m%surf))/size(m%surf%spans)
+        class default
+            return
+        end select
+        es = model%bodies(pair%slave_body)%mat%youngs_modulus
+        em = model%bodies(pair%master_body)%mat%youngs_modulus
+        why = ''
+        if (es > em) why = "stiffer (E = "//trim(adjustl(real_str(es, 'es10.3')))//' against '// &
+                           trim(adjustl(real_str(em, 'es10.3')))//')'
+        if (hs > coarser_factor*hm) then
+            if (len(why) > 0) why = why//' and '
+            why = why//'coarser (elements '//trim(adjustl(real_str(hs, 'es10.3')))//' long against '// &
+                  trim(adjustl(real_str(hm, 'es10.3')))//' on average along the contact edges)'
+        end if
+        if (len(why) == 0) return
+        list = [list, warning_t(pair_label(pair)//"the slave is "//why//' than its master: the master '// &
+                                "may then penetrate between the slave's points; the usual choice is the "// &
+                                'softer, finer body as slave (swap slave and master), or more slave points '// &
+                                '(n_gauss)')]
+    end subroutine slave_choice_warning
+
+    !> After converged step `step`: remember which pairs touch, and report (once per
+    !> pair) a penetration deeper than `deep_fraction` of its slave element.
+    subroutine watch_after_step(self, model, step, list)
+        class(contact_watch_t), intent(inout) :: self
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: step
+        type(warning_t), allocatable, intent(out) :: list(:)
+        real(dp), allocatable :: ratio(:)
+        integer :: ip, k
+        allocate (list(0))
+        do ip = 1, size(model%pairs)
+            associate (pair => model%pairs(ip)%pair)
+                if (any(pair%out%state /= state_inactive)) self%ever_active(ip) = .true.
+                if (self%deep_reported(ip)) cycle
+                ratio = depth_ratios(pair, self%slave(ip)%h, pair%out%state /= state_inactive)
+                if (maxval(ratio) <= deep_fraction) cycle
+                self%deep_reported(ip) = .true.
+                k = maxloc(ratio, dim=1)
+                list = [list, warning_t(pair_label(pair)//'step '//str(step)//': a penetration of '// &
+                                        trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
+                                        point_str(pair%out(k)%x)//' is '// &
+                                        trim(adjustl(real_str(ratio(k), 'f6.2')))//' of its slave element '// &
+                                        '(more than '//trim(adjustl(real_str(deep_fraction, 'f6.2')))// &
+                                        '): the penalty is too soft for this load; raise penalty_normal')]
+            end associate
+        end do
+    end subroutine watch_after_step
+
+    !> At the end of a run of `n_steps` steps: the pairs that never touched.
+    pure subroutine watch_at_end(self, model, n_steps, list)
+        class(contact_watch_t), intent(in) :: self
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: n_steps
+        type(warning_t), allocatable, intent(out) :: list(:)
+        integer :: ip
+        allocate (list(0))
+        do ip = 1, size(model%pairs)
+            if (self%ever_active(ip)) cycle
+            list = [list, warning_t(pair_label(model%pairs(ip)%pair)//'no point came into contact in '// &
+                                    str(n_steps)//' steps: check the loads, the contact edges and the gap '// &
+                                    'between the bodies')]
+        end do
+    end subroutine watch_at_end
+
+end module voiga_model_checks

@@ -1,0 +1,117 @@
+!> Stress, strain and von Mises stress sampled in every element of a body, for the
+!> result file (`&output`; read by `voiga_io_case_output`, written by
+!> `voiga_io_results` at the steps the case asks for, and only then). The values
+!> come from the body's material law (`material_t%fields`): the Cauchy stress and
+!> the law's strain measure at each sample point.
+!>
+!> Samples: `samples` x `samples` points per element on a uniform grid of its
+!> parameter range, ends included (`samples` = 1: the element's centre), in the
+!> body's oriented patch (contact edge at eta = 1); element by element, xi fastest.
+module voiga_model_fields
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
+    use voiga_material, only: von_mises
+    use voiga_discretization_element, only: element_basis, element_nfun
+    use voiga_element_solid, only: reference_gradients
+    use voiga_model_body, only: body_t
+    implicit none
+    private
+
+    public :: output_settings_t, field_samples_t, sample_fields, field_names
+
+    !> The fields `&output fields` may name.
+    character(len=*), parameter :: field_names(3) = [character(len=9) :: 'stress', 'strain', 'von_mises']
+
+    !> What a case asks to be written besides the displacements (`&output`;
+    !> docs/formats.md). Without the group: nothing.
+    type :: output_settings_t
+        !> Which of `field_names` to write (none: no fields are computed).
+        logical :: fields(3) = .false.
+        !> Samples per element and direction.
+        integer :: samples = 3
+        !> Write at every `every`-th step (and the last); 0: at the last step only.
+        integer :: every = 1
+        !> Or exactly at these steps (overrides `every` when allocated).
+        integer, allocatable :: steps(:)
+    contains
+        procedure :: wants => output_wants
+    end type output_settings_t
+
+    !> The fields of one body at its sample points (n of them).
+    type :: field_samples_t
+        !> Parameters (oriented patch) and element of each point [n].
+        real(dp), allocatable :: xi(:), eta(:)
+        integer, allocatable :: element(:)
+        !> Cauchy stress and strain [4, n] ([xx, yy, zz, xy]), von Mises stress [n].
+        real(dp), allocatable :: stress(:, :), strain(:, :), von_mises(:)
+    end type field_samples_t
+
+contains
+
+    !> Are fields written at step `step` of `last`?
+    pure logical function output_wants(self, step, last) result(wants)
+        class(output_settings_t), intent(in) :: self
+        integer, intent(in) :: step, last
+        wants = .false.
+        if (.not. any(self%fields)) return
+        if (allocated(self%steps)) then
+            wants = any(self%steps == step)
+        else
+            wants = step == last
+            if (self%every > 0) wants = wants .or. mod(step, self%every) == 0
+        end if
+    end function output_wants
+
+    !> The fields of `body` with the global displacement `u` at `samples` x `samples`
+    !> points per element. Fails (numeric) where the deformation is inverted.
+    subroutine sample_fields(body, u, samples, out, error)
+        type(body_t), intent(in) :: body
+        real(dp), intent(in) :: u(:)
+        integer, intent(in) :: samples
+        type(field_samples_t), intent(out) :: out
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: r(:), dr(:, :), dndx(:, :), ue(:, :)
+        real(dp) :: t(samples), det, grad_u(2, 2), xi, eta
+        integer :: e, i, j, q, n, a
+        logical :: ok
+
+        n = body%disc%nel*samples**2
+        allocate (out%xi(n), out%eta(n), out%element(n), out%stress(4, n), out%strain(4, n), out%von_mises(n))
+        t = 0.5_dp
+        if (samples > 1) t = [(real(i, dp)/real(samples - 1, dp), i=0, samples - 1)]
+        q = 0
+        do e = 1, body%disc%nel
+            associate (el => body%disc%elements(e))
+                allocate (r(element_nfun(body%disc, e)), dr(2, element_nfun(body%disc, e)), &
+                          dndx(2, element_nfun(body%disc, e)))
+                allocate (ue(2, size(el%conn)))
+                do a = 1, size(el%conn)
+                    ue(:, a) = u(body%dof0 + 2*el%conn(a) - 1:body%dof0 + 2*el%conn(a))
+                end do
+                do j = 1, samples
+                    eta = el%eta(1) + t(j)*(el%eta(2) - el%eta(1))
+                    do i = 1, samples
+                        xi = el%xi(1) + t(i)*(el%xi(2) - el%xi(1))
+                        q = q + 1
+                        call element_basis(body%disc, e, xi, eta, r, dr)
+                        call reference_gradients(body%disc%x(:, el%conn), dr, dndx, det)
+                        grad_u = matmul(ue, transpose(dndx))
+                        call body%mat%fields(grad_u, out%stress(:, q), out%strain(:, q), ok)
+                        if (.not. ok) then
+                            call fatal_error(error, "fields: body '"//trim(body%name)//"' element "//str(e)// &
+                                             ': the deformation is inverted (J <= 0)', error_code%numeric)
+                            return
+                        end if
+                        out%von_mises(q) = von_mises(out%stress(:, q))
+                        out%xi(q) = xi
+                        out%eta(q) = eta
+                        out%element(q) = e
+                    end do
+                end do
+                deallocate (r, dr, dndx, ue)
+            end associate
+        end do
+    end subroutine sample_fields
+
+end module voiga_model_fields

@@ -1,0 +1,121 @@
+"""Warnings, not silence (issue 18, item 8): what voiga reports on stderr
+(``voiga: warning: ...``) and records in the result file (root attribute
+``warnings``, one line each) while it still runs: bodies overlapping at the start,
+a contact edge on the wrong side of a body, a slave stiffer or coarser than its
+master, a penetration deeper than a tenth of its slave element, a pair that never
+comes into contact. ``--check`` prints the set-up ones and exits 0."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import h5py
+
+from conftest import REPO
+from test_cli import edit
+
+
+def warnings_of(res) -> list[str]:
+    return [line for line in res.stderr.splitlines() if line.startswith("voiga: warning: ")]
+
+
+def recorded(result: Path) -> list[str]:
+    with h5py.File(result) as f:
+        text = f.attrs.get("warnings", b"")
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    return [line for line in text.rstrip("\x00 ").split("\n") if line]
+
+
+def short_ironing(case: Path) -> None:
+    """Ironing in 2 + 1 steps (the warnings come at the start, after a step, at the end)."""
+    edit(case, "n_steps = 10, 200", "n_steps = 2, 1")
+
+
+def hertz_copy(folder: Path) -> Path:
+    shutil.copy(REPO / "cases" / "hertz" / "geometry.h5", folder)
+    case = folder / "m1-NN2.2.nml"
+    shutil.copy(REPO / "cases" / "hertz" / "m1-NN2.2.nml", case)
+    return case
+
+
+def test_wrong_side_master_edge(run, ironing_copy: Path) -> None:
+    """The slab's contact edge named on its bottom (the die sits on its top): the
+    master's normal points into the die, every die point seems 3 deep inside."""
+    edit(ironing_copy, "  edge = 'bottom'", "  edge = 'top'")   # the slab supported on its top
+    edit(ironing_copy, "contact_edge = 'top'", "contact_edge = 'bottom'")
+    short_ironing(ironing_copy)
+    res = run(ironing_copy, "--check")
+    assert res.returncode == 0, res.stderr
+    (w,) = [x for x in warnings_of(res) if "overlap" in x]
+    assert "contact 'die' on 'slab'" in w and "wrong side" in w and "contact_edge" in w
+    # the run fails (an inverted element after the first cuts): the warning came first
+    res = run(ironing_copy, "--quiet")
+    assert res.returncode == 3
+    assert any("overlap at the start" in x for x in warnings_of(res)), res.stderr
+    assert any("overlap at the start" in x for x in recorded(ironing_copy.with_name("m1-N2.h5")))
+
+
+def test_wrong_side_slave_edge(run, ironing_copy: Path) -> None:
+    """The die's contact edge named on its inner arc: the slave edge faces away."""
+    edit(ironing_copy, "  edge = 'inner'", "  edge = 'outer'")   # the die driven on its other arc
+    edit(ironing_copy, "contact_edge = 'outer'", "contact_edge = 'inner'")
+    res = run(ironing_copy, "--check")
+    assert res.returncode == 0, res.stderr
+    (w,) = [x for x in warnings_of(res) if "faces away" in x]
+    assert "contact_edge = 'inner'" in w and "choose the edge that faces it" in w
+
+
+def test_bodies_overlapping(run, tmp_path: Path) -> None:
+    """The rigid plane moved 0.01 up into the hertz cylinder: reported with the depth."""
+    case = hertz_copy(tmp_path)
+    edit(case, "rigid_point = 0.0, -1.0", "rigid_point = 0.0, -0.99")
+    res = run(case, "--check")
+    assert res.returncode == 0
+    (w,) = warnings_of(res)
+    # the deepest slave point: the Gauss point nearest the axis, 0.01 - x^2/2 deep
+    assert "overlap at the start" in w and "the deepest by 9.999E-03 at (1.1233E-03, -1.0000E+00)" in w, w
+
+
+def test_stiffer_and_coarser_slave(run, ironing_copy: Path) -> None:
+    """Ironing as the paper has it (the die, E = 10 and longer elements, is the slave)
+    warns with the suggestion; swapped, it does not."""
+    res = run(ironing_copy, "--check")
+    (w,) = warnings_of(res)
+    assert "the slave is stiffer (E = 1.000E+01 against 1.000E+00) and coarser" in w
+    assert "swap slave and master" in w
+    edit(ironing_copy, "slave = 'die'", "slave = 'SLAB'")
+    edit(ironing_copy, "master = 'slab'", "master = 'die'")
+    edit(ironing_copy, "slave = 'SLAB'", "slave = 'slab'")
+    res = run(ironing_copy, "--check")
+    assert res.returncode == 0 and warnings_of(res) == [], res.stderr
+
+
+def test_deep_penetration(run, tmp_path: Path) -> None:
+    """Hertz with a penalty of 0.01 E: the cylinder sinks into the plane by more than
+    a tenth of a slave element from step 2 on; reported once, in the file too."""
+    case = hertz_copy(tmp_path)
+    edit(case, "penalty_normal = 1000.0", "penalty_normal = 0.01")
+    res = run(case, "--quiet")
+    assert res.returncode == 0, res.stderr
+    (w,) = warnings_of(res)
+    assert "step 2: a penetration of 3.990E-03" in w and "0.17 of its slave element" in w, w
+    assert "raise penalty_normal" in w
+    assert recorded(case.with_suffix(".h5")) == [w.removeprefix("voiga: warning: ")]
+
+
+def test_pair_never_in_contact(run, tmp_path: Path) -> None:
+    """The plane 0.5 below the cylinder, pressed 0.01: no point ever touches."""
+    case = hertz_copy(tmp_path)
+    edit(case, "rigid_point = 0.0, -1.0", "rigid_point = 0.0, -1.5")
+    res = run(case, "--quiet")
+    assert res.returncode == 0, res.stderr
+    (w,) = warnings_of(res)
+    assert "contact 'cylinder' on 'rigid': no point came into contact in 5 steps" in w, w
+    assert len(recorded(case.with_suffix(".h5"))) == 1
+
+
+def test_no_warning_on_a_sound_case(run, tmp_path: Path) -> None:
+    case = hertz_copy(tmp_path)
+    res = run(case, "--quiet")
+    assert res.returncode == 0 and warnings_of(res) == [], res.stderr
+    assert recorded(case.with_suffix(".h5")) == []
