@@ -38,10 +38,12 @@ NAMELISTS: dict[str, frozenset[str]] = {
     "dirichlet": frozenset({"body", "edge", "fix_x", "fix_y", "ux", "uy"}),
     "pressure": frozenset({"body", "edge", "p"}),
     "contact": frozenset({"slave", "master", "rigid_point", "rigid_normal", "penalty_normal",
-                          "penalty_tangent", "friction", "n_gauss", "method"}),
+                          "penalty_tangent", "friction", "n_gauss", "method", "tolerance", "rigid_curve",
+                          "rigid_ux", "rigid_uy"}),
+    "output": frozenset({"fields", "samples", "every", "steps"}),
 }
-"""Namelist group -> its variables, as ``src/io/case.f90`` declares them (a test
-compares the two)."""
+"""Namelist group -> its variables, as the readers in ``src/io/case/`` declare them (a
+test compares the two)."""
 
 SELECTOR_KEYS = ("name", "slave", "body")
 """The variable a ``group[name]`` selector matches, first present wins (``&body``:

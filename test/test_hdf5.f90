@@ -13,6 +13,8 @@ module test_hdf5
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check, test_failed
     use voiga_io_hdf5, only: h5file_t
+    use voiga_io_results, only: results_t
+    use voiga_solver_records, only: solver_stats_t, cut_record_t
     implicit none
     private
 
@@ -30,9 +32,43 @@ contains
                     new_unittest('string_dataset_read_as_numbers_refused', test_string_dataset), &
                     new_unittest('wrong_type_or_rank_refused', test_wrong_type), &
                     new_unittest('wide_integers_range_checked', test_wide_integers), &
-                    new_unittest('wrong_attributes_refused', test_wrong_attributes) &
+                    new_unittest('wrong_attributes_refused', test_wrong_attributes), &
+                    new_unittest('hundreds_of_cuts_finish_the_file', test_many_cuts) &
                     ]
     end subroutine collect_hdf5
+
+    !> A run with 400 cuts of 256-character reasons (more than an HDF5 attribute
+    !> holds) still finishes its result file with its status: the reasons the root's
+    !> /cuts lists are shortened to fit (penalty-1e5 of the hard cases has 386).
+    subroutine test_many_cuts(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(results_t) :: results
+        type(solver_stats_t) :: stats
+        character(len=:), allocatable :: path, status, reasons
+        integer :: i
+        path = scratch('many-cuts')
+        call results%h5%open(path, 'w', error)
+        if (allocated(error)) return
+        allocate (stats%cut_records(400))
+        do i = 1, 400
+            stats%cut_records(i) = cut_record_t(step=i, time=1.0_dp, fraction=0.5_dp, new_fraction=0.25_dp, &
+                                                reason=repeat('x', 255)//'y')
+        end do
+        call results%finish('converged', 1.0_dp, stats, error)
+        if (allocated(error)) return
+        call results%h5%open(path, 'r', error)
+        if (allocated(error)) return
+        call results%h5%read_attr_str('/', 'status', status, error)
+        if (allocated(error)) return
+        call check(error, status == 'converged', 'status written: '//status)
+        if (allocated(error)) return
+        call results%h5%read_attr_str('/cuts', 'reasons', reasons, error)
+        if (allocated(error)) return
+        call check(error, len(reasons) > 400*16 .and. len(reasons) <= 60000, 'the reasons, shortened')
+        if (allocated(error)) return
+        call results%h5%close(error)
+        call remove(path)
+    end subroutine test_many_cuts
 
     !> A scratch file name under build/ (fpm runs the tests from the project root).
     function scratch(name) result(path)

@@ -28,12 +28,13 @@ def write_study(folder: Path, text: str, name: str = "study.toml") -> Path:
 
 
 def test_namelists_are_those_of_the_solver() -> None:
-    """The groups and variables a study may change are the ones src/io/case.f90 reads."""
-    source = (REPO / "src" / "io" / "case.f90").read_text()
+    """The groups and variables a study may change are the ones the readers of
+    src/io/case/ (one per group) read."""
     found = {}
-    for m in re.finditer(r"namelist\s*/(\w+)/\s*((?:[^\n]*&\s*\n)*[^\n]*)", source):
-        names = re.sub(r"&\s*\n", " ", m.group(2))
-        found[m.group(1)] = frozenset(v.strip() for v in names.split(",") if v.strip())
+    for path in sorted((REPO / "src" / "io").rglob("*.f90")):
+        for m in re.finditer(r"namelist\s*/(\w+)/\s*((?:[^\n]*&\s*\n)*[^\n]*)", path.read_text()):
+            names = re.sub(r"&\s*\n", " ", m.group(2))
+            found[m.group(1)] = frozenset(v.strip() for v in names.split(",") if v.strip())
     assert found == NAMELISTS
 
 

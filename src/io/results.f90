@@ -26,6 +26,10 @@ module voiga_io_results
 
     public :: results_t, restart_case, read_restart
 
+    !> Most characters of the attribute listing the cuts' reasons (HDF5 keeps an
+    !> attribute in the object header, at most 64 KB).
+    integer, parameter :: max_reasons = 60000
+
     !> An open result file; as a `progress_t` it writes every converged step the
     !> solver reports (and the levels of a multigrid solver).
     type, extends(progress_t) :: results_t
@@ -394,13 +398,16 @@ contains
         type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: rows(:, :)
         character(len=:), allocatable :: reasons
-        integer :: i
+        integer :: i, width
         allocate (rows(4, size(cuts)))
+        ! an HDF5 attribute holds at most 64 KB: a run with hundreds of cuts keeps the
+        ! start of each reason here (every step's own /cuts keeps them whole)
+        width = max(16, (max_reasons - size(cuts))/max(1, size(cuts)))
         reasons = ''
         do i = 1, size(cuts)
             rows(:, i) = [real(cuts(i)%step, dp), cuts(i)%time, cuts(i)%fraction, cuts(i)%new_fraction]
             if (i > 1) reasons = reasons//new_line('a')
-            reasons = reasons//trim(cuts(i)%reason)
+            reasons = reasons//trim(cuts(i)%reason(1:min(width, len(cuts(i)%reason))))
         end do
         call h5%write(g//'/cuts', rows, error)
         if (allocated(error)) return
