@@ -87,10 +87,10 @@ contains
         integer :: s, p, k, id
 
         p = self%degree
-        s = find_span(self%knots, p, xi)
-        if (present(span)) then
-            if (span > 0) s = span
-        end if
+        s = 0
+        if (present(span)) s = span
+        ! the search only when no span is forced (a projection forces it at every step)
+        if (s <= 0) s = find_span(self%knots, p, xi)
         ders = basis_ders(self%knots, p, s, xi, 2)
         call reuse(pt%r, p + 1)
         call reuse(pt%dr, p + 1)
