@@ -10,7 +10,8 @@ module voiga_contact_surface
     implicit none
     private
 
-    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point
+    public :: contact_surface_t, new_contact_surface, surface_point_t, surface_point, surface_basis, &
+              surface_point_at
 
     !> The contact edge of one body.
     type :: contact_surface_t
@@ -71,6 +72,28 @@ contains
         end do
     end subroutine new_contact_surface
 
+    !> The nonzero functions of the curve at `xi` in knot span `span` (0: found from
+    !> xi): values `r`, first and second derivatives `dr`, `d2r` [p + 1], and the span
+    !> `s` used. They do not depend on the configuration: a caller that evaluates the
+    !> same parameter in many configurations keeps them (`surface_point_at`).
+    pure subroutine surface_basis(self, xi, span, r, dr, d2r, s)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: xi
+        integer, intent(in) :: span
+        real(dp), intent(out) :: r(:), dr(:), d2r(:)
+        integer, intent(out) :: s
+        real(dp) :: ders(3, self%degree + 1), dr1(1, self%degree + 1), d2r1(1, self%degree + 1)
+        integer :: p
+        p = self%degree
+        s = span
+        ! the search only when no span is forced (a projection forces it at every step)
+        if (s <= 0) s = find_span(self%knots, p, xi)
+        ders = basis_ders(self%knots, p, s, xi, 2)
+        call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), r, dr1, d2r1)
+        dr = dr1(1, :)
+        d2r = d2r1(1, :)
+    end subroutine surface_basis
+
     !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
     !> forces the knot span (0: found from xi), so that a point on an element
     !> boundary can be evaluated from either side. Every component of `pt` is set;
@@ -83,23 +106,38 @@ contains
         real(dp), intent(in) :: xi
         type(surface_point_t), intent(inout) :: pt
         integer, intent(in), optional :: span
-        real(dp) :: ders(3, self%degree + 1), dr(1, self%degree + 1), d2r(1, self%degree + 1), x(2)
-        integer :: s, p, k, id
+        integer :: forced, s
+        forced = 0
+        if (present(span)) forced = span
+        call reuse_point(pt, self%degree + 1)
+        call surface_basis(self, xi, forced, pt%r, pt%dr, pt%d2r, s)
+        call place_point(self, u, xi, s, pt)
+    end subroutine surface_point
 
+    !> `surface_point` at `xi` in span `s` from the functions there (`surface_basis`:
+    !> `r`, `dr`, `d2r` [p + 1]); the same numbers without evaluating them again.
+    pure subroutine surface_point_at(self, u, xi, s, r, dr, d2r, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi
+        integer, intent(in) :: s
+        real(dp), intent(in) :: r(:), dr(:), d2r(:)
+        type(surface_point_t), intent(inout) :: pt
+        call reuse_point(pt, self%degree + 1)
+        pt%r = r
+        pt%dr = dr
+        pt%d2r = d2r
+        call place_point(self, u, xi, s, pt)
+    end subroutine surface_point_at
+
+    !> The point, its derivatives and DOFs from the functions in `pt` (span `s`).
+    pure subroutine place_point(self, u, xi, s, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi
+        integer, intent(in) :: s
+        type(surface_point_t), intent(inout) :: pt
+        real(dp) :: x(2)
+        integer :: p, k, id
         p = self%degree
-        s = 0
-        if (present(span)) s = span
-        ! the search only when no span is forced (a projection forces it at every step)
-        if (s <= 0) s = find_span(self%knots, p, xi)
-        ders = basis_ders(self%knots, p, s, xi, 2)
-        call reuse(pt%r, p + 1)
-        call reuse(pt%dr, p + 1)
-        call reuse(pt%d2r, p + 1)
-        call reuse_int(pt%local, p + 1)
-        call reuse_int(pt%dofs, 2*(p + 1))
-        call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), pt%r, dr, d2r)
-        pt%dr = dr(1, :)
-        pt%d2r = d2r(1, :)
         pt%xi = xi
         pt%x = 0.0_dp
         pt%a = 0.0_dp
@@ -113,6 +151,17 @@ contains
             pt%a = pt%a + pt%dr(k)*x
             pt%a2 = pt%a2 + pt%d2r(k)*x
         end do
+    end subroutine place_point
+
+    !> `pt`'s arrays for `n` functions, kept when they have that size.
+    pure subroutine reuse_point(pt, n)
+        type(surface_point_t), intent(inout) :: pt
+        integer, intent(in) :: n
+        call reuse(pt%r, n)
+        call reuse(pt%dr, n)
+        call reuse(pt%d2r, n)
+        call reuse_int(pt%local, n)
+        call reuse_int(pt%dofs, 2*n)
     contains
         pure subroutine reuse(a, n)
             real(dp), allocatable, intent(inout) :: a(:)
@@ -133,6 +182,6 @@ contains
             end if
             allocate (a(n))
         end subroutine reuse_int
-    end subroutine surface_point
+    end subroutine reuse_point
 
 end module voiga_contact_surface
