@@ -4,7 +4,7 @@
 !> layer's degree-q functions (docs/theory.md, section 7).
 module voiga_contact_surface
     use voiga_kinds, only: dp
-    use voiga_nurbs_basis, only: find_span, basis_ders, distinct_knots
+    use voiga_nurbs_basis, only: find_span, basis_ders_at, distinct_knots, max_fixed_degree
     use voiga_nurbs_rational, only: rationalize
     use voiga_discretization_patch, only: discretization_t
     implicit none
@@ -82,16 +82,29 @@ contains
         integer, intent(in) :: span
         real(dp), intent(out) :: r(:), dr(:), d2r(:)
         integer, intent(out) :: s
-        real(dp) :: ders(3, self%degree + 1), dr1(1, self%degree + 1), d2r1(1, self%degree + 1)
+        ! fixed sizes up to max_fixed_degree: no heap allocation per evaluation
+        real(dp) :: fixed(3, max_fixed_degree + 1), dr1(1, max_fixed_degree + 1), d2r1(1, max_fixed_degree + 1)
+        real(dp), allocatable :: ders(:, :), dr2(:, :), d2r2(:, :)
         integer :: p
         p = self%degree
         s = span
         ! the search only when no span is forced (a projection forces it at every step)
         if (s <= 0) s = find_span(self%knots, p, xi)
-        ders = basis_ders(self%knots, p, s, xi, 2)
-        call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), r, dr1, d2r1)
-        dr = dr1(1, :)
-        d2r = d2r1(1, :)
+        if (p <= max_fixed_degree) then
+            associate (d => fixed(:, 1:p + 1))
+                call basis_ders_at(self%knots, p, s, xi, 2, d)
+                call rationalize(self%w(s - p:s), d(1, :), d(2:2, :), d(3:3, :), r, dr1(:, 1:p + 1), &
+                                 d2r1(:, 1:p + 1))
+            end associate
+            dr = dr1(1, 1:p + 1)
+            d2r = d2r1(1, 1:p + 1)
+        else
+            allocate (ders(3, p + 1), dr2(1, p + 1), d2r2(1, p + 1))
+            call basis_ders_at(self%knots, p, s, xi, 2, ders)
+            call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), r, dr2, d2r2)
+            dr = dr2(1, :)
+            d2r = d2r2(1, :)
+        end if
     end subroutine surface_basis
 
     !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
