@@ -124,7 +124,7 @@ contains
         ! two evaluation buffers: the current one (cur) and the best so far (ib), whose
         ! roles swap instead of copying a point (and its arrays) on every improvement
         type(surface_point_t) :: pts(2)
-        real(dp) :: d, best_d, best, f
+        real(dp) :: d, best_d, best, f, tol
         real(dp) :: lb(size(self%surf%breaks) - 1)
         integer :: nspan, k, j, m, best_span, s0, k0, i, cur, ib
         logical :: ok, best_ok
@@ -180,9 +180,9 @@ contains
                 ! 3. beyond the curve's ends: no orthogonal projection
                 found = best_span > 0
                 f = dot_product(xs - best_pt%x, best_pt%a)
-                if (best_pt%xi <= br(1) .and. f < -1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) found = .false.
-                if (best_pt%xi >= br(nspan + 1) .and. f > 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) &
-                    found = .false.
+                tol = 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)
+                if (best_pt%xi <= br(1) .and. f < -tol) found = .false.
+                if (best_pt%xi >= br(nspan + 1) .and. f > tol) found = .false.
                 mp%xi = best_pt%xi
                 mp%x = best_pt%x
                 mp%a = best_pt%a

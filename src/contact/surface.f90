@@ -83,7 +83,8 @@ contains
         real(dp), intent(out) :: r(:), dr(:), d2r(:)
         integer, intent(out) :: s
         ! fixed sizes up to max_fixed_degree: no heap allocation per evaluation
-        real(dp) :: fixed(3, max_fixed_degree + 1), dr1(1, max_fixed_degree + 1), d2r1(1, max_fixed_degree + 1)
+        real(dp) :: fixed(3, max_fixed_degree + 1), dr1(1, max_fixed_degree + 1), &
+                    d2r1(1, max_fixed_degree + 1)
         real(dp), allocatable :: ders(:, :), dr2(:, :), d2r2(:, :)
         integer :: p
         p = self%degree
