@@ -116,12 +116,34 @@ def solve(case: Path) -> Run:
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         raise RuntimeError(f"voiga {case} failed ({proc.returncode}): {proc.stdout}{proc.stderr}")
-    with h5py.File(out, "r") as f:
+    stages = read_stages(out)
+    if stages.status != "converged":
+        raise RuntimeError(f"{case}: status {stages.status!r}")
+    return Run(case=case.stem, wall=wall, n_dofs=stages.n_dofs, steps=stages.steps,
+               iterations=stages.iterations, seconds=stages.seconds, result=out,
+               linear_iterations=stages.linear_iterations)
+
+
+@dataclass
+class Stages:
+    """What a result file says about its run's cost: the sums over its steps of the
+    ``seconds_<stage>`` attributes, the Newton iterations they cover, the run's own wall
+    time (``wall_time``, start-up excluded) and its status."""
+
+    status: str
+    n_dofs: int
+    steps: int
+    iterations: int
+    linear_iterations: int
+    seconds: dict[str, float]
+    wall_time: float
+
+
+def read_stages(path: Path) -> Stages:
+    """The stage sums of the result file ``path`` (docs/hdf5.md)."""
+    with h5py.File(path, "r") as f:
         status = f.attrs["status"]
         status = (status.decode() if isinstance(status, bytes) else str(status)).strip()
-        if status != "converged":
-            raise RuntimeError(f"{case}: status {status!r}")
-        n_dofs = int(f.attrs["n_dofs"])
         secs = {s: 0.0 for s in STAGES}
         iters = 0
         linear = 0
@@ -135,9 +157,9 @@ def solve(case: Path) -> Run:
             for s in STAGES:
                 secs[s] += float(a[f"seconds_{s}"])
             linear += int(a.get("linear_iterations", 0))
-        n_steps = len(steps)
-    return Run(case=case.stem, wall=wall, n_dofs=n_dofs, steps=n_steps, iterations=iters,
-               seconds=secs, result=out, linear_iterations=linear)
+        return Stages(status=status, n_dofs=int(f.attrs["n_dofs"]), steps=len(steps),
+                      iterations=iters, linear_iterations=linear, seconds=secs,
+                      wall_time=float(f.attrs.get("wall_time", 0.0)))
 
 
 def best_of(case: Path, repeat: int) -> Run:

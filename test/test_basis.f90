@@ -4,7 +4,9 @@ module test_basis
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_nurbs_basis, only: find_span, basis_funs, basis_ders
+    use voiga_nurbs_basis, only: find_span, basis_funs, basis_ders, basis_ders_at, max_fixed_degree
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, surface_basis, &
+                                     surface_point_at
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_basis
     use voiga_test_fixtures, only: lcg_t
     implicit none
@@ -20,7 +22,9 @@ contains
                     new_unittest('find_span', test_find_span), &
                     new_unittest('partition_of_unity', test_partition), &
                     new_unittest('derivatives_fd', test_derivatives_fd), &
-                    new_unittest('nurbs_curve_fd', test_nurbs_curve_fd) &
+                    new_unittest('nurbs_curve_fd', test_nurbs_curve_fd), &
+                    new_unittest('ders_at_no_heap_path', test_ders_at), &
+                    new_unittest('contact_curve_from_cached_basis', test_surface_point_at) &
                     ]
     end subroutine collect_basis
 
@@ -152,5 +156,67 @@ contains
             deallocate (c%w, c%cp, r, dr, d2r, rp, drp, d2rp, rm, drm, d2rm)
         end do
     end subroutine test_nurbs_curve_fd
+
+    !> `basis_ders_at` (work arrays in a fixed buffer up to `max_fixed_degree`, on the heap
+    !> above) gives `basis_ders` bit for bit, on both sides of the limit.
+    subroutine test_ders_at(error)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: knots(:), ders(:, :)
+        type(lcg_t) :: rng
+        real(dp) :: u
+        integer :: p, k, span
+        do p = 1, max_fixed_degree + 2
+            knots = test_knots(p)
+            allocate (ders(3, p + 1))
+            do k = 1, 20
+                u = rng%uniform()
+                span = find_span(knots, p, u)
+                call basis_ders_at(knots, p, span, u, 2, ders)
+                call check(error, all(ders == basis_ders(knots, p, span, u, 2)), &
+                           'basis_ders_at = basis_ders, degree '//trim(adjustl(itoa(p))))
+                if (allocated(error)) return
+            end do
+            deallocate (ders)
+        end do
+    contains
+        pure function itoa(i) result(t)
+            integer, intent(in) :: i
+            character(len=12) :: t
+            write (t, '(i0)') i
+        end function itoa
+    end subroutine test_ders_at
+
+    !> A contact curve evaluated from its functions computed once (`surface_basis`, then
+    !> `surface_point_at` in another configuration) is the same point, bit for bit, as
+    !> `surface_point` evaluating them again.
+    subroutine test_surface_point_at(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(contact_surface_t) :: c
+        type(surface_point_t) :: a, b
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:), r(:), dr(:), d2r(:)
+        real(dp) :: xi
+        integer :: p, n, k, s, i
+        do p = 2, 4
+            c%degree = p
+            c%knots = test_knots(p)
+            n = size(c%knots) - p - 1
+            c%w = [(0.5_dp + rng%uniform(), k=1, n)]
+            c%x0 = reshape([(rng%uniform(), k=1, 2*n)], [2, n])
+            c%dofs = reshape([(k, k=1, 2*n)], [2, n])
+            u = [(0.1_dp*rng%uniform(), k=1, 2*n)]
+            allocate (r(p + 1), dr(p + 1), d2r(p + 1))
+            do i = 1, 20
+                xi = rng%uniform()
+                call surface_basis(c, xi, 0, r, dr, d2r, s)
+                call surface_point(c, u, xi, a)
+                call surface_point_at(c, u, xi, s, r, dr, d2r, b)
+                call check(error, all([a%x, a%a, a%a2] == [b%x, b%a, b%a2]) .and. all(a%dofs == b%dofs) &
+                           .and. all(a%r == b%r), 'surface_point_at = surface_point')
+                if (allocated(error)) return
+            end do
+            deallocate (r, dr, d2r)
+        end do
+    end subroutine test_surface_point_at
 
 end module test_basis

@@ -124,10 +124,12 @@ contains
         real(dp), intent(in) :: u(:), xs(2)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
-        type(surface_point_t) :: pt, best_pt
-        real(dp) :: d, best_d, xi, xi_s, a, b, lo, hi, best, f, df, step
+        ! two evaluation buffers: the current one (cur) and the best so far (ib), whose
+        ! roles swap instead of copying a point (and its arrays) on every improvement
+        type(surface_point_t) :: pts(2)
+        real(dp) :: d, best_d, best, f, tol
         real(dp) :: lb(size(self%surf%breaks) - 1)
-        integer :: nspan, k, j, m, it, best_span, s0, s1, k0, i
+        integer :: nspan, k, j, m, best_span, s0, k0, i, cur, ib
         logical :: ok, best_ok
 
         associate (br => self%surf%breaks)
@@ -158,78 +160,92 @@ contains
             ! 2. Newton in the sample's span and its neighbours, clamped to each span
             best_d = huge(1.0_dp)
             best_ok = .false.
+            best_span = 0
             converged = .true.
+            cur = 1
+            ib = 0
             do k = max(1, s0 - 1), min(nspan, s0 + 1)
-                a = br(k)
-                b = br(k + 1)
-                xi = min(max(best, a), b)
-                lo = a
-                hi = b
-                ok = .false.
-                do it = 1, max_newton
-                    call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
-                    f = dot_product(xs - pt%x, pt%a)
-                    df = -dot_product(pt%a, pt%a) + dot_product(xs - pt%x, pt%a2)
-                    ! keep a bracket of the minimum of the distance: f > 0 -> it lies to the right
-                    if (f > 0.0_dp) then
-                        lo = xi
-                    else if (f < 0.0_dp) then
-                        hi = xi
-                    end if
-                    if (df < 0.0_dp) then
-                        step = -f/df
-                    else
-                        step = merge(hi - xi, lo - xi, f > 0.0_dp)
-                    end if
-                    if (abs(step) <= 1.0e-15_dp*max(1.0_dp, abs(xi))) then
-                        ok = .true.
-                        exit
-                    end if
-                    if ((xi == a .and. f < 0.0_dp) .or. (xi == b .and. f > 0.0_dp)) then
-                        ! the minimum over this span is at its end
-                        ok = .true.
-                        exit
-                    end if
-                    xi_s = min(max(xi + step, a), b)
-                    ! a Newton step that leaves the bracket is replaced by bisection
-                    if (xi_s < lo .or. xi_s > hi) xi_s = 0.5_dp*(lo + hi)
-                    if (xi_s == xi) then
-                        ok = .true.
-                        exit
-                    end if
-                    xi = xi_s
-                end do
+                call span_newton(self%surf, u, xs, k, best, pts(cur), ok)
                 if (.not. ok) converged = .false.
-                call surface_point(self%surf, u, xi, pt, self%surf%spans(k))
-                d = norm2(xs - pt%x)
+                d = norm2(xs - pts(cur)%x)
                 if (d < best_d) then
                     best_d = d
-                    best_pt = pt
+                    ib = cur
+                    cur = 3 - cur
                     best_span = k
                     best_ok = ok
                 end if
             end do
+            ! no distance compared (not a number): the last evaluation, not found
+            if (ib == 0) ib = cur
             if (.not. best_ok) converged = .false.
-            ! 3. beyond the curve's ends: no orthogonal projection
-            found = .true.
-            s1 = size(self%surf%knots)
-            f = dot_product(xs - best_pt%x, best_pt%a)
-            if (best_pt%xi <= br(1) .and. f < -1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) found = .false.
-            if (best_pt%xi >= br(nspan + 1) .and. f > 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)) &
-                found = .false.
+            associate (best_pt => pts(ib))
+                ! 3. beyond the curve's ends: no orthogonal projection
+                found = best_span > 0
+                f = dot_product(xs - best_pt%x, best_pt%a)
+                tol = 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)
+                if (best_pt%xi <= br(1) .and. f < -tol) found = .false.
+                if (best_pt%xi >= br(nspan + 1) .and. f > tol) found = .false.
+                mp%xi = best_pt%xi
+                mp%x = best_pt%x
+                mp%a = best_pt%a
+                mp%a2 = best_pt%a2
+                mp%n = self%sign*[best_pt%a(2), -best_pt%a(1)]/norm2(best_pt%a)
+                mp%r = best_pt%r
+                mp%dr = best_pt%dr
+                mp%dofs = best_pt%dofs
+                mp%first = minval(best_pt%local)
+                mp%last = maxval(best_pt%local)
+            end associate
         end associate
-        mp%xi = best_pt%xi
-        mp%x = best_pt%x
-        mp%a = best_pt%a
-        mp%a2 = best_pt%a2
-        mp%n = self%sign*[best_pt%a(2), -best_pt%a(1)]/norm2(best_pt%a)
-        mp%r = best_pt%r
-        mp%dr = best_pt%dr
-        mp%dofs = best_pt%dofs
-        mp%first = minval(best_pt%local)
-        mp%last = maxval(best_pt%local)
-        if (best_span < 0 .or. s1 < 0) found = .false.
-
     end subroutine nurbs_project
+
+    !> The closest point to `xs` of span `k` of `surf`: Newton on (xs - x).a = 0 from
+    !> `start` clamped to the span, kept in a bracket of the minimum (a step leaving
+    !> it is replaced by bisection). `pt` is the curve at the result (every exit but
+    !> the iteration cap has just evaluated it there: no second evaluation), `ok`
+    !> false if `max_newton` iterations did not settle it.
+    pure subroutine span_newton(surf, u, xs, k, start, pt, ok)
+        type(contact_surface_t), intent(in) :: surf
+        real(dp), intent(in) :: u(:), xs(2), start
+        integer, intent(in) :: k
+        type(surface_point_t), intent(inout) :: pt
+        logical, intent(out) :: ok
+        real(dp) :: xi, xi_s, a, b, lo, hi, f, df, step
+        integer :: it
+        a = surf%breaks(k)
+        b = surf%breaks(k + 1)
+        xi = min(max(start, a), b)
+        lo = a
+        hi = b
+        ok = .false.
+        do it = 1, max_newton
+            call surface_point(surf, u, xi, pt, surf%spans(k))
+            f = dot_product(xs - pt%x, pt%a)
+            df = -dot_product(pt%a, pt%a) + dot_product(xs - pt%x, pt%a2)
+            ! keep a bracket of the minimum of the distance: f > 0 -> it lies to the right
+            if (f > 0.0_dp) then
+                lo = xi
+            else if (f < 0.0_dp) then
+                hi = xi
+            end if
+            if (df < 0.0_dp) then
+                step = -f/df
+            else
+                step = merge(hi - xi, lo - xi, f > 0.0_dp)
+            end if
+            ok = abs(step) <= 1.0e-15_dp*max(1.0_dp, abs(xi))
+            ! or the minimum over this span is at its end
+            ok = ok .or. (xi == a .and. f < 0.0_dp) .or. (xi == b .and. f > 0.0_dp)
+            if (ok) return
+            xi_s = min(max(xi + step, a), b)
+            ! a Newton step that leaves the bracket is replaced by bisection
+            if (xi_s < lo .or. xi_s > hi) xi_s = 0.5_dp*(lo + hi)
+            ok = xi_s == xi
+            if (ok) return
+            xi = xi_s
+        end do
+        call surface_point(surf, u, xi, pt, surf%spans(k))
+    end subroutine span_newton
 
 end module voiga_contact_master_nurbs

@@ -16,7 +16,8 @@ module voiga_contact_pair
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, surface_basis, &
+                                     surface_point_at
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive
     use voiga_text, only: str, real_str
@@ -91,6 +92,9 @@ module voiga_contact_pair
         !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts].
         real(dp), allocatable :: xi(:), w(:)
         integer, allocatable :: span(:)
+        !> The slave functions at each point (they do not change): values, first and
+        !> second derivatives [p + 1, 3, npts] (`surface_basis`).
+        real(dp), allocatable :: slave_basis(:, :, :)
         !> Friction history shared by the methods (allocated only when mu > 0)
         !> [npts]: whether the point was in contact (GPTS) or had a projection
         !> (mortar) at the last converged state, and its projection there;
@@ -204,7 +208,7 @@ contains
     pure subroutine pair_setup(self)
         class(contact_pair_t), intent(inout) :: self
         real(dp), allocatable :: gx(:), gw(:)
-        integer :: ne, ng, e, i, k
+        integer :: ne, ng, e, i, k, s
         real(dp) :: a, b
 
         if (self%n_gauss <= 0) self%n_gauss = self%slave%degree + 1
@@ -222,6 +226,11 @@ contains
                 self%w(k) = 0.5_dp*(b - a)*gw(i)
                 self%span(k) = self%slave%spans(e)
             end do
+        end do
+        allocate (self%slave_basis(self%slave%degree + 1, 3, ne*ng))
+        do k = 1, ne*ng
+            call surface_basis(self%slave, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
+                               self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), s)
         end do
         allocate (self%out(ne*ng))
         ! until the assembly fits them (assemble with refit), every slave element is
@@ -385,7 +394,12 @@ contains
         type(surface_point_t), intent(inout) :: sp
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
-        call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
+        if (allocated(self%slave_basis)) then
+            call surface_point_at(self%slave, u, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
+                                  self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
+        else
+            call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
+        end if
         associate (out => self%out(k))
             out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
             out%x = sp%x

@@ -4,7 +4,7 @@
 !> layer's degree-q functions (docs/theory.md, section 7).
 module voiga_contact_surface
     use voiga_kinds, only: dp
-    use voiga_nurbs_basis, only: find_span, basis_ders, distinct_knots
+    use voiga_nurbs_basis, only: find_span, basis_ders_at, distinct_knots, max_fixed_degree
     use voiga_nurbs_rational, only: rationalize
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_discretization_patch, only: discretization_t
@@ -12,7 +12,7 @@ module voiga_contact_surface
     private
 
     public :: contact_surface_t, new_contact_surface, new_curve_surface, surface_point_t, surface_point, &
-              element_lengths
+              surface_basis, surface_point_at, element_lengths
 
     !> The contact edge of one body.
     type :: contact_surface_t
@@ -97,6 +97,42 @@ contains
         end do
     end subroutine set_spans
 
+    !> The nonzero functions of the curve at `xi` in knot span `span` (0: found from
+    !> xi): values `r`, first and second derivatives `dr`, `d2r` [p + 1], and the span
+    !> `s` used. They do not depend on the configuration: a caller that evaluates the
+    !> same parameter in many configurations keeps them (`surface_point_at`).
+    pure subroutine surface_basis(self, xi, span, r, dr, d2r, s)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: xi
+        integer, intent(in) :: span
+        real(dp), intent(out) :: r(:), dr(:), d2r(:)
+        integer, intent(out) :: s
+        ! fixed sizes up to max_fixed_degree: no heap allocation per evaluation
+        real(dp) :: fixed(3, max_fixed_degree + 1), dr1(1, max_fixed_degree + 1), &
+                    d2r1(1, max_fixed_degree + 1)
+        real(dp), allocatable :: ders(:, :), dr2(:, :), d2r2(:, :)
+        integer :: p
+        p = self%degree
+        s = span
+        ! the search only when no span is forced (a projection forces it at every step)
+        if (s <= 0) s = find_span(self%knots, p, xi)
+        if (p <= max_fixed_degree) then
+            associate (d => fixed(:, 1:p + 1))
+                call basis_ders_at(self%knots, p, s, xi, 2, d)
+                call rationalize(self%w(s - p:s), d(1, :), d(2:2, :), d(3:3, :), r, dr1(:, 1:p + 1), &
+                                 d2r1(:, 1:p + 1))
+            end associate
+            dr = dr1(1, 1:p + 1)
+            d2r = d2r1(1, 1:p + 1)
+        else
+            allocate (ders(3, p + 1), dr2(1, p + 1), d2r2(1, p + 1))
+            call basis_ders_at(self%knots, p, s, xi, 2, ders)
+            call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), r, dr2, d2r2)
+            dr = dr2(1, :)
+            d2r = d2r2(1, :)
+        end if
+    end subroutine surface_basis
+
     !> Evaluate the surface at `xi` with displacements `u` (global vector). `span`
     !> forces the knot span (0: found from xi), so that a point on an element
     !> boundary can be evaluated from either side. Every component of `pt` is set;
@@ -109,23 +145,38 @@ contains
         real(dp), intent(in) :: xi
         type(surface_point_t), intent(inout) :: pt
         integer, intent(in), optional :: span
-        real(dp) :: ders(3, self%degree + 1), dr(1, self%degree + 1), d2r(1, self%degree + 1), x(2)
-        integer :: s, p, k, id
+        integer :: forced, s
+        forced = 0
+        if (present(span)) forced = span
+        call reuse_point(pt, self%degree + 1)
+        call surface_basis(self, xi, forced, pt%r, pt%dr, pt%d2r, s)
+        call place_point(self, u, xi, s, pt)
+    end subroutine surface_point
 
+    !> `surface_point` at `xi` in span `s` from the functions there (`surface_basis`:
+    !> `r`, `dr`, `d2r` [p + 1]); the same numbers without evaluating them again.
+    pure subroutine surface_point_at(self, u, xi, s, r, dr, d2r, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi
+        integer, intent(in) :: s
+        real(dp), intent(in) :: r(:), dr(:), d2r(:)
+        type(surface_point_t), intent(inout) :: pt
+        call reuse_point(pt, self%degree + 1)
+        pt%r = r
+        pt%dr = dr
+        pt%d2r = d2r
+        call place_point(self, u, xi, s, pt)
+    end subroutine surface_point_at
+
+    !> The point, its derivatives and DOFs from the functions in `pt` (span `s`).
+    pure subroutine place_point(self, u, xi, s, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi
+        integer, intent(in) :: s
+        type(surface_point_t), intent(inout) :: pt
+        real(dp) :: x(2)
+        integer :: p, k, id
         p = self%degree
-        s = find_span(self%knots, p, xi)
-        if (present(span)) then
-            if (span > 0) s = span
-        end if
-        ders = basis_ders(self%knots, p, s, xi, 2)
-        call reuse(pt%r, p + 1)
-        call reuse(pt%dr, p + 1)
-        call reuse(pt%d2r, p + 1)
-        call reuse_int(pt%local, p + 1)
-        call reuse_int(pt%dofs, 2*(p + 1))
-        call rationalize(self%w(s - p:s), ders(1, :), ders(2:2, :), ders(3:3, :), pt%r, dr, d2r)
-        pt%dr = dr(1, :)
-        pt%d2r = d2r(1, :)
         pt%xi = xi
         pt%x = 0.0_dp
         pt%a = 0.0_dp
@@ -139,6 +190,17 @@ contains
             pt%a = pt%a + pt%dr(k)*x
             pt%a2 = pt%a2 + pt%d2r(k)*x
         end do
+    end subroutine place_point
+
+    !> `pt`'s arrays for `n` functions, kept when they have that size.
+    pure subroutine reuse_point(pt, n)
+        type(surface_point_t), intent(inout) :: pt
+        integer, intent(in) :: n
+        call reuse(pt%r, n)
+        call reuse(pt%dr, n)
+        call reuse(pt%d2r, n)
+        call reuse_int(pt%local, n)
+        call reuse_int(pt%dofs, 2*n)
     contains
         pure subroutine reuse(a, n)
             real(dp), allocatable, intent(inout) :: a(:)
@@ -159,7 +221,7 @@ contains
             end if
             allocate (a(n))
         end subroutine reuse_int
-    end subroutine surface_point
+    end subroutine reuse_point
 
     !> The reference length of every element of the edge, as the chord between its
     !> ends; shape: [elements along the edge].

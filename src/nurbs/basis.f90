@@ -8,7 +8,12 @@ module voiga_nurbs_basis
     implicit none
     private
 
-    public :: find_span, basis_funs, basis_ders, n_basis, distinct_knots, multiplicity
+    public :: find_span, basis_funs, basis_ders, basis_ders_at, n_basis, distinct_knots, multiplicity
+    public :: max_fixed_degree
+
+    !> Highest degree whose basis evaluation (`basis_ders_at`) and contact curve
+    !> evaluation need no heap allocation (the case reader accepts degrees up to 20).
+    integer, parameter :: max_fixed_degree = 20
 
 contains
 
@@ -90,7 +95,41 @@ contains
         integer, intent(in) :: p, span, nd
         real(dp), intent(in) :: u
         real(dp) :: ders(nd + 1, p + 1)
-        real(dp) :: ndu(0:p, 0:p), a(0:1, 0:p), left(p), right(p), saved, temp, d
+        call basis_ders_at(knots, p, span, u, nd, ders)
+    end function basis_ders
+
+    !> `basis_ders` into `ders` [nd+1, p+1] without a heap allocation up to degree
+    !> `max_fixed_degree` (its work arrays then live in a fixed buffer; gfortran puts
+    !> arrays whose size is known only at run time on the heap): the contact search
+    !> evaluates curves some ten thousand times per Newton iteration.
+    pure subroutine basis_ders_at(knots, p, span, u, nd, ders)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: p, span, nd
+        real(dp), intent(in) :: u
+        real(dp), intent(out) :: ders(:, :)
+        real(dp) :: fixed((max_fixed_degree + 1)*(max_fixed_degree + 5))
+        real(dp), allocatable :: work(:)
+        integer :: n
+        ! ndu(0:p, 0:p), a(0:1, 0:p), left(p), right(p)
+        n = (p + 1)*(p + 1)
+        if (p <= max_fixed_degree) then
+            call ders_kernel(knots, p, span, u, nd, ders, fixed, fixed(n + 1), fixed(n + 2*p + 3), &
+                             fixed(n + 3*p + 3))
+        else
+            allocate (work((p + 1)*(p + 5)))
+            call ders_kernel(knots, p, span, u, nd, ders, work, work(n + 1), work(n + 2*p + 3), &
+                             work(n + 3*p + 3))
+        end if
+    end subroutine basis_ders_at
+
+    !> The algorithm of `basis_ders` (The NURBS Book, A2.3) on work arrays of the caller.
+    pure subroutine ders_kernel(knots, p, span, u, nd, ders, ndu, a, left, right)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: p, span, nd
+        real(dp), intent(in) :: u
+        real(dp), intent(out) :: ders(:, :)
+        real(dp), intent(inout) :: ndu(0:p, 0:p), a(0:1, 0:p), left(p), right(p)
+        real(dp) :: saved, temp, d
         integer :: j, r, k, s1, s2, rk, pk, j1, j2, jj
 
         ders = 0.0_dp
@@ -145,7 +184,7 @@ contains
             ders(k + 1, :) = ders(k + 1, :)*r
             r = r*(p - k)
         end do
-    end function basis_ders
+    end subroutine ders_kernel
 
     !> Distinct knot values (breakpoints) of a knot vector, in increasing order.
     pure function distinct_knots(knots) result(breaks)

@@ -472,10 +472,14 @@ contains
     pure function contact_states(model) result(states)
         type(model_t), intent(in) :: model
         integer, allocatable :: states(:)
-        integer :: ip, k
-        allocate (states(0))
+        integer :: ip, n
+        allocate (states(sum([(size(model%pairs(ip)%pair%out), ip=1, size(model%pairs))])))
+        n = 0
         do ip = 1, size(model%pairs)
-            states = [states, (model%pairs(ip)%pair%out(k)%state, k=1, size(model%pairs(ip)%pair%out))]
+            associate (out => model%pairs(ip)%pair%out)
+                states(n + 1:n + size(out)) = out%state
+                n = n + size(out)
+            end associate
         end do
     end function contact_states
 

@@ -325,13 +325,24 @@ contains
         integer, intent(in) :: dofs(:)
         !> Element matrix; shape: [m, m].
         real(dp), intent(in) :: ke(:, :)
-        integer :: a, b, pos
+        integer :: a, b, pos, last
 
         do b = 1, size(dofs)
             if (dofs(b) <= 0) cycle
+            pos = 0
             do a = 1, size(dofs)
-                if (dofs(a) <= 0) cycle
-                pos = self%index_of(dofs(a), dofs(b))
+                if (dofs(a) <= 0) then
+                    pos = 0
+                    cycle
+                end if
+                ! the y row of a control point follows its x row in the column (rows sorted):
+                ! found without a search
+                last = pos
+                pos = 0
+                if (a > 1 .and. last > 0 .and. last < self%colptr(min(dofs(b), self%n) + 1)) then
+                    if (dofs(a) == dofs(a - 1) + 1 .and. self%rowind(last + 1) == dofs(a) - 1) pos = last + 1
+                end if
+                if (pos == 0) pos = self%index_of(dofs(a), dofs(b))
                 if (pos > 0) then
                     self%values(pos) = self%values(pos) + ke(a, b)
                 else
