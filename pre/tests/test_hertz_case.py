@@ -19,7 +19,7 @@ from pre.cases import STUDIES, hertz_case
 from pre.h5io import read_geometry
 from pre.hertz import (Cylinder, HertzCaseError, cylinder_case, expected_half_width,
                        grading_half_width, write_hertz_case)
-from pre.meshes import HERTZ_A_EXP, HERTZ_N_CONTACT, arc_angle, hertz_theta_c
+from pre.meshes import HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_N_CONTACT, arc_angle, hertz_theta_c
 
 from .conftest import CASES, REPO
 
@@ -45,9 +45,9 @@ def test_the_committed_geometry_comes_out_again(tmp_path: Path) -> None:
 
 
 def test_scaled_cylinder(tmp_path: Path) -> None:
-    """The committed d/R on another cylinder: the committed knots, the geometry scaled by
-    R, the flat at y = -R, u_y = -d, the penalty scaled by E / R (the same problem in
-    other units)."""
+    """The committed d/R on another cylinder: the committed knots (both directions), the
+    geometry scaled by R, the flat at y = -R, u_y = -d, the penalty scaled by E / R (the
+    same problem in other units)."""
     cyl = Cylinder(radius=2.5, youngs_modulus=7.0, poisson_ratio=0.2, indentation=0.025)
     groups = cylinder_case(cyl, "m3", "NN2.2")
     committed = hertz_case("m3", "NN2.2")
@@ -86,7 +86,8 @@ def test_grading_covers_the_expected_half_width(indentation: float, mesh: str) -
     to spare (a_g is 1.05 times the estimate), and its elements shrink with a."""
     radius = 3.0
     cyl = Cylinder(radius=radius, indentation=indentation * radius)
-    knots = np.asarray(cylinder_case(cyl, mesh, "N2")["body"][0]["knots_xi"])
+    body = cylinder_case(cyl, mesh, "N2")["body"][0]
+    knots = np.asarray(body["knots_xi"])
     split = 2 ** (int(mesh[1:]) - 1)
     n_fine = HERTZ_N_CONTACT * split
     angles = arc_angle(np.concatenate([[0.0], knots]))  # from the lowest point
@@ -103,6 +104,20 @@ def test_grading_covers_the_expected_half_width(indentation: float, mesh: str) -
     # the zone x < a holds the expected share of the fine elements, ~ n_fine / 1.5 / 1.05
     inside = np.count_nonzero(radius * np.sin(angles[1:n_fine + 1]) <= a)
     assert inside == pytest.approx(n_fine / 1.5 / 1.0527, abs=1)
+    # radially, the surface element is the committed 0.005 R scaled as a_g (the
+    # annulus is 0.95 R thick; eta = 1 is the surface)
+    surface = (1.0 - body["knots_eta"][-1]) * 0.95 * radius
+    assert surface == pytest.approx(HERTZ_H_SURFACE * a_g / HERTZ_A_EXP * radius, rel=1e-12)
+
+
+@pytest.mark.parametrize("layout", ["L1", "N2", "NN2.2"])
+def test_the_largest_indentation(layout: str) -> None:
+    """Just below R/10 the scaled surface element would exceed a uniform radial mesh: the
+    mesh is uniform radially instead (47 or 48 equal radial elements)."""
+    eta = np.asarray(cylinder_case(Cylinder(indentation=0.0999), "m1", layout)
+                     ["body"][0]["knots_eta"])
+    np.testing.assert_allclose(np.diff(np.concatenate([[0.0], eta, [1.0]])), 1 / (len(eta) + 1),
+                               rtol=1e-9)
 
 
 def test_the_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
