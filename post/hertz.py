@@ -408,8 +408,9 @@ def plot_hertz(comparisons: list[HertzComparison], output: str | Path,
         dev = (p - hertz_pressure(x, h.a, h.p0)) / h.p0
         bottom.plot(xs, 100 * dev, ".-", ms=3, lw=0.8, color=line.get_color())
         xmax = max(xmax, float(np.abs(xs).max()))
-    for ax in (top, bottom):
-        ax.axvspan((1 - EDGE_ZONE) * sx, (1 + EDGE_ZONE) * sx, color="0.9", zorder=0)
+    for ax, label in ((top, f"edge zone: a +- {EDGE_ZONE:.0%}"), (bottom, None)):
+        ax.axvspan((1 - EDGE_ZONE) * sx, (1 + EDGE_ZONE) * sx, color="0.9", zorder=0,
+                   label=label)
         ax.grid(alpha=0.3)
     bottom.axhline(0.0, color="k", lw=0.8)
     top.set_xlim(0.0 if all(h.half_model for h in comparisons) else -xmax, xmax)
