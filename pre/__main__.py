@@ -121,7 +121,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="&contact method, e.g. gpts, mortar, alm (default: the committed case's)")
     s.add_argument("--penalty-normal", default=None,
                    help="a number, or 'auto' (voiga chooses); default: the committed case's "
-                        "scaled by E/R")
+                        "scaled by E and 1/a (its compliance relative to a)")
     s.add_argument("--out", required=True, help="folder for geometry.h5 and <mesh>-<layout>.nml")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz)

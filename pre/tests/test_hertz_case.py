@@ -56,6 +56,10 @@ def test_scaled_cylinder(tmp_path: Path) -> None:
     assert (groups["body"][0]["youngs_modulus"], groups["body"][0]["poisson_ratio"]) == (7.0, 0.2)
     c = groups["contact"][0]
     assert c["rigid_point"] == [0.0, -2.5] and c["penalty_normal"] == pytest.approx(1000 * 7 / 2.5)
+    # another indentation: the penalty also scales as 1/a (the committed E*/(eps a))
+    c = cylinder_case(Cylinder(radius=2.5, youngs_modulus=7.0, indentation=0.005), "m1", "N2")
+    a_ratio = grading_half_width(0.002) / HERTZ_A_EXP
+    assert c["contact"][0]["penalty_normal"] == pytest.approx(1000 * 7 / 2.5 / a_ratio, rel=1e-14)
     assert [d.get("uy") for d in groups["dirichlet"]] == [-0.025, None]
     write_hertz_case(cyl, "m3", "NN2.2", tmp_path)
     _, bodies = read_geometry(tmp_path / "geometry.h5")
