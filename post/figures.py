@@ -194,7 +194,8 @@ def make_all(results: Path, out: Path) -> list[Path]:
     made.append(hertz_pressure(results, out, "m1"))
     made += error_plots(rows, out, "hertz", "l2_ref_field", "L2 error of the pressure field vs N2 m6")
     made += error_plots(rows, out, "hertz", "l2_ref", "L2 error of p/p_max vs N2 m6")
-    made += error_plots(rows, out, "hertz", "l2_analytic", "L2 error of p/p_max vs analytic")
+    made += error_plots(rows, out, "hertz", "l2_analytic",
+                        "L2 error vs analytic Hertz (reference configuration)")
     made += error_plots(rows, out, "rings", "l2_pn_ref", "L2 error of p_N vs reference")
     made += error_plots(rows, out, "rings", "l2_pt_ref", "L2 error of p_T vs reference")
     for scene in ("ironing", "ironing-deep"):
