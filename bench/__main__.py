@@ -93,13 +93,13 @@ def section_nn_vs_n(w: Workdir, repeat: int) -> dict:
 
 
 def section_accuracy(w: Workdir, repeat: int) -> dict:
-    header("3. NN2.2 against N2 at comparable accuracy (hertz; errors from post.contact."
-           "hertz_comparison, last step)")
+    header("3. NN2.2 against N2 at comparable accuracy (hertz; errors from post.hertz."
+           "hertz_comparison, last step: reference configuration)")
     pairs = [("m3-NN2.2", "m3-N2"), ("m3-NN2.2", "m4-N2"), ("m4-NN2.2", "m5-N2")]
     names = sorted({n for p in pairs for n in p})
     runs = dict(zip(names, interleaved([w.case("hertz", n) for n in names], repeat)))
     errs = {n: hertz_errors(r.result) for n, r in runs.items()}
-    print(f"{'case':10s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} {'L2(p/pmax)':>11s} "
+    print(f"{'case':10s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} {'L2 (ref.)':>11s} "
           f"{'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}")
     for n in names:
         r, e = runs[n], errs[n]

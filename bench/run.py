@@ -193,7 +193,7 @@ def header(title: str) -> None:
 
 def hertz_errors(path: Path) -> dict:
     """Errors of a hertz result against analytic Hertz, as ``python -m post hertz``."""
-    from post.contact import hertz_comparison
+    from post.hertz import hertz_comparison
     from post.reader import read_result
     h = hertz_comparison(read_result(path))
     return {"l2": h.l2_error, "a_error": h.a_error, "p0_error": h.p0_error}

@@ -7,7 +7,8 @@ Subcommands:
   plot-contact   p_N and p_T along the contact (PNG)
   history        reactions and contact forces against the load time (CSV and PNG)
   vtk            ParaView time series (.pvd + .vtu)
-  hertz          compare a hertz result with the analytic line contact (and draw it)
+  hertz          a cylinder on a rigid flat against analytic Hertz in the reference
+                 configuration (and the figure; several results: one overlay)
   study          a parameter study from a study file (docs/studies.md): derived cases
                  run on Dask, one table (CSV, markdown, Parquet) and figures
   sweep          the committed cases as a study without changes (the same engine)
@@ -119,17 +120,48 @@ def _cmd_plot_contact(args: argparse.Namespace) -> int:
 
 
 def _cmd_hertz(args: argparse.Namespace) -> int:
-    from .contact import format_hertz, hertz_comparison, plot_hertz
+    from .hertz import HertzError, hertz_comparison, hertz_figure, hertz_report, plot_hertz
+    from .reader import read_result
 
-    result = _result(args)
-    if not result.steps or not result.steps[-1].contact:
-        print(f"python -m post: {args.result} has no converged step with contact output",
-              file=sys.stderr)
-        return 1
-    print(format_hertz(hertz_comparison(result)))
-    if not args.no_figure:
-        print(plot_hertz(result, out=args.out))
-    return 0
+    done, code = [], 0
+    for path in args.result:
+        try:
+            result = read_result(path)
+            if not result.steps:  # as every subcommand: no converged step is exit 1
+                print(f"python -m post hertz: {path} has no converged step (status "
+                      f"{result.status!r})", file=sys.stderr)
+                code = max(code, 1)
+                continue
+            h = hertz_comparison(result, step=args.step, radius=args.radius,
+                                 configuration=args.configuration)
+        except (HertzError, OSError, KeyError, ValueError) as err:
+            print(f"python -m post hertz: {path}: {err}", file=sys.stderr)
+            code = 2
+            continue
+        print("\n".join(hertz_report(h)))
+        done.append((result, h))
+    if done and not args.no_figure:
+        from pathlib import Path
+
+        first, h0 = done[0]
+        if len(done) == 1:
+            print(hertz_figure(first, h0, args.out, args.output))
+        else:
+            output = Path(args.output or Path(args.out or first.path.parent) / "hertz-profiles.png")
+            output.parent.mkdir(parents=True, exist_ok=True)
+            print(plot_hertz([h for _, h in done], output, units=first.units))
+    return code
+
+
+def _positive(text: str) -> float:
+    """``--radius``: a positive number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be positive and finite")
+    return value
 
 
 def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
@@ -324,9 +356,23 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default="docs/validation", help="where to write (default: docs/validation)")
     s.set_defaults(func=_cmd_figures)
 
-    s = sub.add_parser("hertz", help="hertz result against the analytic line contact")
-    s.add_argument("result", help="result file (.h5) of a hertz case")
-    s.add_argument("--out", default=None, help="folder for the figure (default: next to the result)")
+    s = sub.add_parser("hertz", help="cylinder on a rigid flat against analytic Hertz "
+                                     "(reference configuration, nominal pressure)")
+    s.add_argument("result", nargs="+",
+                   help="result file(s) (.h5); several: one figure with every profile")
+    s.add_argument("--step", type=int, default=-1,
+                   help="step number (>= 1) or -k for the k-th last (default: -1)")
+    s.add_argument("--radius", type=_positive, default=None,
+                   help="cylinder radius (default: the circle through the slave edge's "
+                        "reference points near the contact; 1 for the committed hertz scene)")
+    s.add_argument("--configuration", choices=("reference", "current"), default="reference",
+                   help="reference (default): nominal pressure at reference positions, the "
+                        "measure of the theory; current: per current length at current "
+                        "positions, for comparison only")
+    s.add_argument("-o", "--output", default=None, help="PNG file of the figure")
+    s.add_argument("--out", default=None,
+                   help="folder for the figure (default: next to the (first) result); one "
+                        "file: <result>-hertz-<step>.png, several: hertz-profiles.png")
     s.add_argument("--no-figure", action="store_true", help="only print the comparison")
     s.set_defaults(func=_cmd_hertz)
     return p

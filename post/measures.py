@@ -3,9 +3,11 @@
 - ironing: oscillation amplitude of the die forces Px, Py over the second half of the
   sliding steps, after removing a cubic trend (the slab's finite length makes the mean
   force drift as the die approaches its end); reported as % of N2 on the same mesh.
-- hertz: half-width / peak against analytic Hertz, and the relative L2 error of the
-  normalised pressure p/p_max against analytic Hertz and against the reference run
-  (N2 on m6).
+- hertz: against analytic Hertz in the reference configuration (post.hertz: nominal
+  pressure at the reference positions, relative L2 error over the union of both
+  supports, largest pointwise deviation over p0, and the fitted half-width and peak as
+  extras), and the relative L2 error of the normalised pressure p/p_max against the
+  reference run (N2 on m6).
 - rings: relative L2 errors of p_N and p_T against the reference run (N2, finer mesh).
 
 A study may also name measures read from the result file (:func:`file_measure`).
@@ -19,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact import fit_hertz, hertz_comparison, pressure_field
+from .contact import pressure_field
+from .hertz import fit_hertz, hertz_comparison
 from .ironing import die_forces
 from .reader import Result
 
@@ -106,11 +109,13 @@ def _hertz_reference(ref: Result) -> tuple[float, np.ndarray, np.ndarray, np.nda
 
 
 def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
-    """Comparison with analytic Hertz, and with the reference run if given: profiles in
-    x/a on [0, 1.2], pressures divided by the reference's (resp. analytic) peak."""
+    """Comparison with analytic Hertz (:func:`post.hertz.hertz_comparison`), and with the
+    reference run if given: profiles in x/a on [0, 1.2], pressures divided by the
+    reference's peak."""
     h = hertz_comparison(res)
     out = {"force": h.force, "a_err": h.a_error, "p0_err": h.p0_error, "pmax_err": h.p_max / h.p0 - 1.0,
-           "l2_analytic": h.l2_error}
+           "l2_analytic": h.l2_error, "maxdev_analytic": abs(h.error.max_deviation),
+           "maxdev_interior": abs(h.error.interior_deviation)}
     if ref is not None:
         a_ref, xr, pr, xfr, pfr = _hertz_reference(ref)
         x, p = edge_profile(*profile(res))

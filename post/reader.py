@@ -159,6 +159,14 @@ class ContactOutput:
     obstacle on its left, outward normal ``(a_y, -a_x)/|a|``; None otherwise)."""
     rigid_offset: np.ndarray | None = None
     """(2,) that curve's translation from its position at load time 0."""
+    p_n_nominal: np.ndarray | None = None
+    """(n,) contact pressure per *reference* length of the slave edge (``p_n`` times
+    ``stretch``); None in files written before voiga wrote it."""
+    p_t_nominal: np.ndarray | None = None
+    """(n,) tangential traction per reference length; None in older files."""
+    stretch: np.ndarray | None = None
+    """(n,) current over reference length of the slave edge at each point; None in
+    older files."""
 
     @property
     def active(self) -> np.ndarray:
@@ -523,7 +531,8 @@ def _read_contact(g: h5py.Group) -> ContactOutput:
                          rigid_point=vec("rigid_point") if "rigid_point" in g else None,
                          rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None,
                          rigid_curve=read_curve(g["rigid_curve"]) if "rigid_curve" in g else None,
-                         rigid_offset=vec("rigid_offset") if "rigid_offset" in g else None)
+                         rigid_offset=vec("rigid_offset") if "rigid_offset" in g else None,
+                         **{k: vec(k) for k in ("p_n_nominal", "p_t_nominal", "stretch") if k in g})
 
 
 def read_result(path: str | Path, lazy: bool = False) -> Result:

@@ -20,7 +20,7 @@ from .summary import summary_lines
 
 def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> list[Path]:
     """Every figure (and the ParaView series) that fits ``result``; returns the paths."""
-    from .contact import plot_contact, plot_hertz
+    from .contact import plot_contact
     from .history import plot_history, write_history_csv
     from .plot import plot_deformed
 
@@ -33,7 +33,11 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
     if result.steps[-1].contact:
         written.append(plot_contact(result, out=out))
         if result.scene == "hertz":
-            written.append(plot_hertz(result, out=out))
+            from .hertz import HertzError, hertz_comparison, hertz_figure
+            try:
+                written.append(hertz_figure(result, hertz_comparison(result), out))
+            except HertzError:
+                pass  # the summary says why
     if vtk:
         from .paraview import write_vtk
         written.append(write_vtk(result, out=out))

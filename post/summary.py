@@ -95,7 +95,7 @@ def summary_lines(result: Result) -> list[str]:
         lines.append(line)
     lines += warnings_for(result)
     if result.scene == "hertz" and last.contact:
-        from .contact import format_hertz, hertz_comparison
+        from .hertz import format_hertz, hertz_comparison
         try:
             lines.append("hertz vs analytic: " + format_hertz(hertz_comparison(result)))
         except ValueError as err:

@@ -3,6 +3,7 @@
 Subcommands:
   geometry     a geometry spec (TOML) -> geometry file and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
+  hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   refine       refine a case with splipy and write the discretization dump
   plot-layout  draw a body's control nets and contact basis functions
   figures      write the figures of docs/figures/
@@ -32,6 +33,31 @@ def _cmd_cases(args: argparse.Namespace) -> int:
 
     written = write_cases(args.out)
     print(f"wrote {len(written)} files under {args.out}")
+    return 0
+
+
+def _cmd_hertz(args: argparse.Namespace) -> int:
+    from .hertz import Cylinder, HertzCaseError, write_hertz_case
+
+    cyl = Cylinder(radius=args.radius, youngs_modulus=args.youngs_modulus,
+                   poisson_ratio=args.poisson_ratio, indentation=args.indentation)
+    penalty = args.penalty_normal
+    if penalty is not None and penalty != "auto":
+        try:
+            penalty = float(penalty)
+        except ValueError:
+            penalty = args.penalty_normal  # cylinder_case names it
+    try:
+        geometry, case, fresh = write_hertz_case(
+            cyl, args.mesh, args.layout, args.out, force=args.force, n_steps=args.steps,
+            method=args.method, penalty_normal=penalty)
+    except (HertzCaseError, OSError) as err:
+        print(f"python -m pre hertz: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same cylinder)")
+    print(f"wrote {case}")
+    print(f"expected half-width a = {cyl.half_width:.6g} (a/R = {cyl.half_width / cyl.radius:.4g}; "
+          f"estimate, docs/howto.md)")
     return 0
 
 
@@ -79,6 +105,26 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output folder (default: cases, relative to the current directory: run "
                         "it from the repository root to refresh the committed cases)")
     s.set_defaults(func=_cmd_cases)
+
+    s = sub.add_parser("hertz", help="a Hertz case (cylinder on a rigid flat) for any cylinder")
+    s.add_argument("--radius", type=float, default=1.0, help="cylinder radius R (default 1)")
+    s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
+    s.add_argument("--poisson-ratio", type=float, default=0.3, help="nu in (-1, 0.5) (default 0.3)")
+    s.add_argument("--indentation", type=float, default=0.01,
+                   help="downward displacement d of the cylinder's centre cut, 0 < d < R/10 "
+                        "(default 0.01)")
+    s.add_argument("--mesh", default="m3", help="mesh level m1 .. m6 as the committed hertz "
+                                                "cases (default m3)")
+    s.add_argument("--layout", default="NN2.2", help="layout, e.g. N2, NN2.2 (default NN2.2)")
+    s.add_argument("--steps", type=int, default=None, help="load steps (default: the committed 5)")
+    s.add_argument("--method", default=None,
+                   help="&contact method, e.g. gpts, mortar, alm (default: the committed case's)")
+    s.add_argument("--penalty-normal", default=None,
+                   help="a number, or 'auto' (voiga chooses); default: the committed case's "
+                        "scaled by E and 1/a (its compliance relative to a)")
+    s.add_argument("--out", required=True, help="folder for geometry.h5 and <mesh>-<layout>.nml")
+    s.add_argument("--force", action="store_true", help="overwrite existing files")
+    s.set_defaults(func=_cmd_hertz)
 
     s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
     s.add_argument("case", help="case namelist (.nml)")

@@ -21,8 +21,8 @@ import numpy as np
 
 from .h5io import write_geometry
 from .layouts import parse_layout
-from .meshes import (arc_parameter_exact, hertz_eta_knots, hertz_radial_elements, hertz_xi_knots,
-                     mesh_level, nest)
+from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, arc_parameter_exact, hertz_eta_knots,
+                     hertz_radial_elements, hertz_xi_knots, mesh_level, nest)
 from .scenes import RINGS_LOWER, RINGS_UPPER, scene_bodies
 
 Groups = dict[str, Any]
@@ -187,11 +187,14 @@ def ironing_case(mesh: str, layout: str, scene: str = "ironing") -> Groups:
             **ironing_loads(scene)}
 
 
-def hertz_case(mesh: str, layout: str) -> Groups:
-    """hertz: graded arc knots (nested from m1), 49 radial control points."""
+def hertz_case(mesh: str, layout: str, a_exp: float = HERTZ_A_EXP,
+               h_surface: float = HERTZ_H_SURFACE) -> Groups:
+    """hertz: arc knots graded from the expected half-width ``a_exp`` (nested from m1),
+    49 radial control points graded to the radial size ``h_surface`` at the surface
+    (both relative to the radius). ``pre.hertz`` scales it to any cylinder."""
     lay = parse_layout(layout)
-    kx = hertz_xi_knots(mesh_level(mesh))
-    ke = hertz_eta_knots(hertz_radial_elements(lay.degree_eta))
+    kx = hertz_xi_knots(mesh_level(mesh), a_exp)
+    ke = hertz_eta_knots(hertz_radial_elements(lay.degree_eta), h_surface)
     bodies = [_body_group("hertz", "cylinder", layout, knots=(kx, ke))]
     return {"case": _case_group("hertz", mesh, mesh, layout, 1), "body": bodies, **hertz_loads()}
 

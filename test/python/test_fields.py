@@ -31,7 +31,7 @@ import pytest
 from scipy.optimize import brentq
 
 from conftest import REPO
-from post.contact import hertz_reference
+from post.hertz import hertz_reference
 from post.field import evaluate
 from post.paraview import write_vtk
 from post.reader import read_result

@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 import pytest
 
-from post.contact import fit_hertz, hertz_reference
+from post.hertz import fit_hertz, hertz_reference
 from post.reader import read_result
 
 SPEC = """

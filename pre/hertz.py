@@ -1,0 +1,199 @@
+"""A Hertz case for any cylinder (``python -m pre hertz``): the committed hertz scene
+scaled to radius R, with the given E, nu and indentation, its arc mesh graded from the
+expected contact half-width as the committed scene's is.
+
+Geometry: the committed quarter annulus scaled by R (outer radius R, inner 0.05 R,
+centre (0, 0), rigid flat y = -R). The mesh is the committed mesh m<k> graded from the
+grading half-width ``a_g`` below as the committed one is from its 0.08 R: along the arc,
+5 x 2^(k-1) elements over ``theta_c = asin(1.5 a_g / R)``; radially, 49 control points
+with the surface element ``0.005 R x a_g / 0.08`` (the committed 0.005 R for the
+committed indentation). Scaling the radial size with a keeps the contact zone resolved
+alike in both directions: with the committed 0.005 R, an eighth of the committed
+indentation (a = 0.023 R, m4 NN2.2, gpts, penalty 1e4 x 0.076 R / a) gave an L2 error of
+1.03 % instead of 0.49 %. Loads: the top cut moves down by the indentation ``d`` (u_y = -d) in the
+committed number of steps, u_x = 0 on the symmetry cut, frictionless contact with the
+flat. The penalty, when the committed case gives one, is scaled by E / a_g (the
+committed 1000 for E = 1, R = 1, a_g = 0.08): the penalty's own compliance, about
+E* / (eps a) of the pressure, is then the committed one for any cylinder (scaled by
+E / R only, m4 NN2.2 at a = 0.02 R gave 4.6 % instead of 1.7 %), and a case with the committed
+d / R is the committed one in other units.
+
+Expected half-width. In 2D the approach of a cylinder to a flat is not fixed by the
+contact alone (the displacement of a half-plane under a line load grows like a
+logarithm; it depends on where it is measured). We estimate it with the approach of the
+cylinder's centre, ``d = P / (pi E*) (2 ln(4 R / a) - 1)``, which with Hertz's
+``a^2 = 4 P R / (pi E*)`` becomes ``d / R = (a/R)^2 / 4 (2 ln(4 R / a) - 1)``,
+independent of E and nu (:func:`expected_half_width`). On the committed scene
+(d / R = 0.01) it gives a = 0.0760 R, the runs 0.0757 R (docs/howto.md has the other
+indentations). The grading half-width is that estimate times the committed scene's
+ratio ``HERTZ_A_EXP / expected_half_width(0.01) = 0.08 / 0.0760``, so the committed
+indentation gives the committed knots exactly.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from scipy.optimize import brentq
+
+from .cases import GEOMETRY_FILE, HERTZ_DISPLACEMENT, hertz_case, to_namelist_text
+from .h5io import write_geometry
+from .layouts import parse_layout
+from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_R_IN, HERTZ_R_OUT,
+                     hertz_radial_elements, mesh_level)
+from .scenes import HERTZ, annular_sector
+
+MAX_INDENTATION = 0.1
+"""Largest indentation d / R accepted (exclusive): beyond it a / R > 0.3 and the
+half-space theory is far from the cylinder."""
+MAX_MESH_LEVEL = 6
+"""Finest mesh (m6: 288 arc elements)."""
+
+
+class HertzCaseError(ValueError):
+    """A value ``python -m pre hertz`` refuses, or an output it will not overwrite."""
+
+
+def expected_half_width(indentation: float) -> float:
+    """a / R for the indentation d / R: the root of ``(a/R)^2 / 4 (2 ln(4 R/a) - 1) =
+    d / R`` (increasing in a/R on (0, 4/e)); see the module docstring."""
+    if not 0.0 < indentation < MAX_INDENTATION:
+        raise HertzCaseError(f"indentation / radius {indentation:g} outside (0, {MAX_INDENTATION:g})")
+
+    def approach(x: float) -> float:
+        return x * x / 4.0 * (2.0 * math.log(4.0 / x) - 1.0) - indentation
+    return float(brentq(approach, 1e-12, 1.0, xtol=1e-15, rtol=1e-15))
+
+
+def grading_half_width(indentation: float) -> float:
+    """a_g / R, the half-width the arc mesh is graded from: the estimate scaled as the
+    committed scene's (``HERTZ_A_EXP`` for the committed indentation)."""
+    return HERTZ_A_EXP * (expected_half_width(indentation)
+                          / expected_half_width(HERTZ_DISPLACEMENT / HERTZ_R_OUT))
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A Hertz problem: cylinder radius, material and indentation (consistent units)."""
+
+    radius: float = HERTZ_R_OUT
+    youngs_modulus: float = 1.0
+    poisson_ratio: float = 0.3
+    indentation: float = HERTZ_DISPLACEMENT
+
+    def check(self) -> None:
+        """HertzCaseError naming the first value out of range."""
+        values = {"radius": self.radius, "youngs modulus": self.youngs_modulus,
+                  "poisson ratio": self.poisson_ratio, "indentation": self.indentation}
+        for name, v in values.items():
+            if not math.isfinite(v):
+                raise HertzCaseError(f"{name} {v!r} is not a finite number")
+        if self.radius <= 0:
+            raise HertzCaseError(f"radius {self.radius:g} must be > 0")
+        if self.youngs_modulus <= 0:
+            raise HertzCaseError(f"youngs modulus {self.youngs_modulus:g} must be > 0")
+        if not -1.0 < self.poisson_ratio < 0.5:
+            raise HertzCaseError(f"poisson ratio {self.poisson_ratio:g} must be in (-1, 0.5)")
+        if not 0.0 < self.indentation < MAX_INDENTATION * self.radius:
+            raise HertzCaseError(f"indentation {self.indentation:g} must be > 0 and < radius/10 "
+                                 f"= {MAX_INDENTATION * self.radius:g}")
+
+    @property
+    def half_width(self) -> float:
+        """Estimated contact half-width a (:func:`expected_half_width`)."""
+        return self.radius * expected_half_width(self.indentation / self.radius)
+
+
+def cylinder_case(cyl: Cylinder, mesh: str, layout: str, n_steps: int | None = None,
+                  method: str | None = None, penalty_normal: float | str | None = None,
+                  ) -> dict[str, Any]:
+    """The namelist groups of the Hertz case of ``cyl`` on ``mesh`` with ``layout``
+    (:func:`pre.cases.hertz_case` scaled). ``penalty_normal``: None scales the committed
+    one by E / a_g, ``'auto'`` leaves it out (voiga chooses), a number is written as is."""
+    cyl.check()
+    try:
+        level = mesh_level(mesh)
+    except ValueError as err:
+        raise HertzCaseError(str(err)) from None
+    if not 1 <= level <= MAX_MESH_LEVEL:
+        raise HertzCaseError(f"mesh {mesh!r}: levels m1 .. m{MAX_MESH_LEVEL}")
+    try:
+        parse_layout(layout)
+    except ValueError as err:
+        raise HertzCaseError(str(err)) from None
+    r, e = cyl.radius, cyl.youngs_modulus
+    a_g = grading_half_width(cyl.indentation / r)
+    # at most uniform radially (d/R above about 0.093 would ask for a coarser surface)
+    uniform = (HERTZ_R_OUT - HERTZ_R_IN) / hertz_radial_elements(parse_layout(layout).degree_eta)
+    groups = hertz_case(mesh, layout, a_exp=a_g,
+                        h_surface=min(HERTZ_H_SURFACE * (a_g / HERTZ_A_EXP), uniform))
+    groups["case"]["title"] = (f"hertz {mesh} {layout}: R = {r:g}, E = {e:g}, "
+                               f"nu = {cyl.poisson_ratio:g}, indentation {cyl.indentation:g}")
+    body = groups["body"][0]
+    body["youngs_modulus"], body["poisson_ratio"] = float(e), float(cyl.poisson_ratio)
+    for d in groups["dirichlet"]:
+        if "uy" in d:
+            d["uy"] = -float(cyl.indentation)
+    contact = groups["contact"][0]
+    contact["rigid_point"] = [0.0, -float(r)]
+    if penalty_normal == "auto":
+        contact.pop("penalty_normal", None)
+    elif penalty_normal is not None:
+        if not (isinstance(penalty_normal, (int, float)) and 0 < penalty_normal < math.inf):
+            raise HertzCaseError(f"penalty_normal {penalty_normal!r} must be > 0 or 'auto'")
+        contact["penalty_normal"] = float(penalty_normal)
+    elif "penalty_normal" in contact:  # the committed compliance E*/(eps a)
+        contact["penalty_normal"] = contact["penalty_normal"] * e / r * (HERTZ_A_EXP / a_g)
+    if method is not None:
+        contact["method"] = method
+    if n_steps is not None:
+        if n_steps < 1:
+            raise HertzCaseError(f"steps {n_steps} must be >= 1")
+        groups["solver"]["n_steps"] = int(n_steps)
+    return groups
+
+
+def cylinder_geometry(radius: float) -> dict[str, Any]:
+    """The committed hertz body scaled by ``radius``."""
+    scale = radius / HERTZ_R_OUT
+    return {"cylinder": annular_sector(HERTZ["centre"], HERTZ_R_IN * scale, HERTZ_R_OUT * scale,
+                                       [270, 360], {"xi0": "symmetry", "xi1": "top",
+                                                    "eta0": "inner", "eta1": "outer"})}
+
+
+def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
+                     force: bool = False, **options: Any) -> tuple[Path, Path, bool]:
+    """Write ``out/geometry.h5`` and ``out/<mesh>-<layout>.nml`` (the committed layout).
+    An existing case file, or a geometry file with other contents, is refused
+    (HertzCaseError) unless ``force``; nothing is written then. A geometry file with the
+    same contents is kept (several meshes and layouts of one cylinder share it).
+    ``options``: :func:`cylinder_case`'s. Returns ``(geometry, case, geometry written)``."""
+    text = to_namelist_text(cylinder_case(cyl, mesh, layout, **options))
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    case = folder / f"{mesh}-{layout}.nml"
+    geometry = folder / GEOMETRY_FILE
+    tmp = folder / f".{GEOMETRY_FILE}.{os.getpid()}.tmp"
+    try:
+        write_geometry(tmp, "hertz", cylinder_geometry(cyl.radius),
+                       generator="voiga pre (python -m pre hertz)")
+        same = geometry.is_file() and geometry.read_bytes() == tmp.read_bytes()
+        clash = [p for p, exists in ((case, case.exists()),
+                                     (geometry, geometry.exists() and not same)) if exists]
+        if clash and not force:
+            raise HertzCaseError(" and ".join(map(str, clash))
+                                 + (" exist" if len(clash) > 1 else " exists")
+                                 + (" (the geometry of another cylinder)" if geometry in clash
+                                    else "") + "; nothing written (--force to overwrite)")
+        if not same:
+            os.replace(tmp, geometry)
+    finally:
+        tmp.unlink(missing_ok=True)
+    tmp_case = case.with_name(f".{case.name}.tmp")
+    tmp_case.write_text(text)
+    os.replace(tmp_case, case)
+    return geometry, case, not same
