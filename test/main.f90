@@ -13,6 +13,7 @@ program voiga_tests
     use test_stepping, only: collect_stepping
     use test_multigrid, only: collect_multigrid
     use test_hdf5, only: collect_hdf5
+    use test_files, only: collect_files
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -28,7 +29,8 @@ program voiga_tests
              new_testsuite('contact', collect_contact), &
              new_testsuite('stepping', collect_stepping), &
              new_testsuite('multigrid', collect_multigrid), &
-             new_testsuite('hdf5', collect_hdf5) &
+             new_testsuite('hdf5', collect_hdf5), &
+             new_testsuite('files', collect_files) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

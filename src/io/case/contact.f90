@@ -4,7 +4,7 @@ module voiga_io_case_contact
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: unset, body_index, quoted
+    use voiga_io_case_values, only: check_length, unset, is_unset, max_value, body_index, quoted
     use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t, contact_method_names
     implicit none
@@ -14,16 +14,19 @@ module voiga_io_case_contact
 
 contains
 
-    !> Read the next (the `k`-th) `&contact` group from unit `u` for a case with
-    !> `bodies`, and validate it. penalty_tangent defaults to penalty_normal.
-    subroutine read_contact(u, path, k, bodies, entry, error)
-        integer, intent(in) :: u, k
+    !> Read the `k`-th `&contact` group from its text for a case with `bodies`, and
+    !> validate it. penalty_tangent defaults to penalty_normal.
+    subroutine read_contact(text, path, k, bodies, entry, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
+        integer, intent(in) :: k
         character(len=*), intent(in) :: path
         type(body_settings_t), intent(in) :: bodies(:)
         type(contact_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=32) :: slave, master
-        character(len=16) :: method
+        ! one character more than kept: a longer value is refused, not cut
+        character(len=33) :: slave, master
+        character(len=17) :: method
         real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction
         integer :: n_gauss, ios
         character(len=512) :: msg
@@ -34,17 +37,22 @@ contains
         master = ''
         rigid_point = 0.0_dp
         rigid_normal = [0.0_dp, 1.0_dp]
-        penalty_normal = unset
-        penalty_tangent = unset
+        penalty_normal = unset()
+        penalty_tangent = unset()
         friction = 0.0_dp
         n_gauss = 0
         method = 'gpts'
-        read (u, nml=contact, iostat=ios, iomsg=msg)
+        read (text, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call group_error(path, 'contact', k, ios, msg, try_contact, error)
+            call group_error(path, 'contact', text, ios, msg, try_contact, error)
             return
         end if
-        if (penalty_tangent == unset) penalty_tangent = penalty_normal
+        write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        call check_length(slave, 32, 'slave', path//trim(msg)//' ', error)
+        call check_length(master, 32, 'master', path//trim(msg)//' ', error)
+        call check_length(method, 16, 'method', path//trim(msg)//' ', error)
+        if (allocated(error)) return
+        if (is_unset(penalty_tangent)) penalty_tangent = penalty_normal
         entry = contact_settings_t(slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
                                    friction, n_gauss, method)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
@@ -91,9 +99,10 @@ contains
                                  "' has no contact_edge in its &body", error_code%input)
             end if
         else if (.not. all(ieee_is_finite(c%rigid_point)) .or. .not. all(ieee_is_finite(c%rigid_normal)) .or. &
-                 norm2(c%rigid_normal) <= 0.0_dp) then
+                 norm2(c%rigid_normal) <= 0.0_dp .or. any(abs(c%rigid_point) > max_value) .or. &
+                 any(abs(c%rigid_normal) > max_value)) then
             call fatal_error(error, where//'rigid_point must be finite and rigid_normal finite and '// &
-                             'nonzero', error_code%input)
+                             'nonzero (each entry at most 1e100 in magnitude)', error_code%input)
         end if
     end subroutine check_pair
 
@@ -104,7 +113,7 @@ contains
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: e_max
-        if (c%penalty_normal == unset) then
+        if (is_unset(c%penalty_normal)) then
             call fatal_error(error, where//'penalty_normal is required', error_code%input)
         else if (.not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
             call fatal_error(error, where//'penalty_normal must be finite and > 0', error_code%input)

@@ -1,0 +1,619 @@
+!> The operating-system calls of the file layer (Linux, glibc): canonical paths,
+!> rename and remove, advisory locks (`flock`), space reserved for a write
+!> (`fallocate`), the memory a run may use, and leaving the process without its
+!> exit handlers.
+!>
+!> The raw libc interfaces are private. The constants are Linux's (asm-generic,
+!> x86-64 and arm64): `open` flags O_RDONLY 0, O_WRONLY 1, O_RDWR 2, O_CREAT 64,
+!> O_CLOEXEC 524288; `flock` LOCK_SH 1, LOCK_EX 2, LOCK_NB 4, LOCK_UN 8;
+!> `fallocate` FALLOC_FL_KEEP_SIZE 1; `getrlimit` RLIMIT_AS 9; errno EINTR 4,
+!> ENOENT 2, EWOULDBLOCK 11, EOPNOTSUPP 95.
+module voiga_io_os
+    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_long, &
+                                           c_size_t, c_associated, c_f_pointer, c_int64_t, c_loc, &
+                                           c_funptr, c_intptr_t
+    use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
+    use voiga_error, only: error_t, fatal_error, error_code
+    implicit none
+    private
+
+    public :: canonical_path, rename_file, remove_file, path_exists, is_directory
+    public :: lock_t, acquire_lock, release_lock, hold_exclusive, hold_shared, let_go
+    public :: reserve_space, release_space, memory_available, address_space_limited, leave, process_id
+    public :: reexec_with_environment, ignore_file_size_signal
+
+    integer(c_int), parameter :: o_rdonly = 0, o_wronly = 1, o_rdwr = 2, o_creat = 64, &
+                                 o_cloexec = 524288
+    integer(c_int), parameter :: lock_sh = 1, lock_ex = 2, lock_nb = 4, lock_un = 8
+    integer(c_int), parameter :: falloc_fl_keep_size = 1, rlimit_as = 9
+    integer(c_int), parameter :: eintr = 4, enoent = 2, ewouldblock = 11, eopnotsupp = 95
+    !> SIGXFSZ (a write beyond `ulimit -f`), and `signal`'s SIG_IGN.
+    integer(c_int), parameter :: sigxfsz = 25
+    integer(c_intptr_t), parameter :: sig_ign = 1
+    !> `rlim_t` RLIM_INFINITY (all bits set).
+    integer(c_int64_t), parameter :: rlim_infinity = -1_c_int64_t
+
+    !> A lock held on a file (`flock` on an open descriptor; released when the
+    !> descriptor is closed, also by the kernel when the process dies).
+    type :: lock_t
+        integer(c_int) :: fd = -1
+        !> The lock file, when the lock owns one (removed on release).
+        character(len=:), allocatable :: path
+    end type lock_t
+
+    !> `struct rlimit`.
+    type, bind(c) :: rlimit_t
+        integer(c_int64_t) :: cur, max
+    end type rlimit_t
+
+    interface
+        function c_realpath(path, resolved) bind(c, name='realpath') result(p)
+            import :: c_char, c_ptr
+            character(kind=c_char), intent(in) :: path(*)
+            type(c_ptr), value :: resolved
+            type(c_ptr) :: p
+        end function c_realpath
+        subroutine c_free(p) bind(c, name='free')
+            import :: c_ptr
+            type(c_ptr), value :: p
+        end subroutine c_free
+        function c_strlen(s) bind(c, name='strlen') result(n)
+            import :: c_ptr, c_size_t
+            type(c_ptr), value :: s
+            integer(c_size_t) :: n
+        end function c_strlen
+        function c_strerror(errnum) bind(c, name='strerror') result(p)
+            import :: c_int, c_ptr
+            integer(c_int), value :: errnum
+            type(c_ptr) :: p
+        end function c_strerror
+        function c_errno_location() bind(c, name='__errno_location') result(p)
+            import :: c_ptr
+            type(c_ptr) :: p
+        end function c_errno_location
+        function c_rename(from, to) bind(c, name='rename') result(st)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: from(*), to(*)
+            integer(c_int) :: st
+        end function c_rename
+        function c_unlink(path) bind(c, name='unlink') result(st)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: st
+        end function c_unlink
+        function c_open(path, flags, mode) bind(c, name='open') result(fd)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: flags, mode
+            integer(c_int) :: fd
+        end function c_open
+        function c_close(fd) bind(c, name='close') result(st)
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: st
+        end function c_close
+        function c_flock(fd, op) bind(c, name='flock') result(st)
+            import :: c_int
+            integer(c_int), value :: fd, op
+            integer(c_int) :: st
+        end function c_flock
+        function c_lseek(fd, offset, whence) bind(c, name='lseek') result(pos)
+            import :: c_int, c_int64_t
+            integer(c_int), value :: fd, whence
+            integer(c_int64_t), value :: offset
+            integer(c_int64_t) :: pos
+        end function c_lseek
+        function c_fallocate(fd, mode, offset, length) bind(c, name='fallocate') result(st)
+            import :: c_int, c_int64_t
+            integer(c_int), value :: fd, mode
+            integer(c_int64_t), value :: offset, length
+            integer(c_int) :: st
+        end function c_fallocate
+        function c_ftruncate(fd, length) bind(c, name='ftruncate') result(st)
+            import :: c_int, c_int64_t
+            integer(c_int), value :: fd
+            integer(c_int64_t), value :: length
+            integer(c_int) :: st
+        end function c_ftruncate
+        function c_write(fd, buf, n) bind(c, name='write') result(written)
+            import :: c_int, c_char, c_size_t, c_long
+            integer(c_int), value :: fd
+            character(kind=c_char), intent(in) :: buf(*)
+            integer(c_size_t), value :: n
+            integer(c_long) :: written
+        end function c_write
+        function c_readlink(path, buf, n) bind(c, name='readlink') result(length)
+            import :: c_char, c_size_t, c_long
+            character(kind=c_char), intent(in) :: path(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_size_t), value :: n
+            integer(c_long) :: length
+        end function c_readlink
+        function c_getpid() bind(c, name='getpid') result(pid)
+            import :: c_int
+            integer(c_int) :: pid
+        end function c_getpid
+        function c_usleep(usec) bind(c, name='usleep') result(st)
+            import :: c_int
+            integer(c_int), value :: usec
+            integer(c_int) :: st
+        end function c_usleep
+        function c_getrlimit(resource, limit) bind(c, name='getrlimit') result(st)
+            import :: c_int, rlimit_t
+            integer(c_int), value :: resource
+            type(rlimit_t), intent(out) :: limit
+            integer(c_int) :: st
+        end function c_getrlimit
+        subroutine c_exit_now(status) bind(c, name='_exit')
+            import :: c_int
+            integer(c_int), value :: status
+        end subroutine c_exit_now
+        function c_setenv(name, value, overwrite) bind(c, name='setenv') result(st)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: name(*), value(*)
+            integer(c_int), value :: overwrite
+            integer(c_int) :: st
+        end function c_setenv
+        function c_signal(signum, handler) bind(c, name='signal') result(previous)
+            import :: c_int, c_funptr
+            integer(c_int), value :: signum
+            type(c_funptr), value :: handler
+            type(c_funptr) :: previous
+        end function c_signal
+        function c_execv(path, argv) bind(c, name='execv') result(st)
+            import :: c_char, c_ptr, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            type(c_ptr), intent(in) :: argv(*)
+            integer(c_int) :: st
+        end function c_execv
+    end interface
+
+contains
+
+    !> A Fortran string as a NUL-terminated C string.
+    pure function c_str(text) result(s)
+        character(len=*), intent(in) :: text
+        character(kind=c_char, len=:), allocatable :: s
+        s = text//c_null_char
+    end function c_str
+
+    !> The C string at `p` as a Fortran string.
+    function f_str(p) result(text)
+        type(c_ptr), intent(in) :: p
+        character(len=:), allocatable :: text
+        character(kind=c_char), pointer :: chars(:)
+        integer :: n, i
+        n = int(c_strlen(p))
+        call c_f_pointer(p, chars, [n])
+        allocate (character(len=n) :: text)
+        do i = 1, n
+            text(i:i) = chars(i)
+        end do
+    end function f_str
+
+    !> The current `errno`.
+    integer function errno()
+        integer(c_int), pointer :: e
+        call c_f_pointer(c_errno_location(), e)
+        errno = int(e)
+    end function errno
+
+    !> The system's text for error number `e` ("No space left on device").
+    function strerror(e) result(text)
+        integer, intent(in) :: e
+        character(len=:), allocatable :: text
+        text = f_str(c_strerror(int(e, c_int)))
+    end function strerror
+
+    !> Folder part of `path` ('' for a bare name, '/' for the root).
+    pure function folder_of(path) result(dir)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: dir
+        integer :: i
+        i = index(path, '/', back=.true.)
+        if (i == 0) then
+            dir = ''
+        else if (i == 1) then
+            dir = '/'
+        else
+            dir = path(1:i - 1)
+        end if
+    end function folder_of
+
+    !> `realpath`: the absolute path of an existing file or folder with every
+    !> symbolic link, '.' and '..' resolved; `ok` false (and `e` the errno) otherwise.
+    subroutine real_path(path, resolved, ok, e)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: resolved
+        logical, intent(out) :: ok
+        integer, intent(out) :: e
+        type(c_ptr) :: p
+        p = c_realpath(c_str(path), c_null_ptr)
+        ok = c_associated(p)
+        e = 0
+        if (.not. ok) then
+            e = errno()
+            resolved = path
+            return
+        end if
+        resolved = f_str(p)
+        call c_free(p)
+    end subroutine real_path
+
+    !> The target of the symbolic link `path` (`ok` false when it is not one).
+    subroutine link_target(path, target, ok)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: target
+        logical, intent(out) :: ok
+        character(kind=c_char) :: buf(4096)
+        integer(c_long) :: n
+        integer :: i
+        n = c_readlink(c_str(path), buf, int(size(buf), c_size_t))
+        ok = n >= 0 .and. n < size(buf)
+        if (.not. ok) return
+        allocate (character(len=n) :: target)
+        do i = 1, int(n)
+            target(i:i) = buf(i)
+        end do
+    end subroutine link_target
+
+    !> The absolute path `path` names, with every symbolic link, '.' and '..'
+    !> resolved, whether or not the file exists (its folder must): two paths name
+    !> the same file when their canonical paths are equal. A symbolic link to a
+    !> missing file is followed to where the file would be created.
+    recursive subroutine canonical_path(path, resolved, error, depth)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable, intent(out) :: resolved
+        type(error_t), allocatable, intent(out) :: error
+        !> Links followed so far (at most 40, as the kernel allows).
+        integer, intent(in), optional :: depth
+        character(len=:), allocatable :: dir, base, target, real_dir
+        logical :: ok
+        integer :: e, level
+
+        level = 0
+        if (present(depth)) level = depth
+        if (len(path) == 0) then
+            call fatal_error(error, 'an empty file name', error_code%input)
+            return
+        end if
+        call real_path(path, resolved, ok, e)
+        if (ok) return
+        if (e /= enoent) then
+            call fatal_error(error, "'"//path//"': "//strerror(e), error_code%input)
+            return
+        end if
+        dir = folder_of(path)
+        base = path(index(path, '/', back=.true.) + 1:)
+        call link_target(path, target, ok)
+        if (ok) then
+            if (level >= 40) then
+                call fatal_error(error, "'"//path//"': too many levels of symbolic links", &
+                                 error_code%input)
+                return
+            end if
+            if (target(1:1) /= '/' .and. len(dir) > 0) target = dir//'/'//target
+            call canonical_path(target, resolved, error, level + 1)
+            return
+        end if
+        if (base == '.' .or. base == '..' .or. len(base) == 0) then
+            call fatal_error(error, "'"//path//"' names a folder, not a file", error_code%input)
+            return
+        end if
+        if (len(dir) == 0) dir = '.'
+        call real_path(dir, real_dir, ok, e)
+        if (.not. ok) then
+            call fatal_error(error, "folder '"//dir//"' of '"//path//"': "//strerror(e), &
+                             error_code%input)
+            return
+        end if
+        if (real_dir == '/') real_dir = ''
+        resolved = real_dir//'/'//base
+    end subroutine canonical_path
+
+    !> Does `path` exist (after following links)?
+    logical function path_exists(path)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: resolved
+        integer :: e
+        call real_path(path, resolved, path_exists, e)
+    end function path_exists
+
+    !> Is `path` an existing folder?
+    logical function is_directory(path)
+        character(len=*), intent(in) :: path
+        integer(c_int) :: fd
+        ! O_DIRECTORY (65536) opens only a folder
+        fd = c_open(c_str(path), ior(o_rdonly, ior(o_cloexec, 65536_c_int)), 0_c_int)
+        is_directory = fd >= 0
+        if (fd >= 0) fd = c_close(fd)
+    end function is_directory
+
+    !> Rename `from` to `to` (same file system: atomic; `to` is replaced).
+    subroutine rename_file(from, to, error)
+        character(len=*), intent(in) :: from, to
+        type(error_t), allocatable, intent(out) :: error
+        if (c_rename(c_str(from), c_str(to)) /= 0) &
+            call fatal_error(error, "cannot rename '"//from//"' to '"//to//"': "//strerror(errno()))
+    end subroutine rename_file
+
+    !> Remove the file `path` (nothing if it does not exist).
+    subroutine remove_file(path)
+        character(len=*), intent(in) :: path
+        integer(c_int) :: st
+        st = c_unlink(c_str(path))
+    end subroutine remove_file
+
+    !> Take the lock file `path` (created if missing) for this process, without
+    !> waiting: a lock another process holds is an error naming its process id.
+    !> The lock file holds our process id; `release_lock` removes it.
+    subroutine acquire_lock(lock, path, what, error)
+        type(lock_t), intent(inout) :: lock
+        character(len=*), intent(in) :: path
+        !> What the lock guards, for messages ("result file 'out.h5'").
+        character(len=*), intent(in) :: what
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: holder, link
+        character(len=24) :: buf
+        integer(c_int) :: fd, st
+        integer :: attempt
+        logical :: ok
+
+        do attempt = 1, 3
+            fd = c_open(c_str(path), ior(o_rdwr, ior(o_creat, o_cloexec)), int(o'644', c_int))
+            if (fd < 0) then
+                call fatal_error(error, "cannot create the lock file '"//path//"' for "//what//': '// &
+                                 strerror(errno()), error_code%input)
+                return
+            end if
+            if (c_flock(fd, ior(lock_ex, lock_nb)) /= 0) then
+                holder = first_line(path)
+                st = c_close(fd)
+                if (len(holder) > 0) holder = ' (process '//holder//')'
+                call fatal_error(error, what//' is being written by another voiga run'//holder// &
+                                 '; lock file '//path, error_code%input)
+                return
+            end if
+            ! a lock file removed by its last holder between our open and our flock
+            ! is no lock: open it again
+            write (buf, '(i0)') fd
+            call link_target('/proc/self/fd/'//trim(buf), link, ok)
+            if (.not. ok) exit
+            if (index(link, ' (deleted)') == 0) exit
+            st = c_close(fd)
+            fd = -1
+        end do
+        if (fd < 0) then
+            call fatal_error(error, "cannot take the lock file '"//path//"' for "//what, error_code%input)
+            return
+        end if
+        write (buf, '(i0)') c_getpid()
+        st = c_ftruncate(fd, 0_c_int64_t)
+        if (c_write(fd, c_str(trim(buf)//new_line('a')), int(len_trim(buf) + 1, c_size_t)) < 0) continue
+        lock%fd = fd
+        lock%path = path
+    end subroutine acquire_lock
+
+    !> The first line of a small text file ('' if unreadable).
+    function first_line(path) result(line)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: line
+        character(len=64) :: buf
+        integer :: u, ios
+        line = ''
+        open (newunit=u, file=path, status='old', action='read', iostat=ios)
+        if (ios /= 0) return
+        read (u, '(a)', iostat=ios) buf
+        close (u)
+        if (ios == 0) line = trim(adjustl(buf))
+    end function first_line
+
+    !> Let go of a lock; a lock file the lock owns is removed first (while held).
+    subroutine release_lock(lock)
+        type(lock_t), intent(inout) :: lock
+        integer(c_int) :: st
+        if (lock%fd < 0) return
+        if (allocated(lock%path)) call remove_file(lock%path)
+        st = c_close(lock%fd)
+        lock%fd = -1
+    end subroutine release_lock
+
+    !> Hold an exclusive `flock` on the existing file `path` (readers that take a
+    !> shared one wait), waiting at most `seconds`; `held` tells whether it was
+    !> taken (not when a reader kept its lock that long, or the file system has no
+    !> locks). Released by `let_go`.
+    subroutine hold_exclusive(lock, path, seconds, held)
+        type(lock_t), intent(inout) :: lock
+        character(len=*), intent(in) :: path
+        real, intent(in) :: seconds
+        logical, intent(out) :: held
+        call hold(lock, path, lock_ex, seconds, held)
+    end subroutine hold_exclusive
+
+    !> Hold a shared `flock` on `path` (waits while a writer holds an exclusive one,
+    !> at most `seconds`).
+    subroutine hold_shared(lock, path, seconds, held)
+        type(lock_t), intent(inout) :: lock
+        character(len=*), intent(in) :: path
+        real, intent(in) :: seconds
+        logical, intent(out) :: held
+        call hold(lock, path, lock_sh, seconds, held)
+    end subroutine hold_shared
+
+    subroutine hold(lock, path, op, seconds, held)
+        type(lock_t), intent(inout) :: lock
+        character(len=*), intent(in) :: path
+        integer(c_int), intent(in) :: op
+        real, intent(in) :: seconds
+        logical, intent(out) :: held
+        integer :: waited_ms
+        integer(c_int) :: st
+        held = .false.
+        call let_go(lock)
+        lock%fd = c_open(c_str(path), ior(o_rdonly, o_cloexec), 0_c_int)
+        if (lock%fd < 0) return
+        waited_ms = 0
+        do
+            if (c_flock(lock%fd, ior(op, lock_nb)) == 0) then
+                held = .true.
+                return
+            end if
+            if (errno() /= ewouldblock .and. errno() /= eintr) exit
+            if (waited_ms >= int(1000*seconds)) exit
+            st = c_usleep(10000_c_int)
+            waited_ms = waited_ms + 10
+        end do
+        st = c_close(lock%fd)
+        lock%fd = -1
+    end subroutine hold
+
+    !> Release a lock taken by `hold_exclusive` or `hold_shared`.
+    subroutine let_go(lock)
+        type(lock_t), intent(inout) :: lock
+        integer(c_int) :: st
+        if (lock%fd < 0) return
+        st = c_close(lock%fd)
+        lock%fd = -1
+    end subroutine let_go
+
+    !> Reserve `bytes` of disk beyond the end of the existing file `path`, so that
+    !> writes of up to that size cannot fail for want of space (`fallocate`, the
+    !> file's size unchanged). A full disk or an exceeded quota is an error naming
+    !> it; a file system that cannot reserve space is not (nothing is reserved).
+    subroutine reserve_space(path, bytes, error)
+        character(len=*), intent(in) :: path
+        integer(int64), intent(in) :: bytes
+        type(error_t), allocatable, intent(out) :: error
+        integer(c_int) :: fd, st
+        integer(c_int64_t) :: size
+        integer :: e
+        character(len=32) :: buf
+        fd = c_open(c_str(path), ior(o_wronly, o_cloexec), 0_c_int)
+        if (fd < 0) then
+            call fatal_error(error, "cannot open '"//path//"' to reserve space: "//strerror(errno()))
+            return
+        end if
+        size = c_lseek(fd, 0_c_int64_t, 2_c_int)
+        st = c_fallocate(fd, falloc_fl_keep_size, max(size, 0_c_int64_t), int(bytes, c_int64_t))
+        e = errno()
+        if (st /= 0 .and. e /= eopnotsupp) then
+            write (buf, '(f0.1)') real(bytes, 8)/2.0d0**20
+            call fatal_error(error, path//': no room for the next '//trim(buf)//' MB: '//strerror(e))
+        end if
+        st = c_close(fd)
+    end subroutine reserve_space
+
+    !> Give back the space `reserve_space` reserved beyond the end of `path` and
+    !> the writes did not use (truncating the file to its own size does it).
+    subroutine release_space(path)
+        character(len=*), intent(in) :: path
+        integer(c_int) :: fd, st
+        integer(c_int64_t) :: size
+        fd = c_open(c_str(path), ior(o_wronly, o_cloexec), 0_c_int)
+        if (fd < 0) return
+        size = c_lseek(fd, 0_c_int64_t, 2_c_int)
+        if (size >= 0) st = c_ftruncate(fd, size)
+        st = c_close(fd)
+    end subroutine release_space
+
+    !> The memory this process may still use (bytes): `physical`, the system's
+    !> available memory (/proc/meminfo MemAvailable), and `address`, what the
+    !> address-space limit (`ulimit -v`) leaves beside the address space in use
+    !> (/proc/self/status VmSize); -1 when unknown or unlimited.
+    subroutine memory_available(physical, address)
+        integer(int64), intent(out) :: physical, address
+        type(rlimit_t) :: limit
+        physical = proc_value('/proc/meminfo', 'MemAvailable:')
+        address = -1
+        if (c_getrlimit(rlimit_as, limit) == 0) then
+            if (limit%cur /= rlim_infinity .and. limit%cur > 0) &
+                address = max(limit%cur - max(proc_value('/proc/self/status', 'VmSize:'), 0_int64), 0_int64)
+        end if
+    end subroutine memory_available
+
+    !> Is the address space of this process limited (`ulimit -v`)?
+    logical function address_space_limited()
+        type(rlimit_t) :: limit
+        address_space_limited = .false.
+        if (c_getrlimit(rlimit_as, limit) == 0) address_space_limited = limit%cur /= rlim_infinity
+    end function address_space_limited
+
+    !> The value in bytes of the line `key  <n> kB` of a /proc file; -1 if absent.
+    function proc_value(path, key) result(bytes)
+        character(len=*), intent(in) :: path, key
+        integer(int64) :: bytes
+        character(len=256) :: line
+        integer :: u, ios
+        bytes = -1
+        open (newunit=u, file=path, status='old', action='read', iostat=ios)
+        if (ios /= 0) return
+        do
+            read (u, '(a)', iostat=ios) line
+            if (ios /= 0) exit
+            if (index(line, key) /= 1) cycle
+            read (line(len(key) + 1:), *, iostat=ios) bytes
+            if (ios /= 0) bytes = -1
+            if (bytes >= 0) bytes = bytes*1024_int64
+            exit
+        end do
+        close (u)
+    end function proc_value
+
+    !> End the process at once with exit code `code` after flushing standard output
+    !> and error: no exit handler runs (HDF5's would write a half-written step of a
+    !> result file whose writing failed over the steps already on disk).
+    subroutine leave(code)
+        integer, intent(in) :: code
+        flush (output_unit)
+        flush (error_unit)
+        call c_exit_now(int(code, c_int))
+    end subroutine leave
+
+    !> A write beyond the file-size limit (`ulimit -f`, a quota of sorts) fails
+    !> with EFBIG like one on a full disk, instead of killing the process with
+    !> SIGXFSZ (whose default action the gfortran runtime also takes over).
+    subroutine ignore_file_size_signal()
+        type(c_funptr) :: previous
+        previous = c_signal(sigxfsz, transfer(sig_ign, previous))
+    end subroutine ignore_file_size_signal
+
+    !> This process's id.
+    integer function process_id()
+        process_id = int(c_getpid())
+    end function process_id
+
+    !> Run this program again, from the start and with the same arguments, with
+    !> the environment variable `name` set to `value`; returns only if that fails.
+    subroutine reexec_with_environment(name, value)
+        character(len=*), intent(in) :: name, value
+        character(kind=c_char, len=:), allocatable, target :: args(:)
+        type(c_ptr), allocatable :: argv(:)
+        character(len=:), allocatable :: exe
+        integer :: i, n, length, width
+        integer(c_int) :: st
+        logical :: ok
+
+        call link_target('/proc/self/exe', exe, ok)
+        if (.not. ok) return
+        n = command_argument_count()
+        width = 1
+        do i = 0, n
+            call get_command_argument(i, length=length)
+            width = max(width, length + 1)
+        end do
+        allocate (character(kind=c_char, len=width) :: args(0:n))
+        allocate (argv(0:n + 1))
+        do i = 0, n
+            call get_command_argument(i, length=length)
+            call get_command_argument(i, args(i))
+            args(i)(length + 1:length + 1) = c_null_char
+            argv(i) = c_loc(args(i))
+        end do
+        argv(n + 1) = c_null_ptr
+        if (c_setenv(c_str(name), c_str(value), 1_c_int) /= 0) return
+        flush (output_unit)
+        flush (error_unit)
+        st = c_execv(c_str(exe), argv)
+    end subroutine reexec_with_environment
+
+end module voiga_io_os
