@@ -15,6 +15,11 @@ Steps (--step): N >= 1 is the step number, N < 0 counts converged steps from
 the end (-1: the last one), 0 is the reference configuration.
 Files are named <result stem>-<what>[-<step>].<ext> and written next to the result
 file, or into --out.
+
+A result whose run has not converged (running, failed, interrupted) is read as
+far as it goes, with a note on stderr naming its status and the step shown;
+`hertz`, which compares the final load, refuses it unless given --partial. A
+file that is not a readable result is refused in one line (exit code 2).
 """
 
 from __future__ import annotations
@@ -37,16 +42,24 @@ def _scale(text: str) -> float | str:
 
 
 def _result(args: argparse.Namespace):
+    """The result file of the command, with a note on stderr when its run has not
+    converged (the steps shown are those written so far)."""
     from .reader import read_result
 
-    return read_result(args.result)
+    result = read_result(args.result)
+    if not result.converged:
+        last = f"the last is step {result.steps[-1].step}" if result.steps else "none yet"
+        print(f"python -m post {args.command}: note: {args.result}: status {result.status!r}: "
+              f"{len(result.steps)} of {result.n_steps_planned} planned steps written ({last})",
+              file=sys.stderr)
+    return result
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .run import run_case
 
     return run_case(args.case, out=args.out, binary=args.binary, quiet=args.quiet,
-                    figures=not args.no_figures, vtk=not args.no_vtk)
+                    figures=not args.no_figures, vtk=not args.no_vtk, overwrite=args.overwrite)
 
 
 def _cmd_summary(args: argparse.Namespace) -> int:
@@ -120,6 +133,11 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
         print(f"python -m post: {args.result} has no converged step with contact output",
               file=sys.stderr)
         return 1
+    if not result.converged and not args.partial:
+        print(f"python -m post hertz: {args.result}: the run has not converged (status "
+              f"{result.status!r}): the comparison is of the final load; give --partial to compare "
+              f"step {result.steps[-1].step} anyway", file=sys.stderr)
+        return 2
     print(format_hertz(hertz_comparison(result)))
     if not args.no_figure:
         print(plot_hertz(result, out=args.out))
@@ -181,6 +199,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--quiet", action="store_true", help="no per-step lines from voiga")
     s.add_argument("--no-figures", action="store_true", help="only solve and summarize")
     s.add_argument("--no-vtk", action="store_true", help="no ParaView files")
+    s.add_argument("--overwrite", action="store_true",
+                   help="replace an existing result in the case's own folder (with --out it is "
+                        "always replaced: the folder is this tool's)")
     s.set_defaults(func=_cmd_run)
 
     s = sub.add_parser("summary", help="what a result file says, in a few lines")
@@ -247,6 +268,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("result", help="result file (.h5) of a hertz case")
     s.add_argument("--out", default=None, help="folder for the figure (default: next to the result)")
     s.add_argument("--no-figure", action="store_true", help="only print the comparison")
+    s.add_argument("--partial", action="store_true",
+                   help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz)
     return p
 
@@ -266,7 +289,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"python -m post {args.command}: {getattr(args, 'result', '')}: {err}",
               file=sys.stderr)
         return 2
-    except (KeyError, ValueError) as err:
+    except (KeyError, ValueError) as err:  # BadResultError: a file that is no readable result
         print(f"python -m post {args.command}: {err}", file=sys.stderr)
         return 2
 

@@ -108,7 +108,8 @@ def solve(run: Run, binary: Path, timeout: float) -> tuple[Run, int, str]:
     """Run voiga on one case; (run, exit code, last stderr line)."""
     prepare(run)
     try:
-        proc = subprocess.run([str(binary), str(run.work), "--quiet"], capture_output=True,
+        # the work folder is the sweep's: a case it runs again replaces its result
+        proc = subprocess.run([str(binary), str(run.work), "--quiet", "--overwrite"], capture_output=True,
                               text=True, timeout=timeout, env=single_thread_env())
     except subprocess.TimeoutExpired:
         return run, -1, f"timed out after {timeout:g} s"

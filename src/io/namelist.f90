@@ -422,56 +422,117 @@ contains
         count_values = size(first)
     end function count_values
 
-    !> The `name = value` assignments of a group's text, one per entry
-    !> (continuation lines joined; the '&name' and the closing '/' removed).
-    !> Quoted '=' and '/' are not special-cased beyond what case files contain;
-    !> good enough for diagnosis.
+    !> The `name = value` assignments of a group's text, one per entry, wherever
+    !> they start (several on a line, or one over several lines; the '&name' and
+    !> the closing '/' removed): an assignment starts at a name (letters, digits,
+    !> '_', '%', an optional `(index)`) followed by '=', outside quotes.
     pure subroutine group_assignments(text, assignments)
         character(len=*), intent(in) :: text(:)
         character(len=:), allocatable, intent(out) :: assignments(:)
-        character(len=:), allocatable :: t, joined
-        integer, allocatable :: first(:), last(:)
-        integer :: l, n, width, k, cut
+        character(len=:), allocatable :: joined, t
+        integer, allocatable :: starts(:)
+        integer :: l, n, width, k, cut, i, a, b
 
-        allocate (first(size(text)), last(size(text)))
         joined = ''
-        n = 0
         do l = 1, size(text)
-            t = trim(adjustl(strip_comment(text(l))))
+            t = trim(strip_comment(text(l)))
             if (l == 1) then
+                t = adjustl(t)
                 cut = 1
                 do while (cut < len(t))
                     if (.not. is_name_char(t(cut + 1:cut + 1))) exit
                     cut = cut + 1
                 end do
-                t = trim(adjustl(t(cut + 1:)))
+                t = t(cut + 1:)
             end if
-            if (l == size(text) .and. len(t) > 0) then
-                if (t(len(t):len(t)) == '/') t = trim(t(1:len(t) - 1))
-                if (len(t) >= 4) then
-                    if (lower(t(len(t) - 3:)) == '&end' .or. lower(t(len(t) - 3:)) == '$end') &
-                        t = trim(t(1:len(t) - 4))
-                end if
-            end if
-            if (len_trim(t) == 0) cycle
-            if (index(t, '=') > 0 .or. n == 0) then
-                n = n + 1
-                first(n) = len(joined) + 1
-                joined = joined//t
-            else
-                joined = joined//' '//t
-            end if
-            last(n) = len(joined)
+            joined = joined//' '//t
         end do
+        joined = trim(joined)
+        if (len(joined) > 0) then
+            if (joined(len(joined):len(joined)) == '/') joined = joined(1:len(joined) - 1)
+        end if
+        if (len(joined) >= 4) then
+            if (lower(joined(len(joined) - 3:)) == '&end' .or. lower(joined(len(joined) - 3:)) == '$end') &
+                joined = joined(1:len(joined) - 4)
+        end if
+        call assignment_starts(joined, starts)
+        n = size(starts)
+        allocate (character(len=1) :: assignments(0))
+        if (n == 0) return
+        starts = [starts, len(joined) + 1]
         width = 1
         do k = 1, n
-            width = max(width, last(k) - first(k) + 1)
+            width = max(width, starts(k + 1) - starts(k))
         end do
+        deallocate (assignments)
         allocate (character(len=width) :: assignments(n))
         do k = 1, n
-            assignments(k) = joined(first(k):last(k))
+            a = starts(k)
+            b = starts(k + 1) - 1
+            ! the separator before the next assignment is not part of this one
+            do i = b, a, -1
+                if (joined(i:i) /= ',' .and. .not. is_blank(joined(i:i))) exit
+                b = i - 1
+            end do
+            assignments(k) = joined(a:b)
         end do
     end subroutine group_assignments
+
+    !> Where the assignments of a group's joined text start (see `group_assignments`).
+    pure subroutine assignment_starts(text, starts)
+        character(len=*), intent(in) :: text
+        integer, allocatable, intent(out) :: starts(:)
+        integer, allocatable :: found(:)
+        integer :: i, j, depth, n
+        character :: quote
+        allocate (found(len(text) + 1))
+        n = 0
+        quote = ' '
+        i = 1
+        do while (i <= len(text))
+            associate (c => text(i:i))
+                if (quote /= ' ') then
+                    if (c == quote) quote = ' '
+                else if (c == "'" .or. c == '"') then
+                    quote = c
+                else if (is_name_char(c) .or. c == '%') then
+                    if (i == 1 .or. is_separator(text(max(i - 1, 1):max(i - 1, 1)))) then
+                        ! a name, an optional (index), blanks, then '='
+                        j = i
+                        do while (j <= len(text))
+                            if (.not. (is_name_char(text(j:j)) .or. text(j:j) == '%')) exit
+                            j = j + 1
+                        end do
+                        if (j <= len(text)) then
+                            if (text(j:j) == '(') then
+                                depth = index(text(j:), ')')
+                                if (depth > 0) j = j + depth
+                            end if
+                        end if
+                        do while (j <= len(text))
+                            if (.not. is_blank(text(j:j))) exit
+                            j = j + 1
+                        end do
+                        if (j <= len(text)) then
+                            if (text(j:j) == '=') then
+                                n = n + 1
+                                found(n) = i
+                            end if
+                        end if
+                        i = max(i, j - 1)
+                    end if
+                end if
+            end associate
+            i = i + 1
+        end do
+        starts = found(1:n)
+    end subroutine assignment_starts
+
+    !> A blank or ',' (what may come before a name that starts an assignment).
+    pure logical function is_separator(c)
+        character, intent(in) :: c
+        is_separator = is_blank(c) .or. c == ','
+    end function is_separator
 
     !> The line without a trailing '!' comment (outside quotes).
     pure function strip_comment(line) result(code)

@@ -109,7 +109,7 @@ contains
         call h5%read_attr_str('/', 'status', status, error)
         if (.not. allocated(error)) call h5%read_attr_int('/', 'n_steps_done', steps, error)
         if (.not. allocated(error)) then
-            text = " (a result: status '"//status//"', "//str(steps)//' steps'
+            text = " (a result: status '"//status//"', "//str(steps)//' step'//trim(merge('s', ' ', steps /= 1))
             if (status /= 'converged') text = text//'; --restart '//path//' continues it'
             text = text//')'
         end if
