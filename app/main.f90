@@ -125,17 +125,22 @@ program voiga_main
 
 contains
 
-    !> Under an address-space limit (`ulimit -v`) OpenBLAS's worker threads can
-    !> fail to map their buffers and spin, and the program then never ends: run
-    !> again with one BLAS thread unless the caller chose a number. Then map the
-    !> BLAS work buffer (128 MiB of address space) while there is room for it
-    !> (`warm_up_blas`), or stop if there is none.
+    !> Under an address-space limit (`ulimit -v`) an OpenBLAS thread that cannot map
+    !> its work buffer (128 MiB of address space each) retries for ever, and the
+    !> program never ends: run again with one BLAS thread (whatever
+    !> OPENBLAS_NUM_THREADS said; the sparse solver gains little from more), map that
+    !> buffer while there is room for it (`warm_up_blas`), or stop if there is none.
     subroutine single_blas_thread_under_a_memory_limit()
+        character(len=16) :: threads
         integer :: status
         integer(int64) :: physical, address
         if (.not. address_space_limited()) return
-        call get_environment_variable('OPENBLAS_NUM_THREADS', status=status)
-        if (status == 1) call reexec_with_environment('OPENBLAS_NUM_THREADS', '1')
+        call get_environment_variable('OPENBLAS_NUM_THREADS', threads, status=status)
+        if (status /= 0 .or. trim(threads) /= '1') then
+            if (status == 0) write (0, '(a)') 'voiga: note: one BLAS thread under an address-space '// &
+                'limit (ulimit -v), not OPENBLAS_NUM_THREADS = '//trim(threads)
+            call reexec_with_environment('OPENBLAS_NUM_THREADS', '1')
+        end if
         call memory_available(physical, address)
         if (address >= 0 .and. address < 160_int64*2_int64**20) then
             write (0, '(a,i0,a)') 'voiga: error: the address-space limit (ulimit -v) leaves ', &

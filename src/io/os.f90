@@ -19,13 +19,13 @@ module voiga_io_os
 
     public :: canonical_path, rename_file, remove_file, path_exists, is_directory
     public :: lock_t, acquire_lock, release_lock, hold_exclusive, hold_shared, let_go
-    public :: reserve_space, release_space, memory_available, address_space_limited, leave, process_id
+    public :: reserve_space, release_space, write_failure_cause, memory_available, address_space_limited, leave, process_id
     public :: reexec_with_environment, ignore_file_size_signal
 
     integer(c_int), parameter :: o_rdonly = 0, o_wronly = 1, o_rdwr = 2, o_creat = 64, &
                                  o_cloexec = 524288
     integer(c_int), parameter :: lock_sh = 1, lock_ex = 2, lock_nb = 4, lock_un = 8
-    integer(c_int), parameter :: falloc_fl_keep_size = 1, rlimit_as = 9
+    integer(c_int), parameter :: falloc_fl_keep_size = 1, rlimit_as = 9, rlimit_fsize = 1
     integer(c_int), parameter :: eintr = 4, enoent = 2, ewouldblock = 11, eopnotsupp = 95
     !> SIGXFSZ (a write beyond `ulimit -f`), and `signal`'s SIG_IGN.
     integer(c_int), parameter :: sigxfsz = 25
@@ -515,6 +515,23 @@ contains
         if (size >= 0) st = c_ftruncate(fd, size)
         st = c_close(fd)
     end subroutine release_space
+
+    !> Why a write to `path` may have failed, as ' (...)' for a message: the
+    !> file-size limit (`ulimit -f`) when the file has reached it, else a full disk.
+    function write_failure_cause(path) result(text)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: text
+        type(rlimit_t) :: limit
+        integer(int64) :: size
+        character(len=24) :: buf
+        text = ' (is the disk full?)'
+        if (c_getrlimit(rlimit_fsize, limit) /= 0) return
+        if (limit%cur == rlim_infinity) return
+        inquire (file=path, size=size)
+        if (size + 1048576_int64 < limit%cur) return
+        write (buf, '(i0)') limit%cur
+        text = ' (the file-size limit, ulimit -f, of '//trim(buf)//' bytes is reached)'
+    end function write_failure_cause
 
     !> The memory this process may still use (bytes): `physical`, the system's
     !> available memory (/proc/meminfo MemAvailable), and `address`, what the

@@ -24,7 +24,7 @@ module voiga_io_results
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization
     use voiga_io_os, only: lock_t, acquire_lock, release_lock, hold_exclusive, let_go, reserve_space, &
-                           release_space, rename_file, remove_file, path_exists
+                           release_space, rename_file, remove_file, path_exists, write_failure_cause
     use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
@@ -266,6 +266,7 @@ contains
         if (.not. allocated(error)) call self%h5%flush(error)
         if (allocated(error)) then
             self%broken = .true.
+            error%message = error%message//write_failure_cause(self%h5%path)
         else
             call release_space(self%h5%path)
         end if
