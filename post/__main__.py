@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 
 def _scale(text: str) -> float | str:
@@ -280,6 +281,12 @@ def main(argv: list[str] | None = None) -> int:
     from .solver import InputError
 
     args = build_parser().parse_args(argv)
+
+    def note(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001
+        """A warning (e.g. a half-written step skipped) as one line on stderr."""
+        print(f"python -m post {args.command}: note: {message}", file=sys.stderr)
+
+    warnings.showwarning = note
     try:
         return int(args.func(args))
     except (InputError, FileNotFoundError) as err:

@@ -10,6 +10,7 @@ module voiga_io_bodies
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_size, only: body_size_t, body_size
+    use voiga_discretization_layout, only: validate_layout
     implicit none
     private
 
@@ -36,6 +37,10 @@ contains
         if (allocated(error)) return
         allocate (sizes(size(coarse)))
         do i = 1, size(coarse)
+            ! the counts are taken from a layout known to be valid
+            call validate_layout(case%bodies(i)%layout, case%path//": &body '"//trim(case%bodies(i)%name)// &
+                                 "': ", error)
+            if (allocated(error)) return
             sizes(i) = body_size(coarse(i), case%bodies(i)%layout)
         end do
         call check_size(sizes, case%solver%linear_solver, check_memory, case%path//': ', error)

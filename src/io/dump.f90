@@ -5,7 +5,7 @@ module voiga_io_dump
     use voiga_io_hdf5, only: h5file_t
     use voiga_discretization_patch, only: discretization_t
     use voiga_io_case, only: case_t
-    use voiga_io_os, only: rename_file, remove_file
+    use voiga_io_os, only: rename_file, remove_file, companion
     use voiga_version, only: voiga_version_string
     implicit none
     private
@@ -26,7 +26,7 @@ contains
         type(h5file_t) :: h5
         type(error_t), allocatable :: close_error
         integer :: i
-        call h5%open(path//'.part', 'w', error)
+        call h5%open(companion(path, '.part'), 'w', error)
         if (allocated(error)) return
         steps: block
             call h5%write_attr('/', 'title', case%title, error)
@@ -46,8 +46,8 @@ contains
         end block steps
         call h5%close(close_error)
         if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
-        if (.not. allocated(error)) call rename_file(path//'.part', path, error)
-        if (allocated(error)) call remove_file(path//'.part')
+        if (.not. allocated(error)) call rename_file(companion(path, '.part'), path, error)
+        if (allocated(error)) call remove_file(companion(path, '.part'))
     end subroutine write_dump
 
     !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`.

@@ -14,10 +14,11 @@ module voiga_io_os
                                            c_funptr, c_intptr_t
     use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_io_sha256, only: sha256_text
     implicit none
     private
 
-    public :: canonical_path, rename_file, remove_file, path_exists, is_directory
+    public :: canonical_path, rename_file, remove_file, path_exists, is_directory, companion
     public :: lock_t, acquire_lock, release_lock, hold_exclusive, hold_shared, let_go
     public :: reserve_space, release_space, write_failure_cause, memory_available, address_space_limited, leave, process_id
     public :: reexec_with_environment, ignore_file_size_signal
@@ -310,6 +311,24 @@ contains
         if (real_dir == '/') real_dir = ''
         resolved = real_dir//'/'//base
     end subroutine canonical_path
+
+    !> The file beside `path` that a writer keeps with it: `path` with `suffix`
+    !> ('.part', '.lock'), or, when that name would be longer than a file name may
+    !> be (255 bytes), the first 200 characters of the name, '-', 16 hex digits of
+    !> the name's SHA-256 and `suffix` (the same for every writer of `path`).
+    function companion(path, suffix) result(name)
+        character(len=*), intent(in) :: path, suffix
+        character(len=:), allocatable :: name
+        character(len=64) :: hex
+        integer :: i
+        i = index(path, '/', back=.true.)
+        if (len(path) - i + len(suffix) <= 255) then
+            name = path//suffix
+        else
+            hex = sha256_text(path(i + 1:))
+            name = path(1:i)//path(i + 1:i + 200)//'-'//hex(1:16)//suffix
+        end if
+    end function companion
 
     !> Does `path` exist (after following links)?
     logical function path_exists(path)

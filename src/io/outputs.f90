@@ -6,7 +6,7 @@
 module voiga_io_outputs
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_io_os, only: canonical_path, path_exists, is_directory
+    use voiga_io_os, only: canonical_path, path_exists, is_directory, companion
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     implicit none
@@ -86,8 +86,8 @@ contains
             return
         end if
         do i = 1, size(inputs)
-            if (out == trim(inputs(i)) .or. out//'.part' == trim(inputs(i)) .or. &
-                out//'.lock' == trim(inputs(i))) then
+            if (out == trim(inputs(i)) .or. companion(out, '.part') == trim(inputs(i)) .or. &
+                companion(out, '.lock') == trim(inputs(i))) then
                 call fatal_error(error, what//" '"//path//"' is "//trim(names(i))//" ('"//trim(inputs(i))// &
                                  "'): an output never replaces an input or another output", error_code%input)
                 return

@@ -9,7 +9,7 @@
 !> 20 MiB (libraries, the program) plus, per entry of the element stiffness
 !> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
 !> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows
-!> like n log n) or 1.3 x log2(DOFs) with multigrid.
+!> like n log n) or 2.3 x log2(DOFs) with multigrid.
 module voiga_io_resources
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
@@ -22,7 +22,7 @@ module voiga_io_resources
     public :: memory_estimate, check_size
 
     real(dp), parameter :: base_bytes = 20.0_dp*2.0_dp**20
-    real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 1.3_dp
+    real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp
 
 contains
 

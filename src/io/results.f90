@@ -24,7 +24,7 @@ module voiga_io_results
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization
     use voiga_io_os, only: lock_t, acquire_lock, release_lock, hold_exclusive, let_go, reserve_space, &
-                           release_space, rename_file, remove_file, path_exists, write_failure_cause
+                           release_space, rename_file, remove_file, path_exists, write_failure_cause, companion
     use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
@@ -75,7 +75,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call self%claim(case%output, error)
         if (allocated(error)) return
-        self%part_path = case%output//'.part'
+        self%part_path = companion(case%output, '.part')
         call remove_file(self%part_path)
         call self%h5%open(self%part_path, 'w', error)
         if (allocated(error)) then
@@ -93,7 +93,7 @@ contains
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: error
         if (self%writer%fd >= 0) return
-        call acquire_lock(self%writer, path//'.lock', "result file '"//path//"'", error)
+        call acquire_lock(self%writer, companion(path, '.lock'), "result file '"//path//"'", error)
         if (allocated(error)) return
         self%final_path = path
     end subroutine results_claim

@@ -92,8 +92,13 @@ contains
                              error_code%input)
             return
         end if
-        if (nel_xi > max_knots .or. nel_eta > max_knots) then
-            call fatal_error(error, where//'nel_xi and nel_eta must be <= 100000', error_code%input)
+        if (nel_xi < 1 .or. nel_eta < 1 .or. nel_xi > max_knots .or. nel_eta > max_knots) then
+            call fatal_error(error, where//'nel_xi and nel_eta must be between 1 and 100000', error_code%input)
+            return
+        end if
+        if (degree_xi < 1 .or. degree_eta < 1 .or. layer_degree < 0 .or. layer_elevations < 0) then
+            call fatal_error(error, where//'degree_xi and degree_eta must be >= 1, layer_degree and '// &
+                             'layer_elevations >= 0', error_code%input)
             return
         end if
         call take_knots(knots_xi, 'knots_xi', where, entry%layout%knots_xi, error)
