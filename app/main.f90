@@ -11,8 +11,8 @@ program voiga_main
     use voiga_io_outputs, only: check_outputs, resolve_restart
     use voiga_io_provenance, only: check_restart
     use voiga_io_results, only: restart_case, read_restart
-    use voiga_io_os, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
-                           memory_available
+    use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
+                                memory_available
     use voiga_linalg_blas, only: warm_up_blas
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
@@ -64,7 +64,7 @@ program voiga_main
     end if
     if (allocated(error)) call fail(error)
     ! a second writer of the result file is refused before anything is built
-    if (allocated(restart_path) .or. .not. check) call results%claim(case%output, error)
+    if (allocated(restart_path) .or. .not. check) call results%h5%claim(case%output, error)
     if (allocated(error)) call fail(error)
     call discretize_bodies(case, discs, error, memory_check)
     if (allocated(error)) call fail(error)
@@ -96,7 +96,8 @@ program voiga_main
         call restart_in_place()
     else
         call results%open(case, model, error)
-        if (allocated(error) .and. results%broken) call stop_writing(error)
+        ! a write that failed (a full disk): no exit handler may flush the rest
+        if (allocated(error) .and. results%h5%is_open()) call stop_writing(error)
         if (allocated(error)) call fail(error)
     end if
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
@@ -214,7 +215,7 @@ contains
         call read_restart(case%output, model, resume, error)
         if (allocated(error)) call fail(error)
         call results%reopen(case%output, error, note)
-        if (allocated(error) .and. results%broken) call stop_writing(error)
+        if (allocated(error) .and. results%h5%broken) call stop_writing(error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
     end subroutine restart_in_place
@@ -226,7 +227,7 @@ contains
         call results%finish(status, wall_seconds() - t0, stats%cut_records, &
                             [stats%tresca_retries, stats%tresca_accepted, stats%fixed_point_iterations], &
                             finish_error)
-        if (.not. (allocated(finish_error) .or. results%broken)) return
+        if (.not. (allocated(finish_error) .or. results%h5%broken)) return
         if (allocated(error)) then
             if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//error%message
             if (.not. allocated(finish_error)) call move_alloc(error, finish_error)
@@ -238,7 +239,7 @@ contains
     !> an earlier result was there, that this one is kept.
     function where_kept() result(text)
         character(len=:), allocatable :: text
-        if (results%kept_earlier) then
+        if (results%h5%kept_earlier) then
             text = '(none) are not written: the earlier '//case%output//' is kept as it was'
         else
             text = 'are in '//case%output
@@ -250,11 +251,11 @@ contains
     subroutine stop_writing(err)
         type(error_t), intent(in) :: err
         write (0, '(a)') 'voiga: error: '//err%message
-        call results%abandon()
-        if (results%in_place) then
+        call results%h5%abandon()
+        if (results%h5%in_place) then
             write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before are readable in '// &
                 case%output//" (its status may still say 'running')"
-        else if (results%kept_earlier) then
+        else if (results%h5%kept_earlier) then
             write (0, '(a)') 'voiga: '//case%output//' is kept as it was'
         end if
         call leave(1)
@@ -314,7 +315,7 @@ contains
     subroutine fail(err)
         type(error_t), intent(in) :: err
         write (0, '(a)') 'voiga: error: '//err%message
-        call results%abandon()
+        call results%h5%abandon()
         call exit_code(exit_status(err))
     end subroutine fail
 

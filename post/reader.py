@@ -57,6 +57,10 @@ from .units import Units
 LOCK_WAIT: float = 60.0
 """Seconds :func:`open_result` waits for a writer to finish a step."""
 
+READ_ATTEMPTS: int = 3
+"""Reads of a file that fail before :func:`read_result` calls it unreadable (voiga
+writes a step anyway when a read holds the file longer than 30 s)."""
+
 
 class BadResultError(ValueError):
     """A file that is not a readable voiga result; the message names it and the cause."""
@@ -569,13 +573,19 @@ def read_result(path: str | Path, lazy: bool = False) -> Result:
     readable result raises :class:`BadResultError` (or FileNotFoundError).
     """
     path = Path(path)
-    try:
-        return _read_result(path, lazy)
-    except (BadResultError, FileNotFoundError):
-        raise
-    except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, AttributeError) as err:
-        raise BadResultError(f"{path}: not a readable voiga result ({type(err).__name__}: "
-                             f"{_cause(err)})") from err
+    for attempt in range(READ_ATTEMPTS):
+        try:
+            return _read_result(path, lazy)
+        except (BadResultError, FileNotFoundError):
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, AttributeError) as err:
+            # a writer that had to stop waiting for a slow read changes the file
+            # under it: read again; a damaged file fails every time
+            if attempt + 1 == READ_ATTEMPTS:
+                raise BadResultError(f"{path}: not a readable voiga result ({type(err).__name__}: "
+                                     f"{_cause(err)})") from err
+            time.sleep(0.2)
+    raise AssertionError("unreachable")
 
 
 def _read_result(path: Path, lazy: bool) -> Result:

@@ -24,7 +24,7 @@ contains
     !> Record the fingerprints of the case and geometry files of `case` in the open
     !> result file `h5`.
     subroutine write_provenance(h5, case, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         type(case_t), intent(in) :: case
         type(error_t), allocatable, intent(out) :: error
         character(len=64) :: hex

@@ -15,7 +15,7 @@ module voiga_io_resources
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_discretization_size, only: body_size_t
-    use voiga_io_os, only: memory_available
+    use voiga_io_process, only: memory_available
     implicit none
     private
 

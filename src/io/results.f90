@@ -2,18 +2,8 @@
 !> discretization first, then one group per converged step, written and flushed
 !> when the step converges, and a final status ('converged', 'failed: ...',
 !> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
-!>
-!> What a reader of the path sees (docs/hdf5.md, "Writing and reading a running
-!> result"): a new result is written as `<result>.part` and renamed to its name
-!> once its first step is in it, so an earlier file there is replaced only by one
-!> with a step; the writer holds the lock file `<result>.lock` for the whole run
-!> (a second writer is refused, whatever HDF5_USE_FILE_LOCKING says) and an
-!> exclusive `flock` on the file while it writes a step (readers that take a
-!> shared one, as HDF5's own locking and `post` do, read only whole steps). Space
-!> for each write is reserved first: a full disk or quota ends the run before
-!> the write, the steps on disk intact. A write that fails all the same leaves
-!> the file `broken`: nothing more may reach it (the program leaves without
-!> HDF5's exit handlers, which would write half a step over the last flush).
+!> Every write goes through `result_file_t`'s guards (what readers see, a second
+!> writer, a full disk: voiga_io_result_file).
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use, intrinsic :: iso_fortran_env, only: int64
@@ -23,8 +13,8 @@ module voiga_io_results
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization
-    use voiga_io_os, only: lock_t, acquire_lock, release_lock, hold_exclusive, let_go, reserve_space, &
-                           release_space, rename_file, remove_file, path_exists, write_failure_cause, companion
+    use voiga_io_os, only: path_exists
+    use voiga_io_result_file, only: result_file_t
     use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
     use voiga_contact_master_rigid, only: rigid_line_t
@@ -40,25 +30,13 @@ module voiga_io_results
     !> An open result file; as a `progress_t` it writes every converged step the
     !> solver reports (and the levels of a multigrid solver).
     type, extends(progress_t) :: results_t
-        type(h5file_t) :: h5
+        type(result_file_t) :: h5
         integer :: n_written = 0
-        !> The result file, and where it is written until its first step is in it.
-        character(len=:), allocatable :: final_path, part_path
-        !> The writer's lock file, and the `flock` held on the file while writing.
-        type(lock_t) :: writer, window
-        !> Is the file at its name (a step written, or a restart)? Did a write to it
-        !> fail (nothing more may be written)? Was an earlier file at the name kept
-        !> because this run wrote no step?
-        logical :: in_place = .false., broken = .false., kept_earlier = .false.
-        !> Bytes the last step added to the file (what the next one reserves).
-        integer(int64) :: step_bytes = 0
     contains
-        procedure :: claim => results_claim
         procedure :: open => results_open
         procedure :: reopen => results_reopen
         procedure :: write_step => results_write_step
         procedure :: finish => results_finish
-        procedure :: abandon => results_abandon
         !> Record the DOFs of each multigrid level (/multigrid_level_dofs).
         procedure :: write_multigrid => results_write_multigrid
         procedure :: set_up => results_set_up
@@ -73,102 +51,72 @@ contains
         type(case_t), intent(in) :: case
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
-        call self%claim(case%output, error)
-        if (allocated(error)) return
-        self%part_path = companion(case%output, '.part')
-        call remove_file(self%part_path)
-        call self%h5%open(self%part_path, 'w', error)
-        if (allocated(error)) then
-            error%message = error%message//' (is the folder writable?)'
-            return
-        end if
-        call write_metadata(self%h5, case, model, error)
-        if (allocated(error)) self%broken = .true.
-    end subroutine results_open
-
-    !> Take the writer's lock of the result file `path` (its lock file `path`.lock):
-    !> refused while another run writes it.
-    subroutine results_claim(self, path, error)
-        class(results_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: error
-        if (self%writer%fd >= 0) return
-        call acquire_lock(self%writer, companion(path, '.lock'), "result file '"//path//"'", error)
-        if (allocated(error)) return
-        self%final_path = path
-    end subroutine results_claim
-
-    !> The root attributes, the discretization of each body and the Dirichlet
-    !> conditions of a new result file; flushed.
-    subroutine write_metadata(h5, case, model, error)
-        type(h5file_t), intent(inout) :: h5
-        type(case_t), intent(in) :: case
-        type(model_t), intent(in) :: model
-        type(error_t), allocatable, intent(out) :: error
         integer :: i, k
         character(len=:), allocatable :: g
         character(len=16) :: buf
 
-        call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
+        call self%h5%create(case%output, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'title', case%title, error)
+        call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'scene', case%scene, error)
+        call self%h5%write_attr('/', 'title', case%title, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'mesh', case%mesh, error)
+        call self%h5%write_attr('/', 'scene', case%scene, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'layout', case%layout, error)
+        call self%h5%write_attr('/', 'mesh', case%mesh, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'case_file', case%path, error)
+        call self%h5%write_attr('/', 'layout', case%layout, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'status', 'running', error)
+        call self%h5%write_attr('/', 'case_file', case%path, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'n_dofs', model%ndof, error)
+        call self%h5%write_attr('/', 'status', 'running', error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver), error)
+        call self%h5%write_attr('/', 'n_dofs', model%ndof, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'damping', trim(case%solver%damping), error)
+        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver), error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'n_steps_planned', case%solver%total_steps(), error)
+        call self%h5%write_attr('/', 'damping', trim(case%solver%damping), error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'n_steps_done', 0, error)
+        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps(), error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'n_cuts', 0, error)
+        call self%h5%write_attr('/', 'n_steps_done', 0, error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'wall_time', 0.0_dp, error)
+        call self%h5%write_attr('/', 'n_cuts', 0, error)
+        if (allocated(error)) return
+        call self%h5%write_attr('/', 'wall_time', 0.0_dp, error)
         if (allocated(error)) return
         do i = 1, size(model%bodies)
-            call write_body(h5, model, i, trim(case%bodies(i)%material), error)
+            call write_body(self%h5, model, i, trim(case%bodies(i)%material), error)
             if (allocated(error)) return
         end do
         do k = 1, size(model%dirichlet)
             write (buf, '(i0)') k
             g = '/dirichlet/'//trim(buf)
-            call h5%create_group(g, error)
+            call self%h5%create_group(g, error)
             if (allocated(error)) return
-            call h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), &
-                                  error)
+            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), &
+                                    error)
             if (allocated(error)) return
-            call h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge), error)
+            call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge), error)
             if (allocated(error)) return
-            call h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)), error)
+            call self%h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)), error)
             if (allocated(error)) return
-            call h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)), error)
+            call self%h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)), error)
             if (allocated(error)) return
-            call h5%write(g//'/values', model%dirichlet(k)%values, error)
+            call self%h5%write(g//'/values', model%dirichlet(k)%values, error)
             if (allocated(error)) return
         end do
-        call h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)', error)
+        call self%h5%write_attr('/', 'units', 'consistent (the scenes: mm, N)', error)
         if (allocated(error)) return
-        call write_provenance(h5, case, error)
+        call write_provenance(self%h5, case, error)
         if (allocated(error)) return
-        call h5%flush(error)
-    end subroutine write_metadata
+        call self%h5%flush(error)
+    end subroutine results_open
 
     !> The discretization, material and element layout of body `i` of `model` under
     !> /bodies/<name>.
     subroutine write_body(h5, model, i, material, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         type(model_t), intent(in) :: model
         integer, intent(in) :: i
         !> Name of the body's material law.
@@ -229,52 +177,21 @@ contains
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: error
         character(len=*), intent(in), optional :: note
-        call self%claim(path, error)
+        call self%h5%resume(path, error)
         if (allocated(error)) return
-        call self%h5%open(path, 'rw', error)
-        if (allocated(error)) return
-        self%in_place = .true.
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
         if (allocated(error)) return
-        call begin_write(self, 65536_int64, error)
+        call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'status', 'running', error)
         if (.not. allocated(error) .and. present(note)) then
             if (len(note) > 0) call self%h5%write_attr('/', 'restart_forced', note, error)
         end if
-        call end_write(self, error)
+        call self%h5%end_write(error)
     end subroutine results_reopen
 
-    !> Before a write: reserve space for it (`bytes`, or twice what the last step
-    !> added if more) and, once the file is at its name, hold the exclusive `flock`
-    !> readers wait for (at most 5 s for one that holds the file longer).
-    subroutine begin_write(self, bytes, error)
-        class(results_t), intent(inout) :: self
-        integer(int64), intent(in) :: bytes
-        type(error_t), allocatable, intent(out) :: error
-        logical :: held
-        call reserve_space(self%h5%path, max(bytes, 2*self%step_bytes), error)
-        if (allocated(error)) return
-        if (self%in_place) call hold_exclusive(self%window, self%final_path, 5.0, held)
-    end subroutine begin_write
-
-    !> After a write: flush it (unless `error`, which marks the file broken), give
-    !> back the space it did not use and let readers in again.
-    subroutine end_write(self, error)
-        class(results_t), intent(inout) :: self
-        type(error_t), allocatable, intent(inout) :: error
-        if (.not. allocated(error)) call self%h5%flush(error)
-        if (allocated(error)) then
-            self%broken = .true.
-            error%message = error%message//write_failure_cause(self%h5%path)
-        else
-            call release_space(self%h5%path)
-        end if
-        call let_go(self%window)
-    end subroutine end_write
-
-    !> Write one converged step: space reserved, written and flushed while readers
-    !> wait; the first step moves the file to its name.
+    !> Write one converged step (space reserved, readers kept out, flushed); the
+    !> first step gives the file its name.
     subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
                                   error)
         class(results_t), intent(inout) :: self
@@ -286,31 +203,16 @@ contains
         integer, intent(in), optional :: n_cuts
         real(dp), intent(in), optional :: next_fraction, r0_max
         type(error_t), allocatable, intent(out) :: error
-        integer(int64) :: before, after
-        if (self%broken) return
-        inquire (file=self%h5%path, size=before)
+        if (self%h5%broken) return
         ! at least 1 MiB, and for the first step its displacement, contact output
         ! and metadata, generously
-        call begin_write(self, max(1048576_int64, 64_int64*size(u, kind=int64)), error)
+        call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
         if (allocated(error)) return
         call write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, error)
-        call end_write(self, error)
+        call self%h5%end_write(error)
         if (allocated(error)) return
-        inquire (file=self%h5%path, size=after)
-        self%step_bytes = max(after - before, 0_int64)
-        if (.not. self%in_place) call move_into_place(self, error)
+        call self%h5%place(error)
     end subroutine results_write_step
-
-    !> Rename the file written so far to the result's name (the earlier file there,
-    !> if any, replaced at once).
-    subroutine move_into_place(self, error)
-        class(results_t), intent(inout) :: self
-        type(error_t), allocatable, intent(out) :: error
-        call rename_file(self%part_path, self%final_path, error)
-        if (allocated(error)) return
-        self%in_place = .true.
-        self%h5%path = self%final_path
-    end subroutine move_into_place
 
     !> Write one converged step and the current displacement; flush.
     subroutine write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
@@ -396,7 +298,7 @@ contains
 
     !> Per-slave-point contact output of pair `k` under step group `g`.
     subroutine write_contact(h5, g, k, pair, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         integer, intent(in) :: k
         class(contact_pair_t), intent(in) :: pair
@@ -479,7 +381,7 @@ contains
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,
     !> fraction, new fraction), with their reasons as its attribute `reasons` (one line each).
     subroutine write_cuts(h5, g, cuts, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(cut_record_t), intent(in) :: cuts(:)
         type(error_t), allocatable, intent(out) :: error
@@ -501,11 +403,10 @@ contains
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and close;
     !> `cuts`: every cut of the run (written as /cuts when there is one); `tresca`:
     !> the run's Tresca fixed-point counters [retried substeps, accepted, fixed-point
-    !> iterations]. The file is closed whatever fails (the first error is returned);
-    !> a file not at its name yet is moved there, unless it has no step and an
-    !> earlier file is there (that one is kept: `kept_earlier`). A broken file is
-    !> not touched (`abandon`), nor one with no room left for the status (it stays
-    !> 'running', every step written readable).
+    !> iterations]. The file is closed whatever fails (the first error is returned)
+    !> and given its name (`result_file_t%settle`); a broken file is not touched
+    !> (`abandon`), nor one with no room left for the status (it stays 'running',
+    !> every step written readable).
     subroutine results_finish(self, status, wall, cuts, tresca, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
@@ -513,18 +414,13 @@ contains
         type(cut_record_t), intent(in), optional :: cuts(:)
         integer, intent(in), optional :: tresca(3)
         type(error_t), allocatable, intent(out) :: error
-        type(error_t), allocatable :: close_error
-        if (self%broken) then
-            call self%abandon()
+        if (self%h5%broken) then
+            call self%h5%abandon()
             return
         end if
-        if (.not. self%h5%is_open()) then
-            call release_lock(self%writer)
-            return
-        end if
-        call begin_write(self, 65536_int64, error)
+        if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)
         records: block
-            if (allocated(error)) exit records
+            if (allocated(error) .or. .not. self%h5%is_open()) exit records
             if (present(cuts)) then
                 call self%h5%write_attr('/', 'n_cuts', size(cuts), error)
                 if (allocated(error)) exit records
@@ -543,35 +439,14 @@ contains
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'wall_time', wall, error)
             if (allocated(error)) exit records
-            call end_write(self, error)
+            call self%h5%end_write(error)
         end block records
-        if (self%broken) then
-            call self%abandon()
-            return
+        if (self%h5%broken) then
+            call self%h5%abandon()
+        else
+            call self%h5%settle(self%n_written > 0, error)
         end if
-        call self%h5%close(close_error)
-        call let_go(self%window)
-        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
-        if (.not. self%in_place) then
-            if (self%n_written == 0 .and. path_exists(self%final_path)) then
-                call remove_file(self%part_path)
-                self%kept_earlier = .true.
-            else if (.not. allocated(error)) then
-                call move_into_place(self, error)
-            end if
-        end if
-        call release_lock(self%writer)
     end subroutine results_finish
-
-    !> Leave the file as it is on disk: no HDF5 call (a write failed, or no room is
-    !> left; the caller must end the program without exit handlers, `leave`); a
-    !> file not at its name yet is removed. The writer's lock is released.
-    subroutine results_abandon(self)
-        class(results_t), intent(inout) :: self
-        if (.not. self%in_place .and. allocated(self%part_path)) call remove_file(self%part_path)
-        call let_go(self%window)
-        call release_lock(self%writer)
-    end subroutine results_abandon
 
     !> The solver is set up: the levels of its multigrid hierarchy.
     subroutine results_set_up(self, level_dofs, error)
@@ -597,12 +472,12 @@ contains
         class(results_t), intent(inout) :: self
         integer, intent(in) :: level_dofs(:)
         type(error_t), allocatable, intent(out) :: error
-        if (.not. self%h5%is_open() .or. self%broken) return
+        if (.not. self%h5%is_open() .or. self%h5%broken) return
         if (self%h5%exists('/multigrid_level_dofs')) return
-        call begin_write(self, 65536_int64, error)
+        call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
         call self%h5%write('/multigrid_level_dofs', level_dofs, error)
-        call end_write(self, error)
+        call self%h5%end_write(error)
     end subroutine results_write_multigrid
 
     !> The case file recorded in the result file `path`.
