@@ -13,7 +13,7 @@ module voiga_io_namelist
     implicit none
     private
 
-    public :: nml_group_t, scan_groups, group_error, lower
+    public :: nml_group_t, scan_groups, group_error, lower, assignment_reader
 
     !> One namelist group of a file.
     type :: nml_group_t
@@ -24,6 +24,16 @@ module voiga_io_namelist
         !> Its text from '&name' to the closing '/' (or '&end'), one record per line.
         character(len=:), allocatable :: text(:)
     end type nml_group_t
+
+    abstract interface
+        !> Read the namelist text `text` (one group with one assignment) into a
+        !> group's variables: a reader's `try`, for the diagnosis of `group_error`.
+        subroutine assignment_reader(text, ios, msg)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: ios
+            character(len=*), intent(inout) :: msg
+        end subroutine assignment_reader
+    end interface
 
 contains
 
@@ -273,13 +283,7 @@ contains
         character(len=*), intent(in) :: text(:)
         integer, intent(in) :: ios
         character(len=*), intent(in) :: msg
-        interface
-            subroutine try(text, ios, msg)
-                character(len=*), intent(in) :: text
-                integer, intent(out) :: ios
-                character(len=*), intent(inout) :: msg
-            end subroutine try
-        end interface
+        procedure(assignment_reader) :: try
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: assignments(:), name, value
         character(len=512) :: msg1
@@ -329,13 +333,7 @@ contains
     !> (by bisection); -1 when the first value alone does not read.
     integer function values_held(group, name, value, try)
         character(len=*), intent(in) :: group, name, value
-        interface
-            subroutine try(text, ios, msg)
-                character(len=*), intent(in) :: text
-                integer, intent(out) :: ios
-                character(len=*), intent(inout) :: msg
-            end subroutine try
-        end interface
+        procedure(assignment_reader) :: try
         integer, allocatable :: first(:), last(:)
         integer :: lo, hi, mid
         call split_values(value, first, last)
@@ -361,13 +359,7 @@ contains
     !> Does `name = list` read as an assignment of `group`?
     logical function list_reads(group, name, list, try)
         character(len=*), intent(in) :: group, name, list
-        interface
-            subroutine try(text, ios, msg)
-                character(len=*), intent(in) :: text
-                integer, intent(out) :: ios
-                character(len=*), intent(inout) :: msg
-            end subroutine try
-        end interface
+        procedure(assignment_reader) :: try
         character(len=512) :: msg
         integer :: ios
         msg = ''

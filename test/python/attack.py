@@ -390,7 +390,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--list", action="store_true", help="list the attacks and exit")
     args = p.parse_args(argv)
     voiga = Path(os.environ.get("VOIGA_BIN", REPO / "build" / "install" / "bin" / "voiga"))
-    work = args.out or Path(tempfile.mkdtemp(prefix="voiga-attack-"))
+    work = (args.out or Path(tempfile.mkdtemp(prefix="voiga-attack-"))).resolve()
     start = time.perf_counter()
     base = base_result(voiga, work / "_base")
     attacks = select(all_attacks(base), args.reduced)

@@ -21,31 +21,14 @@ from typing import Callable
 import h5py
 import numpy as np
 
+from test_fuzz import BASE as FUZZ_BASE
+
 REPO = Path(__file__).resolve().parents[2]
 GEOMETRY = REPO / "cases" / "ironing" / "geometry.h5"
 
-#: The base case: the ironing slab (3 x 1 elements, a VO layer) pressed on a rigid
-#: plane and slid, frictional GPTS, 4 steps (a fifth of a second).
-BASE = """&case
-  title = 'attack block', geometry = 'geometry.h5', output = 'out.h5', n_bodies = 1
-/
-&body
-  name = 'slab', material = 'neo-hookean', youngs_modulus = 1.0, poisson_ratio = 0.3,
-  degree_xi = 2, degree_eta = 2, nel_xi = 3, nel_eta = 1, contact_edge = 'bottom',
-  layer_degree = 2, layer_elevations = 1
-/
-&solver
-  n_steps = 2, 2
-  max_iterations = 30
-/
-&dirichlet
-  body = 'slab', edge = 'top', fix_x = .true., fix_y = .true., ux = 0.0, 0.3, uy = -0.03, -0.03
-/
-&contact
-  slave = 'slab', master = 'rigid', rigid_point = 0.0, -3.0, rigid_normal = 0.0, 1.0,
-  penalty_normal = 100.0, penalty_tangent = 100.0, friction = 0.3
-/
-"""
+#: The base case (test_fuzz.py's): the ironing slab (3 x 1 elements, a VO layer)
+#: pressed on a rigid plane and slid, frictional GPTS, natural damping, 4 steps.
+BASE = FUZZ_BASE
 
 ANY = frozenset({0, 1, 2, 3})
 REFUSED = frozenset({2})
@@ -173,14 +156,14 @@ def structure_attacks() -> list[Attack]:
         "index-out-of-range": (BASE.replace("ux = 0.0, 0.3", "ux(65) = 1.0"), ["ux(65)", "index out of range"]),
         "unknown-variable": (BASE.replace("friction = 0.3", "friction = 0.3, mu = 0.3"),
                              ["unknown variable 'mu'"]),
-        "case-in-string": (BASE.replace("'attack block'", "'&dirichlet body=x /'") + "\n&body", ["not closed"]),
+        "case-in-string": (BASE.replace("'fuzz block'", "'&dirichlet body=x /'") + "\n&body", ["not closed"]),
     }
     for name, (text, words) in refuse.items():
         out.append(Attack("namelist", f"structure/{name}", with_text(text, "--check"), REFUSED, tuple(words),
                           example=name in ("65-phases", "100001-knots", "duplicate-dirichlet")))
     # accepted structure: a string holding group syntax, 64 phases
     ok = {
-        "string-with-syntax": BASE.replace("'attack block'", "'a / &body $end ! x'"),
+        "string-with-syntax": BASE.replace("'fuzz block'", "'a / &body $end ! x'"),
         "64-phases": BASE.replace("n_steps = 2, 2", "n_steps = " + ", ".join(["1"] * 64)).replace(
             "ux = 0.0, 0.3, uy = -0.03, -0.03", "ux = " + ", ".join(["0.0"] * 64) + ", uy = "
             + ", ".join(["-0.03"] * 64)),
@@ -452,7 +435,7 @@ def output_attacks() -> list[Attack]:
         for target, words in (("geometry.h5", ("is the geometry file",)), ("case.nml", ("is the case file",))):
             def prep(work: Path, t=target, p=prefix) -> None:
                 if p == "absolute:":
-                    text = (work / "case.nml").read_text().replace(f"'absolute:{t}'", f"'{work / t}'")
+                    text = (work / "case.nml").read_text().replace(f"'absolute:{t}'", f"'{(work / t).resolve()}'")
                     (work / "case.nml").write_text(text)
             refused_output(f"output/{prefix.rstrip(':') or 'plain'}-{target}", prefix + target, words, prep,
                            example=prefix == "" and target == "geometry.h5")
