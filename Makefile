@@ -13,7 +13,7 @@ SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # 3x slower while anything else ran (docs/performance.md).
 export OPENBLAS_NUM_THREADS ?= 1
 
-.PHONY: all deps build run test test-fortran test-python clean bench paper stress regress
+.PHONY: all deps build run test test-fortran test-python clean bench paper stress regress attack
 
 all: build
 
@@ -71,6 +71,16 @@ clean:
 stress: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/hard_cases.py --out build/stress \
 	  --markdown build/stress/table.md $(STRESS_ARGS)
+
+## attack: the attack suite of issue 19 (docs/robustness.md, "Attack suite"): every
+## namelist, geometry, output-path and result-file input of test/python/attack_inputs.py
+## (about 1160) judged by its oracles; prints the counts per family and writes them to
+## build/attack/table.md; fails on any crash, hang, silent wrong result or changed input.
+## make test runs the reduced set (test/python/test_attack.py). ATTACK_ARGS e.g.
+## --family output post, --list
+attack: build
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/attack.py --out build/attack \
+	  --markdown build/attack/table.md $(ATTACK_ARGS)
 
 ## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX)
 bench: build

@@ -1,13 +1,19 @@
-!> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet]`. Parses
-!> the arguments, reads the case, builds the model and runs the solver; the
-!> terminal output is `voiga_app_console`'s.
+!> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet] ...`.
+!> Parses the arguments, reads the case, checks where the run writes and that it
+!> fits, builds the model and runs the solver; the terminal output is
+!> `voiga_app_console`'s.
 program voiga_main
-    use voiga_error, only: error_t, error_code, fatal_error
+    use voiga_error, only: error_t, error_code
     use voiga_version, only: voiga_version_string
     use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_dump, only: write_dump
     use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
+    use voiga_io_outputs, only: check_outputs, resolve_restart
+    use voiga_io_provenance, only: check_restart
     use voiga_io_results, only: restart_case, read_restart
+    use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
+                                memory_available
+    use voiga_linalg_blas, only: warm_up_blas
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
     use voiga_model_checks, only: setup_warnings, warning_t
@@ -17,10 +23,11 @@ program voiga_main
     use voiga_solver_heap, only: keep_freed_memory
     use voiga_app_console, only: console_t
     use voiga_kinds, only: dp
+    use, intrinsic :: iso_fortran_env, only: int64
     implicit none
 
-    character(len=:), allocatable :: case_path, dump_path, arg, restart_path
-    logical :: check, quiet, verbose
+    character(len=:), allocatable :: case_path, dump_path, restart_path, note
+    logical :: check, quiet, verbose, overwrite, force_restart, memory_check
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error, finish_error
@@ -31,47 +38,14 @@ program voiga_main
     type(warning_t), allocatable :: warnings(:)
     real(dp), allocatable :: u(:)
     real(dp) :: t0
-    integer :: i, n, total
+    integer :: i, total, length
     logical :: heap_ok
 
+    call single_blas_thread_under_a_memory_limit()
+    call ignore_file_size_signal()
     ! reuse freed memory across factorizations (glibc; without it, only slower)
     call keep_freed_memory(heap_ok)
-    check = .false.
-    quiet = .false.
-    verbose = .false.
-    n = command_argument_count()
-    i = 0
-    do while (i < n)
-        i = i + 1
-        arg = get_arg(i)
-        select case (arg)
-        case ('-h', '--help')
-            call usage()
-            stop
-        case ('--version')
-            write (*, '(a)') 'voiga '//voiga_version_string
-            stop
-        case ('--check')
-            check = .true.
-        case ('--quiet', '-q')
-            quiet = .true.
-        case ('--verbose', '-v')
-            verbose = .true.
-        case ('--restart')
-            if (i == n) call fail_usage('--restart needs a result file')
-            i = i + 1
-            restart_path = get_arg(i)
-        case ('--dump')
-            if (i == n) call fail_usage('--dump needs a file name')
-            i = i + 1
-            dump_path = get_arg(i)
-        case default
-            if (arg(1:1) == '-') call fail_usage("unknown option '"//arg//"'")
-            if (allocated(case_path)) call fail_usage("more than one case file given ('"// &
-                                                      case_path//"', '"//arg//"')")
-            case_path = arg
-        end select
-    end do
+    call parse_arguments()
     if (allocated(restart_path) .and. .not. allocated(case_path)) then
         ! the case the interrupted run was started from
         call restart_case(restart_path, case_path, error)
@@ -82,7 +56,19 @@ program voiga_main
     t0 = wall_seconds()
     call read_case(case_path, case, error)
     if (allocated(error)) call fail(error)
-    call discretize_bodies(case, discs, error)
+    if (allocated(restart_path)) then
+        ! the run continues in the restart file, whatever output the case names
+        call resolve_restart(restart_path, case, case%output, error)
+        if (allocated(error)) call fail(error)
+        call check_outputs(case, .false., dump_path, overwrite, error, restart=.true.)
+    else
+        call check_outputs(case, .not. check, dump_path, overwrite, error)
+    end if
+    if (allocated(error)) call fail(error)
+    ! a second writer of the result file is refused before anything is built
+    if (allocated(restart_path) .or. .not. check) call results%h5%claim(case%output, error)
+    if (allocated(error)) call fail(error)
+    call discretize_bodies(case, discs, error, memory_check)
     if (allocated(error)) call fail(error)
     call read_rigid_curves(case, error)
     if (allocated(error)) call fail(error)
@@ -98,7 +84,7 @@ program voiga_main
     call check_edges(case, discs, error)
     if (allocated(error)) call fail(error)
 
-    if (allocated(dump_path)) then
+    if (len(dump_path) > 0) then
         call write_dump(dump_path, case, discs, error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
@@ -118,38 +104,30 @@ program voiga_main
     results%quiet = quiet
     results%verbose = verbose
     if (allocated(restart_path)) then
-        call read_restart(restart_path, model, resume, error)
-        if (allocated(error)) call fail(error)
-        case%output = restart_path
-        call results%reopen(restart_path, case, error)
-        if (allocated(error)) call fail(error)
-        if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
+        call restart_in_place()
     else
         call results%open(case, model, error)
+        ! a write that failed (a full disk): no exit handler may flush the rest
+        if (allocated(error) .and. results%h5%is_open()) call stop_writing(error)
         if (allocated(error)) call fail(error)
     end if
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
     call catch_signals()
     call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
     if (stats%signal /= 0) then
-        call results%finish('interrupted', wall_seconds() - t0, stats, finish_error)
-        if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//finish_error%message
+        call finish('interrupted')
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
-            ' completed steps are in '//case%output
+            ' completed steps '//where_kept()
         ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
         call exit_code(128 + stats%signal)
     end if
     if (allocated(error)) then
-        call results%finish('failed: '//error%message, wall_seconds() - t0, stats, finish_error)
-        if (allocated(finish_error)) then
-            write (0, '(a)') 'voiga: error: '//finish_error%message
-        else
-            write (0, '(a)') 'voiga: results of the converged steps are in '//case%output
-        end if
-        call fail(error)
+        call finish('failed: '//error%message)
+        write (0, '(a)') 'voiga: results of the converged steps '//where_kept()
+        write (0, '(a)') 'voiga: error: '//error%message
+        call exit_code(exit_status(error))
     end if
-    call results%finish('converged', wall_seconds() - t0, stats, error)
-    if (allocated(error)) call fail(error)
+    call finish('converged')
     write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
         ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
         wall_seconds() - t0, ' s; wrote '//case%output
@@ -159,26 +137,162 @@ program voiga_main
 
 contains
 
+    !> Under an address-space limit (`ulimit -v`) an OpenBLAS thread that cannot map
+    !> its work buffer (128 MiB of address space each) retries for ever, and the
+    !> program never ends: run again with one BLAS thread (whatever
+    !> OPENBLAS_NUM_THREADS said; the sparse solver gains little from more), map that
+    !> buffer while there is room for it (`warm_up_blas`), or stop if there is none.
+    subroutine single_blas_thread_under_a_memory_limit()
+        character(len=16) :: threads
+        integer :: status
+        integer(int64) :: physical, address
+        if (.not. address_space_limited()) return
+        call get_environment_variable('OPENBLAS_NUM_THREADS', threads, status=status)
+        if (status /= 0 .or. trim(threads) /= '1') then
+            if (status == 0) write (0, '(a)') 'voiga: note: one BLAS thread under an address-space '// &
+                'limit (ulimit -v), not OPENBLAS_NUM_THREADS = '//trim(threads)
+            call reexec_with_environment('OPENBLAS_NUM_THREADS', '1')
+        end if
+        call memory_available(physical, address)
+        if (address >= 0 .and. address < 160_int64*2_int64**20) then
+            write (0, '(a,i0,a)') 'voiga: error: the address-space limit (ulimit -v) leaves ', &
+                address/2_int64**20, ' MB; the BLAS library alone needs 128 MB of address space'
+            stop 1, quiet=.true.
+        end if
+        call warm_up_blas()
+    end subroutine single_blas_thread_under_a_memory_limit
+
+    subroutine parse_arguments()
+        character(len=:), allocatable :: arg
+        integer :: n, k
+        check = .false.
+        quiet = .false.
+        verbose = .false.
+        overwrite = .false.
+        force_restart = .false.
+        memory_check = .true.
+        dump_path = ''
+        n = command_argument_count()
+        k = 0
+        do while (k < n)
+            k = k + 1
+            arg = get_arg(k)
+            select case (arg)
+            case ('-h', '--help')
+                call usage()
+                stop
+            case ('--version')
+                write (*, '(a)') 'voiga '//voiga_version_string
+                stop
+            case ('--check')
+                check = .true.
+            case ('--quiet', '-q')
+                quiet = .true.
+            case ('--verbose', '-v')
+                verbose = .true.
+            case ('--overwrite')
+                overwrite = .true.
+            case ('--force-restart')
+                force_restart = .true.
+            case ('--no-memory-check')
+                memory_check = .false.
+            case ('--restart')
+                if (k == n) call fail_usage('--restart needs a result file')
+                k = k + 1
+                restart_path = get_arg(k)
+            case ('--dump')
+                if (k == n) call fail_usage('--dump needs a file name')
+                k = k + 1
+                dump_path = get_arg(k)
+                if (len(dump_path) == 0) call fail_usage('--dump needs a file name')
+            case default
+                if (len(arg) == 0) call fail_usage('an empty argument')
+                if (arg(1:1) == '-') call fail_usage("unknown option '"//arg//"'")
+                if (allocated(case_path)) call fail_usage("more than one case file given ('"// &
+                                                          case_path//"', '"//arg//"')")
+                case_path = arg
+            end select
+        end do
+        if (force_restart .and. .not. allocated(restart_path)) call fail_usage('--force-restart needs --restart')
+    end subroutine parse_arguments
+
+    !> Continue the run of the result file `restart_path` in it (its writer's lock
+    !> is taken): the checks (its run did not converge; same case and
+    !> geometry unless --force-restart), the state after its last step read.
+    subroutine restart_in_place()
+        call check_restart(case%output, case, force_restart, note, error)
+        if (allocated(error)) call fail(error)
+        if (len(note) > 0) write (0, '(a)') 'voiga: warning: --force-restart: '//note
+        call read_restart(case%output, model, resume, error)
+        if (allocated(error)) call fail(error)
+        call results%reopen(case%output, case, error, note)
+        if (allocated(error) .and. results%h5%broken) call stop_writing(error)
+        if (allocated(error)) call fail(error)
+        if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
+    end subroutine restart_in_place
+
+    !> Set the final status and close the result file; a write that failed (here or
+    !> before) ends the program at once (`stop_writing`), after the run's own error.
+    subroutine finish(status)
+        character(len=*), intent(in) :: status
+        call results%finish(status, wall_seconds() - t0, stats, finish_error)
+        if (.not. (allocated(finish_error) .or. results%h5%broken)) return
+        if (allocated(error)) then
+            if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//error%message
+            if (.not. allocated(finish_error)) call move_alloc(error, finish_error)
+        end if
+        call stop_writing(finish_error)
+    end subroutine finish
+
+    !> Where the steps of this run are: 'are in <file>', or, when it wrote none and
+    !> an earlier result was there, that this one is kept.
+    function where_kept() result(text)
+        character(len=:), allocatable :: text
+        if (results%h5%kept_earlier) then
+            text = '(none) are not written: the earlier '//case%output//' is kept as it was'
+        else
+            text = 'are in '//case%output
+        end if
+    end function where_kept
+
+    !> A write to the result file failed: say so and what is on disk, and leave
+    !> without exit handlers (HDF5's would write the half-written step).
+    subroutine stop_writing(err)
+        type(error_t), intent(in) :: err
+        write (0, '(a)') 'voiga: error: '//err%message
+        call results%h5%abandon()
+        if (results%h5%in_place) then
+            write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before are readable in '// &
+                case%output//" (its status may still say 'running')"
+        else if (results%h5%kept_earlier) then
+            write (0, '(a)') 'voiga: '//case%output//' is kept as it was'
+        end if
+        call leave(1)
+    end subroutine stop_writing
+
     function get_arg(k) result(val)
         integer, intent(in) :: k
         character(len=:), allocatable :: val
-        integer :: length
         call get_command_argument(k, length=length)
         allocate (character(len=length) :: val)
         call get_command_argument(k, val)
     end function get_arg
 
     subroutine usage()
-        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--quiet] [--verbose] [--restart R.h5]', &
-            '  (no option)    solve the case and write the result file it names', &
-            '  --check        validate the case, build the discretization, print DOF counts', &
-            '  --restart R.h5 continue the interrupted or failed run whose result file is R.h5', &
-            '  --dump FILE    write the refined discretization of every body to FILE (HDF5)', &
-            '  --quiet        no line per step', &
-            '  --verbose      a line per Newton iteration (residual, energy, contact states)', &
-            '  --version      print the version', &
-            'exit codes: 0 converged, 1 other failure, 2 bad input, 3 numerical failure,', &
-            '  130/143 interrupted by SIGINT/SIGTERM (completed steps kept)'
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--overwrite] [--quiet] [--verbose]', &
+            '       voiga [CASE.nml] --restart RESULT.h5 [--force-restart] [--quiet] [--verbose]', &
+            '  (no option)       solve the case and write the result file it names', &
+            '  --check           validate the case, build the discretization, print DOF counts', &
+            '  --overwrite       replace an existing result file (else refused)', &
+            '  --restart R.h5    continue the interrupted or failed run whose result file is R.h5', &
+            '  --force-restart   continue it although its case or geometry file changed', &
+            '  --dump FILE       write the refined discretization of every body to FILE (HDF5)', &
+            '  --no-memory-check run although the memory estimate exceeds the memory available', &
+            '  --quiet           no line per step', &
+            '  --verbose         a line per Newton iteration (residual, energy, contact states)', &
+            '  --version         print the version', &
+            'exit codes: 0 converged, 1 other failure (e.g. a full disk), 2 bad input, 3 numerical', &
+            '  failure, 130/143 interrupted by SIGINT/SIGTERM (completed steps kept)'
     end subroutine usage
 
     subroutine fail_usage(message)
@@ -194,17 +308,24 @@ contains
         stop code, quiet=.true.
     end subroutine exit_code
 
+    !> The exit code of an error: 2 bad input, 3 numerical failure, else 1.
+    integer function exit_status(err)
+        type(error_t), intent(in) :: err
+        select case (err%code)
+        case (error_code%input)
+            exit_status = 2
+        case (error_code%numeric)
+            exit_status = 3
+        case default
+            exit_status = 1
+        end select
+    end function exit_status
+
     subroutine fail(err)
         type(error_t), intent(in) :: err
         write (0, '(a)') 'voiga: error: '//err%message
-        select case (err%code)
-        case (error_code%input)
-            stop 2, quiet=.true.
-        case (error_code%numeric)
-            stop 3, quiet=.true.
-        case default
-            stop 1, quiet=.true.
-        end select
+        call results%h5%abandon()
+        call exit_code(exit_status(err))
     end subroutine fail
 
 end program voiga_main

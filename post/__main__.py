@@ -18,12 +18,18 @@ Steps (--step): N >= 1 is the step number, N < 0 counts converged steps from
 the end (-1: the last one), 0 is the reference configuration.
 Files are named <result stem>-<what>[-<step>].<ext> and written next to the result
 file, or into --out.
+
+A result whose run has not converged (running, failed, interrupted) is read as
+far as it goes, with a note on stderr naming its status and the step shown;
+`hertz`, which compares the final load, refuses it unless given --partial. A
+file that is not a readable result is refused in one line (exit code 2).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -43,17 +49,30 @@ def _scale(text: str) -> float | str:
     return value
 
 
-def _result(args: argparse.Namespace):
+def _read(path, command: str):
+    """The result file ``path``, with a note on stderr when its run has not
+    converged (the steps shown are those written so far)."""
     from .reader import read_result
 
-    return read_result(args.result)
+    result = read_result(path)
+    if not result.converged:
+        last = f"the last is step {result.steps[-1].step}" if result.steps else "none yet"
+        print(f"python -m post {command}: note: {path}: status {result.status!r}: "
+              f"{len(result.steps)} of {result.n_steps_planned} planned steps written ({last})",
+              file=sys.stderr)
+    return result
+
+
+def _result(args: argparse.Namespace):
+    """The result file of the command (``_read``)."""
+    return _read(args.result, args.command)
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .run import run_case
 
     return run_case(args.case, out=args.out, binary=args.binary, quiet=args.quiet,
-                    figures=not args.no_figures, vtk=not args.no_vtk)
+                    figures=not args.no_figures, vtk=not args.no_vtk, overwrite=args.overwrite)
 
 
 def _cmd_summary(args: argparse.Namespace) -> int:
@@ -121,16 +140,21 @@ def _cmd_plot_contact(args: argparse.Namespace) -> int:
 
 def _cmd_hertz(args: argparse.Namespace) -> int:
     from .hertz import HertzError, hertz_comparison, hertz_figure, hertz_report, plot_hertz
-    from .reader import read_result
 
     done, code = [], 0
     for path in args.result:
         try:
-            result = read_result(path)
+            result = _read(path, "hertz")
             if not result.steps:  # as every subcommand: no converged step is exit 1
                 print(f"python -m post hertz: {path} has no converged step (status "
                       f"{result.status!r})", file=sys.stderr)
                 code = max(code, 1)
+                continue
+            if not result.converged and not args.partial:
+                print(f"python -m post hertz: {path}: the run has not converged (status "
+                      f"{result.status!r}): the comparison is of the final load; give --partial to "
+                      f"compare step {result.steps[-1].step} anyway", file=sys.stderr)
+                code = 2
                 continue
             h = hertz_comparison(result, step=args.step, radius=args.radius,
                                  configuration=args.configuration)
@@ -293,6 +317,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--quiet", action="store_true", help="no per-step lines from voiga")
     s.add_argument("--no-figures", action="store_true", help="only solve and summarize")
     s.add_argument("--no-vtk", action="store_true", help="no ParaView files")
+    s.add_argument("--overwrite", action="store_true",
+                   help="replace an existing result in the case's own folder (with --out it is "
+                        "always replaced: the folder is this tool's)")
     s.set_defaults(func=_cmd_run)
 
     s = sub.add_parser("summary", help="what a result file says, in a few lines")
@@ -374,6 +401,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="folder for the figure (default: next to the (first) result); one "
                         "file: <result>-hertz-<step>.png, several: hertz-profiles.png")
     s.add_argument("--no-figure", action="store_true", help="only print the comparison")
+    s.add_argument("--partial", action="store_true",
+                   help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz)
     return p
 
@@ -384,6 +413,12 @@ def main(argv: list[str] | None = None) -> int:
     from .solver import InputError
 
     args = build_parser().parse_args(argv)
+
+    def note(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001
+        """A warning (e.g. a half-written step skipped) as one line on stderr."""
+        print(f"python -m post {args.command}: note: {message}", file=sys.stderr)
+
+    warnings.showwarning = note
     try:
         return int(args.func(args))
     except (InputError, FileNotFoundError) as err:
@@ -393,7 +428,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"python -m post {args.command}: {getattr(args, 'result', '')}: {err}",
               file=sys.stderr)
         return 2
-    except (KeyError, ValueError) as err:
+    except (KeyError, ValueError) as err:  # BadResultError: a file that is no readable result
         print(f"python -m post {args.command}: {err}", file=sys.stderr)
         return 2
 

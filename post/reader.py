@@ -15,8 +15,17 @@ shows for the Fortran arrays:
 
 Files of runs that are still going (status ``'running'``) or that failed
 (``'failed: <reason>'``) are read as well: they hold the converged steps
-written so far. A step group without its displacement (a run killed while
-writing it) is skipped with a warning.
+written so far. Only the steps the root attribute ``n_steps_done`` counts are
+read (voiga updates it last, once a step is whole); a step group beyond it or
+without its displacement (a run killed while writing it) is skipped with a
+warning.
+
+A running result is read safely (docs/hdf5.md, "Writing and reading a running
+result"): :func:`open_result` holds a shared ``flock`` on the file while it is
+open, so a read waits while voiga writes a step and never sees half of one,
+whatever ``HDF5_USE_FILE_LOCKING`` says. A file that is not a readable voiga
+result (empty, truncated, not HDF5, a group or dataset missing or malformed)
+raises :class:`BadResultError` naming the file and the cause.
 
 Step selection (:meth:`Result.select_step`, :func:`body_displacement`, the
 ``--step`` option of the command line): ``n >= 1`` is the step *number* (the
@@ -26,7 +35,13 @@ the last one), ``0`` is the reference configuration (zero displacement).
 
 from __future__ import annotations
 
+import errno
+import fcntl
+import os
+import time
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -38,6 +53,18 @@ from pre.h5io import read_curve, read_patch
 from pre.nurbs import Curve, Patch
 
 from .units import Units
+
+LOCK_WAIT: float = 60.0
+"""Seconds :func:`open_result` waits for a writer to finish a step."""
+
+READ_ATTEMPTS: int = 3
+"""Reads of a file that fail before :func:`read_result` calls it unreadable (voiga
+writes a step anyway when a read holds the file longer than 30 s)."""
+
+
+class BadResultError(ValueError):
+    """A file that is not a readable voiga result; the message names it and the cause."""
+
 
 STAGES: tuple[str, ...] = ("assembly", "contact", "factorization", "solve", "output")
 """Stages whose wall-clock seconds each step records (attrs ``seconds_<stage>``)."""
@@ -376,18 +403,50 @@ class Result:
         raise KeyError(f"no Dirichlet condition on {body}/{edge}")
 
 
-def _open(path: Path) -> h5py.File:
-    """Open read-only; a file still held by a running voiga is opened without
-    HDF5 file locking (it flushes after every step)."""
+@contextmanager
+def open_result(path: str | Path) -> Iterator[h5py.File]:
+    """Open a result file read-only while holding a shared ``flock`` on it: voiga
+    holds an exclusive one while it writes a step, so the file is read between
+    steps, whole (waits at most :data:`LOCK_WAIT` seconds). Use it for your own
+    h5py reads of a running result::
+
+        with open_result("run.h5") as f:
+            done = int(f.attrs["n_steps_done"])
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no result file {path}")
+    fd = os.open(path, os.O_RDONLY)
     try:
-        return h5py.File(path, "r")
-    except OSError as err:
-        if not path.is_file():
-            raise FileNotFoundError(f"no result file {path}") from err
+        deadline = time.monotonic() + LOCK_WAIT
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+                break
+            except OSError as err:
+                if err.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EINTR):
+                    break  # no locks on this file system: read as it is
+                if time.monotonic() > deadline:
+                    raise BadResultError(f"{path}: a writer has held the file for more than "
+                                         f"{LOCK_WAIT:g} s") from None
+                time.sleep(0.01)
         try:
-            return h5py.File(path, "r", locking=False)
-        except (OSError, TypeError):
-            raise err from None
+            f = h5py.File(path, "r")
+        except OSError as err:
+            raise BadResultError(f"{path}: not a readable HDF5 file ({_cause(err)})") from None
+        with f:
+            yield f
+    finally:
+        os.close(fd)
+
+
+def _cause(err: BaseException) -> str:
+    """The useful part of an h5py/HDF5 error message (its first line)."""
+    text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+    return text.removeprefix("Unable to synchronously open file ").strip("() ") or text
+
+
+_open = open_result
 
 
 def _read_body(name: str, g: h5py.Group) -> Body:
@@ -542,11 +601,30 @@ def read_result(path: str | Path, lazy: bool = False) -> Result:
     iterations, cuts, stage seconds, reactions) and the rest of a step (displacement,
     contact output, norms, load time, substeps) when it is first used, reopening the
     file then. The values are the same either way; a lazy step of a file that has
-    changed since (a run still going) reads the changed file.
+    changed since (a run still going) reads the changed file. A file that is not a
+    readable result raises :class:`BadResultError` (or FileNotFoundError).
     """
     path = Path(path)
+    for attempt in range(READ_ATTEMPTS):
+        try:
+            return _read_result(path, lazy)
+        except (BadResultError, FileNotFoundError):
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, AttributeError) as err:
+            # a writer that had to stop waiting for a slow read changes the file
+            # under it: read again; a damaged file fails every time
+            if attempt + 1 == READ_ATTEMPTS:
+                raise BadResultError(f"{path}: not a readable voiga result ({type(err).__name__}: "
+                                     f"{_cause(err)})") from err
+            time.sleep(0.2)
+    raise AssertionError("unreachable")
+
+
+def _read_result(path: Path, lazy: bool) -> Result:
     with _open(path) as f:
         attrs = _attrs(f)
+        if "status" not in attrs:
+            raise BadResultError(f"{path}: not a voiga result (no root attribute 'status')")
         bodies = [_read_body(name, g) for name, g in f["bodies"].items()] if "bodies" in f else []
         bodies.sort(key=lambda b: b.dof_offset)
         n_dofs = int(attrs.get("n_dofs", 0)) or sum(2 * b.ncp for b in bodies)
@@ -556,10 +634,15 @@ def read_result(path: str | Path, lazy: bool = False) -> Result:
                 a = _attrs(f["dirichlet"][key])
                 dirichlet.append(Dirichlet(body=str(a.get("body", "")),
                                            edge=str(a.get("edge", ""))))
+        done = int(attrs["n_steps_done"]) if "n_steps_done" in attrs else None
         steps = []
         if "steps" in f:
             sid = f["steps"].id
             for key in f["steps"]:
+                if done is not None and int(key) > done:
+                    warnings.warn(f"step group /steps/{key} is beyond n_steps_done = {done} "
+                                  "(a step being or half written); skipped", stacklevel=3)
+                    continue
                 s = _read_step(key, h5py.h5g.open(sid, key.encode()), len(dirichlet), path,
                                n_dofs, lazy)
                 if s is not None:

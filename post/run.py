@@ -5,7 +5,9 @@ writes the figures that fit the case (deformed bodies, load history, contact
 tractions when it has contact, the Hertz overlay for the hertz scene) and the
 ParaView files, and says where they are. With ``--out DIR`` the case is copied
 into DIR (its geometry path rewritten to point at the original) so that the
-result and every figure land there and nothing is written next to the input.
+result and every figure land there and nothing is written next to the input; a
+result there from an earlier run is replaced (DIR is this tool's). In the case's
+own folder an existing result is replaced only with ``overwrite``.
 """
 
 from __future__ import annotations
@@ -45,14 +47,14 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
 
 
 def run_case(case: str | Path, out: str | Path | None = None, binary: str | Path | None = None,
-             quiet: bool = False, figures: bool = True, vtk: bool = True) -> int:
+             quiet: bool = False, figures: bool = True, vtk: bool = True, overwrite: bool = False) -> int:
     """Solve ``case`` (staged into ``out`` when given), print the summary and write
     the figures; returns voiga's exit code (the figures are made of whatever
     converged, also after a failed run)."""
     case = Path(case)
     program = voiga_binary(binary)
     run = stage_case(case, Path(out)) if out is not None else case
-    code = run_voiga(program, run, quiet)
+    code = run_voiga(program, run, quiet, overwrite=overwrite or out is not None)
     path = result_path(run)
     if not path.is_file():
         print(f"voiga exited with {code} and wrote no result file {path}")

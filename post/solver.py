@@ -81,8 +81,9 @@ def result_path(case: Path) -> Path:
     return case.parent / str(output)
 
 
-def run_voiga(binary: Path, case: Path, quiet: bool = False) -> int:
-    """Run ``voiga CASE`` (its per-step lines go to the terminal unless ``quiet``);
+def run_voiga(binary: Path, case: Path, quiet: bool = False, overwrite: bool = False) -> int:
+    """Run ``voiga CASE`` (its per-step lines go to the terminal unless ``quiet``;
+    ``overwrite``: replace an existing result file, which voiga otherwise refuses);
     returns its exit code."""
-    args = [str(binary), str(case)] + (["--quiet"] if quiet else [])
+    args = [str(binary), str(case)] + (["--quiet"] if quiet else []) + (["--overwrite"] if overwrite else [])
     return subprocess.run(args, stdin=subprocess.DEVNULL).returncode

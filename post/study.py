@@ -28,7 +28,7 @@ from .measures import parse_file_measure
 from .sweep import REPO, SUMMARY_COLUMNS, Run, find_cases
 
 NAMELISTS: dict[str, frozenset[str]] = {
-    "case": frozenset({"title", "scene", "mesh", "layout", "geometry", "output", "n_bodies"}),
+    "case": frozenset({"title", "scene", "mesh", "layout", "geometry", "output", "n_bodies", "overwrite"}),
     "body": frozenset({"name", "material", "youngs_modulus", "poisson_ratio", "basis", "degree_xi",
                        "degree_eta", "nel_xi", "nel_eta", "knots_xi", "knots_eta", "contact_edge",
                        "layer_degree", "layer_elevations"}),

@@ -782,7 +782,8 @@ contains
             allocate (r(size(u)))
             call stiffness_pattern(model, k, error)
             if (allocated(error)) return
-            call new_assembly_map(model, k, map)
+            call new_assembly_map(model, k, map, error)
+            if (allocated(error)) return
             nnz_full = k%nnz()
             call assemble(model, u, 1.0_dp, r, stats, error, k, map)
             if (allocated(error)) return

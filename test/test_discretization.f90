@@ -2,12 +2,14 @@
 !> every layout, the VO element basis (partition of unity, non-negativity,
 !> derivatives by finite differences) and its conformity with the next row.
 module test_discretization
+    use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
+    use voiga_discretization_size, only: body_size_t, body_size
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle
     implicit none
@@ -28,7 +30,8 @@ contains
                     new_unittest('vo_basis_partition', test_vo_partition), &
                     new_unittest('vo_basis_derivatives_fd', test_vo_fd), &
                     new_unittest('vo_row_conforming', test_vo_conforming), &
-                    new_unittest('bad_layouts_refused', test_bad_layouts) &
+                    new_unittest('bad_layouts_refused', test_bad_layouts), &
+                    new_unittest('size_counted_without_building', test_size) &
                     ]
     end subroutine collect_discretization
 
@@ -372,5 +375,41 @@ contains
             deallocate (got)
         end subroutine expect
     end subroutine test_bad_layouts
+
+    !> The counts the memory check uses (`body_size`) are those of the built
+    !> discretization, for every layout of the paper, each contact edge, a patch
+    !> with a C0 interior knot (the die: multiplicity 2), mesh counts that do and do
+    !> not meet it, and explicit knots.
+    subroutine test_size(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=5), parameter :: names(9) = [character(len=5) :: 'L1', 'N2', 'N4', 'N6', 'NN4', &
+                                                    'NN6', 'NN2.1', 'NN2.2', 'NN2.3']
+        character(len=5), parameter :: edges(4) = [character(len=5) :: 'start', 'end', 'inner', 'outer']
+        integer, parameter :: meshes(2, 3) = reshape([6, 1, 5, 3, 3, 2], [2, 3])
+        type(discretization_t) :: d
+        type(layout_t) :: layout
+        type(body_size_t) :: counted
+        integer(int64) :: entries
+        integer :: k, e, m, el
+
+        do k = 1, size(names)
+            do e = 1, size(edges)
+                do m = 1, size(meshes, 2)
+                    layout = paper_layout(trim(names(k)), meshes(:, m), trim(edges(e)))
+                    if (m == 3) layout%knots_xi = [0.2_dp, 0.5_dp, 0.7_dp]
+                    call new_discretization(d, die(), layout, '', error)
+                    if (allocated(error)) return
+                    counted = body_size(die(), layout)
+                    entries = 0
+                    do el = 1, d%nel
+                        entries = entries + (2_int64*size(d%elements(el)%conn))**2
+                    end do
+                    call check(error, counted%ncp == d%ncp .and. counted%nel == d%nel .and. counted%entries == entries, &
+                               'counts of '//trim(names(k))//' with contact edge '//trim(edges(e)))
+                    if (allocated(error)) return
+                end do
+            end do
+        end do
+    end subroutine test_size
 
 end module test_discretization

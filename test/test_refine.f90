@@ -5,7 +5,7 @@ module test_refine
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_basis, only: distinct_knots, multiplicity
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_eval, curve_elevate, curve_insert
-    use voiga_nurbs_surface, only: nurbs_surface_t, surface_edge_curve
+    use voiga_nurbs_surface, only: nurbs_surface_t, surface_edge_curve, surface_eval, surface_reorient
     use voiga_test_fixtures, only: lcg_t, annulus_sector
     implicit none
     private
@@ -24,7 +24,8 @@ contains
                     new_unittest('insert_keeps_curve', test_insert), &
                     new_unittest('elevate_keeps_curve', test_elevate), &
                     new_unittest('elevate_multiplicities', test_elevate_mult), &
-                    new_unittest('circle_stays_circle', test_circle) &
+                    new_unittest('circle_stays_circle', test_circle), &
+                    new_unittest('turned_patch_keeps_the_map', test_turn) &
                     ]
     end subroutine collect_refine
 
@@ -159,5 +160,43 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_circle
+
+    !> A patch turned so that each of its edges becomes eta = 1 describes the same
+    !> map with the same orientation; the net is not square (5 x 2 control points),
+    !> the case gfortran 12 got wrong with `transpose` of a reversed section.
+    subroutine test_turn(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_surface_t) :: s, t
+        type(lcg_t) :: rng
+        real(dp) :: xs(2), xt(2), js(2, 2), jt(2, 2), a, b, old(2)
+        integer :: edge, k
+
+        s = annulus_sector([0.0_dp, 0.0_dp], 1.0_dp, 2.0_dp, 0.3_dp, 2)
+        do edge = 1, 4
+            t = s
+            call surface_reorient(t, edge)
+            call check(error, all(shape(t%cp) == [2, size(t%w, 1), size(t%w, 2)]) .and. &
+                       size(t%w, 1) == size(t%knots_xi) - t%degree(1) - 1 .and. &
+                       size(t%w, 2) == size(t%knots_eta) - t%degree(2) - 1, 'turned net and knots agree')
+            if (allocated(error)) return
+            do k = 1, 50
+                a = rng%uniform()
+                b = rng%uniform()
+                select case (edge)
+                case (1); old = [1.0_dp - b, a]
+                case (2); old = [b, 1.0_dp - a]
+                case (3); old = [1.0_dp - a, 1.0_dp - b]
+                case default; old = [a, b]
+                end select
+                call surface_eval(s, old(1), old(2), xs, js)
+                call surface_eval(t, a, b, xt, jt)
+                call check(error, norm2(xt - xs), 0.0_dp, 'turned patch: same point', abs=tol)
+                if (allocated(error)) return
+                call check(error, jt(1, 1)*jt(2, 2) - jt(1, 2)*jt(2, 1), js(1, 1)*js(2, 2) - js(1, 2)*js(2, 1), &
+                           'turned patch: same det J (orientation kept)', rel=tol)
+                if (allocated(error)) return
+            end do
+        end do
+    end subroutine test_turn
 
 end module test_refine

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import concurrent.futures
 import shutil
 import subprocess
 import sys
@@ -173,18 +174,27 @@ def test_running_file(running_h5: Path) -> None:
     assert [s.step for s in r.steps] == [1] and r.n_steps_done == 1
 
 
-def test_file_held_open_by_a_writer(running_h5: Path) -> None:
-    """A file another process holds open for writing (as a running voiga
-    does) can be read."""
-    code = ("import sys, time, h5py\n"
-            "f = h5py.File(sys.argv[1], 'r+')\n"
-            "print('open', flush=True)\n"
-            "time.sleep(60)\n")
+def test_read_waits_for_a_step_being_written(running_h5: Path) -> None:
+    """voiga holds an exclusive flock on the file while it writes a step (docs/hdf5.md):
+    a read waits for it, whatever HDF5_USE_FILE_LOCKING says, and then reads the file."""
+    code = ("import fcntl, os, sys, time\n"
+            "fd = os.open(sys.argv[1], os.O_RDONLY)\n"
+            "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+            "print('locked', flush=True)\n"
+            "sys.stdin.readline()\n"
+            "os.close(fd)\n")
     writer = subprocess.Popen([sys.executable, "-c", code, str(running_h5)],
-                              stdout=subprocess.PIPE, text=True)
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     try:
-        assert writer.stdout.readline().strip() == "open"
-        r = read_result(running_h5)
+        assert writer.stdout.readline().strip() == "locked"
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            reading = pool.submit(read_result, running_h5)
+            # the read cannot finish while the writer holds the lock, however long
+            # that is; it does once the writer lets go
+            assert not reading.done()
+            writer.stdin.write("go\n")
+            writer.stdin.flush()
+            r = reading.result(timeout=60)
     finally:
         writer.kill()
         writer.wait()

@@ -17,7 +17,7 @@ module voiga_discretization_patch
     implicit none
     private
 
-    public :: discretization_t, element_t, edge_t, new_discretization, edge_cps
+    public :: discretization_t, element_t, edge_t, new_discretization, edge_cps, new_knots
 
     !> One element (a knot-span rectangle).
     type :: element_t

@@ -6,7 +6,7 @@
 !> variable.
 module voiga_io_case
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_names
+    use voiga_io_namelist, only: nml_group_t, scan_groups
     use voiga_io_case_case, only: case_settings_t, read_case_group, resolve_path
     use voiga_io_case_body, only: read_body
     use voiga_io_case_solver, only: read_solver
@@ -49,8 +49,8 @@ contains
         character(len=*), intent(in) :: path
         type(case_t), intent(out) :: self
         type(error_t), allocatable, intent(out) :: error
-        integer :: u, ios, i
-        character(len=512) :: msg
+        type(nml_group_t), allocatable :: groups(:)
+        integer :: i
         logical :: exists
 
         inquire (file=path, exist=exists)
@@ -61,34 +61,32 @@ contains
         self%path = path
         i = index(path, '/', back=.true.)
         self%dir = path(1:i)
-        open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
-        if (ios /= 0) then
-            call fatal_error(error, "case file '"//path//"' cannot be read: "//trim(msg), error_code%input)
-            return
-        end if
-        call read_groups(u, self, error)
-        close (u)
+        call scan_groups(path, groups, error)
+        if (allocated(error)) return
+        call read_groups(groups, self, error)
     end subroutine read_case
 
-    !> Read every group of the case file open on unit `u`, in dependency order:
-    !> `&case`, the bodies, then `&solver` (the number of load phases) and the loads
-    !> and pairs that refer to both.
-    subroutine read_groups(u, self, error)
-        integer, intent(in) :: u
+    !> Read every group of the case file (`groups`, as scanned), in dependency
+    !> order: `&case`, the bodies, then `&solver` (the number of load phases) and
+    !> the loads and pairs that refer to both.
+    subroutine read_groups(groups, self, error)
+        type(nml_group_t), intent(in) :: groups(:)
         type(case_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: error
-        character(len=32), allocatable :: names(:)
+        integer, allocatable :: at(:)
         integer :: i, nph
 
-        call read_case_group(u, self%path, self%dir, self%case_settings_t, error)
+        call check_groups(self%path, groups, error)
         if (allocated(error)) return
-        call group_names(self%path, names)
-        call check_groups(self%path, names, self%n_bodies, error)
+        at = where_named(groups, 'case')
+        call read_case_group(groups(at(1))%text, self%path, self%dir, self%case_settings_t, error)
+        if (allocated(error)) return
+        at = where_named(groups, 'body')
+        call check_body_count(self%path, size(at), self%n_bodies, error)
         if (allocated(error)) return
         allocate (self%bodies(self%n_bodies))
-        rewind (u)
         do i = 1, self%n_bodies
-            call read_body(u, self%path, i, self%n_bodies, self%bodies(i), error)
+            call read_body(groups(at(i))%text, self%path, i, self%n_bodies, self%bodies(i), error)
             if (allocated(error)) return
         end do
         do i = 2, self%n_bodies
@@ -98,62 +96,130 @@ contains
                 return
             end if
         end do
-        if (any(names == 'solver')) then
-            call read_solver(u, self%path, self%solver, error)
+        at = where_named(groups, 'solver')
+        if (size(at) > 0) then
+            call read_solver(groups(at(1))%text, self%path, self%solver, error)
             if (allocated(error)) return
         else
             self%solver%n_steps = [1]
         end if
         nph = size(self%solver%n_steps)
-        allocate (self%dirichlet(count(names == 'dirichlet')), self%pressure(count(names == 'pressure')), &
-                  self%contact(count(names == 'contact')))
-        rewind (u)
-        do i = 1, size(self%dirichlet)
-            call read_dirichlet(u, self%path, i, nph, self%bodies, self%dirichlet(i), error)
+        at = where_named(groups, 'dirichlet')
+        allocate (self%dirichlet(size(at)))
+        do i = 1, size(at)
+            call read_dirichlet(groups(at(i))%text, self%path, i, nph, self%bodies, self%dirichlet(i), error)
             if (allocated(error)) return
         end do
-        rewind (u)
-        do i = 1, size(self%pressure)
-            call read_pressure(u, self%path, i, nph, self%bodies, self%pressure(i), error)
+        call check_duplicate_dirichlet(self%path, self%dirichlet, error)
+        if (allocated(error)) return
+        at = where_named(groups, 'pressure')
+        allocate (self%pressure(size(at)))
+        do i = 1, size(at)
+            call read_pressure(groups(at(i))%text, self%path, i, nph, self%bodies, self%pressure(i), error)
             if (allocated(error)) return
         end do
-        rewind (u)
-        do i = 1, size(self%contact)
-            call read_contact(u, self%path, i, nph, self%bodies, self%contact(i), error)
+        at = where_named(groups, 'contact')
+        allocate (self%contact(size(at)))
+        do i = 1, size(at)
+            call read_contact(groups(at(i))%text, self%path, i, nph, self%bodies, self%contact(i), error)
             if (allocated(error)) return
         end do
-        if (any(names == 'output')) call read_output(u, self%path, self%solver%total_steps(), self%field_output, &
-                                                     error)
+        call check_duplicate_contact(self%path, self%contact, error)
+        if (allocated(error)) return
+        at = where_named(groups, 'output')
+        if (size(at) > 0) call read_output(groups(at(1))%text, self%path, self%solver%total_steps(), &
+                                           self%field_output, error)
     end subroutine read_groups
 
-    !> Every group in the file is known, and there are exactly n_bodies &body groups.
-    subroutine check_groups(path, names, n_bodies, error)
-        character(len=*), intent(in) :: path
-        character(len=*), intent(in) :: names(:)
-        integer, intent(in) :: n_bodies
-        type(error_t), allocatable, intent(out) :: error
-        character(len=128) :: msg
+    !> Indices of the groups called `name`, in file order.
+    pure function where_named(groups, name) result(at)
+        type(nml_group_t), intent(in) :: groups(:)
+        character(len=*), intent(in) :: name
+        integer, allocatable :: at(:)
         integer :: i
-        do i = 1, size(names)
-            if (.not. any(known_groups == names(i))) then
-                call fatal_error(error, path//': unknown namelist group &'//trim(names(i))// &
+        at = pack([(i, i=1, size(groups))], groups%name == name)
+    end function where_named
+
+    !> Every group in the file is known, `&case` appears once, `&solver` and
+    !> `&output` at most once.
+    subroutine check_groups(path, groups, error)
+        character(len=*), intent(in) :: path
+        type(nml_group_t), intent(in) :: groups(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        do i = 1, size(groups)
+            if (.not. any(known_groups == groups(i)%name)) then
+                call fatal_error(error, path//': unknown namelist group &'//trim(groups(i)%name)// &
                                  ' (known: &case, &body, &solver, &dirichlet, &pressure, &contact, &output)', &
                                  error_code%input)
                 return
             end if
         end do
-        if (count(names == 'body') /= n_bodies) then
-            write (msg, '(a,i0,a,i0,a)') ': &case: n_bodies = ', n_bodies, ' but the file has ', &
-                count(names == 'body'), ' &body groups'
-            call fatal_error(error, path//trim(msg), error_code%input)
-            return
-        end if
-        if (count(names == 'case') /= 1 .or. count(names == 'solver') > 1 .or. count(names == 'output') > 1) then
+        if (count(groups%name == 'case') == 0) then
+            call fatal_error(error, path//': group &case is missing', error_code%input)
+        else if (count(groups%name == 'case') > 1 .or. count(groups%name == 'solver') > 1 .or. &
+                 count(groups%name == 'output') > 1) then
             call fatal_error(error, path//': groups &case, &solver and &output may appear once each', &
                              error_code%input)
-            return
         end if
     end subroutine check_groups
+
+    !> There are exactly n_bodies &body groups.
+    subroutine check_body_count(path, found, n_bodies, error)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: found, n_bodies
+        type(error_t), allocatable, intent(out) :: error
+        character(len=128) :: msg
+        if (found /= n_bodies) then
+            write (msg, '(a,i0,a,i0,a)') ': &case: n_bodies = ', n_bodies, ' but the file has ', found, &
+                ' &body groups'
+            call fatal_error(error, path//trim(msg), error_code%input)
+        end if
+    end subroutine check_body_count
+
+    !> No two &dirichlet groups prescribe the same component of the same edge (the
+    !> later would silently replace the earlier).
+    subroutine check_duplicate_dirichlet(path, dirichlet, error)
+        character(len=*), intent(in) :: path
+        type(dirichlet_settings_t), intent(in) :: dirichlet(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=128) :: msg
+        integer :: i, j, c
+        character(len=1), parameter :: names(2) = ['x', 'y']
+        do j = 2, size(dirichlet)
+            do i = 1, j - 1
+                if (dirichlet(i)%body /= dirichlet(j)%body .or. dirichlet(i)%edge /= dirichlet(j)%edge) cycle
+                do c = 1, 2
+                    if (.not. (dirichlet(i)%fix(c) .and. dirichlet(j)%fix(c))) cycle
+                    write (msg, '(a,i0,a,i0,a)') ': &dirichlet (', i, ') and (', j, ') both prescribe u'
+                    call fatal_error(error, path//trim(msg)//names(c)//" of edge '"//trim(dirichlet(j)%edge)// &
+                                     "' of body '"//trim(dirichlet(j)%body)//"' (give each component of an "// &
+                                     'edge once)', error_code%input)
+                    return
+                end do
+            end do
+        end do
+    end subroutine check_duplicate_dirichlet
+
+    !> No two &contact groups name the same slave and the same deformable master
+    !> (their contact would count twice; rigid masters may repeat: a floor and a wall).
+    subroutine check_duplicate_contact(path, contact, error)
+        character(len=*), intent(in) :: path
+        type(contact_settings_t), intent(in) :: contact(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=128) :: msg
+        integer :: i, j
+        do j = 2, size(contact)
+            do i = 1, j - 1
+                if (contact(i)%slave /= contact(j)%slave .or. contact(i)%master /= contact(j)%master .or. &
+                    contact(j)%master == 'rigid') cycle
+                write (msg, '(a,i0,a,i0,a)') ': &contact (', i, ') and (', j, ') are the same pair'
+                call fatal_error(error, path//trim(msg)//" (slave '"//trim(contact(j)%slave)//"', master '"// &
+                                 trim(contact(j)%master)//"'): its contact would count twice", error_code%input)
+                return
+            end do
+        end do
+    end subroutine check_duplicate_contact
 
     !> Every edge the loads name exists on its body's discretization `discs` (one
     !> per body, in order): the check that needs the geometry.

@@ -6,6 +6,7 @@ module voiga_io_dump
     use voiga_discretization_patch, only: discretization_t
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_io_case, only: case_t
+    use voiga_io_os, only: rename_file, remove_file, companion
     use voiga_version, only: voiga_version_string
     implicit none
     private
@@ -15,31 +16,39 @@ module voiga_io_dump
 contains
 
     !> The dump file `path` (`voiga --dump`): the case's metadata and the refined
-    !> bulk patch and VO layer of every body (`discs`, one per body).
+    !> bulk patch and VO layer of every body (`discs`, one per body). Written as
+    !> `path`.part and renamed to `path` when complete (a failed write leaves
+    !> whatever was at `path` before).
     subroutine write_dump(path, case, discs, error)
         character(len=*), intent(in) :: path
         type(case_t), intent(in) :: case
         type(discretization_t), intent(in) :: discs(:)
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: h5
+        type(error_t), allocatable :: close_error
         integer :: i
-        call h5%open(path, 'w', error)
+        call h5%open(companion(path, '.part'), 'w', error)
         if (allocated(error)) return
-        call h5%write_attr('/', 'title', case%title, error)
-        if (allocated(error)) return
-        call h5%write_attr('/', 'scene', case%scene, error)
-        if (allocated(error)) return
-        call h5%write_attr('/', 'mesh', case%mesh, error)
-        if (allocated(error)) return
-        call h5%write_attr('/', 'layout', case%layout, error)
-        if (allocated(error)) return
-        call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
-        if (allocated(error)) return
-        do i = 1, size(discs)
-            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i), error)
-            if (allocated(error)) return
-        end do
-        call h5%close(error)
+        steps: block
+            call h5%write_attr('/', 'title', case%title, error)
+            if (allocated(error)) exit steps
+            call h5%write_attr('/', 'scene', case%scene, error)
+            if (allocated(error)) exit steps
+            call h5%write_attr('/', 'mesh', case%mesh, error)
+            if (allocated(error)) exit steps
+            call h5%write_attr('/', 'layout', case%layout, error)
+            if (allocated(error)) exit steps
+            call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
+            if (allocated(error)) exit steps
+            do i = 1, size(discs)
+                call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i), error)
+                if (allocated(error)) exit steps
+            end do
+        end block steps
+        call h5%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
+        if (.not. allocated(error)) call rename_file(companion(path, '.part'), path, error)
+        if (allocated(error)) call remove_file(companion(path, '.part'))
     end subroutine write_dump
 
     !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`.
@@ -75,7 +84,7 @@ contains
     !> Write `curve` as the group `group` (degree (1,), knots, control_points (n, 2)
     !> and weights in h5py's shapes; the schema of the VO layer in docs/formats.md).
     subroutine write_curve(h5, group, curve, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: group
         type(nurbs_curve_t), intent(in) :: curve
         type(error_t), allocatable, intent(out) :: error

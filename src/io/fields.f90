@@ -16,7 +16,7 @@ contains
     !> The sampled fields `settings` asks for, of every body of `model` at `u`, under
     !> `g`/fields/<body> (docs/hdf5.md).
     subroutine write_fields(h5, g, settings, model, u, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(output_settings_t), intent(in) :: settings
         type(model_t), intent(in) :: model

@@ -5,13 +5,19 @@ module voiga_io_geometry
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
-    use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels
+    use voiga_nurbs_basis, only: distinct_knots
+    use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels, surface_eval
     use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
 
-    public :: read_patch, read_curve, validate_knots, geometry_units
+    public :: read_patch, read_curve, validate_knots, geometry_units, check_jacobian
+
+    !> Sample points per knot span and direction for the sign of det J (a fold
+    !> narrower than about 1/32 of a span of the exact geometry could hide between them).
+    integer, parameter :: samples = 32
 
 contains
 
@@ -66,6 +72,8 @@ contains
         end do
         surf%cp = cp
         surf%w = w
+        call check_jacobian(surf, where, error)
+        if (allocated(error)) return
         do i = 1, 4
             label = 'edge_'//trim(edge_labels(i))
             if (h5%has_attr(g, label)) then
@@ -208,6 +216,11 @@ contains
                              error_code%input)
             return
         end if
+        if (knots(p + 2) == knots(1) .or. knots(m - p - 1) == knots(m)) then
+            call fatal_error(error, what//' repeats its first or last knot more than degree + 1 times '// &
+                             '(a basis function would vanish everywhere)', error_code%input)
+            return
+        end if
         i = p + 2
         do while (i <= m - p - 1)
             mult = count(knots(p + 2:m - p - 1) == knots(i))
@@ -219,5 +232,52 @@ contains
             i = i + mult
         end do
     end subroutine validate_knots
+
+    !> The reference map of `surf` keeps its orientation: det J has one sign
+    !> (either: the solver integrates with |det J|) at `samples` x `samples` points
+    !> inside every knot span, and does not vanish there (|det J| > 1e-10 of its
+    !> largest value, the test of `pre`'s check_patch). A patch that folds over
+    !> itself is not a body: |det J| would count the folded part twice. The
+    !> boundary is not sampled: a collapsed edge (det J = 0 there) is allowed.
+    subroutine check_jacobian(surf, where, error)
+        type(nurbs_surface_t), intent(in) :: surf
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: bx(:), be(:), det(:), at(:, :)
+        real(dp) :: x(2), dx(2, 2), xi, eta, scale, sgn
+        integer :: i, j, a, b, n, k
+        character(len=160) :: buf
+        bx = distinct_knots(surf%knots_xi)
+        be = distinct_knots(surf%knots_eta)
+        n = (size(bx) - 1)*(size(be) - 1)*samples**2
+        allocate (det(n), at(4, n))
+        k = 0
+        do j = 1, size(be) - 1
+            do i = 1, size(bx) - 1
+                do b = 1, samples
+                    eta = be(j) + (be(j + 1) - be(j))*(real(b, dp) - 0.5_dp)/samples
+                    do a = 1, samples
+                        xi = bx(i) + (bx(i + 1) - bx(i))*(real(a, dp) - 0.5_dp)/samples
+                        call surface_eval(surf, xi, eta, x, dx)
+                        k = k + 1
+                        det(k) = dx(1, 1)*dx(2, 2) - dx(1, 2)*dx(2, 1)
+                        at(:, k) = [xi, eta, x]
+                    end do
+                end do
+            end do
+        end do
+        scale = maxval(abs(det))
+        sgn = sign(1.0_dp, det(maxloc(abs(det), 1)))
+        k = findloc(sgn*det > 1.0e-10_dp*scale, .false., 1)
+        if (.not. (scale > 0.0_dp) .or. k > 0) then
+            k = max(k, 1)
+            write (buf, '(2(f0.4,a),2(es11.4,a),es10.3)') at(1, k), ', ', at(2, k), '), x = (', at(3, k), ', ', &
+                at(4, k), '): det J = ', det(k)
+            call fatal_error(error, where//'the reference map folds over itself or degenerates (det J '// &
+                             'changes sign or vanishes at '//str(count(.not. sgn*det > 1.0e-10_dp*scale))// &
+                             ' of '//str(n)//' sample points; first at (xi, eta) = ('//trim(buf)//')', &
+                             error_code%input)
+        end if
+    end subroutine check_jacobian
 
 end module voiga_io_geometry

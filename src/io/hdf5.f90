@@ -35,7 +35,8 @@ module voiga_io_hdf5
                     h5screate_simple_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
                     h5gcreate_f, h5lexists_f, h5ldelete_f, h5tget_class_f, H5T_INTEGER_F, &
                     H5T_FLOAT_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, h5kind_to_type, &
-                    H5_INTEGER_KIND, h5eset_auto_f
+                    H5_INTEGER_KIND, h5eset_auto_f, h5pcreate_f, h5pclose_f, h5pset_file_locking_f, &
+                    H5P_FILE_ACCESS_F
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5_status, only: note, release, class_name, not_open, fits_integer
@@ -131,12 +132,16 @@ module voiga_io_hdf5
 contains
 
     !> Open `path`: mode 'r' read-only, 'rw' read-write, 'w' create (truncate).
-    !> A file this object had open is closed first.
+    !> A file this object had open is closed first. HDF5's own file locking is off:
+    !> a result file is guarded by the writer's lock file and its `flock` while a
+    !> step is written (`voiga_io_results`, docs/hdf5.md), whatever
+    !> HDF5_USE_FILE_LOCKING says, and HDF5's lock would exclude that `flock`.
     subroutine file_open(self, path, mode, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path, mode
         type(error_t), allocatable, intent(out) :: error
         integer :: st
+        integer(hid_t) :: fapl
         logical :: present
 
         call self%close(error)
@@ -144,6 +149,8 @@ contains
         call h5open_f(st)
         ! we report errors ourselves: no HDF5 error stack on stderr
         if (st == 0) call h5eset_auto_f(0, st)
+        if (st == 0) call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, st)
+        if (st == 0) call h5pset_file_locking_f(fapl, .false., .true., st)
         if (st /= 0) then
             call fatal_error(error, "cannot initialise the HDF5 library to open '"//path//"'")
             return
@@ -153,27 +160,26 @@ contains
             inquire (file=path, exist=present)
             if (.not. present) then
                 call fatal_error(error, "file '"//path//"' does not exist", error_code%input)
-                return
-            end if
-            call h5fopen_f(path, merge(H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, mode == 'r'), self%id, st)
-            if (st /= 0) then
-                self%id = -1
-                call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", &
-                                 error_code%input)
-                return
+            else
+                call h5fopen_f(path, merge(H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, mode == 'r'), self%id, st, &
+                               access_prp=fapl)
+                if (st /= 0) then
+                    self%id = -1
+                    call fatal_error(error, "file '"//path//"' is not a readable HDF5 file", &
+                                     error_code%input)
+                end if
             end if
         case ('w')
-            call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, st)
+            call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, st, access_prp=fapl)
             if (st /= 0) then
                 self%id = -1
                 call fatal_error(error, "cannot create HDF5 file '"//path//"'", error_code%input)
-                return
             end if
         case default
             call fatal_error(error, "unknown HDF5 open mode '"//mode//"'")
-            return
         end select
-        self%path = path
+        call h5pclose_f(fapl, st)
+        if (.not. allocated(error)) self%path = path
     end subroutine file_open
 
     !> Close the file (nothing to do if it is not open). Data HDF5 still held in

@@ -2,8 +2,11 @@
 !> discretization first, then one group per converged step, written and flushed
 !> when the step converges, and a final status ('converged', 'failed: ...',
 !> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
+!> Every write goes through `result_file_t`'s guards (what readers see, a second
+!> writer, a full disk: voiga_io_result_file).
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_version, only: voiga_version_string
@@ -11,6 +14,9 @@ module voiga_io_results
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization, write_curve
     use voiga_io_geometry, only: geometry_units
+    use voiga_io_os, only: path_exists
+    use voiga_io_result_file, only: result_file_t
+    use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
     use voiga_model_fields, only: output_settings_t
     use voiga_io_fields, only: write_fields
@@ -33,7 +39,7 @@ module voiga_io_results
     !> An open result file; as a `progress_t` it writes every converged step the
     !> solver reports (and the levels of a multigrid solver).
     type, extends(progress_t) :: results_t
-        type(h5file_t) :: h5
+        type(result_file_t) :: h5
         integer :: n_written = 0
         !> The sampled fields the case asks for (`&output`) and the run's last step.
         type(output_settings_t) :: fields
@@ -64,7 +70,7 @@ contains
 
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
-        call self%h5%open(case%output, 'w', error)
+        call self%h5%create(case%output, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
         if (allocated(error)) return
@@ -121,13 +127,15 @@ contains
         ! the geometry's units ('mm, N' from pre), else just consistent ones
         call self%h5%write_attr('/', 'units', geometry_units(case%geometry, 'consistent'), error)
         if (allocated(error)) return
+        call write_provenance(self%h5, case, error)
+        if (allocated(error)) return
         call self%h5%flush(error)
     end subroutine results_open
 
     !> The discretization, material and element layout of body `i` of `model` under
     !> /bodies/<name>.
     subroutine write_body(h5, model, i, material, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         type(model_t), intent(in) :: model
         integer, intent(in) :: i
         !> Name of the body's material law.
@@ -180,27 +188,59 @@ contains
         end associate
     end subroutine write_body
 
-    !> Reopen the result file of an earlier run of `case` to continue it: status
-    !> 'running', the steps it holds counted as written.
-    subroutine results_reopen(self, path, case, error)
+    !> Reopen the result file of an earlier run of `case` to continue it in place
+    !> (its writer's lock taken first): status 'running', the steps it holds counted
+    !> as written; `note` (a forced restart's overrides) is recorded as `restart_forced`.
+    subroutine results_reopen(self, path, case, error, note)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         type(case_t), intent(in) :: case
         type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: note
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
-        call self%h5%open(path, 'rw', error)
+        call self%h5%resume(path, error)
         if (allocated(error)) return
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
         if (allocated(error)) return
-        call self%h5%write_attr('/', 'status', 'running', error)
+        call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
-        call self%h5%flush(error)
+        call self%h5%write_attr('/', 'status', 'running', error)
+        if (.not. allocated(error) .and. present(note)) then
+            if (len(note) > 0) call self%h5%write_attr('/', 'restart_forced', note, error)
+        end if
+        call self%h5%end_write(error)
     end subroutine results_reopen
 
-    !> Write one converged step and the current displacement; flush.
+    !> Write one converged step (space reserved, readers kept out, flushed); the
+    !> first step gives the file its name.
     subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
                                   error, model)
+        class(results_t), intent(inout) :: self
+        type(step_record_t), intent(in) :: rec
+        real(dp), intent(in) :: u(:)
+        type(pair_slot_t), intent(in) :: pairs(:)
+        real(dp), intent(in) :: wall
+        type(cut_record_t), intent(in), optional :: cuts(:)
+        integer, intent(in), optional :: n_cuts
+        real(dp), intent(in), optional :: next_fraction, r0_max
+        type(error_t), allocatable, intent(out) :: error
+        !> The model of `u` (its bodies' sampled fields, when `&output` asks for them).
+        type(model_t), intent(in), optional :: model
+        if (self%h5%broken) return
+        ! at least 1 MiB, and for the first step its displacement, contact output
+        ! and metadata, generously
+        call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
+        if (allocated(error)) return
+        call write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, error, model)
+        call self%h5%end_write(error)
+        if (allocated(error)) return
+        call self%h5%place(error)
+    end subroutine results_write_step
+
+    !> Write one converged step and the current displacement; flush.
+    subroutine write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
+                                 error, model)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -285,13 +325,11 @@ contains
         call self%h5%write_attr('/', 'n_steps_done', self%n_written, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'wall_time', wall, error)
-        if (allocated(error)) return
-        call self%h5%flush(error)
-    end subroutine results_write_step
+    end subroutine write_step_groups
 
     !> Per-slave-point contact output of pair `k` under step group `g`.
     subroutine write_contact(h5, g, k, pair, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         integer, intent(in) :: k
         class(contact_pair_t), intent(in) :: pair
@@ -392,7 +430,7 @@ contains
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,
     !> fraction, new fraction), with their reasons as its attribute `reasons` (one line each).
     subroutine write_cuts(h5, g, cuts, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(cut_record_t), intent(in) :: cuts(:)
         type(error_t), allocatable, intent(out) :: error
@@ -416,16 +454,23 @@ contains
 
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and the
     !> run's counters of `stats` (every cut as /cuts when there is one, the Tresca
-    !> fixed point's, the multiplier updates), and close.
+    !> fixed point's, the multiplier updates), and close. The file is closed whatever fails (the first error is returned)
+    !> and given its name (`result_file_t%settle`); a broken file is not touched
+    !> (`abandon`), nor one with no room left for the status (it stays 'running',
+    !> every step written readable).
     subroutine results_finish(self, status, wall, stats, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
         real(dp), intent(in) :: wall
         type(solver_stats_t), intent(in) :: stats
         type(error_t), allocatable, intent(out) :: error
-        type(error_t), allocatable :: close_error
-        if (.not. self%h5%is_open()) return
+        if (self%h5%broken) then
+            call self%h5%abandon()
+            return
+        end if
+        if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)
         records: block
+            if (allocated(error) .or. .not. self%h5%is_open()) exit records
             call self%h5%write_attr('/', 'n_cuts', size(stats%cut_records), error)
             if (allocated(error)) exit records
             if (size(stats%cut_records) > 0) call write_cuts(self%h5, '', stats%cut_records, error)
@@ -441,9 +486,14 @@ contains
             call self%h5%write_attr('/', 'status', status, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'wall_time', wall, error)
+            if (allocated(error)) exit records
+            call self%h5%end_write(error)
         end block records
-        call self%h5%close(close_error)
-        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
+        if (self%h5%broken) then
+            call self%h5%abandon()
+        else
+            call self%h5%settle(self%n_written > 0, error)
+        end if
     end subroutine results_finish
 
     !> The solver is set up: the levels of its multigrid hierarchy.
@@ -467,21 +517,23 @@ contains
 
     !> A warning: one more line of the root attribute `warnings` (a line the file
     !> has already, e.g. a set-up warning repeated by a restart, is not repeated).
-    !> Written and flushed at once; a failure to write it is not the run's.
+    !> Written at once (space reserved, readers kept out, flushed); a failure to
+    !> write it is not the run's.
     subroutine results_warning(self, text)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: text
         type(error_t), allocatable :: error
         character(len=:), allocatable :: lines
-        if (.not. self%h5%is_open()) return
+        if (.not. self%h5%is_open() .or. self%h5%broken) return
         lines = ''
         if (self%h5%has_attr('/', 'warnings')) call self%h5%read_attr_str('/', 'warnings', lines, error)
         if (allocated(error)) return
         if (index(new_line('a')//lines//new_line('a'), new_line('a')//text//new_line('a')) > 0) return
         if (len(lines) > 0) lines = lines//new_line('a')
-        call self%h5%write_attr('/', 'warnings', lines//text, error)
+        call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
-        call self%h5%flush(error)
+        call self%h5%write_attr('/', 'warnings', lines//text, error)
+        call self%h5%end_write(error)
     end subroutine results_warning
 
     !> Write /multigrid_level_dofs (finest first) unless the file has it (restart).
@@ -489,11 +541,12 @@ contains
         class(results_t), intent(inout) :: self
         integer, intent(in) :: level_dofs(:)
         type(error_t), allocatable, intent(out) :: error
-        if (.not. self%h5%is_open()) return
+        if (.not. self%h5%is_open() .or. self%h5%broken) return
         if (self%h5%exists('/multigrid_level_dofs')) return
-        call self%h5%write('/multigrid_level_dofs', level_dofs, error)
+        call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
-        call self%h5%flush(error)
+        call self%h5%write('/multigrid_level_dofs', level_dofs, error)
+        call self%h5%end_write(error)
     end subroutine results_write_multigrid
 
     !> The case file recorded in the result file `path`.
@@ -502,9 +555,15 @@ contains
         character(len=:), allocatable, intent(out) :: case_file
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: f
+        character(len=:), allocatable :: absolute
         call f%open(path, 'r', error)
         if (allocated(error)) return
         call f%read_attr_str('/', 'case_file', case_file, error)
+        ! run from another folder: the absolute path recorded beside it
+        if (.not. allocated(error) .and. .not. path_exists(case_file) .and. f%has_attr('/', 'case_path')) then
+            call f%read_attr_str('/', 'case_path', absolute, error)
+            if (.not. allocated(error)) case_file = absolute
+        end if
         call close_read(f, error)
         if (allocated(error)) error%message = '--restart: '//error%message
     end subroutine restart_case

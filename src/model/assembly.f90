@@ -72,13 +72,15 @@ contains
         call solid_element(body%mat, body%points(e), ue, fe, ke, ok)
     end subroutine body_element
 
-    !> The positions of every bulk element's entries in `k` (built on its pattern).
-    subroutine new_assembly_map(model, k, map)
+    !> The positions of every bulk element's entries in `k` (built on its pattern);
+    !> an error when there is no memory for them (the largest array of a model).
+    subroutine new_assembly_map(model, k, map, error)
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(inout) :: k
         type(assembly_map_t), intent(out) :: map
+        type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: dofs(:), pos(:, :)
-        integer :: ib, e, nel, n, m, idx
+        integer :: ib, e, nel, n, m, idx, st
         nel = sum([(model%bodies(ib)%disc%nel, ib=1, size(model%bodies))])
         allocate (map%ptr(nel + 1))
         map%ptr(1) = 1
@@ -90,7 +92,12 @@ contains
                 map%ptr(idx + 1) = map%ptr(idx) + n*n
             end do
         end do
-        allocate (map%pos(map%ptr(nel + 1) - 1))
+        allocate (map%pos(map%ptr(nel + 1) - 1), stat=st)
+        if (st /= 0) then
+            call fatal_error(error, 'out of memory: the assembly map needs '// &
+                             str((map%ptr(nel + 1) - 1)/262144)//' MB')
+            return
+        end if
         idx = 0
         do ib = 1, size(model%bodies)
             do e = 1, model%bodies(ib)%disc%nel
@@ -266,7 +273,8 @@ contains
         if (all(old2new(map%pos) > 0)) then
             map%pos = old2new(map%pos)
         else
-            call new_assembly_map(model, k, map)
+            call new_assembly_map(model, k, map, error)
+            if (allocated(error)) return
         end if
         if (present(k_bulk)) then
             allocate (moved(k%nnz()), source=0.0_dp)

@@ -199,9 +199,7 @@ contains
             surf%degree = old%degree([2, 1])
             surf%knots_xi = flip_knots(old%knots_eta)
             surf%knots_eta = old%knots_xi
-            surf%cp = reshape(old%cp(:, :, size(old%w, 2):1:-1), &
-                              [2, size(old%w, 2), size(old%w, 1)], order=[1, 3, 2])
-            surf%w = transpose(old%w(:, size(old%w, 2):1:-1))
+            call turn(old, .false., surf%cp, surf%w)
             ! new xi0 = old eta1, new xi1 = old eta0, new eta0 = old xi0, new eta1 = old xi1
             surf%edge_names = old%edge_names([4, 3, 1, 2])
         case (1)
@@ -209,13 +207,38 @@ contains
             surf%degree = old%degree([2, 1])
             surf%knots_xi = old%knots_eta
             surf%knots_eta = flip_knots(old%knots_xi)
-            surf%cp = reshape(old%cp(:, size(old%w, 1):1:-1, :), &
-                              [2, size(old%w, 2), size(old%w, 1)], order=[1, 3, 2])
-            surf%w = transpose(old%w(size(old%w, 1):1:-1, :))
+            call turn(old, .true., surf%cp, surf%w)
             ! new xi0 = old eta0, new xi1 = old eta1, new eta0 = old xi1, new eta1 = old xi0
             surf%edge_names = old%edge_names([3, 4, 2, 1])
         end select
     end subroutine surface_reorient
+
+    !> The control net of `old` turned by a quarter, shapes [2, n_eta, n_xi] and
+    !> [n_eta, n_xi]: old point (i, j) becomes new point (j, n_xi + 1 - i) when
+    !> `flip_xi` (xi' = eta, eta' = 1 - xi), else (n_eta + 1 - j, i) (xi' = 1 - eta,
+    !> eta' = xi). Explicit loops into fresh arrays: gfortran 12
+    !> gives `x%w = transpose(y%w(n:1:-1, :))` the shape of the old `x%w` when that
+    !> is not square (the double free of a non-square patch turned to its xi0 or xi1).
+    pure subroutine turn(old, flip_xi, cp, w)
+        type(nurbs_surface_t), intent(in) :: old
+        logical, intent(in) :: flip_xi
+        real(dp), allocatable, intent(out) :: cp(:, :, :), w(:, :)
+        integer :: nx, ny, i, j
+        nx = size(old%w, 1)
+        ny = size(old%w, 2)
+        allocate (cp(2, ny, nx), w(ny, nx))
+        do j = 1, ny
+            do i = 1, nx
+                if (flip_xi) then
+                    cp(:, j, nx + 1 - i) = old%cp(:, i, j)
+                    w(j, nx + 1 - i) = old%w(i, j)
+                else
+                    cp(:, ny + 1 - j, i) = old%cp(:, i, j)
+                    w(ny + 1 - j, i) = old%w(i, j)
+                end if
+            end do
+        end do
+    end subroutine turn
 
     !> Knot vector of the reversed parameter u' = a + b - u.
     pure function flip_knots(knots) result(flipped)

@@ -105,7 +105,8 @@ contains
         self%settings = settings
         call stiffness_pattern(model, self%k, error)
         if (allocated(error)) return
-        call new_assembly_map(model, self%k, self%map)
+        call new_assembly_map(model, self%k, self%map, error)
+        if (allocated(error)) return
         call new_linear_solver(self%linear, settings%linear_solver, model, error)
         if (allocated(error)) return
         self%natural = trim(settings%damping) == 'natural'

@@ -77,6 +77,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: dof_ptr(:), dof_elems(:), rows(:)
         integer(i8) :: sumsq
+        integer :: st
 
         call check_element_lists(n, elem_ptr, elem_dofs, error)
         if (allocated(error)) return
@@ -87,7 +88,12 @@ contains
         if (allocated(error)) return
         deallocate (dof_elems, dof_ptr)
         call sort_columns(n, self%colptr, rows, self%rowind)
-        allocate (self%values(size(self%rowind)), source=0.0_c_double)
+        allocate (self%values(size(self%rowind)), source=0.0_c_double, stat=st)
+        if (st /= 0) then
+            call fatal_error(error, 'out of memory: the stiffness matrix needs '// &
+                             str(size(self%rowind)/131072)//' MB')
+            return
+        end if
         self%n = n
         self%missed = 0
     end subroutine new_csc_pattern
@@ -187,11 +193,15 @@ contains
         integer, allocatable, intent(out) :: rows(:)
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: mark(:), rows_new(:)
-        integer :: e, q, p, i, j
+        integer :: e, q, p, i, j, st
         integer(i8) :: top, cap, bound
 
         cap = max(int(n, i8) + sumsq/3, 16_i8)
-        allocate (rows(cap))
+        allocate (rows(cap), stat=st)
+        if (st /= 0) then
+            call fatal_error(error, 'out of memory: the stiffness pattern needs '//str(int(cap/262144))//' MB')
+            return
+        end if
         allocate (mark(n), source=0)
         top = 0
         colptr(1) = 0
@@ -203,7 +213,12 @@ contains
             end do
             if (top + bound > cap) then
                 cap = max(cap + cap/2, top + bound)
-                allocate (rows_new(cap))
+                allocate (rows_new(cap), stat=st)
+                if (st /= 0) then
+                    call fatal_error(error, 'out of memory: the stiffness pattern needs '// &
+                                     str(int(cap/262144))//' MB')
+                    return
+                end if
                 rows_new(1:top) = rows(1:top)
                 call move_alloc(rows_new, rows)
             end if

@@ -165,7 +165,8 @@ def test_fields_only_where_asked(run, tmp_path: Path) -> None:
     ``every = 0`` the last step only."""
     for output, want in ((None, []), ({"steps": [1]}, [1]), ({"every": 0}, [2]), ({}, [1, 2])):
         case = compressed_block(tmp_path, "linear", output=output)
-        assert run(case, "--quiet").returncode == 0
+        # the same folder each time: the earlier result is replaced on purpose
+        assert run(case, "--quiet", "--overwrite").returncode == 0
         with h5py.File(tmp_path / "block.h5") as h:
             have = [int(k) for k in h["steps"] if "fields" in h["steps"][k]]
         assert have == want, output

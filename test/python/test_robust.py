@@ -68,7 +68,7 @@ def test_cut_step_converges_and_is_recorded(run, tmp_path: Path) -> None:
         u_cut = step["displacement"][()]
     # the same equilibrium as 32 nominal steps (hyperelastic: no path dependence)
     block_case(tmp_path, steps="32")
-    res = run(case, "--quiet")
+    res = run(case, "--quiet", "--overwrite")
     assert res.returncode == 0, res.stderr
     with h5py.File(tmp_path / "out" / "block.h5") as f:
         assert f.attrs["n_cuts"] == 0 and "cuts" not in f

@@ -1,10 +1,9 @@
 !> The `&body` group: a body's name, material and discretization (layout).
 module voiga_io_case_body
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: unset, max_knots, take_knots, quoted, either
+    use voiga_io_case_values, only: check_length, unset, is_unset, max_knots, max_value, take_knots, quoted, either
     use voiga_model_body, only: body_settings_t
     use voiga_material_factory, only: material_names
     implicit none
@@ -14,15 +13,16 @@ module voiga_io_case_body
 
 contains
 
-    !> Read the next `&body` group (the `ibody`-th of `n_bodies`) from unit `u` and
-    !> validate it.
-    subroutine read_body(u, path, ibody, n_bodies, entry, error)
-        integer, intent(in) :: u
+    !> Read the `ibody`-th `&body` group (of `n_bodies`) from its text and validate it.
+    subroutine read_body(text, path, ibody, n_bodies, entry, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
         character(len=*), intent(in) :: path
         integer, intent(in) :: ibody, n_bodies
         type(body_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=32) :: name, material, basis, contact_edge
+        ! one character more than kept: a longer value is refused, not cut
+        character(len=33) :: name, material, basis, contact_edge
         real(dp) :: youngs_modulus, poisson_ratio
         integer :: degree_xi, degree_eta, nel_xi, nel_eta, layer_degree, layer_elevations, ios
         real(dp), allocatable :: knots_xi(:), knots_eta(:)
@@ -33,32 +33,37 @@ contains
 
         name = ''
         material = ''
-        youngs_modulus = unset
-        poisson_ratio = unset
+        youngs_modulus = unset()
+        poisson_ratio = unset()
         basis = 'nurbs'
         degree_xi = 2
         degree_eta = 2
         nel_xi = 1
         nel_eta = 1
         allocate (knots_xi(max_knots), knots_eta(max_knots))
-        knots_xi = unset
-        knots_eta = unset
+        knots_xi = unset()
+        knots_eta = unset()
         contact_edge = ''
         layer_degree = 0
         layer_elevations = 0
-        read (u, nml=body, iostat=ios, iomsg=msg)
+        read (text, nml=body, iostat=ios, iomsg=msg)
         if (ios /= 0) then
             if (is_iostat_end(ios)) then
                 write (msg, '(a,i0,a,i0,a)') ': n_bodies = ', n_bodies, ' but &body group ', ibody, &
                     ' is missing'
                 call fatal_error(error, path//trim(msg), error_code%input)
             else
-                call group_error(path, 'body', ibody, ios, msg, try_body, error)
+                call group_error(path, 'body', text, ios, msg, try_body, error)
             end if
             return
         end if
         write (msg, '(a,i0,a)') ': &body (', ibody, ')'
         where = path//trim(msg)
+        call check_length(name, 32, 'name', where//': ', error)
+        call check_length(material, 32, 'material', where//': ', error)
+        call check_length(basis, 32, 'basis', where//': ', error)
+        call check_length(contact_edge, 32, 'contact_edge', where//': ', error)
+        if (allocated(error)) return
         if (len_trim(name) == 0) then
             call fatal_error(error, where//': name is required', error_code%input)
             return
@@ -77,12 +82,23 @@ contains
         entry%layout%contact_edge = contact_edge
         entry%layout%layer_degree = layer_degree
         entry%layout%layer_elevations = layer_elevations
-        if (degree_xi > 20 .or. degree_eta > 20 .or. layer_degree + layer_elevations > 20) then
+        ! each count in its range before any arithmetic on them (no overflow)
+        if (degree_xi > 20 .or. degree_eta > 20 .or. layer_degree > 20 .or. layer_elevations > 20) then
             call fatal_error(error, where//'degrees above 20 are not supported', error_code%input)
             return
         end if
-        if (nel_xi > max_knots .or. nel_eta > max_knots) then
-            call fatal_error(error, where//'nel_xi and nel_eta must be <= 100000', error_code%input)
+        if (layer_degree + layer_elevations > 20) then
+            call fatal_error(error, where//'layer_degree + layer_elevations above 20 is not supported', &
+                             error_code%input)
+            return
+        end if
+        if (nel_xi < 1 .or. nel_eta < 1 .or. nel_xi > max_knots .or. nel_eta > max_knots) then
+            call fatal_error(error, where//'nel_xi and nel_eta must be between 1 and 100000', error_code%input)
+            return
+        end if
+        if (degree_xi < 1 .or. degree_eta < 1 .or. layer_degree < 0 .or. layer_elevations < 0) then
+            call fatal_error(error, where//'degree_xi and degree_eta must be >= 1, layer_degree and '// &
+                             'layer_elevations >= 0', error_code%input)
             return
         end if
         call take_knots(knots_xi, 'knots_xi', where, entry%layout%knots_xi, error)
@@ -113,15 +129,15 @@ contains
                              quoted(material_names), error_code%input)
             return
         end if
-        if (youngs_modulus == unset) then
+        if (is_unset(youngs_modulus)) then
             call fatal_error(error, where//'youngs_modulus is required', error_code%input)
             return
         end if
-        if (.not. (youngs_modulus > 0.0_dp .and. ieee_is_finite(youngs_modulus))) then
-            call fatal_error(error, where//'youngs_modulus must be finite and > 0', error_code%input)
+        if (.not. (youngs_modulus > 0.0_dp .and. youngs_modulus <= max_value)) then
+            call fatal_error(error, where//'youngs_modulus must be > 0 and <= 1e100', error_code%input)
             return
         end if
-        if (poisson_ratio == unset) then
+        if (is_unset(poisson_ratio)) then
             call fatal_error(error, where//'poisson_ratio is required', error_code%input)
             return
         end if

@@ -3,6 +3,7 @@
 module voiga_io_case_case
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
+    use voiga_io_case_values, only: check_length
     implicit none
     private
 
@@ -10,6 +11,8 @@ module voiga_io_case_case
 
     !> Most bodies in a case.
     integer, parameter :: max_bodies = 16
+    !> Longest text value of the group (Linux's PATH_MAX, 4096 with its NUL).
+    integer, parameter :: max_text = 4095
 
     !> The `&case` group (docs/formats.md).
     type :: case_settings_t
@@ -17,6 +20,8 @@ module voiga_io_case_case
         !> Geometry and output files, resolved against the case file's folder.
         character(len=:), allocatable :: geometry, output
         integer :: n_bodies = 0
+        !> May the run replace an existing result file at `output`?
+        logical :: overwrite = .false.
     end type case_settings_t
 
 contains
@@ -34,17 +39,20 @@ contains
         path = dir//name
     end function resolve_path
 
-    !> Read the `&case` group of the case file `path` (folder `dir`) from unit `u`
+    !> Read the `&case` group of the case file `path` (folder `dir`) from its text
     !> and validate it. The output defaults to the case file's name with `.h5`.
-    subroutine read_case_group(u, path, dir, self, error)
-        integer, intent(in) :: u
+    subroutine read_case_group(text, path, dir, self, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
         character(len=*), intent(in) :: path, dir
         type(case_settings_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: error
-        character(len=256) :: title, scene, mesh, layout, geometry, output
+        ! one character more than kept (and than a path may have): refused, not cut
+        character(len=max_text + 1) :: title, scene, mesh, layout, geometry, output
         integer :: n_bodies, ios, i
+        logical :: overwrite
         character(len=512) :: msg
-        namelist /case/ title, scene, mesh, layout, geometry, output, n_bodies
+        namelist /case/ title, scene, mesh, layout, geometry, output, n_bodies, overwrite
 
         title = ''
         scene = ''
@@ -53,11 +61,20 @@ contains
         geometry = ''
         output = ''
         n_bodies = 0
-        read (u, nml=case, iostat=ios, iomsg=msg)
+        overwrite = .false.
+        read (text, nml=case, iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call group_error(path, 'case', 1, ios, msg, try_case, error)
+            call group_error(path, 'case', text, ios, msg, try_case, error)
             return
         end if
+        call check_length(title, max_text, 'title', path//': &case: ', error)
+        call check_length(scene, max_text, 'scene', path//': &case: ', error)
+        call check_length(mesh, max_text, 'mesh', path//': &case: ', error)
+        call check_length(layout, max_text, 'layout', path//': &case: ', error)
+        call check_length(geometry, max_text, 'geometry', path//': &case: ', error)
+        call check_length(output, max_text, 'output', path//': &case: ', error)
+        if (allocated(error)) return
+        self%overwrite = overwrite
         self%title = trim(title)
         self%scene = trim(scene)
         self%mesh = trim(mesh)

@@ -4,7 +4,8 @@ module voiga_io_case_contact
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: unset, max_phases, body_index, quoted, phase_values
+    use voiga_io_case_values, only: check_length, unset, is_unset, max_value, max_phases, body_index, quoted, &
+        phase_values
     use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t, contact_method_names
     use voiga_contact_alm, only: default_alm_tolerance
@@ -15,17 +16,20 @@ module voiga_io_case_contact
 
 contains
 
-    !> Read the next (the `k`-th) `&contact` group from unit `u` for a case with
-    !> `bodies` and `nph` load phases, and validate it. penalty_tangent defaults to
-    !> penalty_normal.
-    subroutine read_contact(u, path, k, nph, bodies, entry, error)
-        integer, intent(in) :: u, k, nph
+    !> Read the `k`-th `&contact` group from its text for a case with `bodies` and
+    !> `nph` load phases, and validate it. penalty_normal not given: automatic;
+    !> penalty_tangent defaults to penalty_normal.
+    subroutine read_contact(text, path, k, nph, bodies, entry, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
+        integer, intent(in) :: k, nph
         character(len=*), intent(in) :: path
         type(body_settings_t), intent(in) :: bodies(:)
         type(contact_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=32) :: slave, master, rigid_curve
-        character(len=16) :: method
+        ! one character more than kept: a longer value is refused, not cut
+        character(len=33) :: slave, master, rigid_curve
+        character(len=17) :: method
         real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, tolerance
         real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases)
         integer :: n_gauss, ios
@@ -37,20 +41,26 @@ contains
         master = ''
         rigid_point = 0.0_dp
         rigid_normal = [0.0_dp, 1.0_dp]
-        penalty_normal = unset
-        penalty_tangent = unset
+        penalty_normal = unset()
+        penalty_tangent = unset()
         friction = 0.0_dp
         n_gauss = 0
         method = 'gpts'
         tolerance = default_alm_tolerance
         rigid_curve = ''
-        rigid_ux = unset
-        rigid_uy = unset
-        read (u, nml=contact, iostat=ios, iomsg=msg)
+        rigid_ux = unset()
+        rigid_uy = unset()
+        read (text, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call group_error(path, 'contact', k, ios, msg, try_contact, error)
+            call group_error(path, 'contact', text, ios, msg, try_contact, error)
             return
         end if
+        write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        call check_length(slave, 32, 'slave', path//trim(msg)//' ', error)
+        call check_length(master, 32, 'master', path//trim(msg)//' ', error)
+        call check_length(rigid_curve, 32, 'rigid_curve', path//trim(msg)//' ', error)
+        call check_length(method, 16, 'method', path//trim(msg)//' ', error)
+        if (allocated(error)) return
         entry = contact_settings_t(slave=slave, master=master, rigid_point=rigid_point, rigid_normal=rigid_normal, &
                                    rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
                                    penalty_tangent=penalty_tangent, friction=friction, n_gauss=n_gauss, &
@@ -61,8 +71,8 @@ contains
         call check_law(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
-        if (entry%penalty_normal == unset) entry%penalty_normal = 0.0_dp
-        if (entry%penalty_tangent == unset) entry%penalty_tangent = entry%penalty_normal
+        if (is_unset(entry%penalty_normal)) entry%penalty_normal = 0.0_dp
+        if (is_unset(entry%penalty_tangent)) entry%penalty_tangent = entry%penalty_normal
         call rigid_motion(entry, rigid_ux, rigid_uy, nph, path//trim(msg)//' ', error)
     contains
         subroutine try_contact(text, ios, msg)
@@ -109,9 +119,10 @@ contains
         else if (len_trim(c%rigid_curve) > 0) then
             return   ! the geometry file must have it (checked when it is read)
         else if (.not. all(ieee_is_finite(c%rigid_point)) .or. .not. all(ieee_is_finite(c%rigid_normal)) .or. &
-                 norm2(c%rigid_normal) <= 0.0_dp) then
+                 norm2(c%rigid_normal) <= 0.0_dp .or. any(abs(c%rigid_point) > max_value) .or. &
+                 any(abs(c%rigid_normal) > max_value)) then
             call fatal_error(error, where//'rigid_point must be finite and rigid_normal finite and '// &
-                             'nonzero', error_code%input)
+                             'nonzero (each entry at most 1e100 in magnitude)', error_code%input)
         end if
     end subroutine check_pair
 
@@ -123,7 +134,7 @@ contains
         integer, intent(in) :: nph
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
-        if (all(ux == unset) .and. all(uy == unset)) return
+        if (all(is_unset(ux)) .and. all(is_unset(uy))) return
         if (trim(c%master) /= 'rigid') then
             call fatal_error(error, where//"rigid_ux and rigid_uy move a rigid master: master = '"// &
                              trim(c%master)//"' is a body (move it by its &dirichlet)", error_code%input)
@@ -142,12 +153,13 @@ contains
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: e_max
-        if (c%penalty_normal /= unset .and. .not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
+        if (.not. is_unset(c%penalty_normal) .and. &
+            .not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
             call fatal_error(error, where//'penalty_normal must be finite and > 0 (or not given: automatic)', &
                              error_code%input)
         else if (.not. (c%friction >= 0.0_dp .and. ieee_is_finite(c%friction))) then
             call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
-        else if (c%friction > 0.0_dp .and. c%penalty_tangent /= unset .and. &
+        else if (c%friction > 0.0_dp .and. (.not. is_unset(c%penalty_tangent)) .and. &
                  .not. (c%penalty_tangent > 0.0_dp .and. ieee_is_finite(c%penalty_tangent))) then
             call fatal_error(error, where//'penalty_tangent must be finite and > 0 (or not given)', &
                              error_code%input)

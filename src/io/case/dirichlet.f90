@@ -3,7 +3,7 @@ module voiga_io_case_dirichlet
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: unset, max_phases, phase_values, check_body_edge
+    use voiga_io_case_values, only: check_length, unset, max_phases, phase_values, check_body_edge
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: dirichlet_settings_t
     implicit none
@@ -13,15 +13,18 @@ module voiga_io_case_dirichlet
 
 contains
 
-    !> Read the next (the `k`-th) `&dirichlet` group from unit `u` for a case with
-    !> `bodies` and `nph` load phases, and validate it.
-    subroutine read_dirichlet(u, path, k, nph, bodies, entry, error)
-        integer, intent(in) :: u, k, nph
+    !> Read the `k`-th `&dirichlet` group from its text for a case with `bodies` and
+    !> `nph` load phases, and validate it.
+    subroutine read_dirichlet(text, path, k, nph, bodies, entry, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
+        integer, intent(in) :: k, nph
         character(len=*), intent(in) :: path
         type(body_settings_t), intent(in) :: bodies(:)
         type(dirichlet_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=32) :: body, edge
+        ! one character more than kept: a longer value is refused, not cut
+        character(len=33) :: body, edge
         logical :: fix_x, fix_y
         real(dp) :: ux(max_phases), uy(max_phases)
         integer :: ios
@@ -33,15 +36,18 @@ contains
         edge = ''
         fix_x = .false.
         fix_y = .false.
-        ux = unset
-        uy = unset
-        read (u, nml=dirichlet, iostat=ios, iomsg=msg)
+        ux = unset()
+        uy = unset()
+        read (text, nml=dirichlet, iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call group_error(path, 'dirichlet', k, ios, msg, try_dirichlet, error)
+            call group_error(path, 'dirichlet', text, ios, msg, try_dirichlet, error)
             return
         end if
         write (msg, '(a,i0,a)') ': &dirichlet (', k, '): '
         where = path//trim(msg)//' '
+        call check_length(body, 32, 'body', where, error)
+        call check_length(edge, 32, 'edge', where, error)
+        if (allocated(error)) return
         call check_body_edge(bodies, body, edge, where, error)
         if (allocated(error)) return
         if (.not. (fix_x .or. fix_y)) then

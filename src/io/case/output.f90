@@ -4,7 +4,7 @@
 module voiga_io_case_output
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: quoted
+    use voiga_io_case_values, only: quoted, check_length
     use voiga_model_fields, only: output_settings_t, field_names
     implicit none
     private
@@ -16,17 +16,21 @@ module voiga_io_case_output
 
 contains
 
-    !> Read the `&output` group from unit `u` (rewound first) for a run of
-    !> `n_steps` steps and validate it. Defaults: every field, 3 samples per element
-    !> and direction, at every step.
-    subroutine read_output(u, path, n_steps, entry, error)
-        integer, intent(in) :: u, n_steps
+    !> Read the `&output` group from its text for a run of `n_steps` steps and
+    !> validate it. Defaults: every field, 3 samples per element and direction, at
+    !> every step.
+    subroutine read_output(text, path, n_steps, entry, error)
+        !> The group's text (`nml_group_t%text`).
+        character(len=*), intent(in) :: text(:)
+        integer, intent(in) :: n_steps
         character(len=*), intent(in) :: path
         type(output_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
-        character(len=16) :: fields(size(field_names) + 1)
-        integer :: samples, every, ios, i, k
-        integer, allocatable :: steps(:)
+        ! one character more than kept: a longer name is refused, not cut
+        character(len=17) :: fields(size(field_names) + 1)
+        integer :: samples, every, ios, i, k, n
+        integer, allocatable :: steps(:), first_read(:)
+        logical, allocatable :: given(:)
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /output/ fields, samples, every, steps
@@ -35,14 +39,24 @@ contains
         fields = ''
         samples = entry%samples
         every = entry%every
+        ! the entries of steps the group sets are those two reads with different
+        ! fillers agree on (no integer is a marker a user could not write)
         steps = 0
-        rewind (u)
-        read (u, nml=output, iostat=ios, iomsg=msg)
+        read (text, nml=output, iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call group_error(path, 'output', 1, ios, msg, try_output, error)
+            call group_error(path, 'output', text, ios, msg, try_output, error)
             return
         end if
+        first_read = steps
+        steps = 1
+        read (text, nml=output, iostat=ios, iomsg=msg)
+        given = steps == first_read
+        n = count(given)
         where = path//': &output: '
+        do i = 1, size(fields)
+            call check_length(fields(i), 16, 'fields', where, error)
+            if (allocated(error)) return
+        end do
         ! none named: all of them
         if (all(len_trim(fields) == 0)) fields(1:size(field_names)) = field_names
         do i = 1, size(fields)
@@ -60,16 +74,16 @@ contains
                              error_code%input)
         else if (every < 0) then
             call fatal_error(error, where//'every must be >= 0 (0: the last step only)', error_code%input)
-        else if (any(steps(count(steps /= 0) + 1:) /= 0)) then
+        else if (.not. all(given(1:n))) then
             call fatal_error(error, where//'steps must be one list starting at entry 1', error_code%input)
-        else if (any(steps < 0 .or. steps > n_steps)) then
+        else if (any(first_read(1:n) < 1 .or. first_read(1:n) > n_steps)) then
             write (msg, '(a,i0,a)') 'steps must lie between 1 and the number of steps (', n_steps, ')'
             call fatal_error(error, where//trim(msg), error_code%input)
         end if
         if (allocated(error)) return
         entry%samples = samples
         entry%every = every
-        if (count(steps /= 0) > 0) entry%steps = steps(1:count(steps /= 0))
+        if (n > 0) entry%steps = first_read(1:n)
     contains
         subroutine try_output(text, ios, msg)
             character(len=*), intent(in) :: text

@@ -3,22 +3,56 @@
 !> and knot lists taken from namelist arrays, and the lookup of a body by name.
 module voiga_io_case_values
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model_body, only: body_settings_t
     implicit none
     private
 
-    public :: unset, max_phases, max_knots, phase_values, take_knots, body_index, check_body_edge, quoted, either
+    public :: check_length, unset, is_unset, max_phases, max_knots, max_value, phase_values, take_knots, body_index, &
+              check_body_edge, quoted, either
 
-    !> Marks a namelist array entry the file did not set.
-    real(dp), parameter :: unset = -huge(1.0_dp)
+    !> The bits of `unset`: a quiet NaN with a payload no input can give (the
+    !> namelist reader gives every NaN it reads, `NaN(...)` included, the default
+    !> payload 0x7FF8000000000000).
+    integer(int64), parameter :: unset_bits = int(z'7FF8DEAD0000BEEF', int64)
+    !> Largest magnitude of a value (loads, moduli, coordinates): beyond it squares
+    !> and products in the residual overflow.
+    real(dp), parameter :: max_value = 1.0e100_dp
     !> Most load phases.
     integer, parameter :: max_phases = 64
     !> Most explicit knots one direction of one body may list.
     integer, parameter :: max_knots = 100000
 
 contains
+
+    !> A text value the reader read into a variable longer than `max_length` (the
+    !> length kept) is not longer than that: nothing is cut off without a word.
+    subroutine check_length(value, max_length, name, where, error)
+        character(len=*), intent(in) :: value, name, where
+        integer, intent(in) :: max_length
+        type(error_t), allocatable, intent(inout) :: error
+        character(len=16) :: buf
+        if (allocated(error)) return
+        if (len_trim(value) <= max_length) return
+        write (buf, '(i0)') max_length
+        call fatal_error(error, where//name//' is longer than '//trim(buf)//' characters', error_code%input)
+    end subroutine check_length
+
+    !> The marker of a namelist entry the file did not set (every real value a user
+    !> can write means itself); test with `is_unset`, never with `==` (a NaN). A
+    !> function, not a named constant: a module file keeps a NaN constant without
+    !> its payload.
+    elemental real(dp) function unset()
+        unset = transfer(unset_bits, 1.0_dp)
+    end function unset
+
+    !> Is `x` the marker of an entry the file did not set?
+    elemental logical function is_unset(x)
+        real(dp), intent(in) :: x
+        is_unset = transfer(x, 0_int64) == unset_bits
+    end function is_unset
 
     !> The names of a list as a message shows them: 'a', 'b', 'c'.
     pure function quoted(names) result(text)
@@ -44,20 +78,24 @@ contains
         integer :: n
         character(len=128) :: msg
         values = 0.0_dp
-        n = count(raw /= unset)
+        n = count(.not. is_unset(raw))
         if (n == 0) return
         if (.not. used) then
             call fatal_error(error, where//name//' is given but its component is not fixed', &
                              error_code%input)
             return
         end if
-        if (n /= nph .or. any(raw(1:nph) == unset)) then
+        if (n /= nph .or. any(is_unset(raw(1:nph)))) then
             write (msg, '(a,i0,a)') ' needs one value per load phase (', nph, ' phases in &solver n_steps)'
             call fatal_error(error, where//name//trim(msg), error_code%input)
             return
         end if
         if (.not. all(ieee_is_finite(raw(1:nph)))) then
             call fatal_error(error, where//name//' must be finite', error_code%input)
+            return
+        end if
+        if (any(abs(raw(1:nph)) > max_value)) then
+            call fatal_error(error, where//name//' must not exceed 1e100 in magnitude', error_code%input)
             return
         end if
         values = raw(1:nph)
@@ -70,9 +108,9 @@ contains
         real(dp), allocatable, intent(out) :: knots(:)
         type(error_t), allocatable, intent(out) :: error
         integer :: n
-        n = count(raw /= unset)
+        n = count(.not. is_unset(raw))
         if (n == 0) return
-        if (any(raw(1:n) == unset)) then
+        if (any(is_unset(raw(1:n)))) then
             call fatal_error(error, where//name//' must be given as one list starting at entry 1', &
                              error_code%input)
             return
