@@ -137,9 +137,9 @@ def structure_attacks() -> list[Attack]:
         "lone-amp": (BASE.replace("&solver", "& solver"), ["does not start a namelist group"]),
         "amp-end-outside": ("&end\n" + BASE, ["does not start a namelist group"]),
         "unknown-group": (BASE + "&friction mu = 0.3 /\n", ["unknown namelist group &friction"]),
-        "two-case": (BASE + BASE[:BASE.index("/") + 1], ["&case and &solver may appear once"]),
+        "two-case": (BASE + BASE[:BASE.index("/") + 1], ["groups &case, &solver and &output may appear once each"]),
         "two-solver": (BASE + BASE[i_solver:BASE.index("/", i_solver) + 1],
-                       ["&case and &solver may appear once"]),
+                       ["groups &case, &solver and &output may appear once each"]),
         "no-case": (BASE[BASE.index("/") + 1:], ["group &case is missing"]),
         "duplicate-dirichlet": (BASE + dirichlet + "\n", ["both prescribe ux", "'top'"]),
         "duplicate-dirichlet-y": (BASE + dirichlet.replace("fix_x = .true., ", "").replace("ux = 0.0, 0.3, ", "")
@@ -206,12 +206,21 @@ VARIABLES = [
     ("contact", "penalty_normal", REALS, False), ("contact", "penalty_tangent", REALS, False),
     ("contact", "friction", REALS, False), ("contact", "rigid_normal", REALS + ["0.0, 0.0", "1.0, 1.0"], False),
     ("contact", "rigid_point", REALS, True), ("contact", "n_gauss", INTS, True),
-    ("contact", "method", TEXTS + ["'mortar'"], True), ("contact", "master", TEXTS, True),
+    ("contact", "method", TEXTS + ["'mortar'", "'alm'"], True), ("contact", "master", TEXTS, True),
+    ("contact", "tolerance", REALS, False), ("contact", "rigid_curve", TEXTS, True),
+    ("contact", "rigid_ux", REALS + ["0.0, 0.1", "0.0, 0.1, 0.2"], False),
+    ("contact", "rigid_uy", REALS + ["0.0, -0.01"], False),
+    ("output", "fields", TEXTS + ["'stress'", "'von_mises', 'strain'", "'stress', 'stress'"], False),
+    ("output", "samples", INTS, True), ("output", "every", INTS, True),
+    ("output", "steps", INTS + ["1, 3", "3, 1", "4", "5"], True),
 ]
 
 
 def set_value(text: str, group: str, name: str, value: str) -> str:
-    """`text` with `name = value` in `group` (replacing the variable's assignment)."""
+    """`text` with `name = value` in `group` (replacing the variable's assignment; a
+    group the text lacks is added)."""
+    if "&" + group not in text:
+        text = text + f"&{group}\n/\n"
     i = text.index("&" + group)
     j = text.index("/\n", i)
     body = text[i:j]
