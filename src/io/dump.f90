@@ -1,6 +1,7 @@
 !> Writing a body's discretization (refined bulk patch, VO layer, DOF counts)
 !> to HDF5, in the schema of docs/formats.md ("discretization dump").
 module voiga_io_dump
+    use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_io_hdf5, only: h5file_t
     use voiga_discretization_patch, only: discretization_t
@@ -11,7 +12,7 @@ module voiga_io_dump
     implicit none
     private
 
-    public :: write_discretization, write_dump, write_curve
+    public :: write_discretization, write_dump, write_curve, write_elements
 
 contains
 
@@ -96,5 +97,47 @@ contains
         if (allocated(error)) return
         call h5%write(group//'/weights', curve%w, error)
     end subroutine write_curve
+
+    !> The refined control net of `disc` under group `g` of a result file, and its
+    !> element layout as post reads it: elements/ptr and conn (CSR of each element's
+    !> control points), elements/vo (1 in the VO layer), elements/range ([xi0, xi1,
+    !> eta0, eta1] per element) and each edge's control points (docs/hdf5.md).
+    subroutine write_elements(h5, g, disc, error)
+        class(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: g
+        type(discretization_t), intent(in) :: disc
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        integer, allocatable :: ptr(:), conn(:), vo(:)
+        real(dp), allocatable :: ranges(:, :)
+
+        call h5%write(g//'/control_points', disc%x, error)
+        if (allocated(error)) return
+        call h5%write(g//'/weights', disc%w, error)
+        if (allocated(error)) return
+        allocate (ptr(disc%nel + 1), vo(disc%nel), ranges(4, disc%nel))
+        ptr(1) = 1
+        do k = 1, disc%nel
+            ptr(k + 1) = ptr(k) + size(disc%elements(k)%conn)
+            vo(k) = merge(1, 0, disc%elements(k)%span_layer > 0)
+            ranges(:, k) = [disc%elements(k)%xi, disc%elements(k)%eta]
+        end do
+        allocate (conn(ptr(disc%nel + 1) - 1))
+        do k = 1, disc%nel
+            conn(ptr(k):ptr(k + 1) - 1) = disc%elements(k)%conn
+        end do
+        call h5%write(g//'/elements/ptr', ptr, error)
+        if (allocated(error)) return
+        call h5%write(g//'/elements/conn', conn, error)
+        if (allocated(error)) return
+        call h5%write(g//'/elements/vo', vo, error)
+        if (allocated(error)) return
+        call h5%write(g//'/elements/range', ranges, error)
+        if (allocated(error)) return
+        do k = 1, 4
+            call h5%write(g//'/edges/'//trim(disc%edges(k)%name), disc%edges(k)%cps, error)
+            if (allocated(error)) return
+        end do
+    end subroutine write_elements
 
 end module voiga_io_dump

@@ -12,7 +12,7 @@ module voiga_io_results
     use voiga_version, only: voiga_version_string
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
-    use voiga_io_dump, only: write_discretization, write_curve
+    use voiga_io_dump, only: write_discretization, write_curve, write_elements
     use voiga_io_geometry, only: geometry_units
     use voiga_io_os, only: path_exists
     use voiga_io_result_file, only: result_file_t
@@ -141,10 +141,7 @@ contains
         !> Name of the body's material law.
         character(len=*), intent(in) :: material
         type(error_t), allocatable, intent(out) :: error
-        integer :: k
         character(len=:), allocatable :: g
-        integer, allocatable :: ptr(:), conn(:), vo(:)
-        real(dp), allocatable :: ranges(:, :)
 
         associate (b => model%bodies(i))
             g = '/bodies/'//trim(b%name)
@@ -158,33 +155,7 @@ contains
             if (allocated(error)) return
             call h5%write_attr(g, 'dof_offset', b%dof0, error)
             if (allocated(error)) return
-            call h5%write(g//'/control_points', b%disc%x, error)
-            if (allocated(error)) return
-            call h5%write(g//'/weights', b%disc%w, error)
-            if (allocated(error)) return
-            allocate (ptr(b%disc%nel + 1), vo(b%disc%nel), ranges(4, b%disc%nel))
-            ptr(1) = 1
-            do k = 1, b%disc%nel
-                ptr(k + 1) = ptr(k) + size(b%disc%elements(k)%conn)
-                vo(k) = merge(1, 0, b%disc%elements(k)%span_layer > 0)
-                ranges(:, k) = [b%disc%elements(k)%xi, b%disc%elements(k)%eta]
-            end do
-            allocate (conn(ptr(b%disc%nel + 1) - 1))
-            do k = 1, b%disc%nel
-                conn(ptr(k):ptr(k + 1) - 1) = b%disc%elements(k)%conn
-            end do
-            call h5%write(g//'/elements/ptr', ptr, error)
-            if (allocated(error)) return
-            call h5%write(g//'/elements/conn', conn, error)
-            if (allocated(error)) return
-            call h5%write(g//'/elements/vo', vo, error)
-            if (allocated(error)) return
-            call h5%write(g//'/elements/range', ranges, error)
-            if (allocated(error)) return
-            do k = 1, 4
-                call h5%write(g//'/edges/'//trim(b%disc%edges(k)%name), b%disc%edges(k)%cps, error)
-                if (allocated(error)) return
-            end do
+            call write_elements(h5, g, b%disc, error)
         end associate
     end subroutine write_body
 
