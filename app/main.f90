@@ -9,6 +9,7 @@ program voiga_main
     use voiga_io_dump, only: write_dump
     use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
     use voiga_io_outputs, only: check_outputs, resolve_restart
+    use voiga_io_os, only: canonical_path
     use voiga_io_provenance, only: check_restart
     use voiga_io_results, only: restart_case, read_restart
     use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
@@ -46,6 +47,9 @@ program voiga_main
     ! reuse freed memory across factorizations (glibc; without it, only slower)
     call keep_freed_memory(heap_ok)
     call parse_arguments()
+    ! a run still writing the restart file is refused before the file is read (it may
+    ! be mid-step)
+    if (allocated(restart_path)) call claim_restart_file()
     if (allocated(restart_path) .and. .not. allocated(case_path)) then
         ! the case the interrupted run was started from
         call restart_case(restart_path, case_path, error)
@@ -215,6 +219,18 @@ contains
         end do
         if (force_restart .and. .not. allocated(restart_path)) call fail_usage('--force-restart needs --restart')
     end subroutine parse_arguments
+
+    !> Take the writer's lock of the result file `restart_path` when it exists (by
+    !> its canonical name, as the run writing it took it); a missing file is reported
+    !> by its reader.
+    subroutine claim_restart_file()
+        character(len=:), allocatable :: resolved
+        type(error_t), allocatable :: missing
+        call canonical_path(restart_path, resolved, missing)
+        if (allocated(missing)) return
+        call results%h5%claim(resolved, error)
+        if (allocated(error)) call fail(error)
+    end subroutine claim_restart_file
 
     !> Continue the run of the result file `restart_path` in it (its writer's lock
     !> is taken): the checks (its run did not converge; same case and
