@@ -106,7 +106,7 @@ contains
         call stiffness_pattern(model, self%k, error)
         if (allocated(error)) return
         call new_assembly_map(model, self%k, self%map)
-        call new_linear_solver(self%linear, settings%linear_solver, model, error)
+        call new_linear_solver(self%linear, settings%linear_solver, model, error, settings%reuse_linear_bulk)
         if (allocated(error)) return
         self%natural = trim(settings%damping) == 'natural'
         self%x0 = reference_coordinates(model)
