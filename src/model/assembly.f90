@@ -34,6 +34,9 @@ module voiga_model_assembly
         integer, allocatable :: ptr(:)
         !> Index into the matrix values of entry (a, b) of each element, column-major.
         integer, allocatable :: pos(:)
+        !> Keep the linear-elastic bodies' stiffness (false: integrate every body at
+        !> every assembly, as for nonlinear ones).
+        logical :: keep_linear = .true.
         !> Per body [nbodies]: its stiffness when it is linear-elastic and was assembled
         !> on this pattern (values allocated), else nothing.
         type(body_stiffness_t), allocatable :: linear(:)
@@ -271,6 +274,7 @@ contains
         integer, allocatable :: old2new(:)
         real(dp), allocatable :: moved(:)
         integer :: p
+        logical :: keep_linear
 
         if (.not. present(map)) then
             call stiffness_pattern(model, k, error)
@@ -287,7 +291,9 @@ contains
         if (all(old2new(map%pos) > 0)) then
             map%pos = old2new(map%pos)
         else
+            keep_linear = map%keep_linear
             call new_assembly_map(model, k, map)
+            map%keep_linear = keep_linear
         end if
         if (present(k_bulk)) then
             allocate (moved(k%nnz()), source=0.0_dp)
@@ -364,8 +370,8 @@ contains
         r = 0.0_dp
         if (present(k)) call k%zero()
         keep = .false.
-        if (present(k) .and. present(map)) then
-            keep = .true.
+        if (present(k) .and. present(map)) keep = map%keep_linear
+        if (keep) then
             if (.not. allocated(map%linear)) allocate (map%linear(size(model%bodies)))
         end if
         idx = 0

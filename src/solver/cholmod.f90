@@ -25,8 +25,9 @@ module voiga_solver_cholmod
     type, extends(linear_solver_t) :: cholmod_t
         !> Factorizations so far (each an ordering and a numeric factorization; read only).
         integer :: n_factor = 0
-        !> Flops of the last factorization and log10 det of its matrix (read only).
-        real(dp) :: flops = 0.0_dp, log10_det = 0.0_dp
+        !> Flops of the last factorization, log10 det of its matrix and CHOLMOD's
+        !> reciprocal condition estimate, (min / max diagonal of L)^2 (read only).
+        real(dp) :: flops = 0.0_dp, log10_det = 0.0_dp, rcond = 0.0_dp
         integer, private :: n = 0
         type(c_ptr), private :: handle = c_null_ptr
     contains
@@ -45,14 +46,14 @@ module voiga_solver_cholmod
     end type cholmod_t
 
     interface
-        function voiga_cholmod_factor(n, colptr, rowind, values, handle, flops, log10_det) result(status) &
+        function voiga_cholmod_factor(n, colptr, rowind, values, handle, flops, log10_det, rcond) result(status) &
             bind(c, name='voiga_cholmod_factor')
             import :: c_int, c_double, c_ptr
             integer(c_int), value :: n
             integer(c_int), intent(in) :: colptr(*), rowind(*)
             real(c_double), intent(in) :: values(*)
             type(c_ptr), intent(out) :: handle
-            real(c_double), intent(out) :: flops, log10_det
+            real(c_double), intent(out) :: flops, log10_det, rcond
             integer(c_int) :: status
         end function voiga_cholmod_factor
 
@@ -82,7 +83,7 @@ contains
         integer(c_int) :: status
         call cholmod_release(self)
         status = voiga_cholmod_factor(int(a%n, c_int), a%colptr, a%rowind, a%values, self%handle, &
-                                      self%flops, self%log10_det)
+                                      self%flops, self%log10_det, self%rcond)
         if (status == 1) then
             call fatal_error(error, 'cholmod: the matrix is not positive definite', error_code%numeric)
             return

@@ -36,9 +36,10 @@ static double log10_determinant(const cholmod_factor *f)
 /* Cholesky factorization of the symmetric n x n matrix whose lower triangle is
  * given in CSC form (0-based colptr [n+1], rowind, values; entries above the
  * diagonal are ignored). On success *handle owns the factor; *flops is the
- * factorization's flop count and *log10_det log10 det A. */
+ * factorization's flop count, *log10_det log10 det A and *rcond CHOLMOD's
+ * reciprocal condition estimate, (min / max diagonal of L)^2. */
 int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const double *values, void **handle,
-                         double *flops, double *log10_det)
+                         double *flops, double *log10_det, double *rcond)
 {
     voiga_cholmod *h;
     cholmod_sparse *a;
@@ -86,6 +87,7 @@ int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const doub
     }
     *flops = h->common.fl;
     *log10_det = log10_determinant(h->factor);
+    *rcond = cholmod_rcond(h->factor, &h->common);
     *handle = h;
     return 0;
 }

@@ -106,6 +106,7 @@ contains
         call stiffness_pattern(model, self%k, error)
         if (allocated(error)) return
         call new_assembly_map(model, self%k, self%map)
+        self%map%keep_linear = settings%reuse_linear_bulk
         call new_linear_solver(self%linear, settings%linear_solver, model, error, settings%reuse_linear_bulk)
         if (allocated(error)) return
         self%natural = trim(settings%damping) == 'natural'
