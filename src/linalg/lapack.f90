@@ -80,13 +80,14 @@ contains
         call dgetrf(size(a, 1), size(a, 2), a, size(a, 1), ipiv, info)
     end subroutine lu_factor
 
-    !> Solve a x = b with the factors of `lu_factor` (LAPACK dgetrs); `b` [n] holds x on exit.
+    !> Solve a X = B with the factors of `lu_factor` (LAPACK dgetrs); `b` [n, nrhs]
+    !> holds X on exit.
     pure subroutine lu_solve(lu, ipiv, b, info)
         real(dp), intent(in) :: lu(:, :)
         integer, intent(in) :: ipiv(:)
-        real(dp), intent(inout) :: b(:)
+        real(dp), intent(inout) :: b(:, :)
         integer, intent(out) :: info
-        call dgetrs('N', size(lu, 1), 1, lu, size(lu, 1), ipiv, b, size(b), info)
+        call dgetrs('N', size(lu, 1), size(b, 2), lu, max(1, size(lu, 1)), ipiv, b, max(1, size(b, 1)), info)
     end subroutine lu_solve
 
     !> LU factorization with partial pivoting of an n x n band matrix with `kl`

@@ -80,6 +80,7 @@ module voiga_solver_bulk_update
     contains
         procedure :: factor => bulk_factor
         procedure :: solve => bulk_solve
+        procedure :: solve_columns => bulk_solve_columns
         procedure :: has_determinant => bulk_has_determinant
         procedure :: determinant => bulk_determinant
         procedure :: factorizations => bulk_factorizations
@@ -242,7 +243,7 @@ contains
                 self%known(q0 + k) = new(k1 + k - 1)
                 self%slot(new(k1 + k - 1)) = q0 + k
             end do
-            call self%chol%solve_columns(e, x, error)
+            call self%chol%solve_columns(self%k0, e, x, error)
             if (allocated(error)) return
             self%ns = q0 + nb
             self%s(:self%ns, q0 + 1:self%ns) = x(self%known(:self%ns), :)
@@ -321,25 +322,41 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Ignored: a direct solve.
         type(solve_accuracy_t), intent(in), optional :: accuracy
-        real(dp), allocatable :: y(:), rhs(:)
-        integer :: info
+        real(dp) :: xx(size(x), 1)
+        call bulk_solve_columns(self, a, reshape(b, [size(b), 1]), xx, error)
+        x = xx(:, 1)
+    end subroutine bulk_solve
+
+    !> Solve a X = B (shapes [n, nrhs]): X0 = K0^-1 B, (I + S D) Y = X0_C,
+    !> X = K0^-1 (B - E D Y), each solve with K0 for all columns at once.
+    subroutine bulk_solve_columns(self, a, b, x, error)
+        class(bulk_update_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
+        real(dp), intent(in) :: b(:, :)
+        real(dp), intent(out) :: x(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: y(:, :), rhs(:, :)
+        integer :: info, j
 
         if (self%whole) then
-            call self%full%solve(a, b, x, error)
+            do j = 1, size(b, 2)
+                call self%full%solve(a, b(:, j), x(:, j), error)
+                if (allocated(error)) return
+            end do
             return
         end if
-        call self%chol%solve(self%k0, b, x, error)
+        call self%chol%solve_columns(self%k0, b, x, error)
         if (allocated(error) .or. size(self%c) == 0) return
-        y = x(self%c)
+        y = x(self%c, :)
         call lu_solve(self%lu, self%piv, y, info)
         if (info /= 0) then
             call fatal_error(error, 'bulk update: dense solve failed (info '//str(info)//')')
             return
         end if
         rhs = b
-        rhs(self%c) = rhs(self%c) - matmul(self%d, y)
-        call self%chol%solve(self%k0, rhs, x, error)
-    end subroutine bulk_solve
+        rhs(self%c, :) = rhs(self%c, :) - matmul(self%d, y)
+        call self%chol%solve_columns(self%k0, rhs, x, error)
+    end subroutine bulk_solve_columns
 
     pure logical function bulk_has_determinant(self)
         class(bulk_update_t), intent(in) :: self

@@ -33,7 +33,7 @@ module voiga_solver_cholmod
     contains
         procedure :: factor => cholmod_factor
         procedure :: solve => cholmod_solve
-        !> Solve A X = B for the columns of B.
+        !> Solve A X = B for the columns of B at once.
         procedure :: solve_columns => cholmod_solve_columns
         procedure :: has_determinant => cholmod_has_determinant
         procedure :: determinant => cholmod_determinant
@@ -106,13 +106,14 @@ contains
         !> Ignored: a direct solve.
         type(solve_accuracy_t), intent(in), optional :: accuracy
         real(dp) :: xx(size(x), 1)
-        call cholmod_solve_columns(self, reshape(b, [size(b), 1]), xx, error)
+        call cholmod_solve_columns(self, a, reshape(b, [size(b), 1]), xx, error)
         x = xx(:, 1)
     end subroutine cholmod_solve
 
-    !> Solve A X = B; shapes: [n, nrhs].
-    subroutine cholmod_solve_columns(self, b, x, error)
+    !> Solve a X = B (`a` is not read), all columns at once; shapes: [n, nrhs].
+    subroutine cholmod_solve_columns(self, a, b, x, error)
         class(cholmod_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
         real(dp), intent(in) :: b(:, :)
         real(dp), intent(out) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
