@@ -57,6 +57,9 @@ module voiga_solver_bulk_update
         !> 8/3 m^3 flops, cost at most a numeric factorization of K0 (CHOLMOD's flop
         !> count; an LU of the whole tangent costs more), and at least `min_rank`.
         integer :: max_rank = 0
+        !> Most values of the whole columns of K0^-1 kept (default 2^24: 128 MiB;
+        !> hertz m4 NN2.2 keeps 171 columns of 7540, 1.3e6).
+        real(dp) :: max_kept = 2.0_dp**24
         !> The bulk stiffness on its own pattern, its Cholesky factor, and the LU of a whole tangent.
         type(csc_matrix_t), private :: k0
         type(cholmod_t), private :: chol
@@ -72,6 +75,9 @@ module voiga_solver_bulk_update
         integer, private :: ns = 0
         !> s(p, q) = K0^-1(known(p), known(q)); shape: [capacity, capacity].
         real(dp), allocatable, private :: s(:, :)
+        !> z(:, q) = K0^-1 e_known(q), the whole columns, kept while they fit in
+        !> `max_kept` (then a solve needs one solve with K0, else two); shape: [n, capacity].
+        real(dp), allocatable, private :: z(:, :)
         !> The update of the last tangent: C [m], D_CC [m, m], the LU of I + S_CC D_CC [m, m] and its pivots.
         integer, allocatable, private :: c(:), piv(:)
         real(dp), allocatable, private :: d(:, :), lu(:, :)
@@ -119,7 +125,8 @@ contains
         end if
         self%max_rank = max(min_rank, floor((3.0_dp*self%chol%flops/8.0_dp)**(1.0_dp/3.0_dp)))
         allocate (self%slot(k0%n), source=0)
-        allocate (self%known(0), self%s(0, 0), self%c(0), self%piv(0), self%d(0, 0), self%lu(0, 0))
+        allocate (self%known(0), self%s(0, 0), self%z(k0%n, 0), self%c(0), self%piv(0), self%d(0, 0), &
+                  self%lu(0, 0))
     end subroutine new_bulk_update
 
     !> Prepare solves with the tangent `a`: find its update D = a - K0, learn the
@@ -233,6 +240,7 @@ contains
             grown(:self%ns, :self%ns) = self%s(:self%ns, :self%ns)
             call move_alloc(grown, self%s)
             self%known = [self%known(:self%ns), [(0, k=self%ns + 1, cap)]]
+            if (allocated(self%z)) call grow_columns(self%z, self%ns, cap, self%max_kept)
         end if
         do k1 = 1, size(new), learn_block
             nb = min(learn_block, size(new) - k1 + 1)
@@ -246,11 +254,28 @@ contains
             call self%chol%solve_columns(self%k0, e, x, error)
             if (allocated(error)) return
             self%ns = q0 + nb
+            if (allocated(self%z)) self%z(:, q0 + 1:self%ns) = x
             self%s(:self%ns, q0 + 1:self%ns) = x(self%known(:self%ns), :)
             self%s(q0 + 1:self%ns, :q0) = transpose(self%s(:q0, q0 + 1:self%ns))
             deallocate (e, x)
         end do
     end subroutine learn
+
+    !> Room for `cap` columns of which the first `ns` are kept; none at all (the
+    !> array deallocated) beyond `max_kept` values.
+    pure subroutine grow_columns(z, ns, cap, max_kept)
+        real(dp), allocatable, intent(inout) :: z(:, :)
+        integer, intent(in) :: ns, cap
+        real(dp), intent(in) :: max_kept
+        real(dp), allocatable :: grown(:, :)
+        if (real(size(z, 1), dp)*real(cap, dp) > max_kept) then
+            deallocate (z)
+            return
+        end if
+        allocate (grown(size(z, 1), cap))
+        grown(:, :ns) = z(:, :ns)
+        call move_alloc(grown, z)
+    end subroutine grow_columns
 
     !> D_CC from the tangent `a` and the matrix I + S_CC D_CC to factorize.
     subroutine update_matrix(self, a)
@@ -328,7 +353,8 @@ contains
     end subroutine bulk_solve
 
     !> Solve a X = B (shapes [n, nrhs]): X0 = K0^-1 B, (I + S D) Y = X0_C,
-    !> X = K0^-1 (B - E D Y), each solve with K0 for all columns at once.
+    !> X = X0 - K0^-1 E D Y (from the kept columns of K0^-1, else by a second
+    !> solve), each solve with K0 for all columns at once.
     subroutine bulk_solve_columns(self, a, b, x, error)
         class(bulk_update_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
@@ -351,6 +377,11 @@ contains
         call lu_solve(self%lu, self%piv, y, info)
         if (info /= 0) then
             call fatal_error(error, 'bulk update: dense solve failed (info '//str(info)//')')
+            return
+        end if
+        if (allocated(self%z)) then
+            ! K0^-1 E D y from the kept columns
+            x = x - matmul(self%z(:, self%slot(self%c)), matmul(self%d, y))
             return
         end if
         rhs = b
