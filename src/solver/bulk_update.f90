@@ -361,8 +361,8 @@ contains
         real(dp), intent(in) :: b(:, :)
         real(dp), intent(out) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: y(:, :), rhs(:, :)
-        integer :: info, j
+        real(dp), allocatable :: y(:, :), rhs(:, :), w(:, :)
+        integer :: info, j, q, k
 
         if (self%whole) then
             do j = 1, size(b, 2)
@@ -380,8 +380,14 @@ contains
             return
         end if
         if (allocated(self%z)) then
-            ! K0^-1 E D y from the kept columns
-            x = x - matmul(self%z(:, self%slot(self%c)), matmul(self%d, y))
+            ! K0^-1 E (D y) from the kept columns, one column at a time (no copy of them)
+            w = matmul(self%d, y)
+            do q = 1, size(self%c)
+                k = self%slot(self%c(q))
+                do j = 1, size(x, 2)
+                    x(:, j) = x(:, j) - w(q, j)*self%z(:, k)
+                end do
+            end do
             return
         end if
         rhs = b
