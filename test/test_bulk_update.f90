@@ -9,6 +9,7 @@ module test_bulk_update
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_model, only: model_t
+    use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_model_loads, only: pressure_settings_t
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
@@ -199,9 +200,6 @@ contains
         real(dp), allocatable, intent(out) :: u(:, :)
         type(error_t), allocatable, intent(out) :: error
         type(scene_t) :: c
-        type(model_t) :: model
-        real(dp), allocatable :: ui(:)
-        integer :: run
         c%bodies = [body('block', material, 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
         c%solver%n_steps = [4, 2]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.02_dp, push, -0.02_dp], [2, 2]))]
@@ -209,16 +207,30 @@ contains
         c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
                                           rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1.0e3_dp, &
                                           penalty_tangent=1.0e2_dp, friction=mu, method=method)
+        call both_paths(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], stats, u, error)
+    end subroutine pressed_block
+
+    !> Scene `c` on the patches `coarse`, solved with the fast path (run 1: stats(1),
+    !> u(:, 1)) and with the plain one (run 2).
+    subroutine both_paths(c, coarse, stats, u, error)
+        type(scene_t), intent(inout) :: c
+        type(nurbs_surface_t), intent(in) :: coarse(:)
+        type(solver_stats_t), intent(out) :: stats(2)
+        real(dp), allocatable, intent(out) :: u(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: ui(:)
+        integer :: run
         do run = 1, 2
             c%solver%reuse_linear_bulk = run == 1
-            call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
+            call build_model(c, coarse, model, error)
             if (allocated(error)) return
             call solve_steps(model, c%solver, ui, stats(run), error)
             if (allocated(error)) return
             if (run == 1) allocate (u(size(ui), 2))
             u(:, run) = ui
         end do
-    end subroutine pressed_block
+    end subroutine both_paths
 
     !> The fast path (run 1) factorized once and ended where the plain one did.
     subroutine check_once(stats, u, error)
@@ -238,44 +250,41 @@ contains
 
     subroutine test_gpts(error)
         type(error_t), allocatable, intent(out) :: error
-        type(solver_stats_t) :: stats(2)
-        real(dp), allocatable :: u(:, :)
-        call pressed_block('linear', 'gpts', 0.0_dp, 0.0_dp, stats, u, error)
-        if (allocated(error)) return
-        call check_once(stats, u, error)
+        call linear_once('gpts', 0.0_dp, 0.0_dp, error)
     end subroutine test_gpts
 
     subroutine test_mortar(error)
         type(error_t), allocatable, intent(out) :: error
-        type(solver_stats_t) :: stats(2)
-        real(dp), allocatable :: u(:, :)
-        call pressed_block('linear', 'mortar', 0.0_dp, 0.0_dp, stats, u, error)
-        if (allocated(error)) return
-        call check_once(stats, u, error)
+        call linear_once('mortar', 0.0_dp, 0.0_dp, error)
     end subroutine test_mortar
 
     !> The augmented Lagrangian's multiplier step solves with the factorized tangent
-    !> too (one solve per active constraint).
+    !> too (all active constraints in one multi-column solve).
     subroutine test_alm(error)
         type(error_t), allocatable, intent(out) :: error
-        type(solver_stats_t) :: stats(2)
-        real(dp), allocatable :: u(:, :)
-        call pressed_block('linear', 'alm', 0.0_dp, 0.0_dp, stats, u, error)
-        if (allocated(error)) return
-        call check_once(stats, u, error)
-        if (allocated(error)) return
-        call check(error, stats(1)%multiplier_updates, stats(2)%multiplier_updates, 'the same multiplier updates')
+        call linear_once('alm', 0.0_dp, 0.0_dp, error)
     end subroutine test_alm
 
     !> Coulomb friction, sliding: an unsymmetric contact tangent.
     subroutine test_friction(error)
         type(error_t), allocatable, intent(out) :: error
+        call linear_once('mortar', 0.3_dp, 0.05_dp, error)
+    end subroutine test_friction
+
+    !> The linear pressed block by `method`, friction `mu`, pushed by `push`: the
+    !> fast path factorizes once and ends where the plain one does.
+    subroutine linear_once(method, mu, push, error)
+        character(len=*), intent(in) :: method
+        real(dp), intent(in) :: mu, push
+        type(error_t), allocatable, intent(out) :: error
         type(solver_stats_t) :: stats(2)
         real(dp), allocatable :: u(:, :)
-        call pressed_block('linear', 'mortar', 0.3_dp, 0.05_dp, stats, u, error)
+        call pressed_block('linear', method, mu, push, stats, u, error)
         if (allocated(error)) return
         call check_once(stats, u, error)
-    end subroutine test_friction
+        if (allocated(error)) return
+        call check(error, stats(1)%multiplier_updates, stats(2)%multiplier_updates, 'the same multiplier updates')
+    end subroutine linear_once
 
     !> A Neo-Hookean body: no linear body to keep, no bulk to factorize once; the
     !> run is the plain one, bit for bit.
@@ -297,10 +306,8 @@ contains
     subroutine test_fall_back(error)
         type(error_t), allocatable, intent(out) :: error
         type(scene_t) :: c
-        type(model_t) :: model
         type(solver_stats_t) :: stats(2)
-        real(dp), allocatable :: u(:, :), ui(:)
-        integer :: run
+        real(dp), allocatable :: u(:, :)
         c%bodies = [body('upper', 'linear', 1.0_dp, paper_layout('N2', [3, 2], 'bottom')), &
                     body('lower', 'linear', 1.0_dp, paper_layout('N2', [5, 2], 'top'))]
         c%solver%n_steps = [2]
@@ -310,16 +317,9 @@ contains
         c%pressure = [pressure_settings_t(body='upper', edge='top', values=[0.01_dp])]
         allocate (c%contact(1))
         c%contact(1) = contact_settings_t(slave='upper', master='lower', penalty_normal=100.0_dp, n_gauss=9)
-        do run = 1, 2
-            c%solver%reuse_linear_bulk = run == 1
-            call build_model(c, [rectangle(0.0_dp, 1.0_dp, 2.0_dp, 1.0_dp), &
-                                 rectangle(0.0_dp, 0.0_dp, 2.0_dp, 1.0_dp)], model, error)
-            if (allocated(error)) return
-            call solve_steps(model, c%solver, ui, stats(run), error)
-            if (allocated(error)) return
-            if (run == 1) allocate (u(size(ui), 2))
-            u(:, run) = ui
-        end do
+        call both_paths(c, [rectangle(0.0_dp, 1.0_dp, 2.0_dp, 1.0_dp), rectangle(0.0_dp, 0.0_dp, 2.0_dp, 1.0_dp)], &
+                        stats, u, error)
+        if (allocated(error)) return
         call check(error, stats(1)%numeric_factorizations, stats(2)%numeric_factorizations, &
                    'a factorization per tangent')
         if (allocated(error)) return

@@ -365,10 +365,7 @@ contains
         integer :: info, j, q, k
 
         if (self%whole) then
-            do j = 1, size(b, 2)
-                call self%full%solve(a, b(:, j), x(:, j), error)
-                if (allocated(error)) return
-            end do
+            call self%full%solve_columns(a, b, x, error)
             return
         end if
         call self%chol%solve_columns(self%k0, b, x, error)
