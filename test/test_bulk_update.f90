@@ -42,6 +42,7 @@ contains
                     new_unittest('linear_mortar_factorizes_once', test_mortar), &
                     new_unittest('linear_alm_factorizes_once', test_alm), &
                     new_unittest('linear_friction_factorizes_once', test_friction), &
+                    new_unittest('two_linear_bodies_factorize_once', test_two_bodies), &
                     new_unittest('neo_hookean_path_unchanged', test_neo_hookean), &
                     new_unittest('contact_held_bodies_fall_back', test_fall_back) &
                     ]
@@ -299,6 +300,30 @@ contains
         if (allocated(error)) return
         call check(error, maxval(abs(u(:, 1) - u(:, 2))), 0.0_dp, 'bit for bit', abs=0.0_dp)
     end subroutine test_neo_hookean
+
+    !> Two linear blocks, each held by its own Dirichlet edge, the upper pressed
+    !> down onto the lower and pushed along it: a deformable master, whose contact
+    !> couplings change the tangent's pattern as the slave points move along it
+    !> (the bulk update places K0 on each new pattern).
+    subroutine test_two_bodies(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_t) :: c
+        type(solver_stats_t) :: stats(2)
+        real(dp), allocatable :: u(:, :)
+        c%bodies = [body('upper', 'linear', 1.0_dp, paper_layout('N2', [3, 2], 'bottom')), &
+                    body('lower', 'linear', 1.0_dp, paper_layout('N2', [40, 2], 'top'))]
+        c%solver%n_steps = [3, 6]
+        c%dirichlet = [bc('lower', 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2])), &
+                       bc('upper', 'top', [.true., .true.], reshape([0.0_dp, -0.03_dp, 2.0_dp, -0.03_dp], [2, 2]))]
+        allocate (c%contact(1))
+        c%contact(1) = contact_settings_t(slave='upper', master='lower', penalty_normal=100.0_dp, n_gauss=9)
+        call both_paths(c, [rectangle(0.5_dp, 1.0_dp, 1.0_dp, 1.0_dp), rectangle(0.0_dp, 0.0_dp, 4.0_dp, 1.0_dp)], &
+                        stats, u, error)
+        if (allocated(error)) return
+        call check_once(stats, u, error)
+        if (allocated(error)) return
+        call check(error, stats(1)%assembly%pattern_rebuilds > 0, 'the pattern was rebuilt')
+    end subroutine test_two_bodies
 
     !> Two linear blocks, the upper held in y only by the contact: the bodies'
     !> stiffness alone is singular, so every tangent is factorized whole (the kept
