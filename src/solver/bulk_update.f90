@@ -217,25 +217,27 @@ contains
 
     !> Learn the columns of K0^-1 of the DOFs of `c` not yet known, `learn_block`
     !> at a time (K0 is symmetric: they are its rows too). When the known set would
-    !> outgrow four times `max_rank`, it is started again from `c`.
+    !> outgrow four times `max_rank`, or its matrix S `max_kept` values, it is started
+    !> again from `c`.
     subroutine learn(self, c, error)
         type(bulk_update_t), intent(inout) :: self
         integer, intent(in) :: c(:)
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: new(:)
         real(dp), allocatable :: e(:, :), x(:, :), grown(:, :)
-        integer :: k, k1, nb, q0, cap
+        integer :: k, k1, nb, q0, cap, limit
 
         new = pack(c, self%slot(c) == 0)
         if (size(new) == 0) return
-        if (self%ns + size(new) > 4*self%max_rank) then
+        limit = min(4*self%max_rank, floor(sqrt(self%max_kept)))
+        if (self%ns + size(new) > limit) then
             self%slot(self%known(:self%ns)) = 0
             self%ns = 0
             new = c
         end if
         cap = size(self%s, 1)
         if (self%ns + size(new) > cap) then
-            cap = max(2*cap, self%ns + size(new))
+            cap = max(min(2*cap, limit), self%ns + size(new))
             allocate (grown(cap, cap), source=0.0_dp)
             grown(:self%ns, :self%ns) = self%s(:self%ns, :self%ns)
             call move_alloc(grown, self%s)
