@@ -12,6 +12,8 @@ SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # runs one case per core, and OpenBLAS threads that wait by spinning made hertz m3
 # 3x slower while anything else ran (docs/performance.md).
 export OPENBLAS_NUM_THREADS ?= 1
+# The same for CHOLMOD's OpenMP loops (the Cholesky factor of linear bodies' stiffness).
+export OMP_NUM_THREADS ?= 1
 
 .PHONY: all deps build run test test-fortran test-python clean bench paper stress regress attack
 

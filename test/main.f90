@@ -17,6 +17,7 @@ program voiga_tests
     use test_rigid, only: collect_rigid
     use test_fields, only: collect_fields
     use test_files, only: collect_files
+    use test_bulk_update, only: collect_bulk_update
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -36,7 +37,8 @@ program voiga_tests
              new_testsuite('alm', collect_alm), &
              new_testsuite('rigid', collect_rigid), &
              new_testsuite('fields', collect_fields), &
-             new_testsuite('files', collect_files) &
+             new_testsuite('files', collect_files), &
+             new_testsuite('bulk_update', collect_bulk_update) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -4,7 +4,7 @@ module voiga_linalg_lapack
     implicit none
     private
 
-    public :: solve_spd, solve_general, band_factor
+    public :: solve_spd, solve_general, band_factor, lu_factor, lu_solve
 
     interface
         pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
@@ -20,6 +20,21 @@ module voiga_linalg_lapack
             real(dp), intent(inout) :: a(lda, *), b(ldb, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgesv
+        pure subroutine dgetrf(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetrf
+        pure subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: dp
+            character(len=1), intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb
+            real(dp), intent(in) :: a(lda, *)
+            integer, intent(in) :: ipiv(*)
+            real(dp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgetrs
         pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
             import :: dp
             integer, intent(in) :: m, n, kl, ku, ldab
@@ -54,6 +69,26 @@ contains
         integer :: ipiv(size(a, 1))
         call dgesv(size(a, 1), size(b, 2), a, size(a, 1), ipiv, b, size(b, 1), info)
     end subroutine solve_general
+
+    !> LU factorization with partial pivoting of a square `a` (LAPACK dgetrf), kept
+    !> for several `lu_solve`s. On exit `a` holds L and U, `ipiv` [n] the row
+    !> interchanges; `info` > 0: `a` is singular.
+    pure subroutine lu_factor(a, ipiv, info)
+        !> shape: [n, n]
+        real(dp), intent(inout) :: a(:, :)
+        integer, intent(out) :: ipiv(:), info
+        call dgetrf(size(a, 1), size(a, 2), a, size(a, 1), ipiv, info)
+    end subroutine lu_factor
+
+    !> Solve a X = B with the factors of `lu_factor` (LAPACK dgetrs); `b` [n, nrhs]
+    !> holds X on exit.
+    pure subroutine lu_solve(lu, ipiv, b, info)
+        real(dp), intent(in) :: lu(:, :)
+        integer, intent(in) :: ipiv(:)
+        real(dp), intent(inout) :: b(:, :)
+        integer, intent(out) :: info
+        call dgetrs('N', size(lu, 1), size(b, 2), lu, max(1, size(lu, 1)), ipiv, b, max(1, size(b, 1)), info)
+    end subroutine lu_solve
 
     !> LU factorization with partial pivoting of an n x n band matrix with `kl`
     !> sub- and `ku` superdiagonals (LAPACK dgbtrf). `ab` has shape [2 kl + ku + 1, n]

@@ -15,15 +15,31 @@ module voiga_model_assembly
     private
 
     public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
-    public :: assembly_map_t, new_assembly_map
+    public :: assembly_map_t, new_assembly_map, bulk_stiffness
+
+    !> The stiffness of one linear-elastic body on the tangent's pattern: the values
+    !> of its DOFs' columns (a contiguous range of the CSC values; no other body and,
+    !> before contact is added, no coupling has entries there).
+    type :: body_stiffness_t
+        !> Columns of the body's DOFs, 1-based, and their values [colptr(last + 1) - colptr(first)].
+        integer :: first = 0, last = -1
+        real(dp), allocatable :: values(:)
+    end type body_stiffness_t
 
     !> Where each element's stiffness entries go in the CSC values, computed once per
-    !> pattern so that assembly needs no search.
+    !> pattern so that assembly needs no search; and, once assembled, the constant
+    !> stiffness of each linear-elastic body, so that it is not integrated again.
     type :: assembly_map_t
         !> Start of each element's entries in `pos`, over all bodies in order [nel_total + 1].
         integer, allocatable :: ptr(:)
         !> Index into the matrix values of entry (a, b) of each element, column-major.
         integer, allocatable :: pos(:)
+        !> Keep the linear-elastic bodies' stiffness (false: integrate every body at
+        !> every assembly, as for nonlinear ones).
+        logical :: keep_linear = .true.
+        !> Per body [nbodies]: its stiffness when it is linear-elastic and was assembled
+        !> on this pattern (values allocated), else nothing.
+        type(body_stiffness_t), allocatable :: linear(:)
     end type assembly_map_t
 
     !> What the assembly did (to show that a scene simulates only what it asks for).
@@ -114,18 +130,20 @@ contains
         end do
     end subroutine new_assembly_map
 
-    !> The stiffness pattern of all bodies (every element couples its DOFs).
-    subroutine stiffness_pattern(model, k, error)
+    !> The stiffness pattern of all bodies (every element couples its DOFs) and,
+    !> unless `contact` is false, of the contact pairs' couplings.
+    subroutine stiffness_pattern(model, k, error, contact)
         type(model_t), intent(in) :: model
         type(csc_matrix_t), intent(out) :: k
         type(error_t), allocatable, intent(out) :: error
+        logical, intent(in), optional :: contact
         integer, allocatable :: ptr(:), dofs(:), mdofs(:)
         !> The DOFs of one contact block.
         type :: dof_block_t
             integer, allocatable :: dofs(:)
         end type dof_block_t
         type(dof_block_t), allocatable :: blocks(:)
-        integer :: ib, e, nel, n, pos, ip
+        integer :: ib, e, nel, n, pos, ip, npairs
 
         nel = 0
         n = 0
@@ -138,9 +156,13 @@ contains
         ! the contact pairs' nonempty blocks (contact_pair_t%block_dofs): with a deformable master
         ! each slave element's edge DOFs with the master's control points in its range
         ! (contact_pair_t%mlo, mhi); a mortar pair, each slave control point's support
-        allocate (blocks(sum([(model%pairs(ip)%pair%n_blocks(), ip=1, size(model%pairs))])))
+        npairs = size(model%pairs)
+        if (present(contact)) then
+            if (.not. contact) npairs = 0
+        end if
+        allocate (blocks(sum([(model%pairs(ip)%pair%n_blocks(), ip=1, npairs)])))
         pos = 0
-        do ip = 1, size(model%pairs)
+        do ip = 1, npairs
             mdofs = model%pairs(ip)%pair%master%all_dofs()
             do e = 1, model%pairs(ip)%pair%n_blocks()
                 pos = pos + 1
@@ -259,6 +281,7 @@ contains
         integer, allocatable :: old2new(:)
         real(dp), allocatable :: moved(:)
         integer :: p
+        logical :: keep_linear
 
         if (.not. present(map)) then
             call stiffness_pattern(model, k, error)
@@ -270,11 +293,15 @@ contains
         call stiffness_pattern(model, k, error)
         if (allocated(error)) return
         call pattern_positions(old, k, old2new)
+        ! the bodies' cached stiffness is integrated again on the new pattern
+        if (allocated(map%linear)) deallocate (map%linear)
         if (all(old2new(map%pos) > 0)) then
             map%pos = old2new(map%pos)
         else
+            keep_linear = map%keep_linear
             call new_assembly_map(model, k, map, error)
             if (allocated(error)) return
+            map%keep_linear = keep_linear
         end if
         if (present(k_bulk)) then
             allocate (moved(k%nnz()), source=0.0_dp)
@@ -314,29 +341,58 @@ contains
         end do
     end function refit_contact_ranges
 
+    !> The stiffness of the bodies alone, on a pattern without contact couplings,
+    !> at u = 0: for linear-elastic bodies, the bulk part of every tangent, the same
+    !> numbers as `assemble` adds (the same elements summed in the same order).
+    subroutine bulk_stiffness(model, k, error)
+        type(model_t), intent(in) :: model
+        type(csc_matrix_t), intent(out) :: k
+        type(error_t), allocatable, intent(out) :: error
+        type(assembly_stats_t) :: stats
+        real(dp), allocatable :: u(:), r(:)
+        call stiffness_pattern(model, k, error, contact=.false.)
+        if (allocated(error)) return
+        allocate (u(model%ndof), r(model%ndof), source=0.0_dp)
+        call assemble_bulk(model, u, 0.0_dp, r, stats, error, k)
+    end subroutine bulk_stiffness
+
     !> The bulk part of `assemble`: every element's internal force and tangent, and
     !> the external forces (r = f_int - f_ext; `k` zeroed first).
     subroutine assemble_bulk(model, u, t, r, stats, error, k, map)
-        type(model_t), intent(inout) :: model
+        type(model_t), intent(in) :: model
         real(dp), intent(in) :: u(:)
         real(dp), intent(in) :: t
         real(dp), intent(out) :: r(:)
         type(assembly_stats_t), intent(inout) :: stats
         type(error_t), allocatable, intent(out) :: error
         type(csc_matrix_t), intent(inout), optional :: k
-        type(assembly_map_t), intent(in), optional :: map
+        !> With `k`: element positions; the linear bodies' stiffness is kept in it.
+        type(assembly_map_t), intent(inout), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
         integer :: ib, e, n, npts, idx
-        logical :: ok
+        logical :: ok, keep
         integer(i8) :: c0, c1, rate
 
         call system_clock(c0, rate)
         r = 0.0_dp
         if (present(k)) call k%zero()
+        keep = .false.
+        if (present(k) .and. present(map)) keep = map%keep_linear
+        if (keep) then
+            if (.not. allocated(map%linear)) allocate (map%linear(size(model%bodies)))
+        end if
         idx = 0
         do ib = 1, size(model%bodies)
             associate (body => model%bodies(ib))
+                if (keep) then
+                    ! a linear body's stiffness is constant: f_int = K u
+                    if (allocated(map%linear(ib)%values)) then
+                        call add_linear_body(map%linear(ib), u, k, r)
+                        idx = idx + body%disc%nel
+                        cycle
+                    end if
+                end if
                 npts = product(body%n_gauss)
                 do e = 1, body%disc%nel
                     n = 2*size(body%disc%elements(e)%conn)
@@ -366,6 +422,7 @@ contains
                     stats%finite_strain_points = stats%finite_strain_points + int(npts, i8)*body%disc%nel
                 else
                     stats%small_strain_points = stats%small_strain_points + int(npts, i8)*body%disc%nel
+                    if (keep) call keep_linear_body(k, body%dof0 + 1, body%dof0 + 2*body%disc%ncp, map%linear(ib))
                 end if
             end associate
         end do
@@ -378,6 +435,34 @@ contains
         call system_clock(c1)
         stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
     end subroutine assemble_bulk
+
+    !> Keep the stiffness a linear body just added to `k` (columns `first`..`last`:
+    !> its DOFs; only its elements have entries there yet).
+    pure subroutine keep_linear_body(k, first, last, kept)
+        type(csc_matrix_t), intent(in) :: k
+        integer, intent(in) :: first, last
+        type(body_stiffness_t), intent(inout) :: kept
+        kept%first = first
+        kept%last = last
+        kept%values = k%values(k%colptr(first) + 1:k%colptr(last + 1))
+    end subroutine keep_linear_body
+
+    !> A kept linear body's part of the assembly: its stiffness into `k`, its
+    !> internal force K u into `r` (the same as integrating it, to round-off).
+    pure subroutine add_linear_body(kept, u, k, r)
+        type(body_stiffness_t), intent(in) :: kept
+        real(dp), intent(in) :: u(:)
+        type(csc_matrix_t), intent(inout) :: k
+        real(dp), intent(inout) :: r(:)
+        integer :: j, p, p0
+        p0 = k%colptr(kept%first)
+        k%values(p0 + 1:k%colptr(kept%last + 1)) = kept%values
+        do j = kept%first, kept%last
+            do p = k%colptr(j) + 1, k%colptr(j + 1)
+                r(k%rowind(p) + 1) = r(k%rowind(p) + 1) + kept%values(p - p0)*u(j)
+            end do
+        end do
+    end subroutine add_linear_body
 
     !> values(pos(i)) += ke(i) for the entries of an element matrix in column-major
     !> order (positions from `new_assembly_map`).

@@ -32,6 +32,8 @@ module voiga_solver_linear
         procedure(factor_interface), deferred :: factor
         !> Solve a x = b with what `factor` prepared (`a`: the matrix passed to it).
         procedure(solve_interface), deferred :: solve
+        !> Solve a X = B for several right-hand sides (default: one `solve` each).
+        procedure :: solve_columns => linear_solve_columns
         !> Whether it solves iteratively, to the accuracy asked (default: no).
         procedure :: iterative => linear_iterative
         !> Whether `determinant` gives the sign of det(a) (default: no).
@@ -68,6 +70,20 @@ module voiga_solver_linear
     end interface
 
 contains
+
+    !> Solve a X = B column by column with `solve`; shapes: [n, nrhs].
+    subroutine linear_solve_columns(self, a, b, x, error)
+        class(linear_solver_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
+        real(dp), intent(in) :: b(:, :)
+        real(dp), intent(out) :: x(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: j
+        do j = 1, size(b, 2)
+            call self%solve(a, b(:, j), x(:, j), error)
+            if (allocated(error)) return
+        end do
+    end subroutine linear_solve_columns
 
     pure logical function linear_iterative(self)
         class(linear_solver_t), intent(in) :: self

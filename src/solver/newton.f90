@@ -107,7 +107,8 @@ contains
         if (allocated(error)) return
         call new_assembly_map(model, self%k, self%map, error)
         if (allocated(error)) return
-        call new_linear_solver(self%linear, settings%linear_solver, model, error)
+        self%map%keep_linear = settings%reuse_linear_bulk
+        call new_linear_solver(self%linear, settings%linear_solver, model, error, settings%reuse_linear_bulk)
         if (allocated(error)) return
         self%natural = trim(settings%damping) == 'natural'
         self%x0 = reference_coordinates(model)

@@ -203,21 +203,22 @@ contains
         type(constraint_set_t), intent(in) :: sets(:)
         real(dp), intent(out) :: w(:, :), s(:, :), c(:)
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: rhs(:)
+        real(dp), allocatable :: rhs(:, :)
         integer :: ip, i, j
-        allocate (rhs(size(fixed)))
+        allocate (rhs(size(fixed), size(w, 2)))
         j = 0
         do ip = 1, size(sets)
             do i = 1, size(sets(ip)%c)
                 j = j + 1
                 c(j) = sets(ip)%c(i)
-                rhs = 0.0_dp
-                rhs(sets(ip)%cols(i)%dofs) = rhs(sets(ip)%cols(i)%dofs) + sets(ip)%cols(i)%values
-                rhs = merge(0.0_dp, rhs, fixed)
-                call newton%linear%solve(newton%k, rhs, w(:, j), error)
-                if (allocated(error)) return
+                rhs(:, j) = 0.0_dp
+                rhs(sets(ip)%cols(i)%dofs, j) = rhs(sets(ip)%cols(i)%dofs, j) + sets(ip)%cols(i)%values
+                rhs(:, j) = merge(0.0_dp, rhs(:, j), fixed)
             end do
         end do
+        ! all columns at once: a solver with a multi-column solve (bulk_update_t) uses it
+        call newton%linear%solve_columns(newton%k, rhs, w, error)
+        if (allocated(error)) return
         i = 0
         do ip = 1, size(sets)
             do j = 1, size(sets(ip)%c)

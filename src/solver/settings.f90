@@ -42,6 +42,13 @@ module voiga_solver_settings
         !> last converged state), not only those whose Newton attempt folds: for tests
         !> and comparisons (Fortran API only, not a case-file setting).
         logical :: tresca_always = .false.
+        !> Integrate each linear-elastic body's stiffness once per stiffness pattern
+        !> (its internal force is then K u) and, with the direct solver and only
+        !> linear-elastic bodies, factorize the bodies' stiffness once per run and
+        !> solve each tangent as an update of it (`voiga_solver_bulk_update`). False:
+        !> integrate every body and factorize every tangent whole at every iteration.
+        !> The results agree to round-off (Fortran API only: for tests and comparisons).
+        logical :: reuse_linear_bulk = .true.
     contains
         !> Total number of load steps over all phases.
         procedure :: total_steps => settings_total_steps
