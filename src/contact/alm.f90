@@ -18,7 +18,7 @@
 !> others follow the law (lambda_A = 0 where A is open, tau_A = t_A where it slips),
 !> until every constraint holds to `tolerance` times the slave element size. The
 !> penalties then only set how the active set is found and how stiff each Newton
-!> solve is, not the solution (docs/theory.md, section 7.5).
+!> solve is, not the solution (docs/theory.md, section 7, "Augmented Lagrangian").
 !>
 !> Why this rather than plain Uzawa updates (lambda_A <- p_A): those converge by a
 !> factor 1 / (1 + eps C) per update, C the compliance of the constraint mode, and

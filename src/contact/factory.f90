@@ -72,7 +72,7 @@ contains
     !> element of size h, and q / h is the spacing of the edge's control points;
     !> the factor keeps the penalty's own compliance (about E* / (eps a) of the
     !> pressure over a zone of size a) small without making the tangent stiff
-    !> (docs/theory.md, section 7.6; docs/howto.md, "Choosing contact settings").
+    !> (docs/theory.md, section 7, "Automatic penalty"; docs/howto.md, "Choose contact settings").
     pure real(dp) function automatic_penalty(e_star, degree, h) result(eps)
         real(dp), intent(in) :: e_star, h
         integer, intent(in) :: degree

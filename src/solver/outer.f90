@@ -1,6 +1,6 @@
 !> Outer loops around Newton.
 !>
-!> The augmented Lagrangian (Uzawa, docs/theory.md section 7.5): with the contact
+!> The augmented Lagrangian (docs/theory.md, section 7, "Augmented Lagrangian"): with the contact
 !> multipliers fixed Newton solves the substep, then every pair with multipliers
 !> updates them from the solution and tests its constraints; repeated until every
 !> pair's constraints hold to its tolerance. `substep_attempt` runs it when a pair
@@ -41,7 +41,7 @@ module voiga_solver_outer
 
     !> Most multiplier updates of one substep (augmented Lagrangian); the constraint
     !> error falls by a roughly constant factor per update, small for stiff penalties
-    !> (docs/theory.md, section 7.5).
+    !> (docs/theory.md, section 7, "Augmented Lagrangian").
     integer, parameter :: max_updates = 100
     !> The smallest fraction of a multiplier step, and the updates without a new
     !> smallest constraint residual after which the step is halved
