@@ -1,0 +1,356 @@
+"""Section 6: Kratos Multiphysics on the same Hertz problem (a peer with mortar contact).
+
+Quarter cylinder (R = 1, hole R = 0.05 as in the hertz scene, E = 1, nu = 0.3), small
+displacement Q4 plane strain (SmallDisplacementElement2D4N, LinearElasticPlaneStrain2DLaw),
+meshed on voiga's graded hertz parameter grid: the knot spans of cases/hertz/<mesh>-N2.nml
+each cut into ``split`` x ``split`` Q4 and mapped through the exact NURBS geometry. The
+flat is a block of Q4 whose nodes are all fixed (rigid); contact is Kratos's 2D mortar
+(``PenaltyContactFrictionless`` or ``ALMContactFrictionless``) with the outer arc as slave
+and the top of the block as master, its penalty chosen by Kratos (stiffness_factor x E / h).
+u_y = -0.01 t on the top cut (u_x free there), u_x = 0 on the symmetry cut, five load steps
+as voiga's five.
+
+Kratos runs in its own virtual environment (build/kratos-venv, made here with pip); if
+that fails, the section is skipped with a message. The pressure is Kratos's nodal normal
+contact pressure of the slave nodes (per current length, at the current positions),
+taken per reference length (times the stretch of the slave edge at the node) at the
+reference positions; the force is the reaction on the top cut. The same post.hertz
+functions as ``python -m post hertz`` give the errors.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .ccx import breakpoints
+from .run import ROOT, Workdir
+
+UY = -0.01
+E, NU = 1.0, 0.3
+N_STEPS = 5
+VENV = ROOT / "build" / "kratos-venv"
+PACKAGES = ("KratosMultiphysics", "KratosStructuralMechanicsApplication",
+            "KratosContactStructuralMechanicsApplication", "KratosLinearSolversApplication")
+DRIVER = Path(__file__).resolve().parent / "kratos_driver.py"
+MORTAR = {"penalty": ("PenaltyContactFrictionless", "penalty_contact_process",
+                      "AUGMENTED_NORMAL_CONTACT_PRESSURE"),
+          "alm": ("ALMContactFrictionless", "alm_contact_process",
+                  "LAGRANGE_MULTIPLIER_CONTACT_PRESSURE")}
+IMPORT_CHECK = ("import KratosMultiphysics, KratosMultiphysics.StructuralMechanicsApplication, "
+                "KratosMultiphysics.ContactStructuralMechanicsApplication, "
+                "KratosMultiphysics.LinearSolversApplication")
+
+
+def venv_python() -> Path:
+    return VENV / "bin" / "python"
+
+
+def kratos_available() -> bool:
+    """Kratos imports in build/kratos-venv (nothing is installed here)."""
+    py = venv_python()
+    return py.exists() and subprocess.run([str(py), "-c", IMPORT_CHECK],
+                                          capture_output=True).returncode == 0
+
+
+def ensure_kratos() -> Path | None:
+    """The venv's Python, after making the venv and pip-installing Kratos if needed."""
+    if kratos_available():
+        return venv_python()
+    print(f"bench: installing Kratos Multiphysics into {VENV} with pip", flush=True)
+    steps = [[sys.executable, "-m", "venv", str(VENV)],
+             [str(venv_python()), "-m", "pip", "install", "-q", *PACKAGES, "numpy"]]
+    for cmd in steps:
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            print(f"bench: {' '.join(cmd[:4])} ... failed ({proc.returncode}): "
+                  f"{proc.stderr.strip()[-400:]}\nbench: skipping Kratos")
+            return None
+    if not kratos_available():
+        print(f"bench: Kratos installed in {VENV} but does not import; skipping Kratos")
+        return None
+    return venv_python()
+
+
+def refine(b: np.ndarray, split: int) -> np.ndarray:
+    """Breakpoints ``b`` with every span cut into ``split`` equal parts."""
+    t = np.linspace(0.0, 1.0, split + 1)[:-1]
+    return np.append((b[:-1, None] + t * np.diff(b)[:, None]).ravel(), b[-1])
+
+
+def cylinder_q4(mesh: str, split: int):
+    """Nodes (n, 2), counter-clockwise Q4 connectivity (nel, 4; 0-based) and the node
+    index lists of the symmetry cut, the top cut and the outer arc (in xi order)."""
+    from pre.nurbs import evaluate_patch
+    from pre.scenes import hertz
+    bx, be = breakpoints(mesh)
+    gx, ge = refine(bx, split), refine(be, split)
+    xi, eta = np.meshgrid(gx, ge, indexing="ij")
+    xy = evaluate_patch(hertz()["cylinder"], xi.ravel(), eta.ravel())
+    xy[np.isclose(xi.ravel(), 0.0), 0] = 0.0
+    xy[np.isclose(xi.ravel(), 1.0), 1] = 0.0
+    ids = np.arange(len(gx) * len(ge)).reshape(len(gx), len(ge))
+    conn = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], axis=-1)
+    conn = conn.reshape(-1, 4)
+    p = xy[conn[0]]
+    if np.dot(p[:, 0], np.roll(p[:, 1], -1)) - np.dot(np.roll(p[:, 0], -1), p[:, 1]) < 0:
+        conn = conn[:, ::-1]
+    return xy, conn, ids[0, :], ids[-1, :], ids[:, -1]
+
+
+def block_q4(top_x: np.ndarray, ny: int = 2, y0: float = -1.1, y1: float = -1.0):
+    """Rigid flat: a Q4 block under y = -1 whose top nodes are at ``top_x`` (increasing);
+    nodes, counter-clockwise connectivity and the top nodes from left to right."""
+    gy = np.linspace(y0, y1, ny + 1)
+    X, Y = np.meshgrid(top_x, gy, indexing="ij")
+    ids = np.arange(X.size).reshape(X.shape)
+    conn = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], axis=-1)
+    return np.column_stack([X.ravel(), Y.ravel()]), conn.reshape(-1, 4), ids[:, -1]
+
+
+def master_x(slave_x: np.ndarray, reach: float = 0.2) -> np.ndarray:
+    """Top nodes of the flat: a master segment under every slave segment up to ``reach``
+    (a coarser master makes Kratos's mortar pressure oscillate with the master's period;
+    measured on m4 split 2: L2 13 % with 60 uniform segments), coarser beyond, and the
+    same spacing mirrored a little past the symmetry cut."""
+    near = np.sort(slave_x[slave_x < reach])
+    h = near[1] - near[0]
+    left = -h * np.arange(1, 6)[::-1]
+    far = np.linspace(near[-1], 0.35, 12)[1:]
+    return np.concatenate([left, near, far])
+
+
+def _block(name: str, rows: list[str]) -> list[str]:
+    return [f"Begin {name}", *rows, f"End {name.split()[0]}"]
+
+
+def _sub(name: str, nodes=(), elems=(), conds=()) -> list[str]:
+    body = (_block("SubModelPartNodes", [str(int(i)) for i in nodes])
+            + _block("SubModelPartElements", [str(int(i)) for i in elems])
+            + _block("SubModelPartConditions", [str(int(i)) for i in conds]))
+    return [f"Begin SubModelPart {name}", *body, f"End SubModelPart"]
+
+
+def write_mdpa(path: Path, mesh: str, split: int) -> dict:
+    """The model (1-based ids; cylinder nodes first) and what the run needs to know."""
+    xy, conn, sym, top, outer = cylinder_q4(mesh, split)
+    bxy, bconn, btop = block_q4(master_x(xy[outer, 0]))
+    nb = len(xy)
+    nodes = [f"{k + 1} {x:.16g} {y:.16g} 0.0" for k, (x, y) in enumerate(np.vstack([xy, bxy]))]
+    elems = [f"{k + 1} 1 " + " ".join(str(v + 1) for v in c) for k, c in enumerate(conn)]
+    elems += [f"{len(conn) + k + 1} 2 " + " ".join(str(v + nb + 1) for v in c)
+              for k, c in enumerate(bconn)]
+    # line conditions: the slave arc walked from the symmetry cut towards the top (the
+    # body on the left: counter-clockwise... orientation is checked by Kratos's
+    # NormalCheckProcess), the master top of the block from right to left
+    slave = [(outer[i] + 1, outer[i + 1] + 1) for i in range(len(outer) - 1)]
+    master = [(btop[i + 1] + nb + 1, btop[i] + nb + 1) for i in range(len(btop) - 1)]
+    conds = [f"{k + 1} 1 {a} {b}" for k, (a, b) in enumerate(slave)]
+    conds += [f"{len(slave) + k + 1} 2 {a} {b}" for k, (a, b) in enumerate(master)]
+    lines = (["Begin ModelPartData", "End ModelPartData",
+              "Begin Properties 1", "End Properties", "Begin Properties 2", "End Properties"]
+             + _block("Nodes", nodes)
+             + _block("Elements SmallDisplacementElement2D4N", elems)
+             + _block("Conditions LineCondition2D2N", conds)
+             + _sub("Cylinder", range(1, nb + 1), range(1, len(conn) + 1))
+             + _sub("Block", range(nb + 1, nb + len(bxy) + 1),
+                    range(len(conn) + 1, len(conn) + len(bconn) + 1))
+             + _sub("Symmetry", sym + 1) + _sub("Top", top + 1)
+             + _sub("Slave", outer + 1, conds=range(1, len(slave) + 1))
+             + _sub("Master", btop + nb + 1,
+                    conds=range(len(slave) + 1, len(slave) + len(master) + 1)))
+    path.write_text("\n".join(lines) + "\n")
+    return {"dofs": 2 * nb, "elements": len(conn), "slave": (outer + 1).tolist(),
+            "top": (top + 1).tolist()}
+
+
+def materials(path: Path) -> None:
+    def prop(part: str, pid: int) -> dict:
+        # the block is rigid through its fixed nodes; E = 1 keeps Kratos's automatic
+        # penalty (a mean of E / h over the contact pair) that of the cylinder
+        return {"model_part_name": f"Structure.{part}", "properties_id": pid,
+                "Material": {"constitutive_law": {"name": "LinearElasticPlaneStrain2DLaw"},
+                             "Variables": {"YOUNG_MODULUS": E, "POISSON_RATIO": NU,
+                                           "DENSITY": 1.0, "THICKNESS": 1.0},
+                             "Tables": {}}}
+    path.write_text(json.dumps({"properties": [prop("Cylinder", 1), prop("Block", 2)]}))
+
+
+def fix(part: str, constrained: list[bool], value: list) -> dict:
+    return {"python_module": "assign_vector_variable_process", "kratos_module": "KratosMultiphysics",
+            "Parameters": {"model_part_name": f"Structure.{part}", "variable_name": "DISPLACEMENT",
+                           "interval": [0.0, "End"], "constrained": constrained, "value": value}}
+
+
+def parameters(stem: str, method: str, stiffness: float) -> dict:
+    mortar, process, _ = MORTAR[method]
+    return {
+        "problem_data": {"problem_name": stem, "parallel_type": "OpenMP", "echo_level": 0,
+                         "start_time": 0.0, "end_time": 1.0},
+        "solver_settings": {
+            "model_part_name": "Structure", "domain_size": 2, "solver_type": "Static",
+            "echo_level": 0, "analysis_type": "non_linear",
+            "model_import_settings": {"input_type": "mdpa", "input_filename": stem},
+            "material_import_settings": {"materials_filename": "materials.json"},
+            "contact_settings": {"mortar_type": mortar},
+            "time_stepping": {"time_step": 1.0 / N_STEPS},
+            "convergence_criterion": "contact_residual_criterion",
+            "displacement_relative_tolerance": 1e-6, "displacement_absolute_tolerance": 1e-12,
+            "residual_relative_tolerance": 1e-6, "residual_absolute_tolerance": 1e-12,
+            "max_iteration": 30,
+            "linear_solver_settings": {"solver_type": "sparse_lu"}},
+        "processes": {
+            "constraints_process_list": [
+                fix("Block", [True, True, True], [0.0, 0.0, 0.0]),
+                fix("Symmetry", [True, False, True], [0.0, 0.0, 0.0]),
+                fix("Top", [False, True, True], [0.0, f"{UY}*t", 0.0])],
+            "loads_process_list": [],
+            "contact_process_list": [{
+                "python_module": process,
+                "kratos_module": "KratosMultiphysics.ContactStructuralMechanicsApplication",
+                "Parameters": {"model_part_name": "Structure",
+                               "contact_model_part": {"0": ["Slave", "Master"]},
+                               "assume_master_slave": {"0": ["Slave"]},
+                               "contact_type": "Frictionless",
+                               "advance_ALM_parameters": {"stiffness_factor": stiffness}}}]},
+        "output_processes": {}}
+
+
+def run_kratos(py: Path, w: Workdir, mesh: str, split: int, method: str,
+               stiffness: float = 1.0) -> dict:
+    """One analysis; its wall time (the whole process) and the Hertz errors."""
+    from post.hertz import compare_profile
+    stem = f"hertz-{mesh}-q{split}-{method}-k{stiffness:g}"
+    d = w.path / "kratos" / stem
+    d.mkdir(parents=True, exist_ok=True)
+    info = write_mdpa(d / f"{stem}.mdpa", mesh, split)
+    materials(d / "materials.json")
+    pressure = MORTAR[method][2]
+    job = {"parameters": parameters(stem, method, stiffness), "slave_nodes": info["slave"],
+           "top_nodes": info["top"], "contact_variables": [pressure, "WEIGHTED_GAP"]}
+    (d / "job.json").write_text(json.dumps(job, indent=1))
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    t0 = time.perf_counter()
+    proc = subprocess.run([str(py), str(DRIVER), "job.json"], cwd=d, capture_output=True,
+                          text=True, env=env)
+    wall = time.perf_counter() - t0
+    (d / "log.txt").write_text(proc.stdout + proc.stderr)
+    if proc.returncode != 0:
+        raise RuntimeError(f"Kratos {stem} failed ({proc.returncode}); see {d / 'log.txt'}")
+    res = json.loads((d / "result.json").read_text())
+    x0 = np.array([[r["x0"], r["y0"]] for r in res["slave"]])
+    fy = np.array([r["force"][1] for r in res["slave"]])
+    nominal = nodal_pressure(x0, fy)
+    # the arc's end on the top cut carries that cut's Dirichlet reaction, not contact
+    on_top = np.isin([r["id"] for r in res["slave"]], info["top"])
+    nominal[on_top] = 0.0
+    force = 2.0 * abs(res["reaction_y"])
+    h = compare_profile(x0[:, 0], nominal, force, E, NU, 1.0, half_model=True)
+    return {"mesh": mesh, "split": split, "method": method, "dofs": info["dofs"],
+            "elements": info["elements"], "wall": wall, "analysis_seconds": res["seconds"],
+            "iterations": res["iterations"], "force": h.force, "a": h.a, "p0": h.p0,
+            "a_error": h.a_error, "p0_error": h.p0_error, "l2": h.l2_error,
+            "active_nodes": int(np.count_nonzero(nominal > 0)),
+            "penalty": res["initial_penalty"],
+            "contact_force": -2.0 * float(fy[~on_top].sum())}
+
+
+def nodal_pressure(ref: np.ndarray, fy: np.ndarray) -> np.ndarray:
+    """Pressure per reference length at the slave nodes (reference positions ``ref``, in
+    order along the arc) from the y components ``fy`` of the elements' nodal forces there.
+
+    Those forces are what the mortar contact conditions balance: with dual Lagrange
+    multipliers the contact force of slave node i is D_ii lambda_i, D_ii the integral of
+    its shape function over the slave edge, so lambda_i = f_i / D_ii; over the reference
+    edge that is the pressure per reference length. Round-off forces of nodes out of
+    contact (|f| below 1e-9 of the largest) are zero."""
+    edge = np.linalg.norm(np.diff(ref, axis=0), axis=1)
+    trib = np.zeros(len(ref))
+    trib[:-1] += 0.5 * edge
+    trib[1:] += 0.5 * edge
+    p = -np.asarray(fy) / trib
+    p[np.abs(fy) < 1e-9 * np.abs(fy).max()] = 0.0
+    return p
+
+
+PENALTY_FACTOR = 10.0
+"""Kratos's stiffness_factor for the penalty runs (its automatic penalty, E / h scaled,
+times this): with 1 the penalty limits the accuracy (m4 split 1: L2 1.74 % against 1.30 %
+with 10, 1.31 % with 100 and 1.32 % with the augmented Lagrangian)."""
+
+
+def parse_runs(spec: str) -> list[tuple[str, str, int]]:
+    """``'penalty:m6:1,alm:m6:1'`` -> [(method, mesh, split), ...]."""
+    out = []
+    for item in spec.split(","):
+        method, mesh, split = item.strip().split(":")
+        if method not in MORTAR:
+            raise SystemExit(f"bench: unknown Kratos method {method!r} (known: {sorted(MORTAR)})")
+        out.append((method, mesh, int(split)))
+    return out
+
+
+def kratos_once(py: Path, w: Workdir, run: tuple[str, str, int]) -> dict:
+    method, mesh, split = run
+    return run_kratos(py, w, mesh, split, method,
+                      PENALTY_FACTOR if method == "penalty" else 1.0)
+
+
+def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2) -> dict:
+    """Kratos on the meshes ``runs``; then ``match`` and voiga's hertz m4 NN2.2 (as
+    committed) interleaved, best of ``repeat``, for the wall-time ratio."""
+    from .run import header, hertz_errors, solve
+    header("6. Kratos Multiphysics (Q4 small-displacement plane strain, 2D mortar contact, "
+           "rigid flat) against voiga hertz m4 NN2.2;\n   same measure as python -m post "
+           "hertz (pressure per reference length at reference positions)")
+    py = ensure_kratos()
+    if py is None:
+        return {"available": False}
+    head = (f"{'code':9s} {'method':8s} {'mesh':9s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} "
+            f"{'solve s':>8s} {'L2 (ref.)':>10s} {'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}")
+    print(head, flush=True)
+    out: dict = {"available": True, "penalty_factor": PENALTY_FACTOR, "runs": []}
+
+    def line(r: dict) -> str:
+        return (f"{'kratos':9s} {r['method']:8s} {r['mesh'] + ' x' + str(r['split']):9s} "
+                f"{r['dofs']:6d} {sum(r['iterations']):5d} {r['wall']:8.3f} "
+                f"{r['analysis_seconds']:8.3f} {r['l2']:10.5f} {r['a_error']:+10.4f} "
+                f"{r['p0_error']:+12.4f}")
+
+    for run in parse_runs(runs):
+        try:
+            r = kratos_once(py, w, run)
+        except Exception as err:  # noqa: BLE001 - report and go on with the next run
+            print(f"kratos    {':'.join(map(str, run))} failed: {err}", flush=True)
+            continue
+        print(line(r), flush=True)
+        out["runs"].append(r)
+    (match_run,) = parse_runs(match)
+    case = w.case("hertz", "m4-NN2.2", tag="-kratoscmp")
+    best_v = best_k = None
+    for _ in range(repeat):
+        v = solve(case)
+        k = kratos_once(py, w, match_run)
+        best_v = v if best_v is None or v.wall < best_v.wall else best_v
+        best_k = k if best_k is None or k["wall"] < best_k["wall"] else best_k
+    e = hertz_errors(best_v.result)
+    print(f"{'voiga':9s} {'penalty':8s} {'m4 NN2.2':9s} {best_v.n_dofs:6d} "
+          f"{best_v.iterations:5d} {best_v.wall:8.3f} {'':8s} {e['l2']:10.5f} "
+          f"{e['a_error']:+10.4f} {e['p0_error']:+12.4f}")
+    print(line(best_k))
+    ratio = best_k["wall"] / best_v.wall
+    print(f"\nwall Kratos {match} / voiga m4 NN2.2: {ratio:.2f} (interleaved, best of "
+          f"{repeat}; L2 {best_k['l2']:.3%} against {e['l2']:.3%})")
+    print("wall: the whole process (Kratos: python, import, model read, analysis); solve s: "
+          "Kratos's analysis.Run();\nOMP_NUM_THREADS=1 for both; Kratos penalty: automatic "
+          f"penalty x {PENALTY_FACTOR:g}; dofs: 2 x the cylinder's nodes")
+    out["match"] = {"kratos": best_k, "voiga": {"wall": best_v.wall, "dofs": best_v.n_dofs,
+                                                "iterations": best_v.iterations, **e},
+                    "ratio": ratio, "repeat": repeat}
+    return out
