@@ -189,8 +189,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ccx-meshes", default="m2,m3,m4", help="section 5 meshes")
     ap.add_argument("--kratos-runs", default="penalty:m4:1,penalty:m5:1,penalty:m6:1,alm:m6:1",
                     help="section 6: method:mesh:split, the Q4 mesh being the hertz <mesh> "
-                         "knot spans cut split x split")
-    ap.add_argument("--kratos-match", default="penalty:m6:1",
+                         "knot spans cut split x split (or AxB: A along the arc, B radially)")
+    ap.add_argument("--kratos-solver", default="amgcl",
+                    help="section 6: Kratos's linear solver (amgcl, sparse_lu, ...)")
+    ap.add_argument("--kratos-match", default="penalty:m5:2",
                     help="section 6: the Kratos run timed against voiga hertz m4 NN2.2")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
@@ -218,7 +220,8 @@ def main(argv: list[str] | None = None) -> int:
         figures["calculix"] = section_calculix(w, args.ccx_meshes.split(","), args.repeat)
     if "6" in only:
         from .kratos import section_kratos
-        figures["kratos"] = section_kratos(w, args.kratos_runs, args.kratos_match, args.repeat)
+        figures["kratos"] = section_kratos(w, args.kratos_runs, args.kratos_match, args.repeat,
+                                          args.kratos_solver)
     total = time.perf_counter() - t0
     print(f"\nbench: done in {total:.0f} s")
     path = args.json or (w.path / "bench.json")

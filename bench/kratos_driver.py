@@ -62,7 +62,7 @@ def main(job_path: str) -> int:
         n = part.GetNode(i)
         row = {"id": i, "x0": n.X0, "y0": n.Y0,
                "ux": n.GetSolutionStepValue(KM.DISPLACEMENT_X),
-               "uy": n.GetSolutionStepValue(KM.DISPLACEMENT_Y)}
+               "uy": n.GetSolutionStepValue(KM.DISPLACEMENT_Y), "active": n.Is(KM.ACTIVE)}
         for name in job["contact_variables"]:
             row[name] = nodal(n, name)
         row["force"] = [0.0, 0.0]
