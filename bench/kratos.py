@@ -3,19 +3,22 @@
 Quarter cylinder (R = 1, hole R = 0.05 as in the hertz scene, E = 1, nu = 0.3), small
 displacement Q4 plane strain (SmallDisplacementElement2D4N, LinearElasticPlaneStrain2DLaw),
 meshed on voiga's graded hertz parameter grid: the knot spans of cases/hertz/<mesh>-N2.nml
-each cut into ``split`` Q4 (``'2'``: 2 x 2; ``'2x1'``: 2 along the arc, 1 radially) and mapped through the exact NURBS geometry. The
-flat is a block of Q4 whose nodes are all fixed (rigid); contact is Kratos's 2D mortar
-(``PenaltyContactFrictionless`` or ``ALMContactFrictionless``) with the outer arc as slave
-and the top of the block as master, its penalty chosen by Kratos (stiffness_factor x E / h).
-u_y = -0.01 t on the top cut (u_x free there), u_x = 0 on the symmetry cut, five load steps
-as voiga's five.
+each cut into ``split`` Q4 (``'2'``: 2 x 2; ``'2x1'``: 2 along the arc, 1 radially) and
+mapped through the exact NURBS geometry. The flat is a block of Q4 whose nodes are all
+fixed (rigid); contact is Kratos's 2D mortar (``PenaltyContactFrictionless`` or
+``ALMContactFrictionless``) with the outer arc as slave and the top of the block as
+master, the penalty Kratos's own (stiffness_factor x E / h, see PENALTY_FACTOR). u_y =
+-0.01 t on the top cut (u_x free there), u_x = 0 on the symmetry cut, five load steps as
+voiga's five.
 
 Kratos runs in its own virtual environment (build/kratos-venv, made here with pip); if
-that fails, the section is skipped with a message. The pressure is Kratos's nodal normal
-contact pressure of the slave nodes (per current length, at the current positions),
-taken per reference length (times the stretch of the slave edge at the node) at the
-reference positions; the force is the reaction on the top cut. The same post.hertz
-functions as ``python -m post hertz`` give the errors.
+that fails, the section is skipped with a message. The pressure per reference length at
+the slave nodes is their contact force over their reference length (:func:`nodal_pressure`)
+at the reference positions; the force is the reaction on the top cut. The same post.hertz
+functions as ``python -m post hertz`` give the errors. Kratos's own nodal variables are
+kept in result.json for inspection but not used: AUGMENTED_NORMAL_CONTACT_PRESSURE
+(penalty x weighted gap) integrates to 2.8 times the reaction on m5 x2 and grows away
+from the centre instead of falling; the ALM multiplier is scaled by Kratos's SCALE_FACTOR.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ VENV = ROOT / "build" / "kratos-venv"
 PACKAGES = ("KratosMultiphysics", "KratosStructuralMechanicsApplication",
             "KratosContactStructuralMechanicsApplication", "KratosLinearSolversApplication")
 DRIVER = Path(__file__).resolve().parent / "kratos_driver.py"
+# method -> (mortar_type, contact process, the nodal variable kept for inspection)
 MORTAR = {"penalty": ("PenaltyContactFrictionless", "penalty_contact_process",
                       "AUGMENTED_NORMAL_CONTACT_PRESSURE"),
           "alm": ("ALMContactFrictionless", "alm_contact_process",
