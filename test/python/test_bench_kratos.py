@@ -74,3 +74,12 @@ def test_kratos_hertz_m4_penalty(tmp_path: Path) -> None:
     assert r["contact_force"] == pytest.approx(r["force"], rel=1e-3)
     assert r["l2"] < 0.015
     assert abs(r["a_error"]) < 0.003 and abs(r["p0_error"]) < 0.003
+
+
+def test_section_skipped_with_a_message_when_the_venv_cannot_be_made(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture) -> None:
+    """No network needed: the venv step itself fails (its python is /bin/false)."""
+    monkeypatch.setattr(kratos, "VENV", tmp_path / "venv")
+    monkeypatch.setattr(kratos.sys, "executable", "/bin/false")
+    assert kratos.ensure_kratos() is None
+    assert "skipping Kratos" in capsys.readouterr().out
