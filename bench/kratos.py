@@ -204,6 +204,13 @@ def fix(part: str, constrained: list[bool], value: list) -> dict:
                            "interval": [0.0, "End"], "constrained": constrained, "value": value}}
 
 
+SOLVER_SETTINGS = {"amgcl": {"tolerance": 1e-10, "max_iteration": 1000}}
+"""Settings beyond the solver type. amgcl is not reliable on these meshes: on m5 1x3
+(elements 1:1 at the contact) it gave L2 6.45 % at its default tolerance 1e-6 and 1.92 %
+at 1e-10 (234 s), where sparse_lu gives 0.66 %; on m5 x2 and m6 x1 it agrees with
+sparse_lu to 2e-6."""
+
+
 def parameters(stem: str, method: str, stiffness: float, solver: str) -> dict:
     mortar, process, _ = MORTAR[method]
     return {
@@ -220,7 +227,8 @@ def parameters(stem: str, method: str, stiffness: float, solver: str) -> dict:
             "displacement_relative_tolerance": 1e-6, "displacement_absolute_tolerance": 1e-12,
             "residual_relative_tolerance": 1e-6, "residual_absolute_tolerance": 1e-12,
             "max_iteration": 30,
-            "linear_solver_settings": {"solver_type": solver}},
+            "linear_solver_settings": {"solver_type": solver,
+                                       **SOLVER_SETTINGS.get(solver, {})}},
         "processes": {
             "constraints_process_list": [
                 fix("Block", [True, True, True], [0.0, 0.0, 0.0]),
@@ -318,10 +326,11 @@ def parse_runs(spec: str) -> list[tuple[str, str, str]]:
     return out
 
 
-SOLVER = "amgcl"
-"""Kratos's linear solver: of those its pip build offers (sparse_lu, skyline_lu_factorization,
-amgcl, sparse_cg; no pardiso, umfpack or cholmod), the fastest here at the same answer
-(hertz m5 split 2, penalty: amgcl 13.4 s, sparse_lu 42 s, L2 0.4566 % and 0.4568 %)."""
+SOLVER = "sparse_lu"
+"""Kratos's linear solver for the table: the direct one of those its pip build offers
+(sparse_lu, skyline_lu_factorization, amgcl, sparse_cg; no pardiso, umfpack or cholmod).
+The matched run is also timed with amgcl, about 3x faster where it gives the same answer
+(SOLVER_SETTINGS)."""
 
 
 def kratos_once(py: Path, w: Workdir, run: tuple[str, str, str],
@@ -332,10 +341,12 @@ def kratos_once(py: Path, w: Workdir, run: tuple[str, str, str],
 
 
 def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
-                   solver: str = SOLVER) -> dict:
+                   solvers: str = f"{SOLVER},amgcl") -> dict:
     """Kratos on the meshes ``runs``; then ``match`` and voiga's hertz m4 NN2.2 (as
     committed, penalty 1e3, and with the automatic penalty) interleaved, best of
-    ``repeat``, for the wall-time ratios."""
+    ``repeat``, for the wall-time ratios. ``solvers``: Kratos's linear solvers, the first
+    for the table, each for the matched run."""
+    solver, *_ = names = [v.strip() for v in solvers.split(",")]
     from .run import header, hertz_errors, solve
     header("6. Kratos Multiphysics (Q4 small-displacement plane strain, 2D mortar contact, "
            "rigid flat) against voiga hertz m4 NN2.2;\n   same measure as python -m post "
@@ -346,7 +357,7 @@ def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
     head = (f"{'code':9s} {'method':11s} {'mesh':9s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} "
             f"{'solve s':>8s} {'L2 (ref.)':>10s} {'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}")
     print(head, flush=True)
-    out: dict = {"available": True, "penalty_factor": PENALTY_FACTOR, "solver": solver,
+    out: dict = {"available": True, "penalty_factor": PENALTY_FACTOR, "solvers": names,
                  "runs": []}
 
     def line(r: dict) -> str:
@@ -374,14 +385,15 @@ def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
             v = solve(case)
             if name not in best or v.wall < best[name].wall:
                 best[name] = v
-        try:
-            k = kratos_once(py, w, match_run, solver)
-        except Exception as err:  # noqa: BLE001 - the section ends, the bench goes on
-            print(f"kratos    {match} failed: {err}; no ratio", flush=True)
-            return out
-        if "kratos" not in best or k["wall"] < best["kratos"]["wall"]:
-            best["kratos"] = k
-    out["match"] = {"repeat": repeat, "kratos": best["kratos"]}
+        for name in names:
+            try:
+                k = kratos_once(py, w, match_run, name)
+            except Exception as err:  # noqa: BLE001 - the section ends, the bench goes on
+                print(f"kratos    {match} {name} failed: {err}; no ratio", flush=True)
+                return out
+            if name not in best or k["wall"] < best[name]["wall"]:
+                best[name] = k
+    out["match"] = {"repeat": repeat, **{n: best[n] for n in names}}
     for name in cases:
         v = best[name]
         e = hertz_errors(v.result)
@@ -389,16 +401,18 @@ def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
               f"{v.wall:8.3f} {'':8s} {e['l2']:10.5f} {e['a_error']:+10.4f} "
               f"{e['p0_error']:+12.4f}")
         out["match"][name] = {"wall": v.wall, "dofs": v.n_dofs, "iterations": v.iterations,
-                              **e, "ratio": best["kratos"]["wall"] / v.wall}
-    print(line(best["kratos"]))
+                              **e, "ratio": {n: best[n]["wall"] / v.wall for n in names}}
+    for n in names:
+        print(line(best[n]) + f"  {n}")
     print(f"\nwall Kratos {match} / voiga m4 NN2.2 (interleaved, best of {repeat}):")
     for name in cases:
         m = out["match"][name]
-        print(f"  voiga {name:11s}: {m['ratio']:7.2f}  (L2 Kratos {best['kratos']['l2']:.3%}, "
-              f"voiga {m['l2']:.3%})")
+        for n in names:
+            print(f"  Kratos {n:9s} / voiga {name:11s}: {m['ratio'][n]:7.2f}  (L2 Kratos "
+                  f"{best[n]['l2']:.4%}, voiga {m['l2']:.4%})")
     print("wall: the whole process (Kratos: python, import, model read, analysis); solve s: "
-          "Kratos's analysis.Run();\nOMP_NUM_THREADS=1 for both; Kratos's linear solver: "
-          f"{solver}; Kratos penalty: automatic "
+          "Kratos's analysis.Run();\nOMP_NUM_THREADS=1 for both; Kratos's linear solver in the "
+          f"table: {solver}; Kratos penalty: automatic "
           f"penalty x {PENALTY_FACTOR:g}; voiga auto: the committed case without "
           "penalty_normal (automatic penalty);\ndofs: 2 x the cylinder's nodes")
     return out
