@@ -310,8 +310,9 @@ PENALTY_FACTOR = 10.0
 times this): with 1 the penalty limits the accuracy (m4 split 1: L2 1.74 % against 1.30 %
 with 10, 1.31 % with 100 and 1.32 % with the augmented Lagrangian). On finer meshes the
 error is not monotone in the mesh or the factor (m6 split 1: 0.53 % with 10, 0.98 % with
-100, 1.08 % augmented Lagrangian; m6 split 2x1: 1.70 %; m5 split 3x1: 0.86 %): the last
-active node takes less than its share near the edge of the zone."""
+100, 1.08 % augmented Lagrangian; m6 split 2x1: 1.70 %; m5 split 3x1: 0.86 %; m6 split 2:
+1.63 %, sparse_lu): the nodes near the edge of the zone and at the slave's end on the
+symmetry cut deviate by 1-5 % of p0."""
 
 
 def parse_runs(spec: str) -> list[tuple[str, str, str]]:
