@@ -84,7 +84,8 @@ attack: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/attack.py --out build/attack \
 	  --markdown build/attack/table.md $(ATTACK_ARGS)
 
-## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX)
+## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX,
+## Kratos)
 bench: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m bench $(BENCH_ARGS)
 

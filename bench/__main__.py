@@ -6,6 +6,8 @@ Sections (``--only 1,2,...``):
   3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
   4  scaling of the time per iteration with the DOFs (hertz N2), direct and multigrid
   5  CalculiX (CPE8, penalty contact) on the same Hertz problem, if apt offers it
+  6  Kratos Multiphysics (Q4, 2D mortar penalty / augmented Lagrangian) on the same Hertz
+     problem, installed by pip into build/kratos-venv (skipped if that fails)
 
 Runs go to a scratch directory (default build/bench); every ratio compares runs made
 here, interleaved and best of --repeat, never against figures from another run.
@@ -175,7 +177,7 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", default="1,2,3,4,5", help="comma-separated sections")
+    ap.add_argument("--only", default="1,2,3,4,5,6", help="comma-separated sections")
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
@@ -185,6 +187,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="section 4: largest mesh for the direct solver (m9 takes it 18 min, 18 GB)")
     ap.add_argument("--work", type=Path, default=ROOT / "build" / "bench")
     ap.add_argument("--ccx-meshes", default="m2,m3,m4", help="section 5 meshes")
+    ap.add_argument("--kratos-runs", default="penalty:m4:1,penalty:m5:1,penalty:m6:1,alm:m6:1",
+                    help="section 6: method:mesh:split, the Q4 mesh being the hertz <mesh> "
+                         "knot spans cut split x split (or AxB: A along the arc, B radially)")
+    ap.add_argument("--kratos-solvers", default="sparse_lu,amgcl",
+                    help="section 6: Kratos's linear solvers, the first for the table, each "
+                         "timed on the matched run")
+    ap.add_argument("--kratos-match", default="penalty:m5:2",
+                    help="section 6: the Kratos run timed against voiga hertz m4 NN2.2")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
     if not VOIGA.exists():
@@ -209,6 +219,10 @@ def main(argv: list[str] | None = None) -> int:
     if "5" in only:
         from .ccx import section_calculix
         figures["calculix"] = section_calculix(w, args.ccx_meshes.split(","), args.repeat)
+    if "6" in only:
+        from .kratos import section_kratos
+        figures["kratos"] = section_kratos(w, args.kratos_runs, args.kratos_match, args.repeat,
+                                          args.kratos_solvers)
     total = time.perf_counter() - t0
     print(f"\nbench: done in {total:.0f} s")
     path = args.json or (w.path / "bench.json")
