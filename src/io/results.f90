@@ -203,26 +203,22 @@ contains
         ! and metadata, generously
         call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
         if (allocated(error)) return
-        call write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, error, model)
+        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
+        if (.not. allocated(error)) call write_counters(self, wall, n_cuts, error)
         call self%h5%end_write(error)
         if (allocated(error)) return
         call self%h5%place(error)
     end subroutine results_write_step
 
     !> Write one converged step and the current displacement; flush.
-    subroutine write_step_groups(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
-                                 error, model)
+    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
         !> Contact pairs with the output of their last evaluation.
         type(pair_slot_t), intent(in) :: pairs(:)
-        !> Wall time so far (s).
-        real(dp), intent(in) :: wall
         !> The cuts made while solving this step.
         type(cut_record_t), intent(in), optional :: cuts(:)
-        !> Cuts of the run so far.
-        integer, intent(in), optional :: n_cuts
         !> Solver state needed to restart after this step: the substep fraction carried
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
@@ -286,17 +282,29 @@ contains
             if (self%fields%wants(rec%step, self%last_step)) call write_fields(self%h5, g, self%fields, model, u, error)
             if (allocated(error)) return
         end if
-        self%n_written = self%n_written + 1
-        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
-        if (allocated(error)) return
         ! this step's own output time (the record was made before it was written)
         call system_clock(c1)
         call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp), error)
+    end subroutine write_step_groups
+
+    !> The root's counters after a step: written only once the step itself is on
+    !> disk (flushed), so that a process killed while the step is flushed leaves
+    !> n_steps_done counting whole steps only (HDF5 writes metadata in no order a
+    !> reader can rely on).
+    subroutine write_counters(self, wall, n_cuts, error)
+        class(results_t), intent(inout) :: self
+        real(dp), intent(in) :: wall
+        integer, intent(in), optional :: n_cuts
+        type(error_t), allocatable, intent(out) :: error
+        call self%h5%flush(error)
+        if (allocated(error)) return
+        self%n_written = self%n_written + 1
+        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'n_steps_done', self%n_written, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'wall_time', wall, error)
-    end subroutine write_step_groups
+    end subroutine write_counters
 
     !> Per-slave-point contact output of pair `k` under step group `g`.
     subroutine write_contact(h5, g, k, pair, error)
