@@ -206,6 +206,25 @@ def test_second_writer_refused_whatever_hdf5_locking_says(voiga_bin: Path, tmp_p
     assert len(displacements(tmp_path / "out.h5")) == 200
 
 
+
+def test_restart_refused_before_it_reads_a_file_being_written(voiga_bin: Path, tmp_path: Path) -> None:
+    """A result another run holds the writer's lock of may be half-written at any
+    moment: --restart is refused as that run's before it reads the file (it read it
+    first and reported 'not a readable HDF5 file' when it caught the writer mid-step)."""
+    import fcntl
+
+    block(tmp_path)
+    out = tmp_path / "out.h5"
+    out.write_bytes(b"half a step" * 100)      # what a reader may meet mid-write
+    with open(tmp_path / "out.h5.lock", "w") as lock:
+        lock.write(f"{os.getpid()}\n")
+        lock.flush()
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        res = subprocess.run([str(voiga_bin), "--restart", str(out)], capture_output=True, text=True,
+                             timeout=120)
+    refused(res, "is being written by another voiga run")
+    assert out.read_bytes() == b"half a step" * 100
+
 # --- class 4: geometry that is not a valid body ----------------------------------------
 
 
