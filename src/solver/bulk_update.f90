@@ -23,7 +23,7 @@ module voiga_solver_bulk_update
     use voiga_text, only: str, real_str
     use voiga_linalg_lapack, only: lu_factor, lu_solve
     use voiga_solver_sparse, only: csc_matrix_t, pattern_positions
-    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
+    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_cholmod, only: cholmod_t
     implicit none
@@ -349,9 +349,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Ignored: a direct solve.
         type(solve_accuracy_t), intent(in), optional :: accuracy
-        real(dp) :: xx(size(x), 1)
-        call bulk_solve_columns(self, a, reshape(b, [size(b), 1]), xx, error)
-        x = xx(:, 1)
+        call solve_one_column(self, a, b, x, error)
     end subroutine bulk_solve
 
     !> Solve a X = B (shapes [n, nrhs]): X0 = K0^-1 B, (I + S D) Y = X0_C,

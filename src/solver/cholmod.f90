@@ -15,7 +15,7 @@ module voiga_solver_cholmod
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
     use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
+    use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     implicit none
     private
 
@@ -105,9 +105,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Ignored: a direct solve.
         type(solve_accuracy_t), intent(in), optional :: accuracy
-        real(dp) :: xx(size(x), 1)
-        call cholmod_solve_columns(self, a, reshape(b, [size(b), 1]), xx, error)
-        x = xx(:, 1)
+        call solve_one_column(self, a, b, x, error)
     end subroutine cholmod_solve
 
     !> Solve a X = B (`a` is not read), all columns at once; shapes: [n, nrhs].

@@ -14,7 +14,7 @@ module voiga_solver_linear
     implicit none
     private
 
-    public :: linear_solver_t, solve_accuracy_t
+    public :: linear_solver_t, solve_accuracy_t, solve_one_column
 
     !> How accurately an iterative solver is to solve (direct solvers ignore it).
     type :: solve_accuracy_t
@@ -84,6 +84,19 @@ contains
             if (allocated(error)) return
         end do
     end subroutine linear_solve_columns
+
+    !> Solve a x = b as one column of `self%solve_columns`: the `solve` of a solver
+    !> whose work is done a block of right-hand sides at a time.
+    subroutine solve_one_column(self, a, b, x, error)
+        class(linear_solver_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
+        real(dp), intent(in) :: b(:)
+        real(dp), intent(out) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: xx(size(x), 1)
+        call self%solve_columns(a, reshape(b, [size(b), 1]), xx, error)
+        x = xx(:, 1)
+    end subroutine solve_one_column
 
     pure logical function linear_iterative(self)
         class(linear_solver_t), intent(in) :: self
