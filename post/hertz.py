@@ -22,9 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
+from pre.nurbs import patch_to_splipy
+
 from .contact import edge_stretch
 from .naming import output_path
-from .reader import ContactOutput, Result, Step
+from .reader import Body, ContactOutput, Result, Step
 from .units import Units
 
 EDGE_ZONE = 0.05
@@ -34,7 +36,7 @@ GRID_POINTS = 20001
 """Uniform points of the integration grid over the union of both supports (the slave
 points and +-a are added to it)."""
 CIRCLE_TOLERANCE = 1e-3
-"""Largest rms distance of the slave points near the contact from the fitted circle,
+"""Largest rms distance of the slave edge near the contact from the fitted circle,
 relative to its radius, for the slave edge to count as a cylinder."""
 HALF_MODEL_SIDE = 0.02
 """The contact zone is on one side of the centre (a half model with a symmetry cut)
@@ -232,9 +234,16 @@ def _nominal_pressure(result: Result, st: Step, pair: int) -> tuple[np.ndarray, 
             "and the displacement)")
 
 
-def _cylinder(c: ContactOutput, active: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """Centre, radius and relative rms misfit of the circle through the reference slave
-    points around the contact zone (three zone lengths on either side)."""
+def _cylinder(c: ContactOutput, active: np.ndarray,
+              body: Body) -> tuple[np.ndarray, float, float]:
+    """Centre, radius and relative rms misfit of the circle through the slave edge around
+    the contact zone (three zone lengths on either side).
+
+    A curved (degree >= 2) edge is fitted through its slave points' reference positions:
+    they lie on the edge. A linear edge (the L1 layout) is a polygon inscribed in the
+    cylinder: its slave points lie on chords, and a fit through them missed the radius by
+    up to a half on a coarse mesh (0.45 on hertz m1-L1); it is fitted through the
+    polygon's vertices (the distinct knots at eta = 1 of the bulk patch, at least six)."""
     t = np.array([c.rigid_normal[1], -c.rigid_normal[0]])
     s = c.x_ref @ t
     lo, hi = s[active].min(), s[active].max()
@@ -242,8 +251,22 @@ def _cylinder(c: ContactOutput, active: np.ndarray) -> tuple[np.ndarray, float, 
     near = (s >= lo - 3 * w) & (s <= hi + 3 * w)
     if np.count_nonzero(near) < 6:
         near = np.ones_like(near)
-    centre, radius, rms = fit_circle(c.x_ref[near])
+    linear = (body.layer.degree if body.layer is not None else body.bulk.degree[0]) == 1
+    points = _vertices(body, c.xi_slave[near]) if linear else c.x_ref[near]
+    centre, radius, rms = fit_circle(points)
     return centre, radius, rms / radius
+
+
+def _vertices(body: Body, xi: np.ndarray) -> np.ndarray:
+    """Reference positions of the contact edge's element vertices (eta = 1 of the bulk
+    patch) within the span of ``xi``, widened to the six nearest when fewer."""
+    knots = np.unique(body.bulk.knots_xi)
+    inside = (knots >= xi.min()) & (knots <= xi.max())
+    if np.count_nonzero(inside) < 6:
+        inside = np.zeros_like(inside)
+        inside[np.argsort(np.abs(knots - 0.5 * (xi.min() + xi.max())))[:6]] = True
+    surface = patch_to_splipy(body.bulk)
+    return np.array([np.ravel(surface(float(k), 1.0)) for k in knots[inside]])
 
 
 def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
@@ -253,7 +276,7 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
     :meth:`Result.select_step`) with the Hertz line contact of a cylinder on a rigid flat.
 
     The cylinder is recognised from the pair: its master must be a rigid line, and the
-    slave's reference points around the contact must lie on a circle (:func:`fit_circle`,
+    slave edge around the contact must lie on a circle (:func:`fit_circle`,
     misfit below :data:`CIRCLE_TOLERANCE`); the circle gives the radius (unless
     ``radius`` is given) and the centre, whose projection on the flat is the centre of
     the contact. E and nu are the slave body's. When the contact zone lies on one side
@@ -281,13 +304,13 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
     if not active.any() or normal_force <= 0:
         raise HertzError(f"{result.path}: no point of {c.slave} -> {c.master} is in contact "
                          f"at step {st.step}")
-    centre, r_fit, misfit = _cylinder(c, active)
+    body = result.body(c.slave)
+    centre, r_fit, misfit = _cylinder(c, active, body)
     if misfit > CIRCLE_TOLERANCE or (centre - c.rigid_point) @ n <= 0:
         raise HertzError(f"{result.path}: the contact edge of {c.slave!r} is not a cylinder "
                          f"pressing on the flat (its reference points near the contact are "
                          f"{misfit:.2g} of the radius off the best circle, allowed "
                          f"{CIRCLE_TOLERANCE:g}); post hertz compares a cylinder on a rigid flat")
-    body = result.body(c.slave)
     e, nu = float(body.attrs["youngs_modulus"]), float(body.attrs["poisson_ratio"])
     if configuration == "reference":
         p, what = _nominal_pressure(result, st, pair)
