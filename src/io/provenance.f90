@@ -5,7 +5,8 @@
 !> files are unchanged: otherwise it is refused with the difference named (the
 !> values the result file records beside its steps: the bodies' materials, the
 !> load steps, the solver, the Dirichlet conditions and the contact laws), unless
-!> the restart is forced (`--force-restart`), which the file then records.
+!> the restart is forced (`--force-restart`), which the file then records. It also
+!> records the thread counts its timings were measured with (`library_threads`).
 module voiga_io_provenance
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
@@ -14,6 +15,7 @@ module voiga_io_provenance
     use voiga_io_sha256, only: sha256_file
     use voiga_io_os, only: canonical_path
     use voiga_io_case, only: case_t
+    use voiga_linalg_blas, only: library_threads
     implicit none
     private
 
@@ -40,6 +42,13 @@ contains
         if (allocated(error)) return
         call canonical_path(case%path, absolute, ignored)
         if (.not. allocated(ignored)) call h5%write_attr('/', 'case_path', absolute, error)
+        if (allocated(error)) return
+        ! what the run's timings were measured with
+        if (len(library_threads()) == 0) then
+            call h5%write_attr('/', 'library_threads', '1 (voiga''s default)', error)
+        else
+            call h5%write_attr('/', 'library_threads', library_threads()//' (environment)', error)
+        end if
     end subroutine write_provenance
 
     !> May the result file `path` be continued with `case`? Not when its run
