@@ -52,6 +52,7 @@ import numpy as np
 from pre.h5io import read_curve, read_patch
 from pre.nurbs import Curve, Patch
 
+from .journal import recover
 from .units import Units
 
 LOCK_WAIT: float = 60.0
@@ -416,6 +417,7 @@ def open_result(path: str | Path) -> Iterator[h5py.File]:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no result file {path}")
+    recover(path)  # a flush its killed writer left half done (docs/hdf5.md)
     fd = os.open(path, os.O_RDONLY)
     try:
         deadline = time.monotonic() + LOCK_WAIT

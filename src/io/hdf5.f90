@@ -27,7 +27,7 @@
 !> becomes the most negative integer, wide integers are clamped to the narrow range),
 !> a rank other than the array's, and attributes of more than one value.
 module voiga_io_hdf5
-    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_int, path_char => c_char, path_end => c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use hdf5, only: hid_t, hsize_t, h5open_f, h5fopen_f, h5fcreate_f, h5fclose_f, h5fflush_f, &
                     H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
@@ -43,7 +43,7 @@ module voiga_io_hdf5
     implicit none
     private
 
-    public :: h5file_t
+    public :: h5file_t, finish_interrupted_flush
 
     !> An open HDF5 file.
     type :: h5file_t
@@ -129,6 +129,22 @@ module voiga_io_hdf5
         end subroutine attr_read_real
     end interface
 
+    interface
+        !> The journaled file driver on a file access list (journal_vfd.c); 0: done.
+        function c_journal_fapl(fapl) bind(c, name='voiga_journal_fapl') result(st)
+            import :: c_int, hid_t
+            integer(hid_t), value :: fapl
+            integer(c_int) :: st
+        end function c_journal_fapl
+        !> Finish a flush a killed writer left in `path` (journal_vfd.c): 1 done,
+        !> 0 nothing to do, -1 failed.
+        function c_journal_recover(path) bind(c, name='voiga_journal_recover') result(st)
+            import :: c_int, path_char
+            character(kind=path_char), intent(in) :: path(*)
+            integer(c_int) :: st
+        end function c_journal_recover
+    end interface
+
 contains
 
     !> Open `path`: mode 'r' read-only, 'rw' read-write, 'w' create (truncate).
@@ -151,6 +167,9 @@ contains
         if (st == 0) call h5eset_auto_f(0, st)
         if (st == 0) call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, st)
         if (st == 0) call h5pset_file_locking_f(fapl, .false., .true., st)
+        ! files voiga writes are written through the journaled driver: a kill at any
+        ! instant leaves the file as it was after a flush (docs/hdf5.md, "Crash safety")
+        if (st == 0 .and. mode /= 'r') st = c_journal_fapl(fapl)
         if (st /= 0) then
             call fatal_error(error, "cannot initialise the HDF5 library to open '"//path//"'")
             return
@@ -181,6 +200,16 @@ contains
         call h5pclose_f(fapl, st)
         if (.not. allocated(error)) self%path = path
     end subroutine file_open
+
+    !> Finish the flush a killed writer of the file `path` left half done, if it
+    !> did (docs/hdf5.md, "Crash safety"; journal_vfd.c): `done` tells whether there
+    !> was one. Nothing while another process holds the file's `flock`, or when the
+    !> file cannot be written (then it is read as it is).
+    subroutine finish_interrupted_flush(path, done)
+        character(len=*), intent(in) :: path
+        logical, intent(out) :: done
+        done = c_journal_recover(path//path_end) == 1
+    end subroutine finish_interrupted_flush
 
     !> Close the file (nothing to do if it is not open). Data HDF5 still held in
     !> its caches is written here, so a full disk can show up only now.

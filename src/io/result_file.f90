@@ -15,7 +15,7 @@
 module voiga_io_result_file
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t
-    use voiga_io_hdf5, only: h5file_t
+    use voiga_io_hdf5, only: h5file_t, finish_interrupted_flush
     use voiga_io_os, only: lock_t, acquire_lock, release_lock, hold_exclusive, let_go, reserve_space, &
                            release_space, rename_file, remove_file, path_exists, companion
     use voiga_io_process, only: write_failure_cause
@@ -56,15 +56,20 @@ module voiga_io_result_file
 contains
 
     !> Take the writer's lock of the result file `path` (its lock file beside it):
-    !> refused while another run writes it. Nothing if this object holds it.
+    !> refused while another run writes it. Nothing if this object holds it. A flush
+    !> that a killed earlier writer left half done is finished (`finish_interrupted_flush`):
+    !> whatever reads the file next (a restart, or a reader while this run has not
+    !> replaced it) reads the file of that writer's last flush.
     subroutine file_claim(self, path, error)
         class(result_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: error
+        logical :: finished
         if (self%writer%fd >= 0) return
         call acquire_lock(self%writer, companion(path, '.lock'), "result file '"//path//"'", error)
         if (allocated(error)) return
         self%final_path = path
+        if (path_exists(path)) call finish_interrupted_flush(path, finished)
     end subroutine file_claim
 
     !> Start a new result file `path` (claimed first): `path`.part, created afresh.
