@@ -187,11 +187,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--direct-levels", type=int, default=8,
                     help="section 4: largest mesh for the direct solver (m9 takes it 18 min, 18 GB)")
     ap.add_argument("--work", type=Path, default=ROOT / "build" / "bench")
-    ap.add_argument("--ccx-runs", default="m4:1:1e3,m4:1:1e4,m4:1:1e5,m4:1:1e6,m5:1,m6:1",
+    ap.add_argument("--ccx-runs", default="m4:1,m5:1:1e3,m5:1:1e4,m5:1:1e5,m6:1",
                     help="section 5: mesh:split[:penalty], the CPE8 mesh being the hertz "
                          "<mesh> knot spans cut split x split (or AxB as for Kratos), the "
                          "contact slope penalty x E (default --ccx-penalty)")
-    ap.add_argument("--ccx-penalty", type=float, default=1e5,
+    ap.add_argument("--ccx-penalty", type=float, default=1e4,
                     help="section 5: contact slope / E of the runs that give none")
     ap.add_argument("--ccx-match", default="m5:1",
                     help="section 5: the CalculiX run timed against voiga hertz m4 NN2.2")

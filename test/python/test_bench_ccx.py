@@ -95,3 +95,55 @@ def test_interleaved_calls_keep_the_fastest_of_each() -> None:
     best = interleaved_calls({"a": voiga_like, "b": peer}, 3)
     assert order == ["a", "b"] * 3
     assert best["a"].wall == 1.0 and best["b"]["wall"] == 0.4
+
+
+@pytest.mark.parametrize("section", ["calculix", "kratos"])
+def test_matched_comparison_with_a_stand_in_peer(
+        section: str, voiga_bin: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture) -> None:
+    """Sections 5 and 6 end the same way: the matched peer run and voiga hertz m4 NN2.2 (as
+    committed and with the automatic penalty) interleaved, best of --repeat, and the peer's
+    wall time over each voiga run's. The peer is a stand-in here (voiga runs for real);
+    every call of it is counted."""
+    import bench.run
+    from bench import kratos
+    from bench.run import Workdir
+    monkeypatch.setattr(bench.run, "VOIGA", voiga_bin)
+    calls: list[tuple] = []
+
+    def peer(*args, **kwargs) -> dict:
+        calls.append(args)
+        return {"wall": 10.0 + len(calls), "l2": 0.004, "mesh": "m5", "split": "1",
+                "penalty": 1e4, "dofs": 1, "iterations": [1] * 5 if section == "kratos" else 48,
+                "force": 0.005, "a_error": 0.0, "p0_error": 0.0, "method": "penalty",
+                "analysis_seconds": 1.0}
+
+    w = Workdir(tmp_path / "w")
+    if section == "calculix":
+        monkeypatch.setattr(ccx, "ensure_ccx", lambda: "ccx")
+        monkeypatch.setattr(ccx, "run_ccx", peer)
+        out = ccx.section_calculix(w, "m4:1,m5:1:1e3", "m5:1", 1e4, repeat=2)
+        assert [c[2:] for c in calls] == [("m4", "1", 1e4), ("m5", "1", 1e3),
+                                          ("m5", "1", 1e4), ("m5", "1", 1e4)]
+        peers = ["ccx"]
+    else:
+        monkeypatch.setattr(kratos, "ensure_kratos", lambda: Path("python"))
+        monkeypatch.setattr(kratos, "kratos_once", peer)
+        out = kratos.section_kratos(w, "penalty:m4:1", "penalty:m5:2", repeat=2,
+                                    solvers="sparse_lu,amgcl")
+        assert [c[2:] for c in calls] == [(("penalty", "m4", "1"), "sparse_lu")] + [
+            (("penalty", "m5", "2"), s) for s in ("sparse_lu", "amgcl")] * 2
+        peers = ["sparse_lu", "amgcl"]
+    assert len(out["runs"]) == (2 if section == "calculix" else 1)
+    match = out["match"]
+    # the stand-in's wall grows with every call: the best of each peer's two matched calls
+    # is its first (calculix: calls 3 and 4; kratos: sparse_lu 2 and 4, amgcl 3 and 5)
+    first = {"ccx": 13.0} if section == "calculix" else {"sparse_lu": 12.0, "amgcl": 13.0}
+    assert {p: match[p]["wall"] for p in peers} == first
+    for name in ("penalty 1e3", "auto"):
+        v = match[name]
+        assert v["dofs"] == 7540 and v["wall"] > 0
+        for p in peers:
+            assert v["ratio"][p] == pytest.approx(match[p]["wall"] / v["wall"])
+    assert match["auto"]["l2"] < match["penalty 1e3"]["l2"]
+    assert "no ratio" not in capsys.readouterr().out
