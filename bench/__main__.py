@@ -5,7 +5,8 @@ Sections (``--only 1,2,...``):
   2  NNp against Np on the same mesh (wall time and time per iteration)
   3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
   4  scaling of the time per iteration with the DOFs (hertz N2), direct and multigrid
-  5  CalculiX (CPE8, penalty contact) on the same Hertz problem, if apt offers it
+  5  CalculiX (CPE8, surface-to-surface penalty) on the same Hertz problem, if apt
+     offers it
   6  Kratos Multiphysics (Q4, 2D mortar penalty / augmented Lagrangian) on the same Hertz
      problem, installed by pip into build/kratos-venv (skipped if that fails)
 
@@ -186,7 +187,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--direct-levels", type=int, default=8,
                     help="section 4: largest mesh for the direct solver (m9 takes it 18 min, 18 GB)")
     ap.add_argument("--work", type=Path, default=ROOT / "build" / "bench")
-    ap.add_argument("--ccx-meshes", default="m2,m3,m4", help="section 5 meshes")
+    ap.add_argument("--ccx-runs", default="m4:1,m5:1:1e3,m5:1:1e4,m5:1:1e5,m6:1",
+                    help="section 5: mesh:split[:penalty], the CPE8 mesh being the hertz "
+                         "<mesh> knot spans cut split x split (or AxB as for Kratos), the "
+                         "contact slope penalty x E (default --ccx-penalty)")
+    ap.add_argument("--ccx-penalty", type=float, default=1e4,
+                    help="section 5: contact slope / E of the runs that give none")
+    ap.add_argument("--ccx-match", default="m5:1",
+                    help="section 5: the CalculiX run timed against voiga hertz m4 NN2.2")
     ap.add_argument("--kratos-runs", default="penalty:m4:1,penalty:m5:1,penalty:m6:1,alm:m6:1",
                     help="section 6: method:mesh:split, the Q4 mesh being the hertz <mesh> "
                          "knot spans cut split x split (or AxB: A along the arc, B radially)")
@@ -218,7 +226,8 @@ def main(argv: list[str] | None = None) -> int:
                                               args.direct_levels)
     if "5" in only:
         from .ccx import section_calculix
-        figures["calculix"] = section_calculix(w, args.ccx_meshes.split(","), args.repeat)
+        figures["calculix"] = section_calculix(w, args.ccx_runs, args.ccx_match,
+                                               args.ccx_penalty, args.repeat)
     if "6" in only:
         from .kratos import section_kratos
         figures["kratos"] = section_kratos(w, args.kratos_runs, args.kratos_match, args.repeat,

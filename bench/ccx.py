@@ -3,11 +3,12 @@ a classical FE code at a given contact-pressure accuracy.
 
 Quarter cylinder (R = 1, hole R = 0.05 as in the hertz scene, E = 1, nu = 0.3), CPE8
 plane strain, meshed on the same graded parameter grid as voiga's hertz mesh m<k> (the
-knot spans of the case file mapped through the exact NURBS geometry: one CPE8 per knot
-span, mid-side nodes on the exact arc). The flat is a block of CPE8 whose nodes are all
-fixed (rigid); contact is surface-to-surface with a linear pressure-overclosure law of slope
-1000 (voiga's penalty_normal). u_y = -0.01 on the top cut (y = 0), u_x = 0 on the
-symmetry cut (x = 0), five increments as voiga's five steps.
+knot spans of the case file, each cut ``split`` times as in section 6, mapped through
+the exact NURBS geometry: mid-side nodes on the exact arc). The flat is a block of CPE8
+whose nodes are all fixed (rigid); contact is surface-to-surface with a linear
+pressure-overclosure law of slope K = penalty x E (:data:`PENALTY`). u_y = -0.01 on the
+top cut (y = 0), u_x = 0 on the symmetry cut (x = 0), five increments as voiga's five
+steps.
 
 The pressure is K * overclosure at 3 Gauss points of every quadratic slave edge (what
 the surface-to-surface penalty applies), from the printed nodal displacements, taken per
@@ -21,14 +22,22 @@ import os
 import shutil
 import subprocess
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from .refine import read_knots
-from .run import ROOT, Workdir
+from .refine import split_grid, splits
+from .run import Workdir
 
-PENALTY = 1000.0
+PENALTY = 1e4
+"""Contact slope / E of the runs that give none: the stiffest that is still measured
+faithfully and the most accurate of 1e3, 1e4, 1e5, 1e6 (m4: L2 1.50, 0.78, 0.80,
+0.99 %; m5 1e4 0.40 %, 1e5 0.92 %). 1e3 limits the accuracy (its compliance E*/(K a) is
+1.5 %). From 1e5 on the error does not fall: the stiffer law's pressure deviates more at
+the last active points before the zone's edge, and the overclosure is read from
+displacements printed to 7 digits (ccx's .dat), which K turns into noise of K x 5e-10
+(0.1 % of p0 at 1e5, 1.2 % at 1e6)."""
 UY = -0.01
 E, NU = 1.0, 0.3
 
@@ -56,18 +65,14 @@ def ensure_ccx() -> str | None:
     return exe
 
 
-def breakpoints(mesh: str) -> tuple[np.ndarray, np.ndarray]:
-    text = (ROOT / "cases" / "hertz" / f"{mesh}-N2.nml").read_text()
-    kx, ke = read_knots(text, "knots_xi"), read_knots(text, "knots_eta")
-    return np.concatenate([[0.0], kx, [1.0]]), np.concatenate([[0.0], ke, [1.0]])
-
-
-def cylinder_mesh(mesh: str):
-    """Nodes (n, 2), CPE8 connectivity (nel, 8; 1-based), and node sets."""
+def cylinder_mesh(mesh: str, split: str = "1"):
+    """Nodes (n, 2), CPE8 connectivity (nel, 8; 1-based), node sets and the elements of
+    the outer arc: one CPE8 per knot span of hertz <mesh>, every span cut as ``split``
+    says (:func:`bench.refine.splits`)."""
     from pre.nurbs import evaluate_patch
     from pre.scenes import hertz
     patch = hertz()["cylinder"]
-    bx, be = breakpoints(mesh)
+    bx, be = split_grid(mesh, split)
     # parameter grid with the span midpoints (quadratic serendipity nodes)
     gx = np.empty(2 * len(bx) - 1)
     gx[0::2], gx[1::2] = bx, 0.5 * (bx[:-1] + bx[1:])
@@ -132,8 +137,9 @@ def block_mesh(first_node: int, first_elem: int, nx: int = 40, ny: int = 2,
     return np.array(nodes), np.array(elems), top
 
 
-def write_input(path: Path, mesh: str) -> dict:
-    xy, conn, sets, outer_elems = cylinder_mesh(mesh)
+def write_input(path: Path, mesh: str, split: str = "1", penalty: float = PENALTY) -> dict:
+    """The CalculiX input of hertz <mesh> cut ``split``, contact slope ``penalty`` x E."""
+    xy, conn, sets, outer_elems = cylinder_mesh(mesh, split)
     # orientation: counter-clockwise corners; the outer face of a cylinder element is
     # between corners 2 and 3 (eta = 1) -> face S2, flipped to S4 if reordered
     face = "S2"
@@ -142,7 +148,7 @@ def write_input(path: Path, mesh: str) -> dict:
         face = "S3"  # corners 1 4 3 2: the old 2-3 edge is now 3-4
     assert all(signed_area(xy, c) > 0 for c in conn[:5])
     bxy, bconn, btop = block_mesh(len(xy) + 1, len(conn) + 1)
-    lines = ["*HEADING", f"hertz {mesh}: CPE8 quarter cylinder on a rigid flat", "*NODE"]
+    lines = ["*HEADING", f"hertz {mesh} x{split}: CPE8 quarter cylinder on a rigid flat", "*NODE"]
     lines += [f"{k + 1}, {x:.15g}, {y:.15g}" for k, (x, y) in enumerate(xy)]
     lines += [f"{len(xy) + k + 1}, {x:.15g}, {y:.15g}" for k, (x, y) in enumerate(bxy)]
     lines.append("*ELEMENT, TYPE=CPE8, ELSET=ECYL")
@@ -169,7 +175,7 @@ def write_input(path: Path, mesh: str) -> dict:
               "*SOLID SECTION, ELSET=ECYL, MATERIAL=CYL", "1.",
               "*SOLID SECTION, ELSET=EBLOCK, MATERIAL=RIGID", "1.",
               "*SURFACE INTERACTION, NAME=SI1",
-              "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{PENALTY}, 1e-9, 1e-3",
+              "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{penalty * E:.6g}, 1e-9, 1e-3",
               "*CONTACT PAIR, INTERACTION=SI1, TYPE=SURFACE TO SURFACE", "SSLAVE, SMASTER",
               "*BOUNDARY", "NBLOCK, 1, 2, 0.", "NSYM, 1, 1, 0.",
               "*STEP, INC=1000", "*STATIC", "0.2, 1.0, 1e-6, 0.2",
@@ -225,61 +231,119 @@ def edge_points(xn: np.ndarray, n_gauss: int = 3) -> tuple[np.ndarray, np.ndarra
     return np.concatenate([n @ e for e in edges]), np.concatenate([dn @ e for e in edges])
 
 
-def run_ccx(exe: str, w: Workdir, mesh: str) -> dict:
+def run_ccx(exe: str, w: Workdir, mesh: str, split: str = "1",
+            penalty: float = PENALTY) -> dict:
+    """One analysis (the whole ccx process timed, one thread) and its Hertz errors."""
     from post.hertz import compare_profile
     d = w.path / "calculix"
     d.mkdir(exist_ok=True)
-    inp = d / f"hertz-{mesh}.inp"
-    info = write_input(inp, mesh)
+    stem = f"hertz-{mesh}-x{split}-k{penalty:g}"
+    inp = d / f"{stem}.inp"
+    info = write_input(inp, mesh, split, penalty)
     env = dict(os.environ, OMP_NUM_THREADS="1")
     t0 = time.perf_counter()
     proc = subprocess.run([exe, "-i", inp.stem], cwd=d, capture_output=True, text=True, env=env)
     wall = time.perf_counter() - t0
-    (d / f"hertz-{mesh}.log").write_text(proc.stdout + proc.stderr)
+    (d / f"{stem}.log").write_text(proc.stdout + proc.stderr)
     if proc.returncode != 0 or "Job finished" not in proc.stdout:
-        raise RuntimeError(f"ccx {inp} failed; see {d / f'hertz-{mesh}.log'}")
-    xn, u, rf = parse_dat(d / f"hertz-{mesh}.dat", info)
+        raise RuntimeError(f"ccx {inp} failed; see {d / f'{stem}.log'}")
+    xn, u, rf = parse_dat(d / f"{stem}.dat", info)
     x, dx = edge_points(xn)
     ref, dref = edge_points(xn - u)
-    p = PENALTY * np.clip(-1.0 - x[:, 1], 0.0, None)  # per current length
+    p = penalty * E * np.clip(-1.0 - x[:, 1], 0.0, None)  # per current length
     # as python -m post hertz: per reference length (times the stretch of the edge) at
     # the reference positions, against Hertz for the run's own force
     nominal = p * np.linalg.norm(dx, axis=1) / np.linalg.norm(dref, axis=1)
     h = compare_profile(ref[:, 0], nominal, 2.0 * abs(rf), E, NU, 1.0, half_model=True)
-    return {"mesh": mesh, "dofs": info["dofs"], "elements": info["elements"], "wall": wall,
-            "force": h.force, "a": h.a, "p0": h.p0, "a_error": h.a_error,
-            "p0_error": h.p0_error, "p_max": h.p_max, "l2": h.l2_error,
-            "active_points": int(np.count_nonzero(p > 0))}
+    return {"mesh": mesh, "split": split, "penalty": penalty, "dofs": info["dofs"],
+            "elements": info["elements"], "wall": wall, "force": h.force, "a": h.a,
+            "p0": h.p0, "a_error": h.a_error, "p0_error": h.p0_error, "p_max": h.p_max,
+            "l2": h.l2_error, "active_points": int(np.count_nonzero(p > 0)),
+            "iterations": iterations(proc.stdout)}
 
 
-def section_calculix(w: Workdir, meshes: list[str], repeat: int = 2) -> dict:
-    from .run import header, hertz_errors, interleaved
-    header("5. CalculiX (CPE8 plane strain, surface-to-surface linear penalty 1000, rigid "
-           "flat) against voiga N2 / NN2.2, same meshes")
+def iterations(stdout: str) -> int:
+    """Newton iterations of a ccx run, from its log (one "iteration" line each)."""
+    return sum(1 for line in stdout.splitlines() if line.strip().startswith("iteration "))
+
+
+def short(v: float) -> str:
+    """1e4 for 10000.0, 3.5e4 for 35000.0, 200 for 200.0."""
+    m, e = f"{v:e}".split("e")
+    m = m.rstrip("0").rstrip(".")
+    return f"{v:g}" if abs(int(e)) < 3 else f"{m}e{int(e)}"
+
+
+def parse_runs(spec: str, penalty: float = PENALTY) -> list[tuple[str, str, float]]:
+    """``'m4:1:1e3,m5:2'`` -> [('m4', '1', 1000.0), ('m5', '2', penalty)]: mesh, split
+    (:func:`bench.refine.splits`) and contact slope / E (``penalty`` when left out)."""
+    out = []
+    for item in spec.split(","):
+        mesh, split, *k = item.strip().split(":")
+        splits(split)
+        if len(k) > 1:
+            raise SystemExit(f"bench: CalculiX run {item!r}: expected mesh:split[:penalty]")
+        slope = float(k[0]) if k else penalty
+        if not slope > 0:
+            raise SystemExit(f"bench: CalculiX run {item!r}: penalty must be > 0")
+        out.append((mesh, split, slope))
+    return out
+
+
+def section_calculix(w: Workdir, runs: str, match: str, penalty: float = PENALTY,
+                     repeat: int = 2) -> dict:
+    """CalculiX on the runs ``runs`` (mesh:split[:penalty], ``penalty`` x E when left
+    out); then ``match`` and voiga's hertz m4 NN2.2 (as committed, penalty 1e3, and with
+    the automatic penalty) interleaved, best of ``repeat``, for the wall-time ratios."""
+    from .run import header, interleaved_calls, reference_ratios, solve, voiga_reference
+    header("5. CalculiX (CPE8 plane strain, surface-to-surface linear penalty, rigid flat) "
+           "against voiga hertz m4 NN2.2;\n   same measure as python -m post hertz "
+           "(pressure per reference length at reference positions)")
     exe = ensure_ccx()
     if exe is None:
         return {"available": False}
-    out = {"available": True, "runs": []}
-    print(f"{'code':11s} {'mesh':5s} {'dofs':>6s} {'wall s':>8s} {'P':>10s} {'a_fit/a-1':>10s} "
-          f"{'p0_fit/p0-1':>12s} {'L2 (ref.)':>11s} {'wall/voiga N2':>14s}", flush=True)
-    for mesh in meshes:
-        runs = interleaved([w.case("hertz", f"{mesh}-{lay}", tag="-ccxcmp")
-                            for lay in ("N2", "NN2.2")], repeat)
-        voiga = {lay: (r, hertz_errors(r.result)) for lay, r in zip(("N2", "NN2.2"), runs)}
+    print(f"{'code':6s} {'contact':13s} {'mesh':8s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} "
+          f"{'P':>9s} {'L2 (ref.)':>10s} {'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}", flush=True)
+    out: dict = {"available": True, "penalty": penalty, "runs": []}
+
+    def line(r: dict) -> str:
+        return (f"{'ccx':6s} {'penalty ' + short(r['penalty']):13s} "
+                f"{r['mesh'] + ' x' + r['split']:8s} {r['dofs']:6d} {r['iterations']:5d} "
+                f"{r['wall']:8.3f} {r['force']:9.6f} {r['l2']:10.5f} {r['a_error']:+10.4f} "
+                f"{r['p0_error']:+12.4f}")
+
+    for mesh, split, slope in parse_runs(runs, penalty):
         try:
-            c = run_ccx(exe, w, mesh)
-        except Exception as err:  # noqa: BLE001 - report and go on with the next mesh
-            print(f"ccx         {mesh:5s} failed: {err}")
+            r = run_ccx(exe, w, mesh, split, slope)
+        except Exception as err:  # noqa: BLE001 - report and go on with the next run
+            print(f"ccx    {mesh}:{split}:{slope:g} failed: {err}", flush=True)
             continue
-        for lay, (r, e) in voiga.items():
-            print(f"voiga {lay:5s} {mesh:5s} {r.n_dofs:6d} {r.wall:8.3f} {'':>10s} "
-                  f"{e['a_error']:+10.4f} {e['p0_error']:+12.4f} {e['l2']:11.5f} "
-                  f"{r.wall / voiga['N2'][0].wall:14.3f}")
-        print(f"ccx         {mesh:5s} {c['dofs']:6d} {c['wall']:8.3f} {c['force']:10.6f} "
-              f"{c['a_error']:+10.4f} {c['p0_error']:+12.4f} {c['l2']:11.5f} "
-              f"{c['wall'] / voiga['N2'][0].wall:14.3f}", flush=True)
-        out["runs"].append({**c, "voiga": {k: {"wall": r.wall, "dofs": r.n_dofs, **e}
-                                           for k, (r, e) in voiga.items()}})
-    print(f"voiga: best of {repeat}; ccx: one run, OMP_NUM_THREADS=1; ccx dofs: 2 x nodes of the cylinder (the fixed block's are not counted); P is the "
-          "full cylinder's force per length")
+        print(line(r), flush=True)
+        out["runs"].append(r)
+    (mrun,) = parse_runs(match, penalty)
+    cases = voiga_reference(w, "-ccxcmp")
+    calls = {name: partial(solve, case) for name, case in cases.items()}
+    calls["ccx"] = partial(run_ccx, exe, w, *mrun)
+    try:
+        best = interleaved_calls(calls, repeat)
+    except Exception as err:  # noqa: BLE001 - the section ends, the bench goes on
+        print(f"{match} (voiga m4 NN2.2 or ccx) failed: {err}; no ratio", flush=True)
+        return out
+    out["match"] = {"repeat": repeat, "ccx": best["ccx"],
+                    **reference_ratios(best, cases, ["ccx"])}
+    print("matched error, interleaved:")
+    for name in cases:
+        m = out["match"][name]
+        print(f"{'voiga':6s} {name:13s} {'m4 NN2.2':8s} {m['dofs']:6d} {m['iterations']:5d} "
+              f"{m['wall']:8.3f} {'':9s} {m['l2']:10.5f} {m['a_error']:+10.4f} "
+              f"{m['p0_error']:+12.4f}")
+    print(line(best["ccx"]))
+    print(f"\nwall ccx {match} / voiga m4 NN2.2 (interleaved, best of {repeat}):")
+    for name in cases:
+        m = out["match"][name]
+        print(f"  ccx / voiga {name:11s}: {m['ratio']['ccx']:7.2f}  (L2 ccx "
+              f"{best['ccx']['l2']:.4%}, voiga {m['l2']:.4%})")
+    print("wall: the whole process; OMP_NUM_THREADS=1 for both (ccx: SPOOLES); iters: Newton "
+          "iterations (ccx: its log's);\npenalty: the contact slope / E; P: the full "
+          "cylinder's force per length; dofs: 2 x the cylinder's nodes")
     return out

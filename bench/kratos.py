@@ -25,15 +25,15 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import subprocess
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from .ccx import breakpoints
+from .refine import split_grid, splits
 from .run import ROOT, Workdir
 
 UY = -0.01
@@ -83,30 +83,12 @@ def ensure_kratos() -> Path | None:
     return venv_python()
 
 
-def refine(b: np.ndarray, split: int) -> np.ndarray:
-    """Breakpoints ``b`` with every span cut into ``split`` equal parts."""
-    t = np.linspace(0.0, 1.0, split + 1)[:-1]
-    return np.append((b[:-1, None] + t * np.diff(b)[:, None]).ravel(), b[-1])
-
-
-def splits(split: str) -> tuple[int, int]:
-    """``'2'`` -> (2, 2), ``'3x1'`` -> (3, 1): cuts per knot span along xi and eta."""
-    parts = [int(v) for v in str(split).split("x")]
-    if len(parts) == 1:
-        parts *= 2
-    if len(parts) != 2 or min(parts) < 1:
-        raise ValueError(f"split {split!r}: expected n or nxm with n, m >= 1")
-    return parts[0], parts[1]
-
-
 def cylinder_q4(mesh: str, split: str):
     """Nodes (n, 2), counter-clockwise Q4 connectivity (nel, 4; 0-based) and the node
     index lists of the symmetry cut, the top cut and the outer arc (in xi order)."""
     from pre.nurbs import evaluate_patch
     from pre.scenes import hertz
-    bx, be = breakpoints(mesh)
-    sx, se = splits(split)
-    gx, ge = refine(bx, sx), refine(be, se)
+    gx, ge = split_grid(mesh, split)
     xi, eta = np.meshgrid(gx, ge, indexing="ij")
     xy = evaluate_patch(hertz()["cylinder"], xi.ravel(), eta.ravel())
     xy[np.isclose(xi.ravel(), 0.0), 0] = 0.0
@@ -348,7 +330,7 @@ def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
     ``repeat``, for the wall-time ratios. ``solvers``: Kratos's linear solvers, the first
     for the table, each for the matched run."""
     solver, *_ = names = [v.strip() for v in solvers.split(",")]
-    from .run import header, hertz_errors, solve
+    from .run import header, interleaved_calls, reference_ratios, solve, voiga_reference
     header("6. Kratos Multiphysics (Q4 small-displacement plane strain, 2D mortar contact, "
            "rigid flat) against voiga hertz m4 NN2.2;\n   same measure as python -m post "
            "hertz (pressure per reference length at reference positions)")
@@ -376,33 +358,21 @@ def section_kratos(w: Workdir, runs: str, match: str, repeat: int = 2,
         print(line(r), flush=True)
         out["runs"].append(r)
     (match_run,) = parse_runs(match)
-    committed = (ROOT / "cases" / "hertz" / "m4-NN2.2.nml").read_text()
-    auto = re.sub(r"^\s*penalty_normal\s*=.*\n", "", committed, flags=re.M)
-    cases = {"penalty 1e3": w.case("hertz", "m4-NN2.2", tag="-kratoscmp"),
-             "auto": w.case("hertz", "m4-NN2.2", tag="-kratoscmp-auto", text=auto)}
-    best: dict = {}
-    for _ in range(repeat):
-        for name, case in cases.items():
-            v = solve(case)
-            if name not in best or v.wall < best[name].wall:
-                best[name] = v
-        for name in names:
-            try:
-                k = kratos_once(py, w, match_run, name)
-            except Exception as err:  # noqa: BLE001 - the section ends, the bench goes on
-                print(f"kratos    {match} {name} failed: {err}; no ratio", flush=True)
-                return out
-            if name not in best or k["wall"] < best[name]["wall"]:
-                best[name] = k
-    out["match"] = {"repeat": repeat, **{n: best[n] for n in names}}
+    cases = voiga_reference(w, "-kratoscmp")
+    calls = {name: partial(solve, case) for name, case in cases.items()}
+    calls.update({n: partial(kratos_once, py, w, match_run, n) for n in names})
+    try:
+        best = interleaved_calls(calls, repeat)
+    except Exception as err:  # noqa: BLE001 - the section ends, the bench goes on
+        print(f"{match} (voiga m4 NN2.2 or Kratos) failed: {err}; no ratio", flush=True)
+        return out
+    out["match"] = {"repeat": repeat, **{n: best[n] for n in names},
+                    **reference_ratios(best, cases, names)}
     for name in cases:
-        v = best[name]
-        e = hertz_errors(v.result)
-        print(f"{'voiga':9s} {name:11s} {'m4 NN2.2':9s} {v.n_dofs:6d} {v.iterations:5d} "
-              f"{v.wall:8.3f} {'':8s} {e['l2']:10.5f} {e['a_error']:+10.4f} "
-              f"{e['p0_error']:+12.4f}")
-        out["match"][name] = {"wall": v.wall, "dofs": v.n_dofs, "iterations": v.iterations,
-                              **e, "ratio": {n: best[n]["wall"] / v.wall for n in names}}
+        m = out["match"][name]
+        print(f"{'voiga':9s} {name:11s} {'m4 NN2.2':9s} {m['dofs']:6d} {m['iterations']:5d} "
+              f"{m['wall']:8.3f} {'':8s} {m['l2']:10.5f} {m['a_error']:+10.4f} "
+              f"{m['p0_error']:+12.4f}")
     for n in names:
         print(line(best[n]) + f"  {n}")
     print(f"\nwall Kratos {match} / voiga m4 NN2.2 (interleaved, best of {repeat}):")

@@ -1,6 +1,8 @@
 """Hertz meshes beyond the committed m6: copy m6-N2 and insert the midpoint of every
 knot span along xi and along eta (more radial knots), so each level has about 4x the
-DOFs of the one before (m7 ~ 1.1e5, m8 ~ 4.5e5 DOFs)."""
+DOFs of the one before (m7 ~ 1.1e5, m8 ~ 4.5e5 DOFs). Also the parameter grids of the
+peers' meshes (sections 5 and 6): the knot spans of a committed hertz mesh, each cut
+``split`` times."""
 
 from __future__ import annotations
 
@@ -16,6 +18,36 @@ def read_knots(text: str, name: str) -> np.ndarray:
     if m is None:
         raise KeyError(name)
     return np.array([float(v) for v in m.group(1).replace("\n", " ").split(",") if v.strip()])
+
+
+def breakpoints(mesh: str) -> tuple[np.ndarray, np.ndarray]:
+    """All knot values (ends included) along xi and eta of cases/hertz/<mesh>-N2.nml."""
+    text = (ROOT / "cases" / "hertz" / f"{mesh}-N2.nml").read_text()
+    kx, ke = read_knots(text, "knots_xi"), read_knots(text, "knots_eta")
+    return np.concatenate([[0.0], kx, [1.0]]), np.concatenate([[0.0], ke, [1.0]])
+
+
+def cut_spans(b: np.ndarray, split: int) -> np.ndarray:
+    """Breakpoints ``b`` with every span cut into ``split`` equal parts."""
+    t = np.linspace(0.0, 1.0, split + 1)[:-1]
+    return np.append((b[:-1, None] + t * np.diff(b)[:, None]).ravel(), b[-1])
+
+
+def splits(split: str) -> tuple[int, int]:
+    """``'2'`` -> (2, 2), ``'3x1'`` -> (3, 1): cuts per knot span along xi and eta."""
+    parts = [int(v) for v in str(split).split("x")]
+    if len(parts) == 1:
+        parts *= 2
+    if len(parts) != 2 or min(parts) < 1:
+        raise ValueError(f"split {split!r}: expected n or nxm with n, m >= 1")
+    return parts[0], parts[1]
+
+
+def split_grid(mesh: str, split: str = "1") -> tuple[np.ndarray, np.ndarray]:
+    """The breakpoints of hertz <mesh> along xi and eta, every span cut as ``split`` says."""
+    bx, be = breakpoints(mesh)
+    sx, se = splits(split)
+    return cut_spans(bx, sx), cut_spans(be, se)
 
 
 def midpoints(interior: np.ndarray) -> np.ndarray:

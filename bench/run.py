@@ -197,3 +197,41 @@ def hertz_errors(path: Path) -> dict:
     from post.reader import read_result
     h = hertz_comparison(read_result(path))
     return {"l2": h.l2_error, "a_error": h.a_error, "p0_error": h.p0_error}
+
+
+def voiga_reference(w: Workdir, tag: str) -> dict[str, Path]:
+    """The voiga runs the peers (sections 5 and 6) are timed against: hertz m4 NN2.2 as
+    committed (penalty_normal = 1e3) and without penalty_normal (the automatic penalty)."""
+    committed = (ROOT / "cases" / "hertz" / "m4-NN2.2.nml").read_text()
+    auto = re.sub(r"^\s*penalty_normal\s*=.*\n", "", committed, flags=re.M)
+    return {"penalty 1e3": w.case("hertz", "m4-NN2.2", tag=tag),
+            "auto": w.case("hertz", "m4-NN2.2", tag=f"{tag}-auto", text=auto)}
+
+
+def interleaved_calls(calls: dict, repeat: int) -> dict:
+    """Best of ``repeat`` for every call of ``calls`` (name -> function of no argument
+    returning a :class:`Run` or a dict with a "wall" entry), the calls interleaved as in
+    :func:`interleaved`. An exception of a call ends the comparison (it propagates)."""
+    def wall(r):
+        return r.wall if isinstance(r, Run) else r["wall"]
+
+    best: dict = {}
+    for _ in range(repeat):
+        for name, call in calls.items():
+            r = call()
+            if name not in best or wall(r) < wall(best[name]):
+                best[name] = r
+    return best
+
+
+def reference_ratios(best: dict, cases: dict, peers: list[str]) -> dict:
+    """For every voiga run of ``cases`` (:func:`voiga_reference`) in ``best``: its wall
+    time, DOFs, iterations, Hertz errors and the wall-time ratio of every peer run
+    ``best[p]`` (a dict with "wall") of ``peers`` to it."""
+    out = {}
+    for name in cases:
+        v = best[name]
+        out[name] = {"wall": v.wall, "dofs": v.n_dofs, "iterations": v.iterations,
+                     **hertz_errors(v.result),
+                     "ratio": {p: best[p]["wall"] / v.wall for p in peers}}
+    return out
