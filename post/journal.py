@@ -14,18 +14,12 @@ import errno
 import fcntl
 import os
 import struct
+import zlib
 from pathlib import Path
 
 MAGIC = b"VOIGAJ01"
 FOOTER = struct.Struct("<8sQQQQ")
-"""magic, journal start, records' length, file size after the flush, FNV-1a of the records."""
-
-
-def _fnv1a(data: bytes) -> int:
-    h = 14695981039346656037
-    for b in data:
-        h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
-    return h
+"""magic, journal start, records' length, file size after the flush, CRC-32 of the records."""
 
 
 def _records(data: bytes) -> list[tuple[int, bytes]] | None:
@@ -63,7 +57,7 @@ def recover(path: str | Path) -> bool:
         if magic != MAGIC or start + length + FOOTER.size != size or final > start:
             return False
         data = os.pread(fd, length, start)
-        records = _records(data) if _fnv1a(data) == check else None
+        records = _records(data) if zlib.crc32(data) == check else None
         if records is None:
             return False
         try:

@@ -6,7 +6,7 @@
  * Between flushes every write HDF5 issues is kept in memory (reads see it). A flush
  *   1. appends the kept writes to the end of the file as a journal: records
  *      (address, size, bytes), then a footer (magic, where the journal starts, its
- *      length, the file's size after the flush, a checksum of the records);
+ *      length, the file's size after the flush, the CRC-32 of the records);
  *   2. writes the kept writes at their addresses;
  *   3. truncates the file to its size after the flush, which removes the journal.
  * Killed before the footer is complete, the file is the previous one plus bytes
@@ -53,10 +53,22 @@ typedef struct {
 
 static hid_t driver_id = -1;
 
-static uint64_t fnv1a(uint64_t h, const unsigned char *p, size_t n)
+/* CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) of `n` bytes. */
+static uint64_t crc32_of(const unsigned char *p, size_t n)
 {
-    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 1099511628211ULL;
-    return h;
+    static uint32_t table[256];
+    static int ready = 0;
+    uint32_t c = 0xFFFFFFFFu;
+    if (!ready) {
+        for (uint32_t i = 0; i < 256; i++) {
+            uint32_t v = i;
+            for (int k = 0; k < 8; k++) v = (v & 1) ? 0xEDB88320u ^ (v >> 1) : v >> 1;
+            table[i] = v;
+        }
+        ready = 1;
+    }
+    for (size_t i = 0; i < n; i++) c = table[(c ^ p[i]) & 0xFF] ^ (c >> 8);
+    return (uint64_t)(c ^ 0xFFFFFFFFu);
 }
 
 static int write_all(int fd, const void *buf, size_t n, off_t at)
@@ -124,7 +136,7 @@ static int apply_records(int fd, const unsigned char *rec, uint64_t length, uint
 /* Steps 1-3 for the writes kept, leaving the file `final_size` bytes long. */
 static int commit(journal_file_t *f, uint64_t final_size)
 {
-    uint64_t length = 0, start, h = 14695981039346656037ULL;
+    uint64_t length = 0, start;
     unsigned char *rec, *p, footer[FOOTER_BYTES];
     struct stat st;
     int status;
@@ -148,12 +160,11 @@ static int commit(journal_file_t *f, uint64_t final_size)
         memcpy(p + 16, f->kept[i].bytes, f->kept[i].size);
         p += 16 + f->kept[i].size;
     }
-    h = fnv1a(h, rec, length);
     memcpy(footer, JOURNAL_MAGIC, 8);
     put64(footer + 8, start);
     put64(footer + 16, length);
     put64(footer + 24, final_size);
-    put64(footer + 32, h);
+    put64(footer + 32, crc32_of(rec, length));
     status = write_all(f->fd, rec, length, (off_t)start);
     if (status == 0) status = write_all(f->fd, footer, FOOTER_BYTES, (off_t)(start + length));
     if (status == 0) status = apply_records(f->fd, rec, length, final_size, ++f->commits == f->kill_at);
@@ -171,7 +182,7 @@ static int commit(journal_file_t *f, uint64_t final_size)
 int voiga_journal_recover(const char *path)
 {
     unsigned char footer[FOOTER_BYTES], *rec;
-    uint64_t start, length, final_size, h = 14695981039346656037ULL;
+    uint64_t start, length, final_size;
     struct stat st;
     int fd, status = 0;
 
@@ -200,7 +211,7 @@ int voiga_journal_recover(const char *path)
         close(fd);
         return -1;
     }
-    if (fnv1a(h, rec, length) == get64(footer + 32))
+    if (crc32_of(rec, length) == get64(footer + 32))
         status = apply_records(fd, rec, length, final_size, 0) == 0 ? 1 : -1;
     free(rec);
     close(fd);

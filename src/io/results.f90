@@ -287,17 +287,14 @@ contains
         call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp), error)
     end subroutine write_step_groups
 
-    !> The root's counters after a step: written only once the step itself is on
-    !> disk (flushed), so that a process killed while the step is flushed leaves
-    !> n_steps_done counting whole steps only (HDF5 writes metadata in no order a
-    !> reader can rely on).
+    !> The root's counters after a step, flushed with it: the flush is journaled
+    !> (journal_vfd.c), so the step and its count reach the file together or not at
+    !> all, and n_steps_done counts whole steps only.
     subroutine write_counters(self, wall, n_cuts, error)
         class(results_t), intent(inout) :: self
         real(dp), intent(in) :: wall
         integer, intent(in), optional :: n_cuts
         type(error_t), allocatable, intent(out) :: error
-        call self%h5%flush(error)
-        if (allocated(error)) return
         self%n_written = self%n_written + 1
         if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
         if (allocated(error)) return
