@@ -376,10 +376,25 @@ static const H5FD_class_t journal_class = {
     j_open, j_close, j_cmp, j_query, NULL, NULL, NULL, j_get_eoa, j_set_eoa, j_get_eof, j_get_handle,
     j_read, j_write, j_flush, j_truncate, NULL, NULL, H5FD_FLMAP_DICHOTOMY};
 
-/* Make the file access property list `fapl` use the journaled driver. 0 on success. */
+/* Make the file access property list `fapl` use the journaled driver, with a small
+ * metadata cache (64 KiB): HDF5 1.10 scans every cached entry at each flush
+ * (H5C_set_slist_enabled, 16 % of an ironing m1 N2 run with the default 2 MiB cache,
+ * which keeps every step's headers); a result file's writes need few entries at a
+ * time. Measured: ironing m1 N2 0.89 (256 KiB) and 0.85 (64 KiB) of the default's
+ * wall time. 0 on success. */
 int voiga_journal_fapl(hid_t fapl)
 {
     if (driver_id < 0) driver_id = H5FDregister(&journal_class);
     if (driver_id < 0) return -1;
+    {
+        H5AC_cache_config_t c;
+        c.version = H5AC__CURR_CACHE_CONFIG_VERSION;
+        if (H5Pget_mdc_config(fapl, &c) < 0) return -1;
+        c.set_initial_size = 1;
+        c.initial_size = 64 * 1024;
+        c.min_size = 32 * 1024;
+        c.max_size = 64 * 1024;
+        if (H5Pset_mdc_config(fapl, &c) < 0) return -1;
+    }
     return H5Pset_driver(fapl, driver_id, NULL) < 0 ? -1 : 0;
 }
