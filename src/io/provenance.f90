@@ -30,7 +30,7 @@ contains
         type(case_t), intent(in) :: case
         type(error_t), allocatable, intent(out) :: error
         character(len=64) :: hex
-        character(len=:), allocatable :: absolute
+        character(len=:), allocatable :: absolute, threads
         type(error_t), allocatable :: ignored
         call sha256_file(case%path, hex, error)
         if (allocated(error)) return
@@ -44,10 +44,11 @@ contains
         if (.not. allocated(ignored)) call h5%write_attr('/', 'case_path', absolute, error)
         if (allocated(error)) return
         ! what the run's timings were measured with
-        if (len(library_threads()) == 0) then
+        threads = library_threads()
+        if (len(threads) == 0) then
             call h5%write_attr('/', 'library_threads', '1 (voiga''s default)', error)
         else
-            call h5%write_attr('/', 'library_threads', library_threads()//' (environment)', error)
+            call h5%write_attr('/', 'library_threads', threads//' (environment)', error)
         end if
     end subroutine write_provenance
 

@@ -6,6 +6,7 @@ finish the flush, and the file then holds every step it counts, and a restart
 reproduces the uninterrupted run."""
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -86,8 +87,6 @@ def test_bytes_beyond_the_end_are_harmless(voiga_bin: Path, tmp_path: Path, full
 def test_recover_leaves_a_file_being_written(voiga_bin: Path, tmp_path: Path) -> None:
     """While another process holds the file's flock (a writer flushing), recover
     does nothing, even to a file that ends in a journal."""
-    import fcntl
-
     path = killed(voiga_bin, tmp_path, 9)
     before = path.read_bytes()
     fd = os.open(path, os.O_RDONLY)
