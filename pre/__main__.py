@@ -50,7 +50,8 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     try:
         geometry, case, fresh = write_hertz_case(
             cyl, args.mesh, args.layout, args.out, force=args.force, n_steps=args.steps,
-            method=args.method, penalty_normal=penalty)
+            method=args.method, penalty_normal=penalty, edge_refine=args.edge_refine,
+            surface_size=args.surface_size)
     except (HertzCaseError, OSError) as err:
         print(f"python -m pre hertz: {err}", file=sys.stderr)
         return 2
@@ -122,6 +123,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--penalty-normal", default=None,
                    help="a number, or 'auto' (voiga chooses); default: the committed case's "
                         "scaled by E and 1/a (its compliance relative to a)")
+    s.add_argument("--edge-refine", type=int, default=1, metavar="K",
+                   help="split the arc elements around the expected edge of the zone (0.9 a "
+                        "to 1.1 a) and the first coarse one beyond the graded zone into K "
+                        "(default 1; the case is <mesh>-<layout>-edgeK.nml)")
+    s.add_argument("--surface-size", type=float, default=None, metavar="S",
+                   help="radial size of the element at the surface, a fraction of the "
+                        "expected half-width a (default: as the committed scene, about 1/15)")
     s.add_argument("--out", required=True, help="folder for geometry.h5 and <mesh>-<layout>.nml")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz)

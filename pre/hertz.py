@@ -44,7 +44,7 @@ from .cases import GEOMETRY_FILE, HERTZ_DISPLACEMENT, hertz_case, to_namelist_te
 from .h5io import write_geometry
 from .layouts import parse_layout
 from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_R_IN, HERTZ_R_OUT,
-                     hertz_radial_elements, mesh_level)
+                     arc_parameter_exact, hertz_radial_elements, hertz_theta_c, mesh_level)
 from .scenes import HERTZ, annular_sector
 
 MAX_INDENTATION = 0.1
@@ -52,6 +52,10 @@ MAX_INDENTATION = 0.1
 half-space theory is far from the cylinder."""
 MAX_MESH_LEVEL = 6
 """Finest mesh (m6: 288 arc elements)."""
+EDGE_BAND = (0.9, 1.1)
+"""The arc elements overlapping this band of the expected half-width a are the ones
+``--edge-refine`` splits (the estimate is within 0.5 % of the runs' a)."""
+MAX_EDGE_REFINE = 16
 
 
 class HertzCaseError(ValueError):
@@ -108,13 +112,51 @@ class Cylinder:
         return self.radius * expected_half_width(self.indentation / self.radius)
 
 
+def split_spans(knots: list[float], parameters: list[tuple[float, float]],
+                factor: int) -> list[float]:
+    """Interior knots with every span that overlaps one of the parameter intervals
+    ``(t0, t1)`` split into ``factor`` equal parameter spans."""
+    full = [0.0, *knots, 1.0]
+    out: list[float] = []
+    for k0, k1 in zip(full[:-1], full[1:]):
+        n = factor if any(k1 > t0 and k0 < t1 for t0, t1 in parameters) else 1
+        out.extend(k0 + (k1 - k0) * j / n for j in range(n))
+    return out[1:]
+
+
+def edge_refined_knots(knots: list[float], half_width: float, grading: float,
+                       factor: int) -> list[float]:
+    """The arc knots refined for a resolved edge: the spans that overlap the angles of
+    :data:`EDGE_BAND` times ``half_width`` (a / R) from the lowest point, and the first
+    coarse span beyond the graded zone (``grading`` = a_g / R; the zone's elements are
+    up to 75 times smaller than it), each split into ``factor``."""
+    t0, t1 = (arc_parameter_exact(math.asin(f * half_width)) for f in EDGE_BAND)
+    tc = arc_parameter_exact(hertz_theta_c(grading))
+    return split_spans(knots, [(t0, t1), (tc, tc + 1e-9)], factor)
+
+
+def case_stem(mesh: str, layout: str, edge_refine: int = 1,
+              surface_size: float | None = None) -> str:
+    """``m4-NN2.2``; ``m4-NN2.2-edge4`` for a mesh refined at the edge, ``-surf0.02`` for
+    a given surface size."""
+    return (f"{mesh}-{layout}" + (f"-edge{edge_refine}" if edge_refine > 1 else "")
+            + (f"-surf{surface_size:g}" if surface_size is not None else ""))
+
+
 def cylinder_case(cyl: Cylinder, mesh: str, layout: str, n_steps: int | None = None,
                   method: str | None = None, penalty_normal: float | str | None = None,
-                  ) -> dict[str, Any]:
+                  edge_refine: int = 1, surface_size: float | None = None) -> dict[str, Any]:
     """The namelist groups of the Hertz case of ``cyl`` on ``mesh`` with ``layout``
     (:func:`pre.cases.hertz_case` scaled). ``penalty_normal``: None scales the committed
-    one by E / a_g, ``'auto'`` leaves it out (voiga chooses), a number is written as is."""
+    one by E / a_g, ``'auto'`` leaves it out (voiga chooses), a number is written as is.
+    ``edge_refine`` > 1 splits the arc elements around the expected edge of the zone and
+    the first coarse one into that many (:func:`edge_refined_knots`). ``surface_size``:
+    the radial size of the surface element relative to the expected a (None: scaled as
+    the committed scene's, about a / 15)."""
     cyl.check()
+    if not (isinstance(edge_refine, int) and 1 <= edge_refine <= MAX_EDGE_REFINE):
+        raise HertzCaseError(f"edge refinement {edge_refine!r} must be an integer in "
+                             f"1 .. {MAX_EDGE_REFINE}")
     try:
         level = mesh_level(mesh)
     except ValueError as err:
@@ -129,11 +171,23 @@ def cylinder_case(cyl: Cylinder, mesh: str, layout: str, n_steps: int | None = N
     a_g = grading_half_width(cyl.indentation / r)
     # at most uniform radially (d/R above about 0.093 would ask for a coarser surface)
     uniform = (HERTZ_R_OUT - HERTZ_R_IN) / hertz_radial_elements(parse_layout(layout).degree_eta)
-    groups = hertz_case(mesh, layout, a_exp=a_g,
-                        h_surface=min(HERTZ_H_SURFACE * (a_g / HERTZ_A_EXP), uniform))
+    if surface_size is None:
+        h_surface = HERTZ_H_SURFACE * (a_g / HERTZ_A_EXP)
+    elif not 0.0 < surface_size <= 1.0:
+        raise HertzCaseError(f"surface size {surface_size!r} must be in (0, 1] (a fraction "
+                             f"of the expected half-width a)")
+    else:
+        h_surface = surface_size * cyl.half_width / r
+    groups = hertz_case(mesh, layout, a_exp=a_g, h_surface=min(h_surface, uniform))
     groups["case"]["title"] = (f"hertz {mesh} {layout}: R = {r:g}, E = {e:g}, "
                                f"nu = {cyl.poisson_ratio:g}, indentation {cyl.indentation:g}")
     body = groups["body"][0]
+    groups["case"]["output"] = f"{case_stem(mesh, layout, edge_refine, surface_size)}.h5"
+    if edge_refine > 1:
+        body["knots_xi"] = edge_refined_knots(body["knots_xi"], cyl.half_width / r, a_g, edge_refine)
+        groups["case"]["title"] += f", arc elements at the edge split in {edge_refine}"
+    if surface_size is not None:
+        groups["case"]["title"] += f", surface element {surface_size:g} a"
     body["youngs_modulus"], body["poisson_ratio"] = float(e), float(cyl.poisson_ratio)
     for d in groups["dirichlet"]:
         if "uy" in d:
@@ -175,7 +229,7 @@ def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
     text = to_namelist_text(cylinder_case(cyl, mesh, layout, **options))
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    case = folder / f"{mesh}-{layout}.nml"
+    case = folder / f"{case_stem(mesh, layout, options.get('edge_refine', 1), options.get('surface_size'))}.nml"
     geometry = folder / GEOMETRY_FILE
     tmp = folder / f".{GEOMETRY_FILE}.{os.getpid()}.tmp"
     try:

@@ -17,7 +17,7 @@ import pytest
 from scipy.integrate import quad
 
 from post.__main__ import main
-from post.hertz import (EDGE_ZONE, HertzError, hertz_comparison, hertz_pressure,
+from post.hertz import (EDGE_LEVEL, EDGE_ZONE, HertzError, hertz_comparison, hertz_pressure,
                         hertz_reference, profile_error)
 from post.reader import read_result
 
@@ -163,6 +163,32 @@ def test_profile_error_is_symmetric() -> None:
     assert full.l2 == pytest.approx(_quad_l2(lambda s: float(np.interp(s, x, p)), a, p0, 1.4,
                                              breaks=x), abs=1e-6)
     # the trapezoidal rule next to the edge's square root: 1.6e-7 here (docs/post.md)
+
+
+def test_error_split_and_edge() -> None:
+    """The interior and edge parts of the L2 error add up in squares and each matches its
+    own quadrature; the reported edge is where the profile falls to EDGE_LEVEL p0, so a
+    zone ending 0.5 % short of a is reported 0.5 % short."""
+    a, p0 = 1.0, 2.0
+    x = np.linspace(-1.2, 1.2, 9601)  # both sides, as compare_profile mirrors
+    exact = profile_error(x, hertz_pressure(x, a, p0), a, p0)
+    assert exact.l2 < 1e-4 and exact.l2_interior < 1e-6
+    assert exact.edge == pytest.approx(np.sqrt(1 - EDGE_LEVEL**2), abs=2e-5)
+    short = 0.995
+    p = hertz_pressure(x, short * a, p0)  # the same p0, the zone 0.5 % narrower
+    err = profile_error(x, p, a, p0)
+    assert err.edge == pytest.approx(short * np.sqrt(1 - EDGE_LEVEL**2), abs=2e-5)
+    assert err.l2_interior**2 + err.l2_edge**2 == pytest.approx(err.l2**2, rel=1e-12)
+    rim = (1 - EDGE_ZONE) * a
+    def sim(s: float) -> float:
+        return float(np.interp(s, x, p))
+    norm = quad(lambda s: float(hertz_pressure(np.array(s), a, p0)) ** 2, 0, a)[0]
+    inner = quad(lambda s: (sim(s) - float(hertz_pressure(np.array(s), a, p0))) ** 2, 0, rim,
+                 limit=400)[0]
+    assert err.l2_interior == pytest.approx(np.sqrt(inner / norm), rel=1e-3)
+    assert err.l2_edge > 2 * err.l2_interior  # a narrower zone is mostly an edge error
+    flat = profile_error(x, np.zeros_like(x) + 1e-3 * (x < 0.1), a, p0)
+    assert np.isnan(flat.edge)  # never reaches the level
 
 
 def test_file_without_nominal_pressure(hertz_h5: Path, tmp_path: Path) -> None:

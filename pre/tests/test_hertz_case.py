@@ -157,6 +157,8 @@ def test_the_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
     (["--steps", "0"], "steps 0"),
     (["--penalty-normal", "-5"], "penalty_normal"),
     (["--penalty-normal", "soft"], "penalty_normal"),
+    (["--edge-refine", "0"], "edge refinement 0"),
+    (["--edge-refine", "17"], "edge refinement 17"),
 ])
 def test_bad_values_exit_2(bad: list[str], says: str, tmp_path: Path,
                            capsys: pytest.CaptureFixture[str]) -> None:
@@ -187,6 +189,40 @@ def test_no_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Non
     assert case.read_text().startswith("&case")
     with pytest.raises(HertzCaseError):
         write_hertz_case(Cylinder(radius=3.0), "m1", "N2", tmp_path)
+
+
+def test_edge_refinement(tmp_path: Path) -> None:
+    """--edge-refine K splits exactly the arc spans that overlap 0.9 a .. 1.1 a (a the
+    expected half-width) and the first span beyond the graded zone into K equal spans,
+    leaves every other knot in place, and names the case and its output
+    <mesh>-<layout>-edgeK; --surface-size S sets the radial surface element to S a."""
+    cyl = Cylinder(indentation=0.0025)
+    plain = cylinder_case(cyl, "m3", "NN2.2")["body"][0]["knots_xi"]
+    groups = cylinder_case(cyl, "m3", "NN2.2", edge_refine=3)
+    fine = groups["body"][0]["knots_xi"]
+    a = cyl.half_width
+    angles = arc_angle(np.array([0.0, *plain, 1.0]))  # from the lowest point
+    theta_c = hertz_theta_c(grading_half_width(0.0025))
+    first_coarse = int(np.flatnonzero(angles[:-1] >= theta_c * (1 - 1e-12))[0])
+    hit = [(lo < math.asin(1.1 * a)) and (hi > math.asin(0.9 * a)) or k == first_coarse
+           for k, (lo, hi) in enumerate(zip(angles[:-1], angles[1:]))]
+    assert 2 <= sum(hit) <= 7 and hit[first_coarse] and not hit[first_coarse - 1]
+    assert len(fine) == len(plain) + 2 * sum(hit)
+    assert set(plain) <= set(fine)
+    spans = np.diff([0.0, *fine, 1.0])
+    full = np.diff([0.0, *plain, 1.0])
+    assert np.allclose(np.sort(spans), np.sort(np.concatenate(
+        [np.repeat(full[hit] / 3, 3), full[~np.array(hit)]])), rtol=1e-12)
+    assert groups["case"]["output"] == "m3-NN2.2-edge3.h5"
+    _, case, _ = write_hertz_case(cyl, "m3", "NN2.2", tmp_path, edge_refine=3)
+    assert case.name == "m3-NN2.2-edge3.nml"
+    assert f90nml.read(str(case))["body"]["knots_xi"] == pytest.approx(fine, rel=1e-15)
+    surf = cylinder_case(cyl, "m3", "NN2.2", surface_size=0.02)
+    eta = surf["body"][0]["knots_eta"]
+    assert (1 - eta[-1]) * (1 - 0.05) == pytest.approx(0.02 * a, rel=1e-9)  # thickness 0.95 R
+    assert surf["case"]["output"] == "m3-NN2.2-surf0.02.h5"
+    with pytest.raises(HertzCaseError, match="surface size"):
+        cylinder_case(cyl, "m3", "NN2.2", surface_size=0.0)
 
 
 def _voiga() -> Path | None:
