@@ -157,7 +157,7 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
                 code = 2
                 continue
             h = hertz_comparison(result, step=args.step, radius=args.radius,
-                                 configuration=args.configuration)
+                                 configuration=args.configuration, reference=args.reference)
         except (HertzError, OSError, KeyError, ValueError) as err:
             print(f"python -m post hertz: {path}: {err}", file=sys.stderr)
             code = 2
@@ -392,6 +392,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--radius", type=_positive, default=None,
                    help="cylinder radius (default: the circle through the slave edge's "
                         "reference points near the contact; 1 for the committed hertz scene)")
+    s.add_argument("--reference", choices=("hertz", "circle"), default="hertz",
+                   help="hertz (default): Hertz's parabolic profile; circle: the half-plane "
+                        "solution for the exact circle (differs by O(a^2/R^2))")
     s.add_argument("--configuration", choices=("reference", "current"), default="reference",
                    help="reference (default): nominal pressure at reference positions, the "
                         "measure of the theory; current: per current length at current "

@@ -17,6 +17,7 @@ peak or fitted).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +26,7 @@ import numpy as np
 from pre.nurbs import patch_to_splipy
 
 from .contact import edge_stretch
+from .halfplane import CircleContact, circle_contact
 from .naming import output_path
 from .reader import Body, ContactOutput, Result, Step
 from .units import Units
@@ -98,6 +100,8 @@ class ProfileError:
     """|x| / a where the profile last falls to EDGE_LEVEL p0 (the outermost crossing;
     analytic: sqrt(1 - EDGE_LEVEL^2)). A level above zero keeps the tails of a spline
     pressure out of it."""
+    edge_reference: float = float("nan")
+    """The same for the reference profile (Hertz: sqrt(1 - EDGE_LEVEL^2))."""
 
 
 def _largest(dev: np.ndarray, at: np.ndarray) -> tuple[float, float]:
@@ -107,7 +111,8 @@ def _largest(dev: np.ndarray, at: np.ndarray) -> tuple[float, float]:
     return float(dev[k]), float(at[k])
 
 
-def profile_error(x: np.ndarray, p: np.ndarray, a: float, p0: float) -> ProfileError:
+def profile_error(x: np.ndarray, p: np.ndarray, a: float, p0: float,
+                  shape: Callable[[np.ndarray], np.ndarray] | None = None) -> ProfileError:
     """Compare point values ``p`` at positions ``x`` (from the centre of the contact;
     a half model's points mirrored to both sides) with ``p0 sqrt(1 - (x/a)^2)``.
 
@@ -120,6 +125,8 @@ def profile_error(x: np.ndarray, p: np.ndarray, a: float, p0: float) -> ProfileE
     +-a (so the interpolant's kinks and the analytic edge are grid points; against
     adaptive quadrature the rule's own error in the L2 value is about 2e-7). The
     pointwise deviation is taken at the data points in [lo, hi], relative to p0.
+    ``shape``: another reference profile with half-width a and centre pressure p0 (the
+    exact circle of :mod:`post.halfplane`) instead of Hertz's.
 
     The L2 error is split into its interior part (|x| < (1 - EDGE_ZONE) a) and the rest
     (their squares add up): an edge of the simulated zone a fraction delta of a off the
@@ -140,18 +147,20 @@ def profile_error(x: np.ndarray, p: np.ndarray, a: float, p0: float) -> ProfileE
     grid = np.unique(np.concatenate([np.linspace(lo, hi, GRID_POINTS), x[inside],
                                      [v for v in (-a, a, -rim, rim) if lo <= v <= hi]]))
     sim = np.interp(grid, x, p, left=0.0, right=0.0)
-    ref = hertz_pressure(grid, a, p0)
+    shape = shape or (lambda s: hertz_pressure(s, a, p0))
+    ref = shape(grid)
     norm = np.trapezoid(ref**2, grid)
     l2 = float(np.sqrt(np.trapezoid((sim - ref) ** 2, grid) / norm))
     core = np.abs(grid) <= rim  # contiguous, +-rim are grid points
     l2_interior = float(np.sqrt(np.trapezoid((sim[core] - ref[core]) ** 2, grid[core]) / norm))
-    dev = (p[inside] - hertz_pressure(x[inside], a, p0)) / p0
+    dev = (p[inside] - shape(x[inside])) / p0
     at = np.abs(x[inside]) / a
     interior = at < 1.0 - EDGE_ZONE
     return ProfileError(l2, float(lo), float(hi), *_largest(dev, at),
                         *_largest(dev[interior], at[interior]), l2_interior=l2_interior,
                         l2_edge=float(np.sqrt(max(l2**2 - l2_interior**2, 0.0))),
-                        edge=_edge(grid, sim, EDGE_LEVEL * p0) / a)
+                        edge=_edge(grid, sim, EDGE_LEVEL * p0) / a,
+                        edge_reference=_edge(grid, ref, EDGE_LEVEL * p0) / a)
 
 
 def _edge(grid: np.ndarray, sim: np.ndarray, level: float) -> float:
@@ -222,6 +231,20 @@ class HertzComparison:
     """Which pressure was compared, in words (e.g. the dataset it came from)."""
     radius_source: str = "given"
     friction: float = 0.0
+    circle: CircleContact | None = field(default=None, repr=False)
+    """Set when the reference is the half-plane solution for the exact circle, not Hertz's
+    parabola (``a`` and ``p0`` are then that solution's)."""
+
+    @property
+    def reference_name(self) -> str:
+        return ("the half-plane solution for the exact circle" if self.circle is not None
+                else "analytic Hertz")
+
+    def reference_pressure(self, x: np.ndarray) -> np.ndarray:
+        """The reference pressure at ``x`` (Hertz's, or the exact circle's)."""
+        if self.circle is not None:
+            return self.circle.pressure(x)
+        return hertz_pressure(x, self.a, self.p0)
 
     @property
     def e_star(self) -> float:
@@ -309,7 +332,8 @@ def _vertices(body: Body, xi: np.ndarray) -> np.ndarray:
 
 def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
                      radius: float | None = None,
-                     configuration: str = "reference") -> HertzComparison:
+                     configuration: str = "reference",
+                     reference: str = "hertz") -> HertzComparison:
     """Compare contact pair ``pair`` (0-based) at ``step`` (as in
     :meth:`Result.select_step`) with the Hertz line contact of a cylinder on a rigid flat.
 
@@ -325,7 +349,8 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
     length, ``p_n_nominal``; for older files ``p_n`` times the stretch computed from the
     edge) at the reference positions ``x_ref``: the measure of the theory.
     ``'current'`` compares ``p_n`` (per current length) at the current positions ``x``,
-    only to show what that measure would report. HertzError (a ValueError) when the pair
+    only to show what that measure would report. ``reference='circle'`` compares with the
+    half-plane solution for the exact circle (:mod:`post.halfplane`). HertzError (a ValueError) when the pair
     is not a cylinder on a rigid flat or has no contact.
     """
     if configuration not in ("reference", "current"):
@@ -366,21 +391,33 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
                            e, nu, float(radius) if radius is not None else r_fit, half,
                            source=str(result.path), step=st.step, time=float(st.time),
                            configuration=configuration, pressure=what, radius_source=source,
-                           friction=float(c.attrs.get("friction", 0.0)))
+                           friction=float(c.attrs.get("friction", 0.0)), reference=reference)
 
 
 def compare_profile(x: np.ndarray, p: np.ndarray, force: float, youngs_modulus: float,
                     poisson_ratio: float, radius: float, half_model: bool,
-                    **info: object) -> HertzComparison:
+                    reference: str = "hertz", **info: object) -> HertzComparison:
     """Point values ``p`` at distances ``x`` from the centre of the contact (>= 0 for a
     half model, whose points are mirrored) against Hertz for the force ``force`` (per
     unit thickness, of the full cylinder): :func:`profile_error` and the fit.
+    ``reference='circle'``: against the half-plane solution for the exact circular profile
+    (:func:`post.halfplane.circle_contact`) instead of Hertz's parabola.
     ``info``: the descriptive fields of :class:`HertzComparison` (source, step, ...)."""
+    if reference not in ("hertz", "circle"):
+        raise ValueError(f"reference must be 'hertz' or 'circle', not {reference!r}")
     a, p0 = hertz_reference(force, youngs_modulus, poisson_ratio, radius)
+    circle = None
+    if reference == "circle":
+        try:
+            circle = circle_contact(force, youngs_modulus / (1.0 - poisson_ratio**2), radius)
+        except ValueError as err:
+            raise HertzError(str(err)) from None
+        a, p0 = circle.a, circle.p0
     order = np.argsort(x, kind="stable")
     x, p = np.asarray(x, float)[order], np.asarray(p, float)[order]
     err = profile_error(np.concatenate([-x[::-1], x]) if half_model else x,
-                        np.concatenate([p[::-1], p]) if half_model else p, a, p0)
+                        np.concatenate([p[::-1], p]) if half_model else p, a, p0,
+                        circle.pressure if circle is not None else None)
     try:
         a_fit, p0_fit = fit_hertz(np.abs(x[p > 0]), p[p > 0])
     except ValueError:
@@ -388,7 +425,7 @@ def compare_profile(x: np.ndarray, p: np.ndarray, force: float, youngs_modulus: 
     return HertzComparison(radius=radius, youngs_modulus=youngs_modulus,
                            poisson_ratio=poisson_ratio, half_model=half_model, force=force,
                            a=a, p0=p0, error=err, a_fit=a_fit, p0_fit=p0_fit,
-                           p_max=float(p.max()), x=x, p=p, **info)
+                           p_max=float(p.max()), x=x, p=p, circle=circle, **info)
 
 
 def _zone(at: float) -> str:
@@ -422,11 +459,14 @@ def hertz_report(h: HertzComparison) -> list[str]:
              f"  P = {h.force:.6g} per unit thickness ("
              + ("2 x the pair's normal force: half model, contact on one side of the centre"
                 if h.half_model else "the pair's normal force") + ")",
-             f"  analytic: a = sqrt(4PR/(pi E*)) = {h.a:.6g} (a/R = {h.a / h.radius:.4g}), "
-             f"p0 = 2P/(pi a) = {h.p0:.6g}",
+             (f"  analytic: a = sqrt(4PR/(pi E*)) = {h.a:.6g} (a/R = {h.a / h.radius:.4g}), "
+              f"p0 = 2P/(pi a) = {h.p0:.6g}" if h.circle is None else
+              f"  reference: the half-plane solution for the exact circle R - sqrt(R^2 - x^2) "
+              f"(not Hertz's parabola): a = {h.a:.6g} (a/R = {h.a / h.radius:.4g}), "
+              f"p(0) = {h.p0:.6g}"),
              f"  relative L2 error over the union of both supports (|x| <= {e.hi / h.a:.4f} a): "
              f"{e.l2:.3%}",
-             f"  largest |p - p_Hertz| / p0 at a slave point: {abs(e.max_deviation):.3%} "
+             f"  largest |p - p_ref| / p0 at a slave point: {abs(e.max_deviation):.3%} "
              f"({'+' if e.max_deviation >= 0 else '-'}) at x/a = {e.max_deviation_at:.4f} "
              f"({_zone(e.max_deviation_at)}: within {EDGE_ZONE:.0%} of a from the edge is the "
              f"edge zone)",
@@ -435,7 +475,7 @@ def hertz_report(h: HertzComparison) -> list[str]:
              f"  L2 error split: {e.l2_interior:.3%} from |x| < {1 - EDGE_ZONE:.2f} a, "
              f"{e.l2_edge:.3%} from the edge zone and beyond (squares add up)",
              f"  edge: the profile falls to {EDGE_LEVEL:.0%} of p0 at |x| = {e.edge:.4f} a "
-             f"(analytic: {np.sqrt(1 - EDGE_LEVEL**2):.4f} a)",
+             f"(reference: {e.edge_reference:.4f} a)",
              f"  extra, fit p^2 = p0^2 (1 - x^2/a^2) to the points in contact: a {h.a_error:+.3%}, "
              f"p0 {h.p0_error:+.3%}; largest pressure {h.p_max / h.p0 - 1:+.3%} of p0"]
     if h.friction > 0:
@@ -459,9 +499,10 @@ def plot_hertz(comparisons: list[HertzComparison], output: str | Path,
     s = np.linspace(0.0, 1.0, 600)
     h0 = comparisons[0]
     sx, sp = (h0.a, h0.p0) if single else (1.0, 1.0)
-    top.plot(s * sx, np.sqrt(1 - s**2) * sp, "k-", lw=1.8,
-             label=f"analytic Hertz: a = {h0.a:.4g}, p0 = {h0.p0:.4g}" if single
-             else "analytic Hertz (each run's own P)")
+    shape = h0.reference_pressure(s * h0.a) / h0.p0
+    top.plot(s * sx, shape * sp, "k-", lw=1.8,
+             label=f"{h0.reference_name}: a = {h0.a:.4g}, p0 = {h0.p0:.4g}" if single
+             else f"{h0.reference_name} (each run's own P)")
     xmax = 0.0
     for h in comparisons:
         keep = np.abs(h.x) <= max(h.error.hi, h.a) * 1.25
@@ -470,7 +511,7 @@ def plot_hertz(comparisons: list[HertzComparison], output: str | Path,
         label = (f"slave points ({h.configuration} configuration)" if single
                  else f"{h.label}: L2 {h.l2_error:.3%}")
         line, = top.plot(xs, ps, ".-", ms=3.5, lw=0.8, label=label)
-        dev = (p - hertz_pressure(x, h.a, h.p0)) / h.p0
+        dev = (p - h.reference_pressure(x)) / h.p0
         bottom.plot(xs, 100 * dev, ".-", ms=3, lw=0.8, color=line.get_color())
         xmax = max(xmax, float(np.abs(xs).max()))
     for ax, label in ((top, f"edge zone: a +- {EDGE_ZONE:.0%}"), (bottom, None)):
@@ -490,8 +531,8 @@ def plot_hertz(comparisons: list[HertzComparison], output: str | Path,
     else:
         top.set_ylabel("p / p0 (analytic p0 of each run)")
         bottom.set_xlabel(f"x / a ({h0.configuration} configuration; a analytic for each run)")
-        top.set_title(f"{len(comparisons)} runs against analytic Hertz", fontsize=10)
-    bottom.set_ylabel("(p - p_Hertz) / p0 [%]")
+        top.set_title(f"{len(comparisons)} runs against {h0.reference_name}", fontsize=10)
+    bottom.set_ylabel("(p - p_ref) / p0 [%]")
     top.legend(fontsize=8)
     path = Path(output)
     fig.savefig(path, dpi=150)

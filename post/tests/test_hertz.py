@@ -206,6 +206,24 @@ def test_file_without_nominal_pressure(hertz_h5: Path, tmp_path: Path) -> None:
     assert fallback.l2_error == pytest.approx(new.l2_error, rel=1e-10)
 
 
+def test_circle_reference(hertz_h5: Path, tmp_path: Path,
+                          capsys: pytest.CaptureFixture[str]) -> None:
+    """``--reference circle``: the exact circle's profile for the file's own P has no
+    error against itself and Hertz's profile has the parabola's; the report says which."""
+    from post.halfplane import circle_contact
+    circle = circle_contact(P, E / (1 - NU**2), R)
+    x = _points(1.2 * circle.a)
+    path = _write(hertz_h5, tmp_path / "circle.h5", x, circle.pressure(x), -P / 2)
+    h = hertz_comparison(read_result(path), reference="circle")
+    assert h.a == pytest.approx(circle.a, rel=1e-12) and h.l2_error < 2e-4
+    a, p0 = _analytic()
+    assert hertz_comparison(read_result(path)).l2_error > 5 * h.l2_error
+    assert circle.a / a - 1 == pytest.approx(-3 / 16 * (a / R) ** 2, rel=0.05)
+    assert main(["hertz", str(path), "--reference", "circle", "--no-figure"]) == 0
+    out = capsys.readouterr().out
+    assert "exact circle" in out and "not Hertz's parabola" in out
+
+
 def test_not_a_cylinder_on_a_flat(hertz_h5: Path, press_h5: Path, tmp_path: Path,
                                   capsys: pytest.CaptureFixture[str]) -> None:
     """A deformable master, a straight slave edge, no contact: HertzError; the command
