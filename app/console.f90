@@ -23,6 +23,7 @@ module voiga_app_console
         procedure :: factorized => console_factorized
         procedure :: linear_solved => console_linear_solved
         procedure :: retried => console_retried
+        procedure :: softened => console_softened
         procedure :: cut => console_cut
         procedure :: fixed_point => console_fixed_point
         procedure :: fixed_point_done => console_fixed_point_done
@@ -82,6 +83,15 @@ contains
         if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a)') 'retry step ', step, '  t=', time, &
             ' from the last converged state (the predicted start failed: '//reason//')'
     end subroutine console_retried
+
+    subroutine console_softened(self, step, time, pair, what, reason)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: step, pair
+        real(dp), intent(in) :: time
+        character(len=*), intent(in) :: what, reason
+        if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,i0,a)') 'soften step ', step, '  t=', time, &
+            ' pair ', pair, ' (alm): '//what//', the same increment again (it failed: '//reason//')'
+    end subroutine console_softened
 
     subroutine console_cut(self, cut, reason)
         class(console_t), intent(inout) :: self

@@ -32,6 +32,7 @@ contains
                     new_unittest('alm_one_update_when_linear', test_one_update), &
                     new_unittest('alm_friction_stick_and_slip', test_friction), &
                     new_unittest('automatic_penalty', test_automatic_penalty), &
+                    new_unittest('alm_soften_to_automatic', test_soften), &
                     new_unittest('nominal_pressure_integrates_to_force', test_nominal_pressure) &
                     ]
     end subroutine collect_alm
@@ -184,6 +185,56 @@ contains
             call check(error, pair%law%eps_t, pair%law%eps_n, 'penalty_tangent = penalty_normal')
         end associate
     end subroutine test_automatic_penalty
+
+    !> After a failed substep an alm pair divides both penalties by 10, the normal one
+    !> not below the automatic penalty (then it stops and says nothing changed); a
+    !> penalty given below the automatic one, and a pair of another method, never
+    !> change. The solution does not depend on them (`alm_patch_exact_any_penalty`).
+    subroutine test_soften(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(solver_stats_t) :: stats
+        real(dp), allocatable :: u(:)
+        character(len=:), allocatable :: text
+        real(dp) :: auto, eps
+        logical :: changed
+        integer :: k
+        call pressed_blocks(1.0e5_dp, 0.0_dp, model, u, stats, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1)%pair)
+            auto = pair%eps_automatic
+            call check(error, auto, 10.0_dp*(1.0_dp/(2.0_dp*(1.0_dp - 0.3_dp**2)))*2.0_dp/(2.0_dp/3.0_dp), &
+                       'the automatic penalty is known to the pair', rel=1.0e-12_dp)
+            if (allocated(error)) return
+            eps = pair%law%eps_n
+            do k = 1, 10
+                call pair%soften(changed, text)
+                if (.not. changed) exit
+                call check(error, pair%law%eps_n, max(eps/10.0_dp, auto), 'divided by 10, not below', rel=1.0e-14_dp)
+                if (allocated(error)) return
+                call check(error, pair%law%eps_t, pair%law%eps_n, 'the tangential one alike', rel=1.0e-14_dp)
+                if (allocated(error)) return
+                call check(error, index(text, '->') > 0, 'says what changed')
+                if (allocated(error)) return
+                eps = pair%law%eps_n
+            end do
+            call check(error, k, 5, '1e5 x E reaches the automatic penalty (15.9) in 4 softenings')
+            if (allocated(error)) return
+            call check(error, pair%law%eps_n, auto, 'ends at the automatic penalty', rel=1.0e-14_dp)
+            if (allocated(error)) return
+        end associate
+        call pressed_blocks(1.0_dp, 0.0_dp, model, u, stats, error)
+        if (allocated(error)) return
+        call model%pairs(1)%pair%soften(changed, text)
+        call check(error, .not. changed .and. model%pairs(1)%pair%law%eps_n == 1.0_dp, &
+                   'a penalty below the automatic one is kept')
+        if (allocated(error)) return
+        call pressed_blocks(1.0e5_dp, 0.0_dp, model, u, stats, error, method='mortar')
+        if (allocated(error)) return
+        call model%pairs(1)%pair%soften(changed, text)
+        call check(error, .not. changed .and. model%pairs(1)%pair%law%eps_n == 1.0e5_dp, &
+                   'a mortar penalty decides the solution: kept')
+    end subroutine test_soften
 
     !> The nominal pressure (per reference length) integrates over the reference
     !> edge to the contact force, for GPTS (whose pressure acts per current length)

@@ -31,6 +31,7 @@
 module voiga_contact_alm
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: real_str
     use voiga_contact_law, only: control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_surface, only: element_lengths
     use voiga_contact_pair, only: history_item_t, sparse_vector_t, constraint_set_t
@@ -38,12 +39,14 @@ module voiga_contact_alm
     implicit none
     private
 
-    public :: alm_pair_t, default_alm_tolerance
+    public :: alm_pair_t, default_alm_tolerance, softening_factor
 
     !> Default constraint tolerance, relative to the slave element size: the mean
     !> weighted gap of an active control point and the mean weighted slip of a
     !> sticking one must be below it.
     real(dp), parameter :: default_alm_tolerance = 1.0e-6_dp
+    !> A failed substep divides the penalties by this (`alm_soften`).
+    real(dp), parameter :: softening_factor = 10.0_dp
 
     !> An augmented Lagrangian pair.
     type, extends(mortar_pair_t) :: alm_pair_t
@@ -79,6 +82,7 @@ module voiga_contact_alm
         procedure :: constraint_test => alm_constraint_test
         procedure :: constraints => alm_constraints
         procedure :: update_multipliers => alm_update_multipliers
+        procedure :: soften => alm_soften
     end type alm_pair_t
 
 contains
@@ -125,6 +129,30 @@ contains
         self%q(a) = sparse_vector_t(blk, q)
         self%m(a) = sparse_vector_t(blk, m)
     end subroutine alm_keep_coupling
+
+    !> A substep failed: divide both penalties by `softening_factor` (the normal one
+    !> not below the pair's automatic penalty, the tangential one by the same
+    !> factor), and say so. The penalties only regularize the Newton solves between multiplier
+    !> updates; the converged state satisfies the constraints whatever they are, so
+    !> a stiff one costs iterations and cuts (its curvature) without changing the
+    !> result (docs/theory.md, section 7, "Augmented Lagrangian"). A penalty given
+    !> below the automatic one is never changed.
+    pure subroutine alm_soften(self, changed, text)
+        class(alm_pair_t), intent(inout) :: self
+        logical, intent(out) :: changed
+        character(len=:), allocatable, intent(out) :: text
+        real(dp) :: old_n, old_t, factor
+        old_n = self%law%eps_n
+        old_t = self%law%eps_t
+        factor = min(softening_factor, old_n/max(self%eps_automatic, tiny(1.0_dp)))
+        changed = factor > 1.0_dp*(1.0_dp + 1.0e-12_dp)
+        text = ''
+        if (.not. changed) return
+        self%law%eps_n = old_n/factor
+        self%law%eps_t = old_t/factor
+        text = 'penalty_normal '//real_str(old_n, 'es10.3')//' -> '//real_str(self%law%eps_n, 'es10.3')// &
+               ', penalty_tangent '//real_str(old_t, 'es10.3')//' -> '//real_str(self%law%eps_t, 'es10.3')
+    end subroutine alm_soften
 
     !> The mortar pair's history, the multipliers (zero: the first Newton solve is
     !> the penalty's) and the element sizes of the constraint test.

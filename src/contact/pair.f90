@@ -87,6 +87,9 @@ module voiga_contact_pair
         type(contact_surface_t) :: slave
         class(contact_master_t), allocatable :: master
         type(contact_law_t) :: law
+        !> The automatic normal penalty of the pair (what `penalty_normal` defaults
+        !> to, `voiga_contact_factory`'s `automatic_penalty`), set by the model.
+        real(dp) :: eps_automatic = 0.0_dp
         !> Gauss points per slave element.
         integer :: n_gauss = 0
         !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts].
@@ -154,6 +157,9 @@ module voiga_contact_pair
         procedure :: constraint_test => pair_constraint_test
         procedure :: constraints => pair_constraints
         procedure :: update_multipliers => pair_update_multipliers
+        !> A substep failed: a pair whose penalties do not decide its solution may
+        !> make them softer for the next attempt (default: not; `text` says what changed).
+        procedure :: soften => pair_soften
         !> What the pair's state says about a failed step (default: nothing).
         procedure :: failure_diagnosis => pair_failure_diagnosis
         !> Helpers of the methods.
@@ -373,6 +379,14 @@ contains
         class(contact_pair_t), intent(inout) :: self
         real(dp), intent(in) :: delta(:)
     end subroutine pair_update_multipliers
+
+    pure subroutine pair_soften(self, changed, text)
+        class(contact_pair_t), intent(inout) :: self
+        logical, intent(out) :: changed
+        character(len=:), allocatable, intent(out) :: text
+        changed = .false.
+        text = ''
+    end subroutine pair_soften
 
     pure subroutine pair_no_op(self)
         class(contact_pair_t), intent(inout) :: self

@@ -172,11 +172,10 @@ contains
                 call new_nurbs_master(master, self%bodies(ib)%disc, self%bodies(ib)%dof0)
                 allocate (pair%master, source=master)
             end if
+            pair%eps_automatic = automatic_penalty(plane_modulus(self, pair%slave_body, pair%master_body), &
+                                                   pair%slave%degree, minval(element_lengths(pair%slave)))
             pair%law%eps_n = inp%penalty_normal
-            if (pair%law%eps_n <= 0.0_dp) pair%law%eps_n = automatic_penalty(plane_modulus(self, pair%slave_body, &
-                                                                                    pair%master_body), &
-                                                                       pair%slave%degree, &
-                                                                       minval(element_lengths(pair%slave)))
+            if (pair%law%eps_n <= 0.0_dp) pair%law%eps_n = pair%eps_automatic
             pair%law%eps_t = inp%penalty_tangent
             if (pair%law%eps_t <= 0.0_dp) pair%law%eps_t = pair%law%eps_n
             pair%law%mu = inp%friction

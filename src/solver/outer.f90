@@ -93,7 +93,9 @@ contains
             end if
             attempt%iterations = attempt%iterations + inner%iterations
             attempt%residual = inner%residual
-            attempt%det_sign = inner%det_sign
+            ! a solve that starts converged (after a multiplier step) factorizes nothing:
+            ! the sign is the last factorized tangent's
+            if (inner%iterations > 0) attempt%det_sign = inner%det_sign
             attempt%nonpositive_det = attempt%nonpositive_det + inner%nonpositive_det
             attempt%switching = inner%switching
             if (allocated(error)) return

@@ -56,6 +56,7 @@ module voiga_solver_progress
         procedure :: factorized => progress_factorized
         procedure :: linear_solved => progress_linear_solved
         procedure :: retried => progress_retried
+        procedure :: softened => progress_softened
         procedure :: cut => progress_cut
         procedure :: fixed_point => progress_fixed_point
         procedure :: fixed_point_done => progress_fixed_point
@@ -102,6 +103,15 @@ contains
         real(dp), intent(in) :: time
         character(len=*), intent(in) :: reason
     end subroutine progress_retried
+
+    !> A substep failed (`reason`) and pair `pair` made its penalties softer
+    !> (`what`); the substep is retried at the same increment.
+    subroutine progress_softened(self, step, time, pair, what, reason)
+        class(progress_t), intent(inout) :: self
+        integer, intent(in) :: step, pair
+        real(dp), intent(in) :: time
+        character(len=*), intent(in) :: what, reason
+    end subroutine progress_softened
 
     !> The increment was cut (`reason`: the whole message, `cut%reason` keeps its start).
     subroutine progress_cut(self, cut, reason)

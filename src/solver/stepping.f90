@@ -312,6 +312,14 @@ contains
         end do
         stop_run = stats%signal /= 0 .or. error%code /= error_code%numeric
         if (stop_run) return
+        if (softened(model, step, t, progress, error%message)) then
+            ! a penalty that does not decide the solution was made softer: the same
+            ! increment again, as it was attempted
+            stats%softenings = stats%softenings + 1
+            sp%unpredicted_retry = .not. predicted
+            deallocate (error)
+            return
+        end if
         if (predicted) then
             ! a predicted start that fails is retried once from the last converged
             ! state, at the same increment, before the increment is cut
@@ -335,6 +343,26 @@ contains
         call progress%cut(cut, error%message)
         deallocate (error)
     end subroutine handle_failure
+
+    !> Let every pair soften its penalties after a failed substep (`reason`); whether
+    !> one did (each says what it changed through `progress`).
+    logical function softened(model, step, t, progress, reason) result(any_changed)
+        type(model_t), intent(inout) :: model
+        integer, intent(in) :: step
+        real(dp), intent(in) :: t
+        class(progress_t), intent(inout) :: progress
+        character(len=*), intent(in) :: reason
+        character(len=:), allocatable :: what
+        logical :: changed
+        integer :: ip
+        any_changed = .false.
+        do ip = 1, size(model%pairs)
+            call model%pairs(ip)%pair%soften(changed, what)
+            if (.not. changed) cycle
+            any_changed = .true.
+            call progress%softened(step, t, ip, what, reason)
+        end do
+    end function softened
 
     !> The step cannot be cut further: the limits it reached, and the diagnoses at
     !> the last converged state (load time `t_conv`).

@@ -190,6 +190,32 @@ def mortar_zone_whole() -> Check:
     return check
 
 
+def alm_softened(given: float, floor: float, forces: tuple[float, float],
+                 rel: float = 1e-4) -> Check:
+    """An augmented-Lagrangian pair that started at penalty `given` ends at most a
+    tenth of it and not below `floor` (the pair's automatic penalty), and the mean die
+    forces over the second half of sliding (post.measures) equal `forces` (those of the
+    stiffest penalty run that converges, penalty-1e6) to `rel`: the penalty did not
+    change the solution."""
+
+    def check(f: h5py.File) -> list[str]:
+        from post.measures import ironing_measures
+        from post.reader import read_result
+        problems = []
+        names = sorted(f["steps"])
+        last = float(f[f"steps/{names[-1]}/contact/1"].attrs["penalty_normal"])
+        if not floor * (1 - 1e-9) <= last <= 0.1 * given:
+            problems.append(f"penalty_normal at the end {last:g}: not softened into "
+                            f"[{floor:g}, {0.1 * given:g}]")
+        m = ironing_measures(read_result(f.filename))
+        for key, want in zip(("mean_px", "mean_py"), forces):
+            if abs(m[key] / want - 1) > rel:
+                problems.append(f"{key} {m[key]:.7g} differs from {want:.7g} by more than {rel:g}")
+        return problems
+
+    return check
+
+
 def reaches_master_end(step: int = 0, xi: float = 0.99) -> Check:
     """A point in contact projects beyond `xi` on the master curve (parameter 0..1) after
     `step` (0: the last step; -1: any step)."""
@@ -240,6 +266,17 @@ def suite() -> list[HardCase]:
                               (contact(penalty_normal=eps, penalty_tangent=eps),)
                               + ((contact(method="mortar"), solver(damping="natural")) if mortar else ()),
                               checks=(mortar_zone_whole(),) if mortar else ()))
+    # the same penalties with the augmented Lagrangian: its solution does not depend on
+    # them, so a failed substep makes them softer (down to the automatic penalty, 26.35
+    # x E here) instead of cutting; the mean die forces are penalty-1e6's (mortar,
+    # 20095 Newton iterations: mean Px 0.17722794, Py -0.59888704) to 1e-5
+    for exponent in (4, 5, 6):
+        eps = 10.0**exponent * E_SLAB
+        cases.append(HardCase(f"alm-1e{exponent}", "ironing", "m1-NN2.2",
+                              f"augmented Lagrangian, penalty_normal = penalty_tangent = 1e{exponent} x E",
+                              (contact(method="alm", penalty_normal=eps, penalty_tangent=eps),),
+                              checks=(alm_softened(eps, 26.35, (0.17722794, -0.59888704), 1e-5),),
+                              reduced=exponent == 6))
     # which of the two penalties: the normal one alone stiff (tangential 1e2 x E)
     for exponent in (4, 6):
         eps = 10.0**exponent * E_SLAB
