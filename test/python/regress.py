@@ -25,7 +25,8 @@ the binary of 7ea93d8 (issue 17: a linear scene's tangent solved as an update of
 bulk's Cholesky factor). That run's contact force is known only to its residual floor
 (docs/robustness.md, "Convergence at the round-off level"): the new order of summation
 moved it by up to 8e-9 (9e-6 relative) with the same iterations, cuts and retries; every
-other run agrees with e54ff29 to 1e-10.
+other run agrees with e54ff29 to 1e-10. The alm hard cases (``alm-1e4`` .. ``alm-1e6``,
+issue 16) were added by the binary of ea01bff, when every other run still agreed.
 """
 from __future__ import annotations
 
