@@ -612,8 +612,25 @@ contains
             write (buf, '(i0)') ip
             call read_history(h5, g//'/contact/'//trim(buf)//'/history', model%pairs(ip)%pair, error)
             if (allocated(error)) return
+            call read_penalties(h5, g//'/contact/'//trim(buf), model%pairs(ip)%pair, error)
+            if (allocated(error)) return
         end do
     end subroutine read_state
+
+    !> The penalties a pair with multipliers used at the step of group `c` (it may
+    !> have softened them, `alm_soften`): a restart goes on with them, as the run
+    !> did. Other pairs keep the case's (a user may restart with another penalty);
+    !> so do files without the attributes.
+    subroutine read_penalties(h5, c, pair, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: c
+        class(contact_pair_t), intent(inout) :: pair
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. pair%has_multipliers()) return
+        if (h5%has_attr(c, 'penalty_normal')) call h5%read_attr_real(c, 'penalty_normal', pair%law%eps_n, error)
+        if (allocated(error)) return
+        if (h5%has_attr(c, 'penalty_tangent')) call h5%read_attr_real(c, 'penalty_tangent', pair%law%eps_t, error)
+    end subroutine read_penalties
 
     !> Read the committed history `pair` keeps (its `history` names the arrays) from
     !> group `c` and set it on the pair.

@@ -99,6 +99,33 @@ def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, me
     compare(full, partial)
 
 
+@pytest.mark.parametrize("keep", [2, 5])
+def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> None:
+    """alm at 1e6 x E with 4 Newton iterations per attempt softens its penalties at
+    steps 1 and 4 (docs/theory.md, "Softening"); a restart after step 2 or 5 goes on
+    with the penalties of the last written step and reproduces the uninterrupted run."""
+    case = setup(tmp_path, 6, "alm")
+    case.write_text(case.read_text()
+                    .replace("penalty_normal = 100.0, penalty_tangent = 100.0",
+                             "penalty_normal = 1e6, penalty_tangent = 1e6")
+                    .replace("n_steps = 3, 6", "n_steps = 3, 6, max_iterations = 4"))
+    res = run(case)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.count("soften step 1 ") == 3 and res.stdout.count("soften step 4 ") == 2
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    with h5py.File(full) as f:
+        used = [f[f"steps/{k}/contact/1"].attrs["penalty_normal"] for k in sorted(f["steps"])]
+    assert used[0] == pytest.approx(1e3) and used[-1] < 100.0
+    partial = tmp_path / "partial.h5"
+    shutil.copy(full, partial)
+    truncate(partial, keep)
+    res = run("--restart", partial)
+    assert res.returncode == 0, res.stderr
+    assert ("soften step 4 " in res.stdout) == (keep < 4)
+    compare(full, partial)
+
+
 def test_restart_after_kill9(voiga_bin: Path, tmp_path: Path) -> None:
     """kill -9 at a random point: the file opens with every completed step, and a
     restart reproduces the uninterrupted results."""
