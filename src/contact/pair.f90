@@ -409,7 +409,7 @@ contains
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
-            call self%master%project(u, sp%x, mp, found, converged)
+            call self%master%project(u, sp%x, mp, found, converged, out%xi_m)
             out%xi_m = mp%xi
             out%first = mp%first
             out%last = mp%last

@@ -45,33 +45,32 @@ contains
     !> from its quadrature points `pts`, with displacements `u` [2, nen]. Small
     !> strain: f = int B^T sigma, K = int B^T c B. Finite strain (total Lagrangian,
     !> spatial form): f_a = int tau g_a dV, K_ab = int (g_a . c . g_b + (g_a . tau g_b) I) dV,
-    !> g = dN/dx = F^-T dN/dX. Evaluated as matrix products over all points:
-    !> K = B^T D B (material part, Voigt form; the tangents of both laws have minor
-    !> symmetries) + G^T T G (geometric part, finite strain only) with B, D, G, T
-    !> stacked over the points. The stacks are stored transposed (one column per
-    !> point and Voigt component, so that every point fills contiguous columns) and
-    !> D B is formed from the gradients directly, without the zeros of B.
-    !> `ok` is false if J <= 0 at a point.
+    !> g = dN/dx = F^-T dN/dX. The four 2 x 2 blocks of K, by displacement component
+    !> (i, k), are K^ik_ab = sum_q g_a^T M^ik_q g_b with M^ik_q the 2 x 2 matrix of the
+    !> Voigt tangent D = w c that couples the components (i, j) and (k, l) (the
+    !> geometric part adds w tau to M^xx and M^yy): all four are one product G R^T,
+    !> G [nen, 2 npts] the stacked gradients and R [4 nen, 2 npts] the stacked G M^T
+    !> (half the flops of B^T D B, whose B is half zeros, plus G^T T G). `ok` is false
+    !> if J <= 0 at a point.
     pure subroutine solid_element(mat, pts, u, fe, ke, ok)
         class(material_t), intent(in) :: mat
         type(element_points_t), intent(in) :: pts
         real(dp), intent(in) :: u(:, :)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        ! B^T and (D B)^T; shape: [2 nen, 3 npts]. Automatic (stack) arrays: no heap
-        ! allocation per element; gt, tgt, kg are used by the finite-strain law only
-        real(dp) :: bt(2*size(u, 2), 3*size(pts%wdv)), dbt(2*size(u, 2), 3*size(pts%wdv))
-        ! G^T and (T G)^T; shape: [nen, 2 npts]
-        real(dp) :: gt(size(u, 2), 2*size(pts%wdv)), tgt(size(u, 2), 2*size(pts%wdv)), &
-                    kg(size(u, 2), size(u, 2))
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3)
-        real(dp) :: g(2, size(u, 2))
+        ! G and R (see above); the blocks [K^xx K^xy K^yx K^yy]. Automatic (stack)
+        ! arrays: no heap allocation per element
+        real(dp) :: gt(size(u, 2), 2*size(pts%wdv)), rt(4*size(u, 2), 2*size(pts%wdv)), &
+                    k4(size(u, 2), 4*size(u, 2))
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
+        real(dp) :: m(2, 2, 4), g1, g2, w
         integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
-        integer :: q, nen, i, j, r, a
+        integer :: q, nen, i, j, a, b, blk
 
         nen = size(u, 2)
         fe = 0.0_dp
         do q = 1, size(pts%wdv)
+            w = pts%wdv(q)
             grad_u = 0.0_dp
             do a = 1, nen
                 grad_u(:, 1) = grad_u(:, 1) + u(:, a)*pts%dndx(1, a, q)
@@ -79,52 +78,79 @@ contains
             end do
             call mat%stress(grad_u, s, c, ok)
             if (.not. ok) return
+            ts = 0.0_dp
             if (mat%finite_strain) then
                 f = grad_u
                 f(1, 1) = f(1, 1) + 1.0_dp
                 f(2, 2) = f(2, 2) + 1.0_dp
                 det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-                finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
-                ! g = finv^T dN/dX
-                do a = 1, nen
-                    g(1, a) = finv(1, 1)*pts%dndx(1, a, q) + finv(2, 1)*pts%dndx(2, a, q)
-                    g(2, a) = finv(1, 2)*pts%dndx(1, a, q) + finv(2, 2)*pts%dndx(2, a, q)
-                end do
-                gt(:, 2*q - 1) = g(1, :)
-                gt(:, 2*q) = g(2, :)
-                tgt(:, 2*q - 1) = pts%wdv(q)*(s(1, 1)*g(1, :) + s(1, 2)*g(2, :))
-                tgt(:, 2*q) = pts%wdv(q)*(s(2, 1)*g(1, :) + s(2, 2)*g(2, :))
-            else
-                g = pts%dndx(:, :, q)
+                finv(1, 1) = f(2, 2)/det
+                finv(2, 1) = -f(2, 1)/det
+                finv(1, 2) = -f(1, 2)/det
+                finv(2, 2) = f(1, 1)/det
+                ts = w*s
             end if
             do j = 1, 3
                 do i = 1, 3
-                    d(i, j) = pts%wdv(q)*c(vi(i), vj(i), vi(j), vj(j))
+                    d(i, j) = w*c(vi(i), vj(i), vi(j), vj(j))
                 end do
             end do
-            sv = pts%wdv(q)*[s(1, 1), s(2, 2), s(1, 2)]
-            r = 3*q - 3
-            ! columns of B^T: [g1 0], [0 g2], [g2 g1] per function (x, y interleaved)
-            bt(1::2, r + 1) = g(1, :)
-            bt(2::2, r + 1) = 0.0_dp
-            bt(1::2, r + 2) = 0.0_dp
-            bt(2::2, r + 2) = g(2, :)
-            bt(1::2, r + 3) = g(2, :)
-            bt(2::2, r + 3) = g(1, :)
-            do i = 1, 3
-                dbt(1::2, r + i) = d(i, 1)*g(1, :) + d(i, 3)*g(2, :)
-                dbt(2::2, r + i) = d(i, 2)*g(2, :) + d(i, 3)*g(1, :)
+            sv = w*[s(1, 1), s(2, 2), s(1, 2)]
+            ! M^xx, M^xy, M^yx, M^yy (rows: the gradient component of g_a, columns: of g_b)
+            call coupling(d, ts, m)
+            do a = 1, nen
+                ! g = F^-T dN/dX (dN/dX for small strain)
+                if (mat%finite_strain) then
+                    g1 = finv(1, 1)*pts%dndx(1, a, q) + finv(2, 1)*pts%dndx(2, a, q)
+                    g2 = finv(1, 2)*pts%dndx(1, a, q) + finv(2, 2)*pts%dndx(2, a, q)
+                else
+                    g1 = pts%dndx(1, a, q)
+                    g2 = pts%dndx(2, a, q)
+                end if
+                gt(a, 2*q - 1) = g1
+                gt(a, 2*q) = g2
+                do blk = 1, 4
+                    rt((blk - 1)*nen + a, 2*q - 1) = m(1, 1, blk)*g1 + m(1, 2, blk)*g2
+                    rt((blk - 1)*nen + a, 2*q) = m(2, 1, blk)*g1 + m(2, 2, blk)*g2
+                end do
+                ! f_a = B_a^T sv
+                fe(2*a - 1) = fe(2*a - 1) + sv(1)*g1 + sv(3)*g2
+                fe(2*a) = fe(2*a) + sv(2)*g2 + sv(3)*g1
             end do
-            ! the same sums, in the same order, as f + B^T sv
-            fe(1::2) = fe(1::2) + sv(1)*g(1, :) + sv(3)*g(2, :)
-            fe(2::2) = fe(2::2) + sv(2)*g(2, :) + sv(3)*g(1, :)
         end do
-        call gemm_nt(bt, dbt, ke, 0.0_dp)
-        if (mat%finite_strain) then
-            call gemm_nt(gt, tgt, kg, 0.0_dp)
-            ke(1::2, 1::2) = ke(1::2, 1::2) + kg
-            ke(2::2, 2::2) = ke(2::2, 2::2) + kg
-        end if
+        call gemm_nt(gt, rt, k4, 0.0_dp)
+        do b = 1, nen
+            do a = 1, nen
+                ke(2*a - 1, 2*b - 1) = k4(a, b)
+                ke(2*a - 1, 2*b) = k4(a, nen + b)
+                ke(2*a, 2*b - 1) = k4(a, 2*nen + b)
+                ke(2*a, 2*b) = k4(a, 3*nen + b)
+            end do
+        end do
     end subroutine solid_element
+
+    !> The 2 x 2 matrices M^xx, M^xy, M^yx, M^yy of `solid_element` from the Voigt
+    !> tangent `d` and the geometric part `ts` (rows: the gradient component of g_a,
+    !> columns: of g_b).
+    pure subroutine coupling(d, ts, m)
+        real(dp), intent(in) :: d(3, 3), ts(2, 2)
+        real(dp), intent(out) :: m(2, 2, 4)
+        m(1, 1, 1) = d(1, 1) + ts(1, 1)
+        m(2, 1, 1) = d(3, 1) + ts(2, 1)
+        m(1, 2, 1) = d(1, 3) + ts(1, 2)
+        m(2, 2, 1) = d(3, 3) + ts(2, 2)
+        m(1, 1, 2) = d(1, 3)
+        m(2, 1, 2) = d(3, 3)
+        m(1, 2, 2) = d(1, 2)
+        m(2, 2, 2) = d(3, 2)
+        m(1, 1, 3) = d(3, 1)
+        m(2, 1, 3) = d(2, 1)
+        m(1, 2, 3) = d(3, 3)
+        m(2, 2, 3) = d(2, 3)
+        m(1, 1, 4) = d(3, 3) + ts(1, 1)
+        m(2, 1, 4) = d(2, 3) + ts(2, 1)
+        m(1, 2, 4) = d(3, 2) + ts(1, 2)
+        m(2, 2, 4) = d(2, 2) + ts(2, 2)
+    end subroutine coupling
 
 end module voiga_element_solid
