@@ -31,17 +31,19 @@ contains
     !> solid), element matrices random and unsymmetric plus `shift` on their diagonal.
     !> With `floating`, every element matrix maps a constant vector to zero (rows
     !> summing to zero, as a stiffness without supports): the sum is singular.
-    subroutine grid_matrix(m, shift, rng, a, error, floating)
+    subroutine grid_matrix(m, shift, rng, a, error, floating, corners)
         integer, intent(in) :: m
         real(dp), intent(in) :: shift
         type(lcg_t), intent(inout) :: rng
         type(csc_matrix_t), intent(out) :: a
         type(error_t), allocatable, intent(out) :: error
         logical, intent(in), optional :: floating
+        !> Also couple the first and the last DOF in the pattern (values zero).
+        logical, intent(in), optional :: corners
         integer, allocatable :: ptr(:), dofs(:)
         real(dp) :: ke(8, 8)
         integer :: i, j, e, n0, a1, b1
-        allocate (ptr((m - 1)**2 + 1), dofs(8*(m - 1)**2))
+        allocate (ptr((m - 1)**2 + 2), dofs(8*(m - 1)**2 + 2))
         e = 0
         do j = 1, m - 1
             do i = 1, m - 1
@@ -52,7 +54,14 @@ contains
             end do
         end do
         ptr(e + 1) = 8*e + 1
-        call new_csc_pattern(a, 2*m*m, ptr, dofs, error)
+        if (present(corners)) then
+            if (corners) then
+                dofs(8*e + 1:8*e + 2) = [1, 2*m*m]
+                ptr(e + 2) = 8*e + 3
+                e = e + 1
+            end if
+        end if
+        call new_csc_pattern(a, 2*m*m, ptr(1:e + 1), dofs, error)
         if (allocated(error)) return
         do e = 1, (m - 1)**2
             do b1 = 1, 8
@@ -176,48 +185,51 @@ contains
         call check(error, log_sn, log_umf, 'log10 |det|', rel=1.0e-10_dp)
     end subroutine test_block_pivots
 
-    !> Entries of the pattern that are zero are left out of the analysis; the
-    !> analysis is redone when they become nonzero, not when nonzeros become zero.
+    !> Entries of the pattern that are zero are left out of the analysis. A nonzero
+    !> outside the analysed fronts (the two far corners of a grid coupled) makes a
+    !> new analysis; the same matrix on a new pattern (the coupling's zero entries
+    !> dropped) is mapped into the fronts there are, without one.
     subroutine test_new_nonzeros(error)
         type(error_t), allocatable, intent(out) :: error
-        type(csc_matrix_t) :: a
+        type(csc_matrix_t) :: a, b
         type(supernodal_lu_t) :: lu
         type(umfpack_t) :: umf
-        type(lcg_t) :: rng
-        real(dp), allocatable :: full(:)
-        integer :: p
+        type(lcg_t) :: rng, rng2
+        integer :: p, q, n
 
-        call grid_matrix(12, 4.0_dp, rng, a, error)
+        call grid_matrix(12, 4.0_dp, rng, a, error, corners=.true.)
         if (allocated(error)) return
-        full = a%values
-        ! every off-diagonal entry of the first 60 columns zero
-        do p = 1, a%colptr(61)
-            if (a%rowind(p) /= col_of(p)) a%values(p) = 0.0_dp
-        end do
-        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'sparser', error)
+        n = a%n
+        p = a%index_of(1, n)
+        q = a%index_of(n, 1)
+        call check(error, p > 0 .and. q > 0, 'the corners are coupled in the pattern')
+        if (allocated(error)) return
+        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'corners zero', error)
         if (allocated(error)) return
         call check(error, lu%n_symbolic, 1, 'one analysis')
         if (allocated(error)) return
-        a%values = full
-        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'all entries', error)
+        a%values(p) = 0.5_dp
+        a%values(q) = -0.5_dp
+        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'corners coupled', error)
         if (allocated(error)) return
-        call check(error, lu%n_symbolic, 2, 'new nonzeros: analysed again')
+        call check(error, lu%n_symbolic, 2, 'a nonzero outside the fronts: analysed again')
         if (allocated(error)) return
-        a%values(1:a%colptr(61)) = 0.5_dp*full(1:a%colptr(61))
-        a%values(2) = 0.0_dp
-        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'fewer nonzeros', error)
+        a%values(p) = 0.0_dp
+        a%values(q) = 0.0_dp
+        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'corners zero again', error)
         if (allocated(error)) return
-        call check(error, lu%n_symbolic, 2, 'fewer nonzeros: analysis kept')
+        call check(error, lu%n_symbolic + lu%n_mapped, 2, 'fewer nonzeros: nothing to analyse or map')
         if (allocated(error)) return
-        call check(error, lu%n_numeric, 3, 'three factorizations')
-    contains
-        pure integer function col_of(q)
-            integer, intent(in) :: q
-            col_of = 0
-            do while (a%colptr(col_of + 2) < q)
-                col_of = col_of + 1
-            end do
-        end function col_of
+        ! the same values on the pattern without the corner coupling
+        call grid_matrix(12, 4.0_dp, rng2, b, error)
+        if (allocated(error)) return
+        call compare_solves(lu, umf, b, rng, 1.0e-12_dp, 'new pattern', error)
+        if (allocated(error)) return
+        call check(error, lu%n_symbolic, 2, 'new pattern, nonzeros in the fronts: no analysis')
+        if (allocated(error)) return
+        call check(error, lu%n_mapped, 1, 'new pattern: mapped into the fronts')
+        if (allocated(error)) return
+        call check(error, lu%n_numeric, 4, 'four factorizations')
     end subroutine test_new_nonzeros
 
     !> A singular matrix (a zero column): the supernodal factorization meets a zero

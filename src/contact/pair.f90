@@ -394,6 +394,7 @@ contains
         type(surface_point_t), intent(inout) :: sp
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
+        real(dp) :: a0(2)
         if (allocated(self%slave_basis)) then
             call surface_point_at(self%slave, u, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
                                   self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
@@ -401,9 +402,9 @@ contains
             call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
         end if
         associate (out => self%out(k))
-            out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
+            call reference_point(self%slave, sp, out%x0, a0)
             out%x = sp%x
-            out%stretch = norm2(sp%a)/norm2(matmul(self%slave%x0(:, sp%local), sp%dr))
+            out%stretch = norm2(sp%a)/norm2(a0)
             out%state = state_inactive
             out%pn = 0.0_dp
             out%pt = 0.0_dp
@@ -417,6 +418,21 @@ contains
             if (found) out%gap = dot_product(sp%x - mp%x, mp%n)
         end associate
     end subroutine pair_project_point
+
+    !> The reference position `x0` and tangent `a0` of the slave point `sp` (its
+    !> functions at the reference control points).
+    pure subroutine reference_point(slave, sp, x0, a0)
+        type(contact_surface_t), intent(in) :: slave
+        type(surface_point_t), intent(in) :: sp
+        real(dp), intent(out) :: x0(2), a0(2)
+        integer :: j
+        x0 = 0.0_dp
+        a0 = 0.0_dp
+        do j = 1, size(sp%local)
+            x0 = x0 + slave%x0(:, sp%local(j))*sp%r(j)
+            a0 = a0 + slave%x0(:, sp%local(j))*sp%dr(j)
+        end do
+    end subroutine reference_point
 
     !> The error of a slave point whose projection did not converge.
     pure subroutine pair_projection_error(self, k, error)

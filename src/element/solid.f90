@@ -6,11 +6,10 @@
 module voiga_element_solid
     use voiga_kinds, only: dp
     use voiga_material, only: material_t
-    use voiga_linalg_blas, only: gemm_nt
     implicit none
     private
 
-    public :: solid_element, reference_gradients, element_points_t
+    public :: solid_element, reference_gradients, element_points_t, element_work_t
 
     !> The quadrature of one element in the reference configuration, computed once
     !> per discretization: reference gradients dN/dX [2, nen, npts] and weights
@@ -18,6 +17,25 @@ module voiga_element_solid
     type :: element_points_t
         real(dp), allocatable :: dndx(:, :, :), wdv(:)
     end type element_points_t
+
+    !> Work arrays of `solid_element` kept by its caller over the elements of a body
+    !> (gfortran puts automatic arrays on the heap: three allocations per element):
+    !> G [ld, 2 npts], R [4 ld, 2 npts] and the blocks of K [ld, 4 ld], grown to the
+    !> largest element they met.
+    type :: element_work_t
+        real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :)
+    end type element_work_t
+
+    interface
+        pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: dp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            real(dp), intent(in) :: alpha, beta
+            real(dp), intent(in) :: a(lda, *), b(ldb, *)
+            real(dp), intent(inout) :: c(ldc, *)
+        end subroutine dgemm
+    end interface
 
 contains
 
@@ -52,22 +70,56 @@ contains
     !> G [nen, 2 npts] the stacked gradients and R [4 nen, 2 npts] the stacked G M^T
     !> (half the flops of B^T D B, whose B is half zeros, plus G^T T G). `ok` is false
     !> if J <= 0 at a point.
-    pure subroutine solid_element(mat, pts, u, fe, ke, ok)
+    pure subroutine solid_element(mat, pts, u, fe, ke, ok, work)
         class(material_t), intent(in) :: mat
         type(element_points_t), intent(in) :: pts
         real(dp), intent(in) :: u(:, :)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        ! G and R (see above); the blocks [K^xx K^xy K^yx K^yy]. Automatic (stack)
-        ! arrays: no heap allocation per element
-        real(dp) :: gt(size(u, 2), 2*size(pts%wdv)), rt(4*size(u, 2), 2*size(pts%wdv)), &
-                    k4(size(u, 2), 4*size(u, 2))
+        !> G, R and the blocks [K^xx K^xy K^yx K^yy] (allocated here when absent).
+        type(element_work_t), intent(inout), optional :: work
+        type(element_work_t) :: own
+        if (present(work)) then
+            call fit_work(work, size(u, 2), 2*size(pts%wdv))
+            call element_kernel(mat, pts, u, fe, ke, ok, work)
+        else
+            call fit_work(own, size(u, 2), 2*size(pts%wdv))
+            call element_kernel(mat, pts, u, fe, ke, ok, own)
+        end if
+    end subroutine solid_element
+
+    !> `work` large enough for `nen` functions and `ncol` = 2 npts columns.
+    pure subroutine fit_work(work, nen, ncol)
+        type(element_work_t), intent(inout) :: work
+        integer, intent(in) :: nen, ncol
+        integer :: ld, nc
+        if (allocated(work%gt)) then
+            if (size(work%gt, 1) >= nen .and. size(work%gt, 2) >= ncol) return
+            ld = max(nen, size(work%gt, 1))
+            nc = max(ncol, size(work%gt, 2))
+            deallocate (work%gt, work%rt, work%k4)
+        else
+            ld = nen
+            nc = ncol
+        end if
+        allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld))
+    end subroutine fit_work
+
+    !> `solid_element` on the work arrays `wk`.
+    pure subroutine element_kernel(mat, pts, u, fe, ke, ok, wk)
+        class(material_t), intent(in) :: mat
+        type(element_points_t), intent(in) :: pts
+        real(dp), intent(in) :: u(:, :)
+        real(dp), intent(out) :: fe(:), ke(:, :)
+        logical, intent(out) :: ok
+        type(element_work_t), intent(inout) :: wk
         real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
         real(dp) :: m(2, 2, 4), g1, g2, w
         integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
-        integer :: q, nen, i, j, a, b, blk
+        integer :: q, nen, i, j, a, b, blk, ld
 
         nen = size(u, 2)
+        ld = size(wk%gt, 1)
         fe = 0.0_dp
         do q = 1, size(pts%wdv)
             w = pts%wdv(q)
@@ -107,27 +159,29 @@ contains
                     g1 = pts%dndx(1, a, q)
                     g2 = pts%dndx(2, a, q)
                 end if
-                gt(a, 2*q - 1) = g1
-                gt(a, 2*q) = g2
+                wk%gt(a, 2*q - 1) = g1
+                wk%gt(a, 2*q) = g2
                 do blk = 1, 4
-                    rt((blk - 1)*nen + a, 2*q - 1) = m(1, 1, blk)*g1 + m(1, 2, blk)*g2
-                    rt((blk - 1)*nen + a, 2*q) = m(2, 1, blk)*g1 + m(2, 2, blk)*g2
+                    wk%rt((blk - 1)*nen + a, 2*q - 1) = m(1, 1, blk)*g1 + m(1, 2, blk)*g2
+                    wk%rt((blk - 1)*nen + a, 2*q) = m(2, 1, blk)*g1 + m(2, 2, blk)*g2
                 end do
                 ! f_a = B_a^T sv
                 fe(2*a - 1) = fe(2*a - 1) + sv(1)*g1 + sv(3)*g2
                 fe(2*a) = fe(2*a) + sv(2)*g2 + sv(3)*g1
             end do
         end do
-        call gemm_nt(gt, rt, k4, 0.0_dp)
+        ! [K^xx K^xy K^yx K^yy] = G R^T
+        call dgemm('N', 'T', nen, 4*nen, 2*size(pts%wdv), 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, &
+                   wk%k4, ld)
         do b = 1, nen
             do a = 1, nen
-                ke(2*a - 1, 2*b - 1) = k4(a, b)
-                ke(2*a - 1, 2*b) = k4(a, nen + b)
-                ke(2*a, 2*b - 1) = k4(a, 2*nen + b)
-                ke(2*a, 2*b) = k4(a, 3*nen + b)
+                ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
+                ke(2*a - 1, 2*b) = wk%k4(a, nen + b)
+                ke(2*a, 2*b - 1) = wk%k4(a, 2*nen + b)
+                ke(2*a, 2*b) = wk%k4(a, 3*nen + b)
             end do
         end do
-    end subroutine solid_element
+    end subroutine element_kernel
 
     !> The 2 x 2 matrices M^xx, M^xy, M^yx, M^yy of `solid_element` from the Voigt
     !> tangent `d` and the geometric part `ts` (rows: the gradient component of g_a,

@@ -9,7 +9,7 @@ module voiga_model_assembly
     use voiga_text, only: str
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: solid_element
+    use voiga_element_solid, only: solid_element, element_work_t
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
     implicit none
     private
@@ -71,21 +71,24 @@ contains
     !> Internal force `fe` [2 nen] and tangent `ke` [2 nen, 2 nen] of element `e`
     !> of `body` for the global displacement vector `u`. `ok` is false if the
     !> Jacobian of the deformation is not positive at some quadrature point.
-    pure subroutine body_element(body, e, u, fe, ke, ok)
+    pure subroutine body_element(body, e, u, fe, ke, ok, work)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
+        !> The element kernel's work arrays, kept by a caller that loops over elements.
+        type(element_work_t), intent(inout), optional :: work
         real(dp) :: ue(2, size(fe)/2)
         integer :: a
 
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                ue(:, a) = u(body%dof0 + 2*conn(a) - 1:body%dof0 + 2*conn(a))
+                ue(1, a) = u(body%dof0 + 2*conn(a) - 1)
+                ue(2, a) = u(body%dof0 + 2*conn(a))
             end do
         end associate
-        call solid_element(body%mat, body%points(e), ue, fe, ke, ok)
+        call solid_element(body%mat, body%points(e), ue, fe, ke, ok, work)
     end subroutine body_element
 
     !> The positions of every bulk element's entries in `k` (built on its pattern);
@@ -370,6 +373,7 @@ contains
         type(assembly_map_t), intent(inout), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
+        type(element_work_t) :: work
         integer :: ib, e, n, npts, idx
         logical :: ok, keep
         integer(i8) :: c0, c1, rate
@@ -400,7 +404,7 @@ contains
                         if (size(fe) /= n) deallocate (fe, ke)
                     end if
                     if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
-                    call body_element(body, e, u, fe, ke, ok)
+                    call body_element(body, e, u, fe, ke, ok, work)
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
                                          ': the deformation is inverted (J <= 0 at a quadrature point)', &
@@ -408,12 +412,12 @@ contains
                         return
                     end if
                     idx = idx + 1
-                    dofs = body_dofs(body, e)
-                    r(dofs) = r(dofs) + fe
+                    call add_force(body, e, fe, r)
                     if (present(k)) then
                         if (present(map)) then
                             call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ke)
                         else
+                            dofs = body_dofs(body, e)
                             call k%add_element(dofs, ke)
                         end if
                     end if
@@ -435,6 +439,22 @@ contains
         call system_clock(c1)
         stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
     end subroutine assemble_bulk
+
+    !> r(dofs of element e) += fe (the element's force, local order 2(a-1) + i).
+    pure subroutine add_force(body, e, fe, r)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        real(dp), intent(in) :: fe(:)
+        real(dp), intent(inout) :: r(:)
+        integer :: a, i
+        associate (conn => body%disc%elements(e)%conn)
+            do a = 1, size(conn)
+                i = body%dof0 + 2*conn(a)
+                r(i - 1) = r(i - 1) + fe(2*a - 1)
+                r(i) = r(i) + fe(2*a)
+            end do
+        end associate
+    end subroutine add_force
 
     !> Keep the stiffness a linear body just added to `k` (columns `first`..`last`:
     !> its DOFs; only its elements have entries there yet).

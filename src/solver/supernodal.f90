@@ -6,7 +6,8 @@
 !> storing L and U, not the dense kernels. Here everything that depends on the
 !> pattern is done once per pattern, and a factorization is three loops:
 !>
-!> - **Analysis** (again only when the nonzero pattern leaves the analysed one):
+!> - **Analysis** (again only when a nonzero falls outside the analysed fronts: a
+!>   new pattern of `a` or new nonzeros are first mapped into the fronts there are):
 !>   the pattern is that of the entries that are nonzero in `a` or its transpose
 !>   (the Dirichlet DOFs' eliminated couplings and the contact blocks no slave point
 !>   uses are left out: half the flops on ironing m3), ordered by AMD with CHOLMOD's
@@ -17,8 +18,8 @@
 !>   of absolute values (UMFPACK's default scaling), are written into the fronts;
 !>   each front eliminates its own columns with pivots chosen inside its diagonal
 !>   block (the diagonal while it is at least `prefer_diagonal` of the block
-!>   column's largest entry), updates its remainder with one `dgemm` and adds it to
-!>   its parent's front.
+!>   column's largest entry), forms its U rows, updates its
+!>   remainder with one `dgemm` and adds it to its parent's front.
 !> - **Fallback**: a multiplier above `max_multiplier` (a pivot the block cannot
 !>   make stable), a zero pivot, or a pattern this type does not take (not
 !>   structurally symmetric, fronts above `max_front_storage`) hands the matrix to
@@ -54,9 +55,10 @@ module voiga_solver_supernodal
 
     !> Supernodal LU with pivots inside supernodes and UMFPACK as its fallback.
     type, extends(linear_solver_t) :: supernodal_lu_t
-        !> Analyses, numeric factorizations (this type's and UMFPACK's), and of
-        !> these the factorizations left to UMFPACK (read only).
-        integer :: n_symbolic = 0, n_numeric = 0, n_fallback = 0
+        !> Analyses, numeric factorizations (this type's and UMFPACK's), of these the
+        !> factorizations left to UMFPACK, and the new patterns or nonzeros that the
+        !> analysed supernodes took without a new analysis (read only).
+        integer :: n_symbolic = 0, n_numeric = 0, n_fallback = 0, n_mapped = 0
         !> Reciprocal condition estimate of the last factorization (read only).
         real(dp) :: rcond = 0.0_dp
         type(umfpack_t), private :: umfpack
@@ -78,8 +80,9 @@ module voiga_solver_supernodal
         integer, allocatable, private :: perm(:), super(:), rptr(:), rows(:), parent(:), rel(:), fptr(:), &
                                          dest(:)
         !> The fronts (after a factorization: L, U and the update of each), the local
-        !> pivot rows [n], the row scale factors [n], a solve's work vector [n].
-        real(dp), allocatable, private :: f(:), scale(:), y(:)
+        !> pivot rows [n], the row scale factors and their reciprocals [n], a solve's
+        !> work vector [n].
+        real(dp), allocatable, private :: f(:), scale(:), rscale(:), y(:)
         integer, allocatable, private :: ipiv(:)
         integer, private :: det_sign = 0
         real(dp), private :: det_log10 = 0.0_dp
@@ -131,19 +134,26 @@ contains
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
-        logical :: ok
+        logical :: ok, new_pattern
 
         self%factored = .false.
         if (a%n < 1 .or. .not. (allocated(a%colptr) .and. allocated(a%rowind) .and. allocated(a%values))) then
             call fatal_error(error, 'supernodal factorize: matrix has no pattern (build it with new_csc_pattern)')
             return
         end if
-        if (.not. same_csc(self, a)) call take_pattern(self, a)
+        new_pattern = .not. same_csc(self, a)
+        if (new_pattern) call take_pattern(self, a)
         ok = .not. self%umfpack_only
         if (ok .and. self%nsuper == 0) then
             call analyse(self, a, ok)
         else if (ok) then
-            if (.not. covered(self, a)) call analyse(self, a, ok)
+            ! a new CSC pattern (the contact couplings refitted) or new nonzeros: the
+            ! supernodes analysed before take them while they fall in their fronts
+            if (new_pattern) then
+                call map_or_analyse(self, a, ok)
+            else if (.not. covered(self, a)) then
+                call map_or_analyse(self, a, ok)
+            end if
         end if
         if (ok) call numeric(self, a, ok)
         self%on_umfpack = .not. ok
@@ -171,18 +181,34 @@ contains
         same_csc = .true.
     end function same_csc
 
-    !> Take a new CSC pattern: its transpose map, and no analysis yet. A pattern that
-    !> is not structurally symmetric, or whose fronts would exceed
-    !> `max_front_storage`, is left to UMFPACK.
+    !> The positions of `a`'s nonzeros in the analysed fronts, or (when one falls
+    !> outside them) a new analysis.
+    subroutine map_or_analyse(self, a, ok)
+        class(supernodal_lu_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
+        logical, intent(out) :: ok
+        integer, allocatable :: pos(:)
+        allocate (pos(a%n), source=0)
+        call entry_positions(self, a, pos, ok)
+        if (ok) then
+            self%n_mapped = self%n_mapped + 1
+        else
+            call analyse(self, a, ok)
+        end if
+    end subroutine map_or_analyse
+
+    !> Take a new CSC pattern: its transpose map (the analysis, if any, is kept for
+    !> `map_or_analyse`). A pattern that is not structurally symmetric is left to
+    !> UMFPACK.
     subroutine take_pattern(self, a)
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         integer, allocatable :: cursor(:)
         integer :: i, j, p
+        if (a%n /= self%n) self%nsuper = 0
         self%n = a%n
         self%colptr = a%colptr
         self%rowind = a%rowind
-        self%nsuper = 0
         self%umfpack_only = .false.
         if (allocated(self%tpos)) deallocate (self%tpos)
         allocate (self%tpos(size(a%rowind)), cursor(a%n))
@@ -313,8 +339,8 @@ contains
         if (.not. ok) return
         if (allocated(self%f)) deallocate (self%f)
         allocate (self%f(self%fptr(self%nsuper + 1) - 1))
-        if (allocated(self%ipiv)) deallocate (self%ipiv, self%scale, self%y)
-        allocate (self%ipiv(a%n), self%scale(a%n), self%y(a%n))
+        if (allocated(self%ipiv)) deallocate (self%ipiv, self%scale, self%rscale, self%y)
+        allocate (self%ipiv(a%n), self%scale(a%n), self%rscale(a%n), self%y(a%n))
     end subroutine front_maps
 
     !> dest: where each analysed entry of `a` goes in the fronts (entry (i, j), new
@@ -348,7 +374,10 @@ contains
                     pi = iperm(i)
                     if (pi < c) cycle
                     r = pos(pi)
-                    if (r == 0) return
+                    if (r == 0) then
+                        pos(self%rows(self%rptr(s):self%rptr(s + 1) - 1)) = 0
+                        return
+                    end if
                     ! F(r, c - f0 + 1) and, above the diagonal, F(c - f0 + 1, r)
                     self%dest(p) = base + (c - f0)*m + r - 1
                     if (pi /= c) self%dest(self%tpos(p)) = base + (r - 1)*m + c - f0
@@ -366,7 +395,7 @@ contains
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         logical, intent(out) :: ok
-        integer :: s, j, p, m, k, par
+        integer :: s, p, m, k, par
 
         ! UMFPACK's default scaling: each row divided by the sum of its absolute values
         self%scale = 0.0_dp
@@ -374,11 +403,10 @@ contains
             self%scale(a%rowind(p) + 1) = self%scale(a%rowind(p) + 1) + abs(a%values(p))
         end do
         where (self%scale == 0.0_dp) self%scale = 1.0_dp
+        self%rscale = 1.0_dp/self%scale
         self%f = 0.0_dp
-        do j = 1, a%n
-            do p = a%colptr(j) + 1, a%colptr(j + 1)
-                if (self%dest(p) > 0) self%f(self%dest(p)) = a%values(p)/self%scale(a%rowind(p) + 1)
-            end do
+        do p = 1, size(a%rowind)
+            if (self%dest(p) > 0) self%f(self%dest(p)) = a%values(p)*self%rscale(a%rowind(p) + 1)
         end do
         do s = 1, self%nsuper
             m = self%rptr(s + 1) - self%rptr(s)
@@ -431,12 +459,19 @@ contains
             do c = j + 1, k
                 fr(j + 1:m, c) = fr(j + 1:m, c) - fr(j + 1:m, j)*fr(j, c)
             end do
-            do c = k + 1, m
-                fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*fr(j, c)
-            end do
         end do
-        if (m > k) call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
-                              fr(k + 1, k + 1), m)
+        if (m > k) then
+            ! U12 = L11^-1 F12 (its rows swapped with the block's) column by column (BLAS's
+            ! dtrsm costs more than the flops at these sizes), then the Schur complement
+            do c = k + 1, m
+                do j = 1, k - 1
+                    t = fr(j, c)
+                    if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
+                end do
+            end do
+            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
+                       fr(k + 1, k + 1), m)
+        end if
         ok = .true.
     end subroutine partial_factor
 
@@ -516,7 +551,7 @@ contains
         real(dp), intent(out) :: x(:)
         integer :: s, c
         do c = 1, self%n
-            self%y(c) = b(self%perm(c))/self%scale(self%perm(c))
+            self%y(c) = b(self%perm(c))*self%rscale(self%perm(c))
         end do
         do s = 1, self%nsuper
             call forward(self%f(self%fptr(s):), self%rptr(s + 1) - self%rptr(s), self%super(s + 1) - self%super(s), &
