@@ -113,24 +113,55 @@ contains
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
         type(element_work_t), intent(inout) :: wk
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
-        real(dp) :: m(2, 2, 4), g1, g2, w
-        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
-        integer :: q, nen, i, j, a, b, blk, ld
+        integer :: nen, np, ld, a, b
 
         nen = size(u, 2)
+        np = size(pts%wdv)
         ld = size(wk%gt, 1)
+        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, wk%gt, ld, wk%rt, size(wk%rt, 1))
+        if (.not. ok) return
+        ! [K^xx K^xy K^yx K^yy] = G R^T
+        call dgemm('N', 'T', nen, 4*nen, 2*np, 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, wk%k4, ld)
+        do b = 1, nen
+            do a = 1, nen
+                ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
+                ke(2*a - 1, 2*b) = wk%k4(a, nen + b)
+                ke(2*a, 2*b - 1) = wk%k4(a, 2*nen + b)
+                ke(2*a, 2*b) = wk%k4(a, 3*nen + b)
+            end do
+        end do
+    end subroutine element_kernel
+
+    !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
+    !> of G and R of every point (explicit shapes, so that the loops over the
+    !> functions are plain vector loops).
+    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, gt, ld, rt, ldr)
+        class(material_t), intent(in) :: mat
+        integer, intent(in) :: nen, np, ld, ldr
+        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
+        real(dp), intent(out) :: fe(2, nen)
+        logical, intent(out) :: ok
+        real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
+        real(dp) :: m(2, 2, 4), w
+        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
+        integer :: q, i, j, a, blk, off, c1, c2
+
         fe = 0.0_dp
-        do q = 1, size(pts%wdv)
-            w = pts%wdv(q)
+        ok = .true.
+        do q = 1, np
+            w = wdv(q)
+            c1 = 2*q - 1
+            c2 = 2*q
             grad_u = 0.0_dp
             do a = 1, nen
-                grad_u(:, 1) = grad_u(:, 1) + u(:, a)*pts%dndx(1, a, q)
-                grad_u(:, 2) = grad_u(:, 2) + u(:, a)*pts%dndx(2, a, q)
+                grad_u(:, 1) = grad_u(:, 1) + u(:, a)*dndx(1, a, q)
+                grad_u(:, 2) = grad_u(:, 2) + u(:, a)*dndx(2, a, q)
             end do
             call mat%stress(grad_u, s, c, ok)
             if (.not. ok) return
             ts = 0.0_dp
+            ! g = F^-T dN/dX (dN/dX for small strain)
             if (mat%finite_strain) then
                 f = grad_u
                 f(1, 1) = f(1, 1) + 1.0_dp
@@ -141,6 +172,13 @@ contains
                 finv(1, 2) = -f(1, 2)/det
                 finv(2, 2) = f(1, 1)/det
                 ts = w*s
+                do a = 1, nen
+                    gt(a, c1) = finv(1, 1)*dndx(1, a, q) + finv(2, 1)*dndx(2, a, q)
+                    gt(a, c2) = finv(1, 2)*dndx(1, a, q) + finv(2, 2)*dndx(2, a, q)
+                end do
+            else
+                gt(1:nen, c1) = dndx(1, :, q)
+                gt(1:nen, c2) = dndx(2, :, q)
             end if
             do j = 1, 3
                 do i = 1, 3
@@ -150,38 +188,20 @@ contains
             sv = w*[s(1, 1), s(2, 2), s(1, 2)]
             ! M^xx, M^xy, M^yx, M^yy (rows: the gradient component of g_a, columns: of g_b)
             call coupling(d, ts, m)
-            do a = 1, nen
-                ! g = F^-T dN/dX (dN/dX for small strain)
-                if (mat%finite_strain) then
-                    g1 = finv(1, 1)*pts%dndx(1, a, q) + finv(2, 1)*pts%dndx(2, a, q)
-                    g2 = finv(1, 2)*pts%dndx(1, a, q) + finv(2, 2)*pts%dndx(2, a, q)
-                else
-                    g1 = pts%dndx(1, a, q)
-                    g2 = pts%dndx(2, a, q)
-                end if
-                wk%gt(a, 2*q - 1) = g1
-                wk%gt(a, 2*q) = g2
-                do blk = 1, 4
-                    wk%rt((blk - 1)*nen + a, 2*q - 1) = m(1, 1, blk)*g1 + m(1, 2, blk)*g2
-                    wk%rt((blk - 1)*nen + a, 2*q) = m(2, 1, blk)*g1 + m(2, 2, blk)*g2
+            do blk = 1, 4
+                off = (blk - 1)*nen
+                do a = 1, nen
+                    rt(off + a, c1) = m(1, 1, blk)*gt(a, c1) + m(1, 2, blk)*gt(a, c2)
+                    rt(off + a, c2) = m(2, 1, blk)*gt(a, c1) + m(2, 2, blk)*gt(a, c2)
                 end do
-                ! f_a = B_a^T sv
-                fe(2*a - 1) = fe(2*a - 1) + sv(1)*g1 + sv(3)*g2
-                fe(2*a) = fe(2*a) + sv(2)*g2 + sv(3)*g1
             end do
-        end do
-        ! [K^xx K^xy K^yx K^yy] = G R^T
-        call dgemm('N', 'T', nen, 4*nen, 2*size(pts%wdv), 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, &
-                   wk%k4, ld)
-        do b = 1, nen
+            ! f_a = B_a^T sv
             do a = 1, nen
-                ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
-                ke(2*a - 1, 2*b) = wk%k4(a, nen + b)
-                ke(2*a, 2*b - 1) = wk%k4(a, 2*nen + b)
-                ke(2*a, 2*b) = wk%k4(a, 3*nen + b)
+                fe(1, a) = fe(1, a) + sv(1)*gt(a, c1) + sv(3)*gt(a, c2)
+                fe(2, a) = fe(2, a) + sv(2)*gt(a, c2) + sv(3)*gt(a, c1)
             end do
         end do
-    end subroutine element_kernel
+    end subroutine point_columns
 
     !> The 2 x 2 matrices M^xx, M^xy, M^yx, M^yy of `solid_element` from the Voigt
     !> tangent `d` and the geometric part `ts` (rows: the gradient component of g_a,

@@ -52,6 +52,8 @@ module voiga_solver_supernodal
     integer, parameter :: max_refine = 2
     !> Most reals all fronts together may hold (128 MiB); larger systems keep UMFPACK.
     integer(i8), parameter :: max_front_storage = 16777216_i8
+    !> Supernodes of at least this many columns form their U rows with BLAS's dtrsm.
+    integer, parameter :: blas_trsm_from = 24
 
     !> Supernodal LU with pivots inside supernodes and UMFPACK as its fallback.
     type, extends(linear_solver_t) :: supernodal_lu_t
@@ -79,6 +81,10 @@ module voiga_solver_supernodal
         integer, private :: nsuper = 0
         integer, allocatable, private :: perm(:), super(:), rptr(:), rows(:), parent(:), rel(:), fptr(:), &
                                          dest(:)
+        !> Each supernode's children (cptr [nsuper+1], kids) and the entries of `a` that
+        !> go into its front (aptr [nsuper+1], apos: positions in `a`), so that a front
+        !> is zeroed, filled and factorized while it is in cache.
+        integer, allocatable, private :: cptr(:), kids(:), aptr(:), apos(:)
         !> The fronts (after a factorization: L, U and the update of each), the local
         !> pivot rows [n], the row scale factors and their reciprocals [n], a solve's
         !> work vector [n].
@@ -115,6 +121,15 @@ module voiga_solver_supernodal
             import :: c_ptr
             type(c_ptr), value :: handle
         end subroutine voiga_supernodal_free
+
+        pure subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
+            import :: dp
+            character(len=1), intent(in) :: side, uplo, transa, diag
+            integer, intent(in) :: m, n, lda, ldb
+            real(dp), intent(in) :: alpha
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: b(ldb, *)
+        end subroutine dtrsm
 
         pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
             import :: dp
@@ -335,6 +350,7 @@ contains
             end do
             pos(self%rows(self%rptr(par):self%rptr(par + 1) - 1)) = 0
         end do
+        call children(self)
         call entry_positions(self, a, pos, ok)
         if (.not. ok) return
         if (allocated(self%f)) deallocate (self%f)
@@ -343,22 +359,49 @@ contains
         allocate (self%ipiv(a%n), self%scale(a%n), self%rscale(a%n), self%y(a%n))
     end subroutine front_maps
 
+    !> The children of every supernode (cptr, kids; ascending), from the parents.
+    pure subroutine children(self)
+        class(supernodal_lu_t), intent(inout) :: self
+        integer :: s, par
+        integer :: next(self%nsuper)
+        if (allocated(self%cptr)) deallocate (self%cptr, self%kids)
+        allocate (self%cptr(self%nsuper + 1), self%kids(count(self%parent > 0)))
+        next = 0
+        do s = 1, self%nsuper
+            if (self%parent(s) > 0) next(self%parent(s)) = next(self%parent(s)) + 1
+        end do
+        self%cptr(1) = 1
+        do s = 1, self%nsuper
+            self%cptr(s + 1) = self%cptr(s) + next(s)
+        end do
+        next = self%cptr(1:self%nsuper)
+        do s = 1, self%nsuper
+            par = self%parent(s)
+            if (par == 0) cycle
+            self%kids(next(par)) = s
+            next(par) = next(par) + 1
+        end do
+    end subroutine children
+
     !> dest: where each analysed entry of `a` goes in the fronts (entry (i, j), new
-    !> indices pi, pj, belongs to the front of the supernode of min(pi, pj)); `pos`
-    !> is a zero work array [n], left zero.
+    !> indices pi, pj, belongs to the front of the supernode of min(pi, pj)), and
+    !> the entries of each front (aptr, apos); `pos` is a zero work array [n], left zero.
     subroutine entry_positions(self, a, pos, ok)
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         integer, intent(inout) :: pos(:)
         logical, intent(out) :: ok
         integer, allocatable :: iperm(:)
-        integer :: s, c, j, p, i, pi, r, m, f0, base
+        integer :: s, c, j, p, i, pi, r, m, f0, base, q
 
         ok = .false.
+        q = 0
         allocate (iperm(a%n))
         iperm(self%perm) = [(c, c=1, a%n)]
-        if (allocated(self%dest)) deallocate (self%dest)
-        allocate (self%dest(size(a%rowind)), source=0)
+        if (allocated(self%dest)) deallocate (self%dest, self%aptr, self%apos)
+        allocate (self%dest(size(a%rowind)), self%apos(size(a%rowind)), self%aptr(self%nsuper + 1))
+        self%dest = 0
+        self%aptr(1) = 1
         do s = 1, self%nsuper
             f0 = self%super(s)
             m = self%rptr(s + 1) - self%rptr(s)
@@ -380,10 +423,17 @@ contains
                     end if
                     ! F(r, c - f0 + 1) and, above the diagonal, F(c - f0 + 1, r)
                     self%dest(p) = base + (c - f0)*m + r - 1
-                    if (pi /= c) self%dest(self%tpos(p)) = base + (r - 1)*m + c - f0
+                    q = q + 1
+                    self%apos(q) = p
+                    if (pi /= c) then
+                        self%dest(self%tpos(p)) = base + (r - 1)*m + c - f0
+                        q = q + 1
+                        self%apos(q) = self%tpos(p)
+                    end if
                 end do
             end do
             pos(self%rows(self%rptr(s):self%rptr(s + 1) - 1)) = 0
+            self%aptr(s + 1) = q + 1
         end do
         ok = .true.
     end subroutine entry_positions
@@ -395,7 +445,7 @@ contains
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         logical, intent(out) :: ok
-        integer :: s, p, m, k, par
+        integer :: s, p, m, k, t, c, mc, kc
 
         ! UMFPACK's default scaling: each row divided by the sum of its absolute values
         self%scale = 0.0_dp
@@ -404,19 +454,25 @@ contains
         end do
         where (self%scale == 0.0_dp) self%scale = 1.0_dp
         self%rscale = 1.0_dp/self%scale
-        self%f = 0.0_dp
-        do p = 1, size(a%rowind)
-            if (self%dest(p) > 0) self%f(self%dest(p)) = a%values(p)*self%rscale(a%rowind(p) + 1)
-        end do
+        ! front by front (postorder): zero it, write a's entries, add the children's
+        ! updates, eliminate
         do s = 1, self%nsuper
             m = self%rptr(s + 1) - self%rptr(s)
             k = self%super(s + 1) - self%super(s)
+            self%f(self%fptr(s):self%fptr(s + 1) - 1) = 0.0_dp
+            do t = self%aptr(s), self%aptr(s + 1) - 1
+                p = self%apos(t)
+                self%f(self%dest(p)) = a%values(p)*self%rscale(a%rowind(p) + 1)
+            end do
+            do t = self%cptr(s), self%cptr(s + 1) - 1
+                c = self%kids(t)
+                mc = self%rptr(c + 1) - self%rptr(c)
+                kc = self%super(c + 1) - self%super(c)
+                call extend_add(self%f(self%fptr(s):), m, self%f(self%fptr(c):), mc, kc, &
+                                self%rel(self%rptr(c) + kc:))
+            end do
             call partial_factor(self%f(self%fptr(s):), m, k, self%ipiv(self%super(s):), ok)
             if (.not. ok) return
-            par = self%parent(s)
-            if (par == 0) cycle
-            call extend_add(self%f(self%fptr(par):), self%rptr(par + 1) - self%rptr(par), &
-                            self%f(self%fptr(s):), m, k, self%rel(self%rptr(s) + k:))
         end do
     end subroutine numeric
 
@@ -461,14 +517,19 @@ contains
             end do
         end do
         if (m > k) then
-            ! U12 = L11^-1 F12 (its rows swapped with the block's) column by column (BLAS's
-            ! dtrsm costs more than the flops at these sizes), then the Schur complement
-            do c = k + 1, m
-                do j = 1, k - 1
-                    t = fr(j, c)
-                    if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
+            ! U12 = L11^-1 F12 (its rows swapped with the block's): column by column for a
+            ! small block (BLAS's dtrsm costs more than the flops there), then the Schur
+            ! complement
+            if (k >= blas_trsm_from) then
+                call dtrsm('L', 'L', 'N', 'U', k, m - k, 1.0_dp, fr, m, fr(1, k + 1), m)
+            else
+                do c = k + 1, m
+                    do j = 1, k - 1
+                        t = fr(j, c)
+                        if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
+                    end do
                 end do
-            end do
+            end if
             call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
                        fr(k + 1, k + 1), m)
         end if
