@@ -112,12 +112,11 @@ contains
         end associate
     end subroutine nurbs_prepare
 
-    !> Distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).
-    pure real(dp) function box_distance(box, x)
+    !> Squared distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).
+    pure real(dp) function box_distance2(box, x)
         real(dp), intent(in) :: box(4), x(2)
-        box_distance = norm2([max(box(1) - x(1), 0.0_dp, x(1) - box(3)), &
-                              max(box(2) - x(2), 0.0_dp, x(2) - box(4))])
-    end function box_distance
+        box_distance2 = max(box(1) - x(1), 0.0_dp, x(1) - box(3))**2 + max(box(2) - x(2), 0.0_dp, x(2) - box(4))**2
+    end function box_distance2
 
     pure function nurbs_all_dofs(self) result(dofs)
         class(nurbs_master_t), intent(in) :: self
@@ -127,9 +126,9 @@ contains
 
     !> The closest point of the curve to `xs` (see the module comment); `start`,
     !> the last projection of the same slave point, starts the Newton iteration in
-    !> the nearest sample's span when it lies there within half a sample spacing of
-    !> that sample (between Newton iterations of a step it is off by the
-    !> iteration's increment, against a sample spacing of 1/(2p + 2) of a span).
+    !> the nearest sample's span when it lies there within a sample spacing of that
+    !> sample (between Newton iterations of a step it is off by the iteration's
+    !> increment, against a sample spacing of 1/(2p + 2) of a span).
     pure subroutine nurbs_project(self, u, xs, mp, found, converged, start)
         class(nurbs_master_t), intent(in) :: self
         real(dp), intent(in) :: u(:), xs(2)
@@ -149,9 +148,10 @@ contains
             ! 1. nearest sample (2p + 3 points per span), visiting the span whose box
             !    is nearest first and skipping spans whose box is farther than the
             !    nearest sample so far
+            !    (squared distances: the same order without square roots)
             m = n_samples(self)
             do k = 1, nspan
-                lb(k) = box_distance(self%boxes(:, k), xs)
+                lb(k) = box_distance2(self%boxes(:, k), xs)
             end do
             best_d = huge(1.0_dp)
             best = br(1)
@@ -161,7 +161,7 @@ contains
                 k = modulo(k0 - 1 + i, nspan) + 1
                 if (lb(k) >= best_d) cycle
                 do j = 1, m
-                    d = norm2(xs - self%samples(:, j, k))
+                    d = (xs(1) - self%samples(1, j, k))**2 + (xs(2) - self%samples(2, j, k))**2
                     if (d < best_d) then
                         best_d = d
                         best = br(k) + (br(k + 1) - br(k))*real(j - 1, dp)/real(m - 1, dp)
@@ -195,7 +195,7 @@ contains
                 end if
                 xi0 = best
                 if (k == s0 .and. present(start)) then
-                    if (abs(start - best) <= 0.5_dp*(br(k + 1) - br(k))/real(m - 1, dp) .and. &
+                    if (abs(start - best) <= (br(k + 1) - br(k))/real(m - 1, dp) .and. &
                         start >= br(k) .and. start <= br(k + 1)) xi0 = start
                 end if
                 call span_newton(self%surf, u, xs, k, xi0, pts(cur), ok)

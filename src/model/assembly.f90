@@ -10,7 +10,7 @@ module voiga_model_assembly
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element, element_work_t
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
     implicit none
     private
 
@@ -511,6 +511,9 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         integer :: ip
         integer(i8) :: c0, c1, rate
+        ! the positions of the last point's entries (the next point of a slave element
+        ! often projects onto the same master span: the same DOFs)
+        type(position_cache_t) :: cache
 
         call system_clock(c0, rate)
         do ip = 1, size(model%pairs)
@@ -527,7 +530,7 @@ contains
         subroutine add_to_k(dofs, kl)
             integer, intent(in) :: dofs(:)
             real(dp), intent(in) :: kl(:, :)
-            call k%add_element(dofs, kl)
+            call k%add_cached(dofs, kl, cache)
         end subroutine add_to_k
     end subroutine assemble_contact
 
