@@ -13,7 +13,7 @@ module voiga_contact_master_nurbs
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_surface, only: contact_surface_t, new_contact_surface, surface_point_t, &
-                                     surface_point
+                                     surface_point, surface_basis, surface_point_at
     implicit none
     private
 
@@ -35,6 +35,10 @@ module voiga_contact_master_nurbs
         !> control-point boxes [xmin, ymin, xmax, ymax] [4, nspan], and the first and
         !> second derivatives at each span's ends [4 (a, a2), 2 (start, end), nspan].
         real(dp), allocatable :: samples(:, :, :), boxes(:, :), ends(:, :, :)
+        !> The curve's functions at the sample parameters (values, first and second
+        !> derivatives) [p + 1, 3, n_samples, nspan]: they do not depend on the
+        !> configuration, so `prepare` computes them once.
+        real(dp), allocatable :: sample_basis(:, :, :, :)
     contains
         procedure :: project => nurbs_project
         procedure :: all_dofs => nurbs_all_dofs
@@ -84,21 +88,27 @@ contains
         class(nurbs_master_t), intent(inout) :: self
         real(dp), intent(in) :: u(:)
         type(surface_point_t) :: pt
-        real(dp) :: xc(2, self%surf%degree + 1), xi
+        real(dp) :: xc(2, self%surf%degree + 1)
         integer :: nspan, m, k, j, s, p
 
         associate (br => self%surf%breaks, surf => self%surf)
             nspan = size(br) - 1
             m = n_samples(self)
             p = surf%degree
-            if (.not. allocated(self%samples)) &
+            if (.not. allocated(self%samples)) then
                 allocate (self%samples(2, m, nspan), self%boxes(4, nspan), self%ends(4, 2, nspan))
+                allocate (self%sample_basis(p + 1, 3, m, nspan))
+                do k = 1, nspan
+                    do j = 0, m - 1
+                        call surface_basis(surf, sample_xi(k, j), surf%spans(k), self%sample_basis(:, 1, j + 1, k), &
+                                           self%sample_basis(:, 2, j + 1, k), self%sample_basis(:, 3, j + 1, k), s)
+                    end do
+                end do
+            end if
             do k = 1, nspan
                 do j = 0, m - 1
-                    xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
-                    ! the span's end exactly: `project` reuses the evaluations there
-                    if (j == m - 1) xi = br(k + 1)
-                    call surface_point(surf, u, xi, pt, surf%spans(k))
+                    call surface_point_at(surf, u, sample_xi(k, j), surf%spans(k), self%sample_basis(:, 1, j + 1, k), &
+                                          self%sample_basis(:, 2, j + 1, k), self%sample_basis(:, 3, j + 1, k), pt)
                     self%samples(:, j + 1, k) = pt%x
                     if (j == 0) self%ends(:, 1, k) = [pt%a, pt%a2]
                     if (j == m - 1) self%ends(:, 2, k) = [pt%a, pt%a2]
@@ -110,6 +120,16 @@ contains
                 self%boxes(3:4, k) = maxval(xc, dim=2)
             end do
         end associate
+    contains
+        !> Sample j (0 .. m - 1) of span k; the last one is the span's end exactly
+        !> (`project` reuses the evaluations there).
+        pure real(dp) function sample_xi(k, j) result(xi)
+            integer, intent(in) :: k, j
+            associate (br => self%surf%breaks)
+                xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
+                if (j == m - 1) xi = br(k + 1)
+            end associate
+        end function sample_xi
     end subroutine nurbs_prepare
 
     !> Squared distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).

@@ -66,17 +66,18 @@ contains
     !> g = dN/dx = F^-T dN/dX. The four 2 x 2 blocks of K, by displacement component
     !> (i, k), are K^ik_ab = sum_q g_a^T M^ik_q g_b with M^ik_q the 2 x 2 matrix of the
     !> Voigt tangent D = w c that couples the components (i, j) and (k, l) (the
-    !> geometric part adds w tau to M^xx and M^yy): all four are one product G R^T,
-    !> G [nen, 2 npts] the stacked gradients and R [4 nen, 2 npts] the stacked G M^T
-    !> (half the flops of B^T D B, whose B is half zeros, plus G^T T G). `ok` is false
-    !> if J <= 0 at a point.
+    !> geometric part adds w tau to M^xx and M^yy): all are one product G R^T, G
+    !> [nen, 2 npts] the stacked gradients and R [4 nen, 2 npts] the stacked G M^T
+    !> (half the flops of B^T D B, whose B is half zeros, plus G^T T G); three of the
+    !> four blocks when D is symmetric at every point (then K^yx = (K^xy)^T). `ok` is
+    !> false if J <= 0 at a point.
     pure subroutine solid_element(mat, pts, u, fe, ke, ok, work)
         class(material_t), intent(in) :: mat
         type(element_points_t), intent(in) :: pts
         real(dp), intent(in) :: u(:, :)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        !> G, R and the blocks [K^xx K^xy K^yx K^yy] (allocated here when absent).
+        !> G, R and the blocks [K^xx K^xy K^yy K^yx] (allocated here when absent).
         type(element_work_t), intent(inout), optional :: work
         type(element_work_t) :: own
         if (present(work)) then
@@ -113,34 +114,51 @@ contains
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
         type(element_work_t), intent(inout) :: wk
-        integer :: nen, np, ld, a, b
+        integer :: nen, np, ld, a, b, nb
+        logical :: sym
 
         nen = size(u, 2)
         np = size(pts%wdv)
         ld = size(wk%gt, 1)
-        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, wk%gt, ld, wk%rt, size(wk%rt, 1))
+        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, sym, wk%gt, ld, wk%rt, size(wk%rt, 1))
         if (.not. ok) return
-        ! [K^xx K^xy K^yx K^yy] = G R^T
-        call dgemm('N', 'T', nen, 4*nen, 2*np, 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, wk%k4, ld)
+        ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
+        ! symmetry at every point (hyperelastic and linear laws)
+        nb = merge(3, 4, sym)
+        call dgemm('N', 'T', nen, nb*nen, 2*np, 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, wk%k4, ld)
         do b = 1, nen
             do a = 1, nen
                 ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
                 ke(2*a - 1, 2*b) = wk%k4(a, nen + b)
-                ke(2*a, 2*b - 1) = wk%k4(a, 2*nen + b)
-                ke(2*a, 2*b) = wk%k4(a, 3*nen + b)
+                ke(2*a, 2*b) = wk%k4(a, 2*nen + b)
             end do
         end do
+        if (sym) then
+            do b = 1, nen
+                do a = 1, nen
+                    ke(2*a, 2*b - 1) = wk%k4(b, nen + a)
+                end do
+            end do
+        else
+            do b = 1, nen
+                do a = 1, nen
+                    ke(2*a, 2*b - 1) = wk%k4(a, 3*nen + b)
+                end do
+            end do
+        end if
     end subroutine element_kernel
 
     !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
     !> of G and R of every point (explicit shapes, so that the loops over the
     !> functions are plain vector loops).
-    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, gt, ld, rt, ldr)
+    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, sym, gt, ld, rt, ldr)
         class(material_t), intent(in) :: mat
         integer, intent(in) :: nen, np, ld, ldr
         real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
         real(dp), intent(out) :: fe(2, nen)
         logical, intent(out) :: ok
+        !> The Voigt tangent was symmetric at every point (M^yx = (M^xy)^T).
+        logical, intent(out) :: sym
         real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
         real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
         real(dp) :: m(2, 2, 4), w
@@ -149,6 +167,7 @@ contains
 
         fe = 0.0_dp
         ok = .true.
+        sym = .true.
         do q = 1, np
             w = wdv(q)
             c1 = 2*q - 1
@@ -186,7 +205,8 @@ contains
                 end do
             end do
             sv = w*[s(1, 1), s(2, 2), s(1, 2)]
-            ! M^xx, M^xy, M^yx, M^yy (rows: the gradient component of g_a, columns: of g_b)
+            sym = sym .and. d(1, 2) == d(2, 1) .and. d(1, 3) == d(3, 1) .and. d(2, 3) == d(3, 2)
+            ! M^xx, M^xy, M^yy, M^yx (rows: the gradient component of g_a, columns: of g_b)
             call coupling(d, ts, m)
             do blk = 1, 4
                 off = (blk - 1)*nen
@@ -203,7 +223,7 @@ contains
         end do
     end subroutine point_columns
 
-    !> The 2 x 2 matrices M^xx, M^xy, M^yx, M^yy of `solid_element` from the Voigt
+    !> The 2 x 2 matrices M^xx, M^xy, M^yy, M^yx of `solid_element` from the Voigt
     !> tangent `d` and the geometric part `ts` (rows: the gradient component of g_a,
     !> columns: of g_b).
     pure subroutine coupling(d, ts, m)
@@ -217,14 +237,14 @@ contains
         m(2, 1, 2) = d(3, 3)
         m(1, 2, 2) = d(1, 2)
         m(2, 2, 2) = d(3, 2)
-        m(1, 1, 3) = d(3, 1)
-        m(2, 1, 3) = d(2, 1)
-        m(1, 2, 3) = d(3, 3)
-        m(2, 2, 3) = d(2, 3)
-        m(1, 1, 4) = d(3, 3) + ts(1, 1)
-        m(2, 1, 4) = d(2, 3) + ts(2, 1)
-        m(1, 2, 4) = d(3, 2) + ts(1, 2)
-        m(2, 2, 4) = d(2, 2) + ts(2, 2)
+        m(1, 1, 3) = d(3, 3) + ts(1, 1)
+        m(2, 1, 3) = d(2, 3) + ts(2, 1)
+        m(1, 2, 3) = d(3, 2) + ts(1, 2)
+        m(2, 2, 3) = d(2, 2) + ts(2, 2)
+        m(1, 1, 4) = d(3, 1)
+        m(2, 1, 4) = d(2, 1)
+        m(1, 2, 4) = d(3, 3)
+        m(2, 2, 4) = d(2, 3)
     end subroutine coupling
 
 end module voiga_element_solid
