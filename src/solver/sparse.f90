@@ -521,12 +521,17 @@ contains
         integer :: i, j, k
 
         do j = 1, self%n
-            do k = self%colptr(j) + 1, self%colptr(j + 1)
-                i = self%rowind(k) + 1
-                if (fixed(i) .or. fixed(j)) then
-                    self%values(k) = merge(1.0_c_double, 0.0_c_double, i == j)
-                end if
-            end do
+            if (fixed(j)) then
+                ! the whole column
+                do k = self%colptr(j) + 1, self%colptr(j + 1)
+                    self%values(k) = merge(1.0_c_double, 0.0_c_double, self%rowind(k) + 1 == j)
+                end do
+            else
+                do k = self%colptr(j) + 1, self%colptr(j + 1)
+                    i = self%rowind(k) + 1
+                    if (fixed(i)) self%values(k) = 0.0_c_double
+                end do
+            end if
         end do
     end subroutine csc_fix_dofs
 
