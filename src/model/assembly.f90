@@ -198,10 +198,11 @@ contains
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
     !> When a contact point falls outside the stiffness pattern, the pattern (and
-    !> `map`) is rebuilt and the contact part evaluated again. With `k` and `map`
-    !> and a deformable master, the bulk part (elements and external forces) is kept
-    !> from before the contact part and carried into the new pattern instead of being
-    !> assembled again (the same numbers: the bulk part does not depend on the pattern).
+    !> `map`) is rebuilt and the contact part evaluated again. With `k` and `map`,
+    !> a deformable master and `refit`, the bulk part (elements and external forces)
+    !> is kept from before the contact part and carried into the new pattern instead
+    !> of being assembled again (the same numbers: the bulk part does not depend on
+    !> the pattern); a rebuild at another assembly assembles it again.
     subroutine assemble(model, u, t, r, stats, error, k, map, refit)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
@@ -225,8 +226,11 @@ contains
         call move_obstacles(model, t)
         fit = .false.
         if (present(refit)) fit = refit .and. present(k)
+        ! the bulk part is kept for a rebuild at a substep's first assembly, where the
+        ! refit makes one likely; elsewhere (a point projecting outside its range: rare)
+        ! it is assembled again (the same numbers), not copied at every assembly
         keep = .false.
-        if (present(k) .and. present(map)) &
+        if (present(k) .and. present(map) .and. fit) &
             keep = any([(model%pairs(ip)%pair%master%deformable, ip=1, size(model%pairs))])
         call assemble_bulk(model, u, t, r, stats, error, k, map)
         if (allocated(error)) return
