@@ -87,8 +87,8 @@ module voiga_solver_supernodal
         integer, allocatable, private :: cptr(:), kids(:), aptr(:), apos(:)
         !> The fronts (after a factorization: L, U and the update of each), the local
         !> pivot rows [n], the row scale factors and their reciprocals [n], a solve's
-        !> work vector [n].
-        real(dp), allocatable, private :: f(:), scale(:), rscale(:), y(:)
+        !> work vectors [n].
+        real(dp), allocatable, private :: f(:), scale(:), rscale(:), y(:), w(:)
         integer, allocatable, private :: ipiv(:)
         integer, private :: det_sign = 0
         real(dp), private :: det_log10 = 0.0_dp
@@ -355,8 +355,8 @@ contains
         if (.not. ok) return
         if (allocated(self%f)) deallocate (self%f)
         allocate (self%f(self%fptr(self%nsuper + 1) - 1))
-        if (allocated(self%ipiv)) deallocate (self%ipiv, self%scale, self%rscale, self%y)
-        allocate (self%ipiv(a%n), self%scale(a%n), self%rscale(a%n), self%y(a%n))
+        if (allocated(self%ipiv)) deallocate (self%ipiv, self%scale, self%rscale, self%y, self%w)
+        allocate (self%ipiv(a%n), self%scale(a%n), self%rscale(a%n), self%y(a%n), self%w(a%n))
     end subroutine front_maps
 
     !> The children of every supernode (cptr, kids; ascending), from the parents.
@@ -616,20 +616,22 @@ contains
         end do
         do s = 1, self%nsuper
             call forward(self%f(self%fptr(s):), self%rptr(s + 1) - self%rptr(s), self%super(s + 1) - self%super(s), &
-                         self%rows(self%rptr(s):), self%ipiv(self%super(s):), self%y)
+                         self%rows(self%rptr(s):), self%ipiv(self%super(s):), self%y, self%w)
         end do
         do s = self%nsuper, 1, -1
             call backward(self%f(self%fptr(s):), self%rptr(s + 1) - self%rptr(s), self%super(s + 1) - self%super(s), &
-                          self%rows(self%rptr(s):), self%y)
+                          self%rows(self%rptr(s):), self%y, self%w)
         end do
         x(self%perm) = self%y
     end subroutine apply_inverse
 
-    !> One supernode of the forward substitution: its row swaps, then L's columns.
-    pure subroutine forward(fr, m, k, rows, piv, y)
+    !> One supernode of the forward substitution: its row swaps, L's diagonal block,
+    !> then its rows below the block, summed in `w` [m - k] and scattered once.
+    pure subroutine forward(fr, m, k, rows, piv, y, w)
         integer, intent(in) :: m, k, rows(m), piv(k)
         real(dp), intent(in) :: fr(m, m)
         real(dp), intent(inout) :: y(:)
+        real(dp), intent(out) :: w(:)
         real(dp) :: t
         integer :: j, i, f0
         f0 = rows(1)
@@ -640,28 +642,53 @@ contains
                 y(f0 + piv(j) - 1) = t
             end if
         end do
+        do j = 1, k - 1
+            t = y(f0 + j - 1)
+            if (t == 0.0_dp) cycle
+            do i = j + 1, k
+                y(f0 + i - 1) = y(f0 + i - 1) - fr(i, j)*t
+            end do
+        end do
+        if (m == k) return
+        w(1:m - k) = 0.0_dp
         do j = 1, k
             t = y(f0 + j - 1)
             if (t == 0.0_dp) cycle
-            do i = j + 1, m
-                y(rows(i)) = y(rows(i)) - fr(i, j)*t
+            do i = k + 1, m
+                w(i - k) = w(i - k) + fr(i, j)*t
             end do
+        end do
+        do i = k + 1, m
+            y(rows(i)) = y(rows(i)) - w(i - k)
         end do
     end subroutine forward
 
-    !> One supernode of the backward substitution: U's rows, last first.
-    pure subroutine backward(fr, m, k, rows, y)
+    !> One supernode of the backward substitution: the rows of U right of the
+    !> diagonal block against the solution gathered in `w` [m - k], then the block.
+    pure subroutine backward(fr, m, k, rows, y, w)
         integer, intent(in) :: m, k, rows(m)
         real(dp), intent(in) :: fr(m, m)
         real(dp), intent(inout) :: y(:)
+        real(dp), intent(out) :: w(:)
         real(dp) :: t
-        integer :: j, c
-        do j = k, 1, -1
-            t = y(rows(j))
-            do c = j + 1, m
-                t = t - fr(j, c)*y(rows(c))
+        integer :: j, c, f0
+        f0 = rows(1)
+        do c = k + 1, m
+            w(c - k) = y(rows(c))
+        end do
+        do c = k + 1, m
+            t = w(c - k)
+            if (t == 0.0_dp) cycle
+            do j = 1, k
+                y(f0 + j - 1) = y(f0 + j - 1) - fr(j, c)*t
             end do
-            y(rows(j)) = t/fr(j, j)
+        end do
+        do j = k, 1, -1
+            t = y(f0 + j - 1)
+            do c = j + 1, k
+                t = t - fr(j, c)*y(f0 + c - 1)
+            end do
+            y(f0 + j - 1) = t/fr(j, j)
         end do
     end subroutine backward
 
