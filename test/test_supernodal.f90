@@ -151,38 +151,46 @@ contains
         call check(error, lu%rcond > 0.0_dp .and. lu%rcond <= 1.0_dp, 'rcond in (0, 1]')
     end subroutine test_matches_umfpack
 
-    !> A dense 6 x 6 matrix (one supernode) with a zero diagonal: every pivot comes
-    !> from another row of the block, and the sign of det follows the row swaps.
+    !> Dense matrices (one supernode each) with a zero diagonal: every pivot comes
+    !> from another row of the block, and the sign of det follows the row swaps; 6
+    !> columns (the loops) and 30 (LAPACK's dgetrf and BLAS 3, from 24 columns).
     subroutine test_block_pivots(error)
         type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: sizes(2) = [6, 30]
         type(csc_matrix_t) :: a
         type(supernodal_lu_t) :: lu
         type(umfpack_t) :: umf
         type(lcg_t) :: rng
-        real(dp) :: ke(6, 6)
-        integer :: i, j, sign_sn, sign_umf
+        real(dp), allocatable :: ke(:, :)
+        integer :: i, j, n, t, sign_sn, sign_umf
         real(dp) :: log_sn, log_umf
 
-        call new_csc_pattern(a, 6, [1, 7], [1, 2, 3, 4, 5, 6], error)
-        if (allocated(error)) return
-        do j = 1, 6
-            do i = 1, 6
-                ke(i, j) = 1.0_dp + rng%uniform()
+        do t = 1, size(sizes)
+            n = sizes(t)
+            call new_csc_pattern(a, n, [1, n + 1], [(i, i=1, n)], error)
+            if (allocated(error)) return
+            allocate (ke(n, n))
+            do j = 1, n
+                do i = 1, n
+                    ke(i, j) = 1.0_dp + rng%uniform()
+                end do
+                ke(j, j) = 0.0_dp
             end do
-            ke(j, j) = 0.0_dp
+            call a%add_element([(i, i=1, n)], ke)
+            deallocate (ke)
+            call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'dense, zero diagonal', error)
+            if (allocated(error)) return
+            call check(error, lu%n_fallback, 0, 'pivoted inside the supernode')
+            if (allocated(error)) return
+            call lu%determinant(sign_sn, log_sn, error)
+            if (allocated(error)) return
+            call umf%determinant(sign_umf, log_umf, error)
+            if (allocated(error)) return
+            call check(error, sign_sn, sign_umf, 'sign of det')
+            if (allocated(error)) return
+            call check(error, log_sn, log_umf, 'log10 |det|', rel=1.0e-10_dp)
+            if (allocated(error)) return
         end do
-        call a%add_element([1, 2, 3, 4, 5, 6], ke)
-        call compare_solves(lu, umf, a, rng, 1.0e-12_dp, 'dense, zero diagonal', error)
-        if (allocated(error)) return
-        call check(error, lu%n_fallback, 0, 'pivoted inside the supernode')
-        if (allocated(error)) return
-        call lu%determinant(sign_sn, log_sn, error)
-        if (allocated(error)) return
-        call umf%determinant(sign_umf, log_umf, error)
-        if (allocated(error)) return
-        call check(error, sign_sn, sign_umf, 'sign of det')
-        if (allocated(error)) return
-        call check(error, log_sn, log_umf, 'log10 |det|', rel=1.0e-10_dp)
     end subroutine test_block_pivots
 
     !> Entries of the pattern that are zero are left out of the analysis. A nonzero

@@ -52,8 +52,9 @@ module voiga_solver_supernodal
     integer, parameter :: max_refine = 2
     !> Most reals all fronts together may hold (128 MiB); larger systems keep UMFPACK.
     integer(i8), parameter :: max_front_storage = 16777216_i8
-    !> Supernodes of at least this many columns form their U rows with BLAS's dtrsm.
-    integer, parameter :: blas_trsm_from = 24
+    !> Supernodes of at least this many columns are factorized with LAPACK and BLAS 3
+    !> (`blocked_factor`); smaller ones by loops, cheaper than the calls there.
+    integer, parameter :: blas_from = 24
 
     !> Supernodal LU with pivots inside supernodes and UMFPACK as its fallback.
     type, extends(linear_solver_t) :: supernodal_lu_t
@@ -121,6 +122,20 @@ module voiga_solver_supernodal
             import :: c_ptr
             type(c_ptr), value :: handle
         end subroutine voiga_supernodal_free
+
+        pure subroutine dgetrf(m, n, a, lda, ipiv, info)
+            import :: dp
+            integer, intent(in) :: m, n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetrf
+
+        pure subroutine dlaswp(n, a, lda, k1, k2, ipiv, incx)
+            import :: dp
+            integer, intent(in) :: n, lda, k1, k2, incx
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(in) :: ipiv(*)
+        end subroutine dlaswp
 
         pure subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
             import :: dp
@@ -487,6 +502,10 @@ contains
         real(dp) :: big, d, t
         integer :: j, i, c, p
 
+        if (k >= blas_from) then
+            call blocked_factor(fr, m, k, piv, ok)
+            return
+        end if
         ok = .false.
         do j = 1, k
             p = j
@@ -517,24 +536,44 @@ contains
             end do
         end do
         if (m > k) then
-            ! U12 = L11^-1 F12 (its rows swapped with the block's): column by column for a
-            ! small block (BLAS's dtrsm costs more than the flops there), then the Schur
-            ! complement
-            if (k >= blas_trsm_from) then
-                call dtrsm('L', 'L', 'N', 'U', k, m - k, 1.0_dp, fr, m, fr(1, k + 1), m)
-            else
-                do c = k + 1, m
-                    do j = 1, k - 1
-                        t = fr(j, c)
-                        if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
-                    end do
+            ! U12 = L11^-1 F12 (its rows swapped with the block's) column by column (BLAS's
+            ! dtrsm costs more than the flops at these sizes), then the Schur complement
+            do c = k + 1, m
+                do j = 1, k - 1
+                    t = fr(j, c)
+                    if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
                 end do
-            end if
+            end do
             call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
                        fr(k + 1, k + 1), m)
         end if
         ok = .true.
     end subroutine partial_factor
+
+    !> `partial_factor` of a supernode of `blas_from` columns or more, with LAPACK
+    !> and BLAS 3: the diagonal block by dgetrf (partial pivoting inside it), its row
+    !> swaps applied to U's part, L21 = F21 U11^-1 and U12 = L11^-1 F12 by dtrsm, the
+    !> Schur complement by dgemm; `ok` false for a zero pivot or a multiplier of L21
+    !> above `max_multiplier`.
+    subroutine blocked_factor(fr, m, k, piv, ok)
+        integer, intent(in) :: m, k
+        real(dp), intent(inout) :: fr(m, m)
+        integer, intent(out) :: piv(k)
+        logical, intent(out) :: ok
+        integer :: info
+        ok = .false.
+        call dgetrf(k, k, fr, m, piv, info)
+        if (info /= 0) return
+        if (m > k) then
+            call dlaswp(m - k, fr(1, k + 1), m, 1, k, piv, 1)
+            call dtrsm('R', 'U', 'N', 'N', m - k, k, 1.0_dp, fr, m, fr(k + 1, 1), m)
+            if (maxval(abs(fr(k + 1:m, 1:k))) > max_multiplier) return
+            call dtrsm('L', 'L', 'N', 'U', k, m - k, 1.0_dp, fr, m, fr(1, k + 1), m)
+            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
+                       fr(k + 1, k + 1), m)
+        end if
+        ok = .true.
+    end subroutine blocked_factor
 
     !> Add the update (rows and columns k+1..m) of a child's front `fc` [m, m] into
     !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k].
