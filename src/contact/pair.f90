@@ -120,6 +120,10 @@ module voiga_contact_pair
         !> stiffness not added: the pattern must be rebuilt and the tangent
         !> assembled again).
         logical :: pattern_miss = .false.
+        !> The projections of the last evaluation may start this one's (set by the
+        !> assembly after an evaluation, cleared at a substep's first: a restarted run
+        !> then projects as the uninterrupted one).
+        logical :: warm = .false.
     contains
         !> Residual and (with `add`) tangent at a displacement; updates the trial history.
         procedure(evaluate_interface), deferred :: evaluate
@@ -410,7 +414,11 @@ contains
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
-            call self%master%project(u, sp%x, mp, found, converged, out%xi_m)
+            if (self%warm) then
+                call self%master%project(u, sp%x, mp, found, converged, out%xi_m)
+            else
+                call self%master%project(u, sp%x, mp, found, converged)
+            end if
             out%xi_m = mp%xi
             out%first = mp%first
             out%last = mp%last

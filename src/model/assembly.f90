@@ -238,8 +238,17 @@ contains
             r_bulk = r
             k_bulk = k%values
         end if
+        ! a substep's first evaluation projects without the last projections as starts
+        if (fit) then
+            do ip = 1, size(model%pairs)
+                model%pairs(ip)%pair%warm = .false.
+            end do
+        end if
         do pass = 1, 3
             call assemble_contact(model, u, r, stats, error, k)
+            do ip = 1, size(model%pairs)
+                model%pairs(ip)%pair%warm = .true.
+            end do
             if (allocated(error) .or. .not. present(k)) return
             if (fit) then
                 fit = .false.
