@@ -18,6 +18,7 @@ program voiga_tests
     use test_fields, only: collect_fields
     use test_files, only: collect_files
     use test_bulk_update, only: collect_bulk_update
+    use test_supernodal, only: collect_supernodal
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -38,7 +39,8 @@ program voiga_tests
              new_testsuite('rigid', collect_rigid), &
              new_testsuite('fields', collect_fields), &
              new_testsuite('files', collect_files), &
-             new_testsuite('bulk_update', collect_bulk_update) &
+             new_testsuite('bulk_update', collect_bulk_update), &
+             new_testsuite('supernodal', collect_supernodal) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -14,6 +14,7 @@ module voiga_contact_gpts
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_contact_surface, only: surface_point_t
+    use voiga_nurbs_basis, only: max_fixed_degree
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive, state_stick, state_slip
     use voiga_contact_kinematics, only: point_operators
@@ -32,6 +33,9 @@ module voiga_contact_gpts
     !> between the zone and a lone point at its edge, 8 %.
     integer, parameter :: min_gaps = 2
     real(dp), parameter :: min_hole_share = 0.2_dp
+    !> Local DOFs of a point whose operators fit `gpts_point`'s fixed buffers: a
+    !> slave and a master function set of degree up to `max_fixed_degree` each.
+    integer, parameter :: max_nd = 4*(max_fixed_degree + 1)
 
     !> A GPTS pair.
     type, extends(contact_pair_t) :: gpts_pair_t
@@ -85,10 +89,11 @@ contains
         real(dp), allocatable :: rl(:), kl(:, :)
         integer, allocatable :: dofs(:)
         real(dp) :: g, pn, pt, anchor, new_anchor
-        integer :: k, state, nd
+        integer :: k, state, nd, j
         logical :: found, converged, inside
 
         self%force = 0.0_dp
+        allocate (dofs(0))
         call self%master%prepare(u)
         do k = 1, size(self%xi)
             call self%project_point(u, k, sp, mp, found, converged)
@@ -122,8 +127,15 @@ contains
                 call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
             end if
             self%n_evaluations = self%n_evaluations + 1
-            dofs = [sp%dofs, mp%dofs]
-            r(dofs) = r(dofs) + rl
+            if (size(dofs) /= nd) then
+                deallocate (dofs)
+                allocate (dofs(nd))
+            end if
+            dofs(1:size(sp%dofs)) = sp%dofs
+            dofs(size(sp%dofs) + 1:nd) = mp%dofs
+            do j = 1, nd
+                r(dofs(j)) = r(dofs(j)) + rl(j)
+            end do
             ! partition of unity: the slave part sums to -da t
             self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
             self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
@@ -333,10 +345,41 @@ contains
         real(dp), intent(out) :: new_anchor
         !> Prescribed slip bound (traction, >= 0): Tresca mode.
         real(dp), intent(in), optional :: bound
-        real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r)), tmat(2, size(r))
-        real(dp) :: c(size(r)), ng(size(r)), na(size(r)), gt(size(r)), dmt(size(r)), dst(size(r))
+        ! the operators of a point with up to `max_nd` local DOFs in fixed (stack)
+        ! buffers: gfortran puts automatic arrays on the heap, eleven per point
+        real(dp) :: ops(2, max_nd, 5), vecs(max_nd, 6)
+        real(dp), allocatable :: big_ops(:, :, :), big_vecs(:, :)
+        integer :: nd
+        nd = size(r)
+        if (nd <= max_nd) then
+            call point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, ops(:, 1:nd, 1), &
+                           ops(:, 1:nd, 2), ops(:, 1:nd, 3), ops(:, 1:nd, 4), ops(:, 1:nd, 5), vecs(1:nd, 1), &
+                           vecs(1:nd, 2), vecs(1:nd, 3), vecs(1:nd, 4), vecs(1:nd, 5), vecs(1:nd, 6), bound)
+        else
+            allocate (big_ops(2, nd, 5), big_vecs(nd, 6))
+            call point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, big_ops(:, :, 1), &
+                           big_ops(:, :, 2), big_ops(:, :, 3), big_ops(:, :, 4), big_ops(:, :, 5), big_vecs(:, 1), &
+                           big_vecs(:, 2), big_vecs(:, 3), big_vecs(:, 4), big_vecs(:, 5), big_vecs(:, 6), bound)
+        end if
+    end subroutine gpts_point
+
+    !> `gpts_point` on its work arrays [2, nd] and [nd].
+    pure subroutine point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, gm, dm, ds, amat, tmat, &
+                              c, ng, na, gt, dmt, dst, bound)
+        type(contact_law_t), intent(in) :: law
+        real(dp), intent(in) :: w
+        type(surface_point_t), intent(in) :: sp
+        type(master_point_t), intent(in) :: mp
+        real(dp), intent(in) :: anchor
+        real(dp), intent(out) :: r(:), k(:, :)
+        integer, intent(out) :: state
+        real(dp), intent(out) :: g, pn, pt
+        real(dp), intent(out) :: new_anchor
+        real(dp), intent(out) :: gm(:, :), dm(:, :), ds(:, :), amat(:, :), tmat(:, :)
+        real(dp), intent(out) :: c(:), ng(:), na(:), gt(:), dmt(:), dst(:)
+        real(dp), intent(in), optional :: bound
         real(dp) :: n(2), that(2), ts(2), t(2), la, las, den, da, slip, ttr, s
-        integer :: a
+        integer :: a, b
 
         call point_operators(sp, mp, gm, dm, ds)
         n = mp%n
@@ -349,12 +392,16 @@ contains
         pn = -law%eps_n*g
         ! linearization of the projection: dxi = c . du
         den = dot_product(mp%a, mp%a) - g*dot_product(n, mp%a2)
-        c = (matmul(mp%a, gm) + g*matmul(n, dm))/den
+        do a = 1, size(r)
+            c(a) = ((mp%a(1)*gm(1, a) + mp%a(2)*gm(2, a)) + g*(n(1)*dm(1, a) + n(2)*dm(2, a)))/den
+        end do
         ! total change of the master tangent: A = Dm + a2 (x) c
         amat(1, :) = dm(1, :) + mp%a2(1)*c
         amat(2, :) = dm(2, :) + mp%a2(2)*c
-        ng = matmul(n, gm)          ! d g
-        na = matmul(n, amat)/la     ! n . dA / |a|: dn = -t_hat na, dt_hat = n na
+        do a = 1, size(r)
+            ng(a) = n(1)*gm(1, a) + n(2)*gm(2, a)                ! d g
+            na(a) = (n(1)*amat(1, a) + n(2)*amat(2, a))/la     ! n . dA / |a|: dn = -t_hat na, dt_hat = n na
+        end do
 
         ! normal traction and its derivative
         t = pn*n
@@ -403,13 +450,17 @@ contains
             end if
         end if
 
-        gt = matmul(t, gm)          ! G^T t
-        dmt = matmul(t, dm)         ! Dm^T t
-        dst = matmul(ts, ds)        ! t_s . Ds
+        do a = 1, size(r)
+            gt(a) = t(1)*gm(1, a) + t(2)*gm(2, a)      ! G^T t
+            dmt(a) = t(1)*dm(1, a) + t(2)*dm(2, a)     ! Dm^T t
+            dst(a) = ts(1)*ds(1, a) + ts(2)*ds(2, a)   ! t_s . Ds
+        end do
         r = -da*gt
         do a = 1, size(r)
             ! K = -da G^T T + da (Dm^T t) c^T - w (G^T t)(t_s^T Ds)
-            k(:, a) = -da*matmul(transpose(gm), tmat(:, a)) + da*dmt*c(a) - w*gt*dst(a)
+            do b = 1, size(r)
+                k(b, a) = -da*(gm(1, b)*tmat(1, a) + gm(2, b)*tmat(2, a)) + da*dmt(b)*c(a) - w*gt(b)*dst(a)
+            end do
         end do
-    end subroutine gpts_point
+    end subroutine point_law
 end module voiga_contact_gpts

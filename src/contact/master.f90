@@ -41,7 +41,7 @@ module voiga_contact_master
         !> Closest point on the master to `xs` in the configuration `u`; `found` is
         !> false when the orthogonal projection falls beyond the master's ends.
         !> `prepare(u)` must have been called with the same `u` first.
-        pure subroutine project_interface(self, u, xs, mp, found, converged)
+        pure subroutine project_interface(self, u, xs, mp, found, converged, start)
             import :: contact_master_t, master_point_t, dp
             class(contact_master_t), intent(in) :: self
             real(dp), intent(in) :: u(:), xs(2)
@@ -49,6 +49,9 @@ module voiga_contact_master
             logical, intent(out) :: found
             !> False if the local Newton iteration did not converge.
             logical, intent(out) :: converged
+            !> Where the same slave point projected at the last evaluation: a start
+            !> for the local iteration (its result does not depend on it but by rounding).
+            real(dp), intent(in), optional :: start
         end subroutine project_interface
     end interface
 

@@ -62,13 +62,14 @@ contains
 
     !> The deformable master's projection on the curve where it is now, without
     !> master functions (no DOFs to couple).
-    pure subroutine curve_project(self, u, xs, mp, found, converged)
+    pure subroutine curve_project(self, u, xs, mp, found, converged, start)
         class(rigid_curve_t), intent(in) :: self
         real(dp), intent(in) :: u(:), xs(2)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
+        real(dp), intent(in), optional :: start
         if (size(u) < 0) return   ! the curve has no DOFs in u
-        call nurbs_project(self, self%zero, xs, mp, found, converged)
+        call nurbs_project(self, self%zero, xs, mp, found, converged, start)
         deallocate (mp%r, mp%dr, mp%dofs)
         allocate (mp%r(0), mp%dr(0), mp%dofs(0))
         mp%first = 1

@@ -13,7 +13,7 @@ module voiga_contact_master_nurbs
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_surface, only: contact_surface_t, new_contact_surface, surface_point_t, &
-                                     surface_point
+                                     surface_point, surface_basis, surface_point_at
     implicit none
     private
 
@@ -31,9 +31,14 @@ module voiga_contact_master_nurbs
         !> Outward normal = sign * (a_y, -a_x)/|a|, fixed by the patch orientation.
         real(dp) :: sign = 1.0_dp
         !> Search structure of the configuration of the last `prepare`: sample
-        !> points [2, n_samples, nspan] and control-point boxes [xmin, ymin, xmax,
-        !> ymax] [4, nspan].
-        real(dp), allocatable :: samples(:, :, :), boxes(:, :)
+        !> points [2, n_samples, nspan] (the first and last at the span's ends),
+        !> control-point boxes [xmin, ymin, xmax, ymax] [4, nspan], and the first and
+        !> second derivatives at each span's ends [4 (a, a2), 2 (start, end), nspan].
+        real(dp), allocatable :: samples(:, :, :), boxes(:, :), ends(:, :, :)
+        !> The curve's functions at the sample parameters (values, first and second
+        !> derivatives) [p + 1, 3, n_samples, nspan]: they do not depend on the
+        !> configuration, so `prepare` computes them once.
+        real(dp), allocatable :: sample_basis(:, :, :, :)
     contains
         procedure :: project => nurbs_project
         procedure :: all_dofs => nurbs_all_dofs
@@ -83,19 +88,30 @@ contains
         class(nurbs_master_t), intent(inout) :: self
         real(dp), intent(in) :: u(:)
         type(surface_point_t) :: pt
-        real(dp) :: xc(2, self%surf%degree + 1), xi
+        real(dp) :: xc(2, self%surf%degree + 1)
         integer :: nspan, m, k, j, s, p
 
         associate (br => self%surf%breaks, surf => self%surf)
             nspan = size(br) - 1
             m = n_samples(self)
             p = surf%degree
-            if (.not. allocated(self%samples)) allocate (self%samples(2, m, nspan), self%boxes(4, nspan))
+            if (.not. allocated(self%samples)) then
+                allocate (self%samples(2, m, nspan), self%boxes(4, nspan), self%ends(4, 2, nspan))
+                allocate (self%sample_basis(p + 1, 3, m, nspan))
+                do k = 1, nspan
+                    do j = 0, m - 1
+                        call surface_basis(surf, sample_xi(k, j), surf%spans(k), self%sample_basis(:, 1, j + 1, k), &
+                                           self%sample_basis(:, 2, j + 1, k), self%sample_basis(:, 3, j + 1, k), s)
+                    end do
+                end do
+            end if
             do k = 1, nspan
                 do j = 0, m - 1
-                    xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
-                    call surface_point(surf, u, xi, pt, surf%spans(k))
+                    call surface_point_at(surf, u, sample_xi(k, j), surf%spans(k), self%sample_basis(:, 1, j + 1, k), &
+                                          self%sample_basis(:, 2, j + 1, k), self%sample_basis(:, 3, j + 1, k), pt)
                     self%samples(:, j + 1, k) = pt%x
+                    if (j == 0) self%ends(:, 1, k) = [pt%a, pt%a2]
+                    if (j == m - 1) self%ends(:, 2, k) = [pt%a, pt%a2]
                 end do
                 s = surf%spans(k)
                 xc(1, :) = surf%x0(1, s - p:s) + u(surf%dofs(1, s - p:s))
@@ -104,14 +120,23 @@ contains
                 self%boxes(3:4, k) = maxval(xc, dim=2)
             end do
         end associate
+    contains
+        !> Sample j (0 .. m - 1) of span k; the last one is the span's end exactly
+        !> (`project` reuses the evaluations there).
+        pure real(dp) function sample_xi(k, j) result(xi)
+            integer, intent(in) :: k, j
+            associate (br => self%surf%breaks)
+                xi = br(k) + (br(k + 1) - br(k))*real(j, dp)/real(m - 1, dp)
+                if (j == m - 1) xi = br(k + 1)
+            end associate
+        end function sample_xi
     end subroutine nurbs_prepare
 
-    !> Distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).
-    pure real(dp) function box_distance(box, x)
+    !> Squared distance from `x` to the box [xmin, ymin, xmax, ymax] (0 inside).
+    pure real(dp) function box_distance2(box, x)
         real(dp), intent(in) :: box(4), x(2)
-        box_distance = norm2([max(box(1) - x(1), 0.0_dp, x(1) - box(3)), &
-                              max(box(2) - x(2), 0.0_dp, x(2) - box(4))])
-    end function box_distance
+        box_distance2 = max(box(1) - x(1), 0.0_dp, x(1) - box(3))**2 + max(box(2) - x(2), 0.0_dp, x(2) - box(4))**2
+    end function box_distance2
 
     pure function nurbs_all_dofs(self) result(dofs)
         class(nurbs_master_t), intent(in) :: self
@@ -119,27 +144,34 @@ contains
         dofs = reshape(self%surf%dofs, [size(self%surf%dofs)])
     end function nurbs_all_dofs
 
-    pure subroutine nurbs_project(self, u, xs, mp, found, converged)
+    !> The closest point of the curve to `xs` (see the module comment); `start`,
+    !> the last projection of the same slave point, starts the Newton iteration in
+    !> the nearest sample's span when it lies there within a sample spacing of that
+    !> sample (between Newton iterations of a step it is off by the iteration's
+    !> increment, against a sample spacing of 1/(2p + 2) of a span).
+    pure subroutine nurbs_project(self, u, xs, mp, found, converged, start)
         class(nurbs_master_t), intent(in) :: self
         real(dp), intent(in) :: u(:), xs(2)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
+        real(dp), intent(in), optional :: start
         ! two evaluation buffers: the current one (cur) and the best so far (ib), whose
         ! roles swap instead of copying a point (and its arrays) on every improvement
         type(surface_point_t) :: pts(2)
-        real(dp) :: d, best_d, best, f, tol
+        real(dp) :: d, best_d, best, f, tol, end_xi, xi0
         real(dp) :: lb(size(self%surf%breaks) - 1)
         integer :: nspan, k, j, m, best_span, s0, k0, i, cur, ib
-        logical :: ok, best_ok
+        logical :: ok, best_ok, at_end
 
         associate (br => self%surf%breaks)
             nspan = size(br) - 1
             ! 1. nearest sample (2p + 3 points per span), visiting the span whose box
             !    is nearest first and skipping spans whose box is farther than the
             !    nearest sample so far
+            !    (squared distances: the same order without square roots)
             m = n_samples(self)
             do k = 1, nspan
-                lb(k) = box_distance(self%boxes(:, k), xs)
+                lb(k) = box_distance2(self%boxes(:, k), xs)
             end do
             best_d = huge(1.0_dp)
             best = br(1)
@@ -149,7 +181,7 @@ contains
                 k = modulo(k0 - 1 + i, nspan) + 1
                 if (lb(k) >= best_d) cycle
                 do j = 1, m
-                    d = norm2(xs - self%samples(:, j, k))
+                    d = (xs(1) - self%samples(1, j, k))**2 + (xs(2) - self%samples(2, j, k))**2
                     if (d < best_d) then
                         best_d = d
                         best = br(k) + (br(k + 1) - br(k))*real(j - 1, dp)/real(m - 1, dp)
@@ -164,8 +196,29 @@ contains
             converged = .true.
             cur = 1
             ib = 0
+            at_end = .false.
             do k = max(1, s0 - 1), min(nspan, s0 + 1)
-                call span_newton(self%surf, u, xs, k, best, pts(cur), ok)
+                ! a neighbour span whose Newton would stop at its first point, the end
+                ! it shares with the sample's span: that point is known from `prepare`
+                ok = .false.
+                if (k /= s0) call settles_at_end(self, xs, k, best, ok, j)
+                if (ok) then
+                    d = norm2(xs - self%samples(:, j, k))
+                    if (d < best_d) then
+                        best_d = d
+                        best_span = k
+                        best_ok = .true.
+                        at_end = .true.
+                        end_xi = br(k + (j - 1)/(m - 1))
+                    end if
+                    cycle
+                end if
+                xi0 = best
+                if (k == s0 .and. present(start)) then
+                    if (abs(start - best) <= (br(k + 1) - br(k))/real(m - 1, dp) .and. &
+                        start >= br(k) .and. start <= br(k + 1)) xi0 = start
+                end if
+                call span_newton(self%surf, u, xs, k, xi0, pts(cur), ok)
                 if (.not. ok) converged = .false.
                 d = norm2(xs - pts(cur)%x)
                 if (d < best_d) then
@@ -174,8 +227,15 @@ contains
                     cur = 3 - cur
                     best_span = k
                     best_ok = ok
+                    at_end = .false.
                 end if
             end do
+            ! the closest is a span's end not evaluated here: the same evaluation as in
+            ! `span_newton` (its first)
+            if (at_end) then
+                ib = cur
+                call surface_point(self%surf, u, end_xi, pts(ib), self%surf%spans(best_span))
+            end if
             ! no distance compared (not a number): the last evaluation, not found
             if (ib == 0) ib = cur
             if (.not. best_ok) converged = .false.
@@ -199,6 +259,40 @@ contains
             end associate
         end associate
     end subroutine nurbs_project
+
+    !> Whether `span_newton` in span `k` from `start` would stop at its first point,
+    !> a span end (the one nearest `start`), with the numbers `prepare` kept there:
+    !> the same test on the same values. `j`: that end's sample (1 or n_samples).
+    pure subroutine settles_at_end(self, xs, k, start, settles, j)
+        class(nurbs_master_t), intent(in) :: self
+        real(dp), intent(in) :: xs(2), start
+        integer, intent(in) :: k
+        logical, intent(out) :: settles
+        integer, intent(out) :: j
+        real(dp) :: xi, a, b, f, df, step, x(2), t(2), t2(2)
+        integer :: e
+        a = self%surf%breaks(k)
+        b = self%surf%breaks(k + 1)
+        xi = min(max(start, a), b)
+        settles = .false.
+        j = 0
+        if (xi /= a .and. xi /= b) return
+        e = merge(1, 2, xi == a)
+        j = merge(1, n_samples(self), e == 1)
+        x = self%samples(:, j, k)
+        t = self%ends(1:2, e, k)
+        t2 = self%ends(3:4, e, k)
+        f = dot_product(xs - x, t)
+        df = -dot_product(t, t) + dot_product(xs - x, t2)
+        if (df < 0.0_dp) then
+            step = -f/df
+        else
+            ! the bracket is the whole span at the first point
+            step = merge(b - xi, a - xi, f > 0.0_dp)
+        end if
+        settles = abs(step) <= 1.0e-15_dp*max(1.0_dp, abs(xi))
+        settles = settles .or. (xi == a .and. f < 0.0_dp) .or. (xi == b .and. f > 0.0_dp)
+    end subroutine settles_at_end
 
     !> The closest point to `xs` of span `k` of `surf`: Newton on (xs - x).a = 0 from
     !> `start` clamped to the span, kept in a bracket of the minimum (a step leaving

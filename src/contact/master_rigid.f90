@@ -32,11 +32,13 @@ contains
         self%t = [self%n(2), -self%n(1)]
     end subroutine new_rigid_line
 
-    pure subroutine rigid_project(self, u, xs, mp, found, converged)
+    pure subroutine rigid_project(self, u, xs, mp, found, converged, start)
         class(rigid_line_t), intent(in) :: self
         real(dp), intent(in) :: u(:), xs(2)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
+        !> Not needed: the projection on a line is explicit.
+        real(dp), intent(in), optional :: start
         if (size(u) < 0) return   ! u is not needed: the line has no DOFs
         mp%xi = dot_product(xs - self%p0, self%t)
         mp%x = self%p0 + mp%xi*self%t

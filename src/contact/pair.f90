@@ -123,6 +123,10 @@ module voiga_contact_pair
         !> stiffness not added: the pattern must be rebuilt and the tangent
         !> assembled again).
         logical :: pattern_miss = .false.
+        !> The projections of the last evaluation may start this one's (set by the
+        !> assembly after an evaluation, cleared at a substep's first: a restarted run
+        !> then projects as the uninterrupted one).
+        logical :: warm = .false.
     contains
         !> Residual and (with `add`) tangent at a displacement; updates the trial history.
         procedure(evaluate_interface), deferred :: evaluate
@@ -408,6 +412,7 @@ contains
         type(surface_point_t), intent(inout) :: sp
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
+        real(dp) :: a0(2)
         if (allocated(self%slave_basis)) then
             call surface_point_at(self%slave, u, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
                                   self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
@@ -415,15 +420,19 @@ contains
             call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
         end if
         associate (out => self%out(k))
-            out%x0 = matmul(self%slave%x0(:, sp%local), sp%r)
+            call reference_point(self%slave, sp, out%x0, a0)
             out%x = sp%x
-            out%stretch = norm2(sp%a)/norm2(matmul(self%slave%x0(:, sp%local), sp%dr))
+            out%stretch = norm2(sp%a)/norm2(a0)
             out%state = state_inactive
             out%pn = 0.0_dp
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
-            call self%master%project(u, sp%x, mp, found, converged)
+            if (self%warm) then
+                call self%master%project(u, sp%x, mp, found, converged, out%xi_m)
+            else
+                call self%master%project(u, sp%x, mp, found, converged)
+            end if
             out%xi_m = mp%xi
             out%first = mp%first
             out%last = mp%last
@@ -431,6 +440,21 @@ contains
             if (found) out%gap = dot_product(sp%x - mp%x, mp%n)
         end associate
     end subroutine pair_project_point
+
+    !> The reference position `x0` and tangent `a0` of the slave point `sp` (its
+    !> functions at the reference control points).
+    pure subroutine reference_point(slave, sp, x0, a0)
+        type(contact_surface_t), intent(in) :: slave
+        type(surface_point_t), intent(in) :: sp
+        real(dp), intent(out) :: x0(2), a0(2)
+        integer :: j
+        x0 = 0.0_dp
+        a0 = 0.0_dp
+        do j = 1, size(sp%local)
+            x0 = x0 + slave%x0(:, sp%local(j))*sp%r(j)
+            a0 = a0 + slave%x0(:, sp%local(j))*sp%dr(j)
+        end do
+    end subroutine reference_point
 
     !> The error of a slave point whose projection did not converge.
     pure subroutine pair_projection_error(self, k, error)

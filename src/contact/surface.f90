@@ -184,8 +184,10 @@ contains
         do k = 1, p + 1
             id = s - p + k - 1
             pt%local(k) = id
-            pt%dofs(2*k - 1:2*k) = self%dofs(:, id)
-            x = self%x0(:, id) + u(self%dofs(:, id))
+            pt%dofs(2*k - 1) = self%dofs(1, id)
+            pt%dofs(2*k) = self%dofs(2, id)
+            x(1) = self%x0(1, id) + u(self%dofs(1, id))
+            x(2) = self%x0(2, id) + u(self%dofs(2, id))
             pt%x = pt%x + pt%r(k)*x
             pt%a = pt%a + pt%dr(k)*x
             pt%a2 = pt%a2 + pt%d2r(k)*x

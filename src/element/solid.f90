@@ -6,11 +6,10 @@
 module voiga_element_solid
     use voiga_kinds, only: dp
     use voiga_material, only: material_t
-    use voiga_linalg_blas, only: gemm_nt
     implicit none
     private
 
-    public :: solid_element, reference_gradients, element_points_t
+    public :: solid_element, reference_gradients, element_points_t, element_work_t
 
     !> The quadrature of one element in the reference configuration, computed once
     !> per discretization: reference gradients dN/dX [2, nen, npts] and weights
@@ -18,6 +17,25 @@ module voiga_element_solid
     type :: element_points_t
         real(dp), allocatable :: dndx(:, :, :), wdv(:)
     end type element_points_t
+
+    !> Work arrays of `solid_element` kept by its caller over the elements of a body
+    !> (gfortran puts automatic arrays on the heap: three allocations per element):
+    !> G [ld, 2 npts], R [4 ld, 2 npts] and the blocks of K [ld, 4 ld], grown to the
+    !> largest element they met.
+    type :: element_work_t
+        real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :)
+    end type element_work_t
+
+    interface
+        pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: dp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            real(dp), intent(in) :: alpha, beta
+            real(dp), intent(in) :: a(lda, *), b(ldb, *)
+            real(dp), intent(inout) :: c(ldc, *)
+        end subroutine dgemm
+    end interface
 
 contains
 
@@ -45,86 +63,188 @@ contains
     !> from its quadrature points `pts`, with displacements `u` [2, nen]. Small
     !> strain: f = int B^T sigma, K = int B^T c B. Finite strain (total Lagrangian,
     !> spatial form): f_a = int tau g_a dV, K_ab = int (g_a . c . g_b + (g_a . tau g_b) I) dV,
-    !> g = dN/dx = F^-T dN/dX. Evaluated as matrix products over all points:
-    !> K = B^T D B (material part, Voigt form; the tangents of both laws have minor
-    !> symmetries) + G^T T G (geometric part, finite strain only) with B, D, G, T
-    !> stacked over the points. The stacks are stored transposed (one column per
-    !> point and Voigt component, so that every point fills contiguous columns) and
-    !> D B is formed from the gradients directly, without the zeros of B.
-    !> `ok` is false if J <= 0 at a point.
-    pure subroutine solid_element(mat, pts, u, fe, ke, ok)
+    !> g = dN/dx = F^-T dN/dX. The four 2 x 2 blocks of K, by displacement component
+    !> (i, k), are K^ik_ab = sum_q g_a^T M^ik_q g_b with M^ik_q the 2 x 2 matrix of the
+    !> Voigt tangent D = w c that couples the components (i, j) and (k, l) (the
+    !> geometric part adds w tau to M^xx and M^yy): all are one product G R^T, G
+    !> [nen, 2 npts] the stacked gradients and R [4 nen, 2 npts] the stacked G M^T
+    !> (half the flops of B^T D B, whose B is half zeros, plus G^T T G); three of the
+    !> four blocks when D is symmetric at every point (then K^yx = (K^xy)^T). `ok` is
+    !> false if J <= 0 at a point.
+    pure subroutine solid_element(mat, pts, u, fe, ke, ok, work)
         class(material_t), intent(in) :: mat
         type(element_points_t), intent(in) :: pts
         real(dp), intent(in) :: u(:, :)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
-        ! B^T and (D B)^T; shape: [2 nen, 3 npts]. Automatic (stack) arrays: no heap
-        ! allocation per element; gt, tgt, kg are used by the finite-strain law only
-        real(dp) :: bt(2*size(u, 2), 3*size(pts%wdv)), dbt(2*size(u, 2), 3*size(pts%wdv))
-        ! G^T and (T G)^T; shape: [nen, 2 npts]
-        real(dp) :: gt(size(u, 2), 2*size(pts%wdv)), tgt(size(u, 2), 2*size(pts%wdv)), &
-                    kg(size(u, 2), size(u, 2))
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3)
-        real(dp) :: g(2, size(u, 2))
-        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
-        integer :: q, nen, i, j, r, a
+        !> G, R and the blocks [K^xx K^xy K^yy K^yx] (allocated here when absent).
+        type(element_work_t), intent(inout), optional :: work
+        type(element_work_t) :: own
+        if (present(work)) then
+            call fit_work(work, size(u, 2), 2*size(pts%wdv))
+            call element_kernel(mat, pts, u, fe, ke, ok, work)
+        else
+            call fit_work(own, size(u, 2), 2*size(pts%wdv))
+            call element_kernel(mat, pts, u, fe, ke, ok, own)
+        end if
+    end subroutine solid_element
+
+    !> `work` large enough for `nen` functions and `ncol` = 2 npts columns.
+    pure subroutine fit_work(work, nen, ncol)
+        type(element_work_t), intent(inout) :: work
+        integer, intent(in) :: nen, ncol
+        integer :: ld, nc
+        if (allocated(work%gt)) then
+            if (size(work%gt, 1) >= nen .and. size(work%gt, 2) >= ncol) return
+            ld = max(nen, size(work%gt, 1))
+            nc = max(ncol, size(work%gt, 2))
+            deallocate (work%gt, work%rt, work%k4)
+        else
+            ld = nen
+            nc = ncol
+        end if
+        allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld))
+    end subroutine fit_work
+
+    !> `solid_element` on the work arrays `wk`.
+    pure subroutine element_kernel(mat, pts, u, fe, ke, ok, wk)
+        class(material_t), intent(in) :: mat
+        type(element_points_t), intent(in) :: pts
+        real(dp), intent(in) :: u(:, :)
+        real(dp), intent(out) :: fe(:), ke(:, :)
+        logical, intent(out) :: ok
+        type(element_work_t), intent(inout) :: wk
+        integer :: nen, np, ld, a, b, nb
+        logical :: sym
 
         nen = size(u, 2)
+        np = size(pts%wdv)
+        ld = size(wk%gt, 1)
+        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, sym, wk%gt, ld, wk%rt, size(wk%rt, 1))
+        if (.not. ok) return
+        ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
+        ! symmetry at every point (hyperelastic and linear laws)
+        nb = merge(3, 4, sym)
+        call dgemm('N', 'T', nen, nb*nen, 2*np, 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, wk%k4, ld)
+        do b = 1, nen
+            do a = 1, nen
+                ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
+                ke(2*a - 1, 2*b) = wk%k4(a, nen + b)
+                ke(2*a, 2*b) = wk%k4(a, 2*nen + b)
+            end do
+        end do
+        if (sym) then
+            do b = 1, nen
+                do a = 1, nen
+                    ke(2*a, 2*b - 1) = wk%k4(b, nen + a)
+                end do
+            end do
+        else
+            do b = 1, nen
+                do a = 1, nen
+                    ke(2*a, 2*b - 1) = wk%k4(a, 3*nen + b)
+                end do
+            end do
+        end if
+    end subroutine element_kernel
+
+    !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
+    !> of G and R of every point (explicit shapes, so that the loops over the
+    !> functions are plain vector loops).
+    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, sym, gt, ld, rt, ldr)
+        class(material_t), intent(in) :: mat
+        integer, intent(in) :: nen, np, ld, ldr
+        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
+        real(dp), intent(out) :: fe(2, nen)
+        logical, intent(out) :: ok
+        !> The Voigt tangent was symmetric at every point (M^yx = (M^xy)^T).
+        logical, intent(out) :: sym
+        real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
+        real(dp) :: m(2, 2, 4), w
+        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
+        integer :: q, i, j, a, blk, off, c1, c2
+
         fe = 0.0_dp
-        do q = 1, size(pts%wdv)
+        ok = .true.
+        sym = .true.
+        do q = 1, np
+            w = wdv(q)
+            c1 = 2*q - 1
+            c2 = 2*q
             grad_u = 0.0_dp
             do a = 1, nen
-                grad_u(:, 1) = grad_u(:, 1) + u(:, a)*pts%dndx(1, a, q)
-                grad_u(:, 2) = grad_u(:, 2) + u(:, a)*pts%dndx(2, a, q)
+                grad_u(:, 1) = grad_u(:, 1) + u(:, a)*dndx(1, a, q)
+                grad_u(:, 2) = grad_u(:, 2) + u(:, a)*dndx(2, a, q)
             end do
             call mat%stress(grad_u, s, c, ok)
             if (.not. ok) return
+            ts = 0.0_dp
+            ! g = F^-T dN/dX (dN/dX for small strain)
             if (mat%finite_strain) then
                 f = grad_u
                 f(1, 1) = f(1, 1) + 1.0_dp
                 f(2, 2) = f(2, 2) + 1.0_dp
                 det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-                finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
-                ! g = finv^T dN/dX
+                finv(1, 1) = f(2, 2)/det
+                finv(2, 1) = -f(2, 1)/det
+                finv(1, 2) = -f(1, 2)/det
+                finv(2, 2) = f(1, 1)/det
+                ts = w*s
                 do a = 1, nen
-                    g(1, a) = finv(1, 1)*pts%dndx(1, a, q) + finv(2, 1)*pts%dndx(2, a, q)
-                    g(2, a) = finv(1, 2)*pts%dndx(1, a, q) + finv(2, 2)*pts%dndx(2, a, q)
+                    gt(a, c1) = finv(1, 1)*dndx(1, a, q) + finv(2, 1)*dndx(2, a, q)
+                    gt(a, c2) = finv(1, 2)*dndx(1, a, q) + finv(2, 2)*dndx(2, a, q)
                 end do
-                gt(:, 2*q - 1) = g(1, :)
-                gt(:, 2*q) = g(2, :)
-                tgt(:, 2*q - 1) = pts%wdv(q)*(s(1, 1)*g(1, :) + s(1, 2)*g(2, :))
-                tgt(:, 2*q) = pts%wdv(q)*(s(2, 1)*g(1, :) + s(2, 2)*g(2, :))
             else
-                g = pts%dndx(:, :, q)
+                gt(1:nen, c1) = dndx(1, :, q)
+                gt(1:nen, c2) = dndx(2, :, q)
             end if
             do j = 1, 3
                 do i = 1, 3
-                    d(i, j) = pts%wdv(q)*c(vi(i), vj(i), vi(j), vj(j))
+                    d(i, j) = w*c(vi(i), vj(i), vi(j), vj(j))
                 end do
             end do
-            sv = pts%wdv(q)*[s(1, 1), s(2, 2), s(1, 2)]
-            r = 3*q - 3
-            ! columns of B^T: [g1 0], [0 g2], [g2 g1] per function (x, y interleaved)
-            bt(1::2, r + 1) = g(1, :)
-            bt(2::2, r + 1) = 0.0_dp
-            bt(1::2, r + 2) = 0.0_dp
-            bt(2::2, r + 2) = g(2, :)
-            bt(1::2, r + 3) = g(2, :)
-            bt(2::2, r + 3) = g(1, :)
-            do i = 1, 3
-                dbt(1::2, r + i) = d(i, 1)*g(1, :) + d(i, 3)*g(2, :)
-                dbt(2::2, r + i) = d(i, 2)*g(2, :) + d(i, 3)*g(1, :)
+            sv = w*[s(1, 1), s(2, 2), s(1, 2)]
+            sym = sym .and. d(1, 2) == d(2, 1) .and. d(1, 3) == d(3, 1) .and. d(2, 3) == d(3, 2)
+            ! M^xx, M^xy, M^yy, M^yx (rows: the gradient component of g_a, columns: of g_b)
+            call coupling(d, ts, m)
+            do blk = 1, 4
+                off = (blk - 1)*nen
+                do a = 1, nen
+                    rt(off + a, c1) = m(1, 1, blk)*gt(a, c1) + m(1, 2, blk)*gt(a, c2)
+                    rt(off + a, c2) = m(2, 1, blk)*gt(a, c1) + m(2, 2, blk)*gt(a, c2)
+                end do
             end do
-            ! the same sums, in the same order, as f + B^T sv
-            fe(1::2) = fe(1::2) + sv(1)*g(1, :) + sv(3)*g(2, :)
-            fe(2::2) = fe(2::2) + sv(2)*g(2, :) + sv(3)*g(1, :)
+            ! f_a = B_a^T sv
+            do a = 1, nen
+                fe(1, a) = fe(1, a) + sv(1)*gt(a, c1) + sv(3)*gt(a, c2)
+                fe(2, a) = fe(2, a) + sv(2)*gt(a, c2) + sv(3)*gt(a, c1)
+            end do
         end do
-        call gemm_nt(bt, dbt, ke, 0.0_dp)
-        if (mat%finite_strain) then
-            call gemm_nt(gt, tgt, kg, 0.0_dp)
-            ke(1::2, 1::2) = ke(1::2, 1::2) + kg
-            ke(2::2, 2::2) = ke(2::2, 2::2) + kg
-        end if
-    end subroutine solid_element
+    end subroutine point_columns
+
+    !> The 2 x 2 matrices M^xx, M^xy, M^yy, M^yx of `solid_element` from the Voigt
+    !> tangent `d` and the geometric part `ts` (rows: the gradient component of g_a,
+    !> columns: of g_b).
+    pure subroutine coupling(d, ts, m)
+        real(dp), intent(in) :: d(3, 3), ts(2, 2)
+        real(dp), intent(out) :: m(2, 2, 4)
+        m(1, 1, 1) = d(1, 1) + ts(1, 1)
+        m(2, 1, 1) = d(3, 1) + ts(2, 1)
+        m(1, 2, 1) = d(1, 3) + ts(1, 2)
+        m(2, 2, 1) = d(3, 3) + ts(2, 2)
+        m(1, 1, 2) = d(1, 3)
+        m(2, 1, 2) = d(3, 3)
+        m(1, 2, 2) = d(1, 2)
+        m(2, 2, 2) = d(3, 2)
+        m(1, 1, 3) = d(3, 3) + ts(1, 1)
+        m(2, 1, 3) = d(2, 3) + ts(2, 1)
+        m(1, 2, 3) = d(3, 2) + ts(1, 2)
+        m(2, 2, 3) = d(2, 2) + ts(2, 2)
+        m(1, 1, 4) = d(3, 1)
+        m(2, 1, 4) = d(2, 1)
+        m(1, 2, 4) = d(3, 3)
+        m(2, 2, 4) = d(2, 3)
+    end subroutine coupling
 
 end module voiga_element_solid

@@ -53,21 +53,33 @@ typedef struct {
 
 static hid_t driver_id = -1;
 
-/* CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) of `n` bytes. */
+/* CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) of `n` bytes, eight
+ * bytes a step ("slicing-by-8": eight tables, the same remainder as the byte-wise
+ * loop); a step's whole journal goes through it before every flush. */
 static uint64_t crc32_of(const unsigned char *p, size_t n)
 {
-    static uint32_t table[256];
+    static uint32_t table[8][256];
     static int ready = 0;
     uint32_t c = 0xFFFFFFFFu;
     if (!ready) {
         for (uint32_t i = 0; i < 256; i++) {
             uint32_t v = i;
             for (int k = 0; k < 8; k++) v = (v & 1) ? 0xEDB88320u ^ (v >> 1) : v >> 1;
-            table[i] = v;
+            table[0][i] = v;
         }
+        for (uint32_t i = 0; i < 256; i++)
+            for (int t = 1; t < 8; t++) table[t][i] = (table[t - 1][i] >> 8) ^ table[0][table[t - 1][i] & 0xFF];
         ready = 1;
     }
-    for (size_t i = 0; i < n; i++) c = table[(c ^ p[i]) & 0xFF] ^ (c >> 8);
+    while (n >= 8) {
+        uint32_t lo = c ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
+        uint32_t hi = (uint32_t)p[4] | (uint32_t)p[5] << 8 | (uint32_t)p[6] << 16 | (uint32_t)p[7] << 24;
+        c = table[7][lo & 0xFF] ^ table[6][(lo >> 8) & 0xFF] ^ table[5][(lo >> 16) & 0xFF] ^ table[4][lo >> 24] ^
+            table[3][hi & 0xFF] ^ table[2][(hi >> 8) & 0xFF] ^ table[1][(hi >> 16) & 0xFF] ^ table[0][hi >> 24];
+        p += 8;
+        n -= 8;
+    }
+    for (size_t i = 0; i < n; i++) c = table[0][(c ^ p[i]) & 0xFF] ^ (c >> 8);
     return (uint64_t)(c ^ 0xFFFFFFFFu);
 }
 

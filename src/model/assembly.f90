@@ -9,8 +9,8 @@ module voiga_model_assembly
     use voiga_text, only: str
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: solid_element
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
+    use voiga_element_solid, only: solid_element, element_work_t
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
     implicit none
     private
 
@@ -71,21 +71,24 @@ contains
     !> Internal force `fe` [2 nen] and tangent `ke` [2 nen, 2 nen] of element `e`
     !> of `body` for the global displacement vector `u`. `ok` is false if the
     !> Jacobian of the deformation is not positive at some quadrature point.
-    pure subroutine body_element(body, e, u, fe, ke, ok)
+    pure subroutine body_element(body, e, u, fe, ke, ok, work)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: fe(:), ke(:, :)
         logical, intent(out) :: ok
+        !> The element kernel's work arrays, kept by a caller that loops over elements.
+        type(element_work_t), intent(inout), optional :: work
         real(dp) :: ue(2, size(fe)/2)
         integer :: a
 
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                ue(:, a) = u(body%dof0 + 2*conn(a) - 1:body%dof0 + 2*conn(a))
+                ue(1, a) = u(body%dof0 + 2*conn(a) - 1)
+                ue(2, a) = u(body%dof0 + 2*conn(a))
             end do
         end associate
-        call solid_element(body%mat, body%points(e), ue, fe, ke, ok)
+        call solid_element(body%mat, body%points(e), ue, fe, ke, ok, work)
     end subroutine body_element
 
     !> The positions of every bulk element's entries in `k` (built on its pattern);
@@ -195,10 +198,11 @@ contains
     !> Residual r = f_int(u) - f_ext and (if `k` present) tangent stiffness.
     !> Fails with a numeric error if J <= 0 at a quadrature point.
     !> When a contact point falls outside the stiffness pattern, the pattern (and
-    !> `map`) is rebuilt and the contact part evaluated again. With `k` and `map`
-    !> and a deformable master, the bulk part (elements and external forces) is kept
-    !> from before the contact part and carried into the new pattern instead of being
-    !> assembled again (the same numbers: the bulk part does not depend on the pattern).
+    !> `map`) is rebuilt and the contact part evaluated again. With `k` and `map`,
+    !> a deformable master and `refit`, the bulk part (elements and external forces)
+    !> is kept from before the contact part and carried into the new pattern instead
+    !> of being assembled again (the same numbers: the bulk part does not depend on
+    !> the pattern); a rebuild at another assembly assembles it again.
     subroutine assemble(model, u, t, r, stats, error, k, map, refit)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
@@ -222,8 +226,11 @@ contains
         call move_obstacles(model, t)
         fit = .false.
         if (present(refit)) fit = refit .and. present(k)
+        ! the bulk part is kept for a rebuild at a substep's first assembly, where the
+        ! refit makes one likely; elsewhere (a point projecting outside its range: rare)
+        ! it is assembled again (the same numbers), not copied at every assembly
         keep = .false.
-        if (present(k) .and. present(map)) &
+        if (present(k) .and. present(map) .and. fit) &
             keep = any([(model%pairs(ip)%pair%master%deformable, ip=1, size(model%pairs))])
         call assemble_bulk(model, u, t, r, stats, error, k, map)
         if (allocated(error)) return
@@ -231,8 +238,17 @@ contains
             r_bulk = r
             k_bulk = k%values
         end if
+        ! a substep's first evaluation projects without the last projections as starts
+        if (fit) then
+            do ip = 1, size(model%pairs)
+                model%pairs(ip)%pair%warm = .false.
+            end do
+        end if
         do pass = 1, 3
             call assemble_contact(model, u, r, stats, error, k)
+            do ip = 1, size(model%pairs)
+                model%pairs(ip)%pair%warm = .true.
+            end do
             if (allocated(error) .or. .not. present(k)) return
             if (fit) then
                 fit = .false.
@@ -370,6 +386,7 @@ contains
         type(assembly_map_t), intent(inout), optional :: map
         real(dp), allocatable :: fe(:), ke(:, :)
         integer, allocatable :: dofs(:)
+        type(element_work_t) :: work
         integer :: ib, e, n, npts, idx
         logical :: ok, keep
         integer(i8) :: c0, c1, rate
@@ -400,7 +417,7 @@ contains
                         if (size(fe) /= n) deallocate (fe, ke)
                     end if
                     if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
-                    call body_element(body, e, u, fe, ke, ok)
+                    call body_element(body, e, u, fe, ke, ok, work)
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
                                          ': the deformation is inverted (J <= 0 at a quadrature point)', &
@@ -408,12 +425,12 @@ contains
                         return
                     end if
                     idx = idx + 1
-                    dofs = body_dofs(body, e)
-                    r(dofs) = r(dofs) + fe
+                    call add_force(body, e, fe, r)
                     if (present(k)) then
                         if (present(map)) then
                             call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ke)
                         else
+                            dofs = body_dofs(body, e)
                             call k%add_element(dofs, ke)
                         end if
                     end if
@@ -435,6 +452,22 @@ contains
         call system_clock(c1)
         stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
     end subroutine assemble_bulk
+
+    !> r(dofs of element e) += fe (the element's force, local order 2(a-1) + i).
+    pure subroutine add_force(body, e, fe, r)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        real(dp), intent(in) :: fe(:)
+        real(dp), intent(inout) :: r(:)
+        integer :: a, i
+        associate (conn => body%disc%elements(e)%conn)
+            do a = 1, size(conn)
+                i = body%dof0 + 2*conn(a)
+                r(i - 1) = r(i - 1) + fe(2*a - 1)
+                r(i) = r(i) + fe(2*a)
+            end do
+        end associate
+    end subroutine add_force
 
     !> Keep the stiffness a linear body just added to `k` (columns `first`..`last`:
     !> its DOFs; only its elements have entries there yet).
@@ -491,6 +524,9 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         integer :: ip
         integer(i8) :: c0, c1, rate
+        ! the positions of the last point's entries (the next point of a slave element
+        ! often projects onto the same master span: the same DOFs)
+        type(position_cache_t) :: cache
 
         call system_clock(c0, rate)
         do ip = 1, size(model%pairs)
@@ -507,7 +543,7 @@ contains
         subroutine add_to_k(dofs, kl)
             integer, intent(in) :: dofs(:)
             real(dp), intent(in) :: kl(:, :)
-            call k%add_element(dofs, kl)
+            call k%add_cached(dofs, kl, cache)
         end subroutine add_to_k
     end subroutine assemble_contact
 

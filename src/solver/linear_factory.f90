@@ -6,6 +6,7 @@ module voiga_solver_linear_factory
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t
     use voiga_solver_umfpack, only: umfpack_t
+    use voiga_solver_supernodal, only: supernodal_lu_t
     use voiga_solver_bulk_update, only: bulk_update_t, new_bulk_update
     use voiga_solver_multigrid, only: multigrid_t
     implicit none
@@ -35,7 +36,7 @@ contains
             reuse = .true.
             if (present(reuse_bulk)) reuse = reuse_bulk
             if (reuse .and. .not. model%finite_strain) call bulk_solver(solver, model)
-            if (.not. allocated(solver)) allocate (umfpack_t :: solver)
+            if (.not. allocated(solver)) allocate (supernodal_lu_t :: solver)
         case ('multigrid')
             allocate (multigrid_t :: solver)
             select type (solver)

@@ -14,7 +14,16 @@ module voiga_solver_sparse
     implicit none
     private
 
-    public :: csc_matrix_t, new_csc_pattern, pattern_positions
+    public :: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
+
+    !> The positions in `values` of the last element `add_cached` was given (its
+    !> DOFs and their entries' positions), for a caller that adds many element
+    !> matrices on the same DOFs in a row (the contact points of a slave element
+    !> that project onto the same master span). Valid for one pattern: a caller
+    !> keeps it only while the pattern does not change.
+    type :: position_cache_t
+        integer, allocatable :: dofs(:), pos(:, :)
+    end type position_cache_t
 
     !> A square n x n matrix in compressed-sparse-column form (0-based indices).
     type :: csc_matrix_t
@@ -36,6 +45,9 @@ module voiga_solver_sparse
         procedure :: zero => csc_zero
         !> Scatter-add an element matrix by global DOF numbers.
         procedure :: add_element => csc_add_element
+        !> Scatter-add an element matrix, reusing the positions of the last one
+        !> when it has the same DOFs (`position_cache_t`).
+        procedure :: add_cached => csc_add_cached
         !> Index into `values` of every (row, column) pair of an element, to cache.
         procedure :: element_positions => csc_element_positions
         !> Scatter-add an element matrix through cached positions.
@@ -367,6 +379,69 @@ contains
         end do
     end subroutine csc_add_element
 
+    !> `add_element` (the same sums in the same order, the same count of missed
+    !> pairs) with the positions of the last element of `cache` when `dofs` are its DOFs.
+    pure subroutine csc_add_cached(self, dofs, ke, cache)
+        class(csc_matrix_t), intent(inout) :: self
+        !> Global DOF numbers, 1-based, <= 0 skipped; shape: [m].
+        integer, intent(in) :: dofs(:)
+        !> Element matrix; shape: [m, m].
+        real(dp), intent(in) :: ke(:, :)
+        type(position_cache_t), intent(inout) :: cache
+        integer :: a, b, m
+        logical :: same
+        m = size(dofs)
+        same = .false.
+        if (allocated(cache%dofs)) then
+            if (size(cache%dofs) == m) same = all(cache%dofs == dofs)
+        end if
+        if (.not. same) then
+            cache%dofs = dofs
+            if (allocated(cache%pos)) then
+                if (size(cache%pos, 1) /= m) deallocate (cache%pos)
+            end if
+            if (.not. allocated(cache%pos)) allocate (cache%pos(m, m))
+            call element_positions_quiet(self, dofs, cache%pos)
+        end if
+        do b = 1, m
+            if (dofs(b) <= 0) cycle
+            do a = 1, m
+                if (dofs(a) <= 0) cycle
+                if (cache%pos(a, b) > 0) then
+                    self%values(cache%pos(a, b)) = self%values(cache%pos(a, b)) + ke(a, b)
+                else
+                    self%missed = self%missed + 1
+                end if
+            end do
+        end do
+    end subroutine csc_add_cached
+
+    !> The positions `element_positions` finds (0 for a DOF <= 0 or a pair not in
+    !> the pattern), without counting the missed pairs; the search of
+    !> `add_element` (the y row of a control point right after its x row).
+    pure subroutine element_positions_quiet(self, dofs, pos)
+        class(csc_matrix_t), intent(in) :: self
+        integer, intent(in) :: dofs(:)
+        integer, intent(out) :: pos(:, :)
+        integer :: a, b, last
+        pos = 0
+        do b = 1, size(dofs)
+            if (dofs(b) <= 0) cycle
+            last = 0
+            do a = 1, size(dofs)
+                if (dofs(a) <= 0) then
+                    last = 0
+                    cycle
+                end if
+                if (a > 1 .and. last > 0 .and. last < self%colptr(min(dofs(b), self%n) + 1)) then
+                    if (dofs(a) == dofs(a - 1) + 1 .and. self%rowind(last + 1) == dofs(a) - 1) pos(a, b) = last + 1
+                end if
+                if (pos(a, b) == 0) pos(a, b) = self%index_of(dofs(a), dofs(b))
+                last = pos(a, b)
+            end do
+        end do
+    end subroutine element_positions_quiet
+
     !> Positions of an element's entries in `values`, for repeated assembly
     !> without searching: compute `pos` once per element after the pattern is
     !> built, keep it, and every iteration call `a%add_at(pos, ke)`. Entries
@@ -446,12 +521,17 @@ contains
         integer :: i, j, k
 
         do j = 1, self%n
-            do k = self%colptr(j) + 1, self%colptr(j + 1)
-                i = self%rowind(k) + 1
-                if (fixed(i) .or. fixed(j)) then
-                    self%values(k) = merge(1.0_c_double, 0.0_c_double, i == j)
-                end if
-            end do
+            if (fixed(j)) then
+                ! the whole column
+                do k = self%colptr(j) + 1, self%colptr(j + 1)
+                    self%values(k) = merge(1.0_c_double, 0.0_c_double, self%rowind(k) + 1 == j)
+                end do
+            else
+                do k = self%colptr(j) + 1, self%colptr(j + 1)
+                    i = self%rowind(k) + 1
+                    if (fixed(i)) self%values(k) = 0.0_c_double
+                end do
+            end if
         end do
     end subroutine csc_fix_dofs
 

@@ -3,7 +3,7 @@ plot-contact`, by post's reader and by plain h5py (docs/hdf5.md, "Writing and
 reading a running result"); `post` refuses bad files in one line and a hertz
 comparison of a run that has not converged unless asked.
 
-No assertion depends on timing: the run is long (2000 steps) and is stopped once the
+No assertion depends on timing: the run is long (6000 steps) and is stopped once the
 reads it is waiting for have been made while its status was 'running'; on a machine
 slow enough that it ends first, the test fails naming that (it never passes
 vacuously)."""
@@ -35,7 +35,7 @@ CASE = """&case
   degree_xi = 2, degree_eta = 2, nel_xi = 4, nel_eta = 2, contact_edge = 'bottom'
 /
 &solver
-  n_steps = 10, 1990
+  n_steps = 10, 5990
 /
 &dirichlet
   body = 'slab', edge = 'top', fix_x = .true., fix_y = .true., ux = 0.0, 2.0, uy = -0.06, -0.06
@@ -49,7 +49,7 @@ CASE = """&case
 
 @pytest.fixture()
 def growing(voiga_bin: Path, tmp_path: Path):
-    """A run of 2000 steps writing `run.h5`; stopped (SIGTERM) at the end of the test."""
+    """A run of 6000 steps writing `run.h5`; stopped (SIGTERM) at the end of the test."""
     shutil.copy(REPO / "cases" / "ironing" / "geometry.h5", tmp_path / "geometry.h5")
     (tmp_path / "case.nml").write_text(CASE)
     proc = subprocess.Popen([str(voiga_bin), "case.nml", "--quiet"], cwd=tmp_path,
