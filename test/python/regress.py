@@ -19,14 +19,17 @@ most); counts must be equal.
     python3 test/python/regress.py --only 'hertz/*' 'penalty-1e2'
 
 The baseline is a gzip'd JSON file, {run name: {"status", "steps": [{...}, ...]}}, its
-floats kept to 13 significant digits. It was made by the binary of commit e54ff29 (before
-the solver redesign of issue 15) with ``--write``, except ``penalty-hertz-1e9``, remade by
-the binary of 7ea93d8 (issue 17: a linear scene's tangent solved as an update of the
-bulk's Cholesky factor). That run's contact force is known only to its residual floor
-(docs/robustness.md, "Convergence at the round-off level"): the new order of summation
-moved it by up to 8e-9 (9e-6 relative) with the same iterations, cuts and retries; every
-other run agrees with e54ff29 to 1e-10. The alm hard cases (``alm-1e4`` .. ``alm-1e6``,
-issue 16) were added by the binary of ea01bff, when every other run still agreed.
+floats kept to 13 significant digits. It was remade by the binary of the merge of issue
+21 (5e8215a: the supernodal LU, the new element and contact kernels) with ``--write``.
+Against the baseline before it (e54ff29's binary; ``penalty-hertz-1e9`` from 7ea93d8's,
+the alm hard cases from ea01bff's), 26 to 28 of 137 runs (over the branch's last
+commits) did not agree to 1e-10: ironing-deep runs, stiff-penalty hard cases, nu-0.49
+and ratio-1e3-rings, where a cut or the last Newton iteration changes with the order of
+floating-point sums. The old
+binary itself with OpenBLAS's Haswell kernels (``OPENBLAS_CORETYPE=Haswell``, another
+order of the same sums) differs from its own baseline in the same steps by the same
+amounts (docs/performance.md). Those runs are reproducible on one machine and binary,
+not to 1e-10 across BLAS kernels or CPUs.
 """
 from __future__ import annotations
 
