@@ -6,6 +6,7 @@
 module voiga_element_solid
     use voiga_kinds, only: dp
     use voiga_material, only: material_t
+    use voiga_linalg_blas, only: dgemm
     implicit none
     private
 
@@ -25,17 +26,6 @@ module voiga_element_solid
     type :: element_work_t
         real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :)
     end type element_work_t
-
-    interface
-        pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
-            import :: dp
-            character(len=1), intent(in) :: transa, transb
-            integer, intent(in) :: m, n, k, lda, ldb, ldc
-            real(dp), intent(in) :: alpha, beta
-            real(dp), intent(in) :: a(lda, *), b(ldb, *)
-            real(dp), intent(inout) :: c(ldc, *)
-        end subroutine dgemm
-    end interface
 
 contains
 

@@ -10,6 +10,8 @@ module voiga_linalg_blas
     private
 
     public :: gemm_tn, gemm_nt, warm_up_blas, default_library_threads, library_threads
+    !> The BLAS routine itself, for kernels that pass leading dimensions of sub-blocks.
+    public :: dgemm
 
     !> The environment variables through which a user chooses the thread counts of
     !> OpenBLAS and OpenMP; when none is set, voiga runs them on one thread.

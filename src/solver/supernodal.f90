@@ -35,6 +35,7 @@ module voiga_solver_supernodal
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_umfpack, only: umfpack_t
+    use voiga_linalg_blas, only: dgemm
     implicit none
     private
 
@@ -146,14 +147,6 @@ module voiga_solver_supernodal
             real(dp), intent(inout) :: b(ldb, *)
         end subroutine dtrsm
 
-        pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
-            import :: dp
-            character(len=1), intent(in) :: transa, transb
-            integer, intent(in) :: m, n, k, lda, ldb, ldc
-            real(dp), intent(in) :: alpha, beta
-            real(dp), intent(in) :: a(lda, *), b(ldb, *)
-            real(dp), intent(inout) :: c(ldc, *)
-        end subroutine dgemm
     end interface
 
 contains
