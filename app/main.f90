@@ -14,7 +14,7 @@ program voiga_main
     use voiga_io_results, only: restart_case, read_restart
     use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
                                 memory_available
-    use voiga_linalg_blas, only: warm_up_blas, default_library_threads
+    use voiga_linalg_blas, only: warm_up_blas, default_library_threads, choose_blas_kernels
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
     use voiga_model_checks, only: setup_warnings, warning_t
@@ -42,6 +42,7 @@ program voiga_main
     integer :: i, total, length
     logical :: heap_ok
 
+    call choose_blas_kernels()
     call default_library_threads()
     call single_blas_thread_under_a_memory_limit()
     call ignore_file_size_signal()

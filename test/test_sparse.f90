@@ -8,6 +8,7 @@ module test_sparse
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
     use voiga_solver_umfpack, only: umfpack_t, dp_is_c_double
     use voiga_test_fixtures, only: lcg_t
+    use voiga_linalg_blas, only: kernels_for
     implicit none
     private
 
@@ -32,9 +33,28 @@ contains
                     new_unittest('umfpack_singular', test_singular), &
                     new_unittest('umfpack_determinant', test_determinant), &
                     new_unittest('umfpack_64bit_indices', test_wide), &
-                    new_unittest('umfpack_misuse', test_misuse) &
+                    new_unittest('umfpack_misuse', test_misuse), &
+                    new_unittest('blas_kernels_choice', test_kernels_choice) &
                     ]
     end subroutine collect_sparse
+
+    !> OpenBLAS's generic kernels (its fallback on a CPU it does not know) are
+    !> replaced by those of the CPU's widest vector features; kernels OpenBLAS chose
+    !> for a CPU it knows are kept.
+    subroutine test_kernels_choice(error)
+        type(error_t), allocatable, intent(out) :: error
+        call check(error, kernels_for('Prescott', .true., .true., .true.) == 'SkylakeX', 'AVX-512: SkylakeX')
+        if (allocated(error)) return
+        call check(error, kernels_for('PRESCOTT', .false., .true., .true.) == 'Haswell', 'AVX2: Haswell')
+        if (allocated(error)) return
+        call check(error, kernels_for('Prescott', .false., .false., .true.) == 'Sandybridge', 'AVX: Sandybridge')
+        if (allocated(error)) return
+        call check(error, kernels_for('Prescott', .false., .false., .false.) == '', 'SSE3 only: kept')
+        if (allocated(error)) return
+        call check(error, kernels_for('Haswell', .true., .true., .true.) == '', 'a known CPU: kept')
+        if (allocated(error)) return
+        call check(error, kernels_for('Zen', .true., .true., .true.) == '', 'Zen kept')
+    end subroutine test_kernels_choice
 
     subroutine test_kinds(error)
         type(error_t), allocatable, intent(out) :: error

@@ -15,7 +15,7 @@ module voiga_io_provenance
     use voiga_io_sha256, only: sha256_file
     use voiga_io_os, only: canonical_path
     use voiga_io_case, only: case_t
-    use voiga_linalg_blas, only: library_threads
+    use voiga_linalg_blas, only: library_threads, blas_kernels
     implicit none
     private
 
@@ -50,6 +50,8 @@ contains
         else
             call h5%write_attr('/', 'library_threads', threads//' (environment)', error)
         end if
+        if (allocated(error)) return
+        call h5%write_attr('/', 'blas_kernels', blas_kernels(), error)
     end subroutine write_provenance
 
     !> May the result file `path` be continued with `case`? Not when its run

@@ -4,12 +4,13 @@
 !> `dgemm` only writes its output argument; its interface is declared `pure` so
 !> that pure kernels may use it.
 module voiga_linalg_blas
-    use, intrinsic :: iso_c_binding, only: c_int
+    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_char, c_associated, c_f_pointer
     use voiga_kinds, only: dp
     implicit none
     private
 
     public :: gemm_tn, gemm_nt, warm_up_blas, default_library_threads, library_threads
+    public :: choose_blas_kernels, blas_kernels, kernels_for
     !> The BLAS routine itself, for kernels that pass leading dimensions of sub-blocks.
     public :: dgemm
 
@@ -17,6 +18,10 @@ module voiga_linalg_blas
     !> OpenBLAS and OpenMP; when none is set, voiga runs them on one thread.
     character(len=*), parameter :: thread_variables(3) = &
         [character(len=20) :: 'OPENBLAS_NUM_THREADS', 'GOTO_NUM_THREADS', 'OMP_NUM_THREADS']
+
+    !> OpenBLAS's kernels were switched by `choose_blas_kernels`, from these.
+    logical, save :: kernels_switched = .false.
+    character(len=32), save :: kernels_detected = ''
 
     interface
         pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
@@ -27,6 +32,21 @@ module voiga_linalg_blas
             real(dp), intent(in) :: a(lda, *), b(ldb, *)
             real(dp), intent(inout) :: c(ldc, *)
         end subroutine dgemm
+        subroutine c_blas_kernels(buf, len) bind(c, name='voiga_blas_kernels')
+            import :: c_int, c_char
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: len
+        end subroutine c_blas_kernels
+        function c_choose_blas_kernels() bind(c, name='voiga_choose_blas_kernels') result(switched)
+            import :: c_int
+            integer(c_int) :: switched
+        end function c_choose_blas_kernels
+        function c_kernels_for(detected, avx512, avx2, avx) bind(c, name='voiga_kernels_for') result(name)
+            import :: c_int, c_char, c_ptr
+            character(kind=c_char), intent(in) :: detected(*)
+            integer(c_int), value :: avx512, avx2, avx
+            type(c_ptr) :: name
+        end function c_kernels_for
         function c_set_library_threads(n) bind(c, name='voiga_set_library_threads') result(found)
             import :: c_int
             integer(c_int), value :: n
@@ -78,6 +98,78 @@ contains
         if (len(library_threads()) > 0) return
         found = c_set_library_threads(1_c_int)
     end subroutine default_library_threads
+
+    !> Run OpenBLAS's kernels for the CPU's features where OpenBLAS does not know the
+    !> CPU and fell back to its generic ones (src/linalg/kernels_shim.c says when);
+    !> before any BLAS call. Nothing is done under a user's `OPENBLAS_CORETYPE` or
+    !> with another BLAS.
+    subroutine choose_blas_kernels()
+        kernels_detected = blas_kernel_name()
+        kernels_switched = c_choose_blas_kernels() /= 0
+    end subroutine choose_blas_kernels
+
+    !> The kernels the BLAS runs, and who chose them, for the result file's
+    !> provenance: 'SkylakeX (OpenBLAS)', 'Prescott (environment: OPENBLAS_CORETYPE)',
+    !> 'SkylakeX (voiga, for the CPU's features; OpenBLAS chose Prescott)';
+    !> 'not OpenBLAS' for another BLAS.
+    function blas_kernels() result(text)
+        character(len=:), allocatable :: text
+        character(len=64) :: value
+        integer :: status
+        text = blas_kernel_name()
+        if (len(text) == 0) then
+            text = 'not OpenBLAS'
+            return
+        end if
+        call get_environment_variable('OPENBLAS_CORETYPE', value, status=status)
+        if (kernels_switched) then
+            text = text//' (voiga, for the CPU''s features; OpenBLAS chose '//trim(kernels_detected)//')'
+        else if (status /= 1) then
+            text = text//' (environment: OPENBLAS_CORETYPE='//trim(value)//')'
+        else
+            text = text//' (OpenBLAS)'
+        end if
+    end function blas_kernels
+
+    !> The kernels voiga runs instead of OpenBLAS's `detected` ones on a CPU with
+    !> these features ('' to keep them).
+    function kernels_for(detected, avx512, avx2, avx) result(name)
+        character(len=*), intent(in) :: detected
+        logical, intent(in) :: avx512, avx2, avx
+        character(len=:), allocatable :: name
+        type(c_ptr) :: p
+        p = c_kernels_for(detected//c_null_char, merge(1_c_int, 0_c_int, avx512), &
+                          merge(1_c_int, 0_c_int, avx2), merge(1_c_int, 0_c_int, avx))
+        name = c_string(p)
+    end function kernels_for
+
+    !> OpenBLAS's name of the kernels it runs ('' another BLAS).
+    function blas_kernel_name() result(name)
+        character(len=:), allocatable :: name
+        character(kind=c_char) :: buf(64)
+        integer :: i
+        call c_blas_kernels(buf, int(size(buf), c_int))
+        name = ''
+        do i = 1, size(buf)
+            if (buf(i) == c_null_char) exit
+            name = name//buf(i)
+        end do
+    end function blas_kernel_name
+
+    !> The zero-terminated C string at `p` ('' for a null pointer).
+    function c_string(p) result(text)
+        type(c_ptr), intent(in) :: p
+        character(len=:), allocatable :: text
+        character(kind=c_char), pointer :: chars(:)
+        integer :: n
+        text = ''
+        if (.not. c_associated(p)) return
+        call c_f_pointer(p, chars, [64])
+        do n = 1, 64
+            if (chars(n) == c_null_char) exit
+            text = text//chars(n)
+        end do
+    end function c_string
 
     !> The thread variables the environment sets, as `NAME=value` separated by
     !> blanks; '' when none is (then voiga runs one thread).

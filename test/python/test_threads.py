@@ -33,3 +33,28 @@ def test_library_threads_recorded(voiga_bin: Path, tmp_path: Path, setting: dict
     assert res.returncode == 0, res.stderr
     with h5py.File(tmp_path / "m1-NN2.2.h5", "r") as f:
         assert decode(f.attrs["library_threads"]) == recorded
+
+
+def _kernels(voiga_bin: Path, tmp_path: Path, setting: dict[str, str]) -> str:
+    """The root attribute ``blas_kernels`` of hertz m1 NN2.2 run under ``setting``."""
+    shutil.copy(REPO / "cases" / "hertz" / "geometry.h5", tmp_path)
+    shutil.copy(REPO / "cases" / "hertz" / "m1-NN2.2.nml", tmp_path / "case.nml")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"} | setting
+    res = subprocess.run([str(voiga_bin), "case.nml", "--quiet", "--overwrite"], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "m1-NN2.2.h5", "r") as f:
+        return decode(f.attrs["blas_kernels"])
+
+
+def test_blas_kernels_recorded_and_environment_kept(voiga_bin: Path, tmp_path: Path) -> None:
+    """A user's OPENBLAS_CORETYPE is what runs (and is recorded as theirs); without
+    it the record says who chose the kernels: OpenBLAS, or voiga replacing OpenBLAS's
+    generic Prescott kernels on a CPU OpenBLAS did not know (kernels_shim.c)."""
+    forced = _kernels(voiga_bin, tmp_path, {"OPENBLAS_CORETYPE": "Prescott"})
+    if forced == "not OpenBLAS":
+        pytest.skip("the BLAS is not OpenBLAS")
+    assert forced == "Prescott (environment: OPENBLAS_CORETYPE=Prescott)"
+    chosen = _kernels(voiga_bin, tmp_path, {})
+    assert chosen.endswith("(OpenBLAS)") or chosen.endswith("OpenBLAS chose Prescott)"), chosen
+    assert not chosen.startswith("Prescott (voiga"), chosen
