@@ -44,9 +44,32 @@ contains
                     new_unittest('linear_friction_factorizes_once', test_friction), &
                     new_unittest('two_linear_bodies_factorize_once', test_two_bodies), &
                     new_unittest('neo_hookean_path_unchanged', test_neo_hookean), &
-                    new_unittest('contact_held_bodies_fall_back', test_fall_back) &
+                    new_unittest('contact_held_bodies_fall_back', test_fall_back), &
+                    new_unittest('unsymmetric_bulk_refused', test_unsymmetric) &
                     ]
     end subroutine collect_bulk_update
+
+    !> A bulk stiffness whose entries (3, 2) and (2, 3) differ by 1e-9 of its largest
+    !> is refused (the update needs K0^-1's rows to be its columns); the same matrix
+    !> made symmetric again is taken.
+    subroutine test_unsymmetric(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t) :: k0, k
+        type(bulk_update_t) :: solver
+        type(error_t), allocatable :: refused
+        integer :: p
+        call chain(6, [2, 3], k0, k, error)
+        if (allocated(error)) return
+        p = k0%index_of(3, 2)
+        k0%values(p) = k0%values(p) + 2.0e-9_dp
+        call new_bulk_update(solver, k0, [(.false., p=1, 6)], refused)
+        call check(error, allocated(refused), 'an unsymmetric K0 is refused')
+        if (allocated(error)) return
+        call check(error, index(refused%message, 'not symmetric') > 0, refused%message)
+        if (allocated(error)) return
+        k0%values(k0%index_of(2, 3)) = k0%values(k0%index_of(3, 2))
+        call new_bulk_update(solver, k0, [(.false., p=1, 6)], error)
+    end subroutine test_unsymmetric
 
     !> K0: a chain of n DOFs with springs between neighbours and to ground (SPD);
     !> the tangent's pattern adds one block coupling `cdofs`.

@@ -22,6 +22,7 @@ module voiga_solver_bulk_update
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str, real_str
     use voiga_linalg_lapack, only: lu_factor, lu_solve
+    use voiga_linalg_blas, only: dgemm
     use voiga_solver_sparse, only: csc_matrix_t, pattern_positions
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     use voiga_solver_umfpack, only: umfpack_t
@@ -303,21 +304,33 @@ contains
         end do
     end subroutine update_matrix
 
-    !> max |a - a^T| / max |a| (0 for a zero matrix).
+    !> max |a - a^T| / max |a| (0 for a zero matrix; huge when an entry's transpose
+    !> is missing from the pattern and the entry is not zero). One pass: column i is
+    !> asked for its rows j in ascending order (the columns j are walked in order and
+    !> each column's rows are sorted), so a cursor per column finds each transpose.
     pure real(dp) function asymmetry(a) result(rel)
         type(csc_matrix_t), intent(in) :: a
-        integer :: j, p, q
+        integer :: j, p, i
+        integer, allocatable :: cursor(:)
         real(dp) :: big
+        logical :: found
         rel = 0.0_dp
         big = maxval(abs(a%values))
         if (big == 0.0_dp) return
+        cursor = a%colptr(1:a%n) + 1
         do j = 1, a%n
             do p = a%colptr(j) + 1, a%colptr(j + 1)
-                q = a%index_of(j, a%rowind(p) + 1)
-                if (q == 0) then
-                    if (a%values(p) /= 0.0_dp) rel = huge(1.0_dp)
-                else
-                    rel = max(rel, abs(a%values(p) - a%values(q)))
+                i = a%rowind(p) + 1
+                do while (cursor(i) <= a%colptr(i + 1))
+                    if (a%rowind(cursor(i)) + 1 >= j) exit
+                    cursor(i) = cursor(i) + 1
+                end do
+                found = .false.
+                if (cursor(i) <= a%colptr(i + 1)) found = a%rowind(cursor(i)) + 1 == j
+                if (found) then
+                    rel = max(rel, abs(a%values(p) - a%values(cursor(i))))
+                else if (a%values(p) /= 0.0_dp) then
+                    rel = huge(1.0_dp)
                 end if
             end do
         end do
@@ -362,7 +375,7 @@ contains
         real(dp), intent(out) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: y(:, :), rhs(:, :), w(:, :)
-        integer :: info, j, q, k
+        integer :: info
 
         if (self%whole) then
             call self%full%solve_columns(a, b, x, error)
@@ -377,14 +390,12 @@ contains
             return
         end if
         if (allocated(self%z)) then
-            ! K0^-1 E (D y) from the kept columns, one column at a time (no copy of them)
-            w = matmul(self%d, y)
-            do q = 1, size(self%c)
-                k = self%slot(self%c(q))
-                do j = 1, size(x, 2)
-                    x(:, j) = x(:, j) - w(q, j)*self%z(:, k)
-                end do
-            end do
+            ! K0^-1 E (D y) from the kept columns: one product with all of them, D y
+            ! scattered to their slots (zeros for the known DOFs outside C)
+            allocate (w(self%ns, size(x, 2)), source=0.0_dp)
+            w(self%slot(self%c), :) = matmul(self%d, y)
+            call dgemm('N', 'N', size(x, 1), size(x, 2), self%ns, -1.0_dp, self%z, size(self%z, 1), &
+                       w, self%ns, 1.0_dp, x, size(x, 1))
             return
         end if
         rhs = b
