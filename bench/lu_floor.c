@@ -1,5 +1,5 @@
 /* What one sparse LU of a voiga tangent costs with the SuiteSparse factorizations on this
- * machine (docs/performance.md, "One Newton iteration of frictional ironing").
+ * machine (docs/performance-ironing.md).
  *
  * Input: a matrix in voiga's CSC form as a stream file: int n, int nnz, int colptr[n+1]
  * (0-based), int rowind[nnz], double values[nnz] (a Fortran `write(u) a%n, size(a%rowind),
