@@ -128,8 +128,6 @@ contains
         type(umfpack_t) :: umf
         type(lcg_t) :: rng
         logical, allocatable :: fixed(:)
-        integer :: sign_sn, sign_umf
-        real(dp) :: log_sn, log_umf
 
         call grid_matrix(20, 4.0_dp, rng, a, error)
         if (allocated(error)) return
@@ -140,6 +138,19 @@ contains
         if (allocated(error)) return
         call check(error, lu%n_fallback, 0, 'factorized without UMFPACK')
         if (allocated(error)) return
+        call same_determinant(lu, umf, error)
+        if (allocated(error)) return
+        call check(error, lu%rcond > 0.0_dp .and. lu%rcond <= 1.0_dp, 'rcond in (0, 1]')
+    end subroutine test_matches_umfpack
+
+    !> The supernodal LU's determinant (sign and log10 |det|, to 1e-10) is UMFPACK's
+    !> of the same matrix.
+    subroutine same_determinant(lu, umf, error)
+        type(supernodal_lu_t), intent(inout) :: lu
+        type(umfpack_t), intent(inout) :: umf
+        type(error_t), allocatable, intent(out) :: error
+        integer :: sign_sn, sign_umf
+        real(dp) :: log_sn, log_umf
         call lu%determinant(sign_sn, log_sn, error)
         if (allocated(error)) return
         call umf%determinant(sign_umf, log_umf, error)
@@ -147,9 +158,7 @@ contains
         call check(error, sign_sn, sign_umf, 'sign of det')
         if (allocated(error)) return
         call check(error, log_sn, log_umf, 'log10 |det|', rel=1.0e-10_dp)
-        if (allocated(error)) return
-        call check(error, lu%rcond > 0.0_dp .and. lu%rcond <= 1.0_dp, 'rcond in (0, 1]')
-    end subroutine test_matches_umfpack
+    end subroutine same_determinant
 
     !> Dense matrices (one supernode each) with a zero diagonal: every pivot comes
     !> from another row of the block, and the sign of det follows the row swaps; 6
@@ -162,8 +171,7 @@ contains
         type(umfpack_t) :: umf
         type(lcg_t) :: rng
         real(dp), allocatable :: ke(:, :)
-        integer :: i, j, n, t, sign_sn, sign_umf
-        real(dp) :: log_sn, log_umf
+        integer :: i, j, n, t
 
         do t = 1, size(sizes)
             n = sizes(t)
@@ -182,13 +190,7 @@ contains
             if (allocated(error)) return
             call check(error, lu%n_fallback, 0, 'pivoted inside the supernode')
             if (allocated(error)) return
-            call lu%determinant(sign_sn, log_sn, error)
-            if (allocated(error)) return
-            call umf%determinant(sign_umf, log_umf, error)
-            if (allocated(error)) return
-            call check(error, sign_sn, sign_umf, 'sign of det')
-            if (allocated(error)) return
-            call check(error, log_sn, log_umf, 'log10 |det|', rel=1.0e-10_dp)
+            call same_determinant(lu, umf, error)
             if (allocated(error)) return
         end do
     end subroutine test_block_pivots
