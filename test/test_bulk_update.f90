@@ -14,6 +14,7 @@ module test_bulk_update
     use voiga_model_loads, only: pressure_settings_t
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
     use voiga_solver_umfpack, only: umfpack_t
+    use voiga_solver_cholmod, only: cholmod_t, cholmod_runs_serial
     use voiga_solver_bulk_update, only: bulk_update_t, new_bulk_update
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
@@ -45,7 +46,8 @@ contains
                     new_unittest('two_linear_bodies_factorize_once', test_two_bodies), &
                     new_unittest('neo_hookean_path_unchanged', test_neo_hookean), &
                     new_unittest('contact_held_bodies_fall_back', test_fall_back), &
-                    new_unittest('unsymmetric_bulk_refused', test_unsymmetric) &
+                    new_unittest('unsymmetric_bulk_refused', test_unsymmetric), &
+                    new_unittest('cholmod_on_calling_thread', test_cholmod_thread) &
                     ]
     end subroutine collect_bulk_update
 
@@ -70,6 +72,85 @@ contains
         k0%values(k0%index_of(2, 3)) = k0%values(k0%index_of(3, 2))
         call new_bulk_update(solver, k0, [(.false., p=1, 6)], error)
     end subroutine test_unsymmetric
+
+    !> With one OpenMP thread allowed (OMP_NUM_THREADS=1, as `make test` sets, or
+    !> fewer threads than CHOLMOD's fixed 4) CHOLMOD's factorization and solves start
+    !> no thread: before cholmod_shim.c ran its loops serially, CHOLMOD started 3
+    !> (its compiled CHOLMOD_OMP_NUM_THREADS of 4) whatever OMP_NUM_THREADS said, and
+    !> their wake-ups cost 0.15 s of hertz m4 NN2.2's 0.6 s. The matrix, a 60 x 60
+    !> grid of 2-DOF nodes, has supernodes large enough for CHOLMOD's parallel loops.
+    subroutine test_cholmod_thread(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t) :: a
+        type(cholmod_t) :: chol
+        real(dp), allocatable :: b(:, :), x(:, :)
+        character(len=16) :: omp
+        integer :: before, status
+        call get_environment_variable('OMP_NUM_THREADS', omp, status=status)
+        if (status == 0 .and. trim(omp) == '1') then
+            call check(error, cholmod_runs_serial(), 'serial under OMP_NUM_THREADS=1')
+            if (allocated(error)) return
+        end if
+        if (.not. cholmod_runs_serial()) return
+        call spd_grid(60, a, error)
+        if (allocated(error)) return
+        before = thread_count()
+        call chol%factor(a, error)
+        if (allocated(error)) return
+        allocate (b(a%n, 8), x(a%n, 8), source=1.0_dp)
+        call chol%solve_columns(a, b, x, error)
+        if (allocated(error)) return
+        call check(error, thread_count(), before, 'threads after CHOLMOD''s factorization and solve')
+    end subroutine test_cholmod_thread
+
+    !> An m x m grid of 4-node elements, 2 DOFs per node, each element matrix
+    !> 1.9 on the diagonal and -0.1 off it (symmetric, diagonally dominant: the sum is SPD).
+    subroutine spd_grid(m, a, error)
+        integer, intent(in) :: m
+        type(csc_matrix_t), intent(out) :: a
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: ptr(:), dofs(:)
+        real(dp) :: ke(8, 8)
+        integer :: i, j, e, k, nodes(4)
+        allocate (ptr((m - 1)**2 + 1), dofs(8*(m - 1)**2))
+        e = 0
+        do j = 1, m - 1
+            do i = 1, m - 1
+                e = e + 1
+                ptr(e) = 8*(e - 1) + 1
+                nodes = (j - 1)*m + i + [0, 1, m + 1, m]
+                dofs(8*e - 7:8*e) = [(2*nodes(k/2 + 1) - 1 + mod(k, 2), k=0, 7)]
+            end do
+        end do
+        ptr(e + 1) = 8*e + 1
+        call new_csc_pattern(a, 2*m*m, ptr, dofs, error)
+        if (allocated(error)) return
+        ke = -0.1_dp
+        do k = 1, 8
+            ke(k, k) = 1.9_dp
+        end do
+        do e = 1, (m - 1)**2
+            call a%add_element(dofs(8*e - 7:8*e), ke)
+        end do
+    end subroutine spd_grid
+
+    !> The process's threads (/proc/self/status), -1 when unknown.
+    integer function thread_count() result(n)
+        character(len=256) :: line
+        integer :: unit, ios
+        n = -1
+        open (newunit=unit, file='/proc/self/status', action='read', status='old', iostat=ios)
+        if (ios /= 0) return
+        do
+            read (unit, '(a)', iostat=ios) line
+            if (ios /= 0) exit
+            if (line(1:8) == 'Threads:') then
+                read (line(9:), *, iostat=ios) n
+                exit
+            end if
+        end do
+        close (unit)
+    end function thread_count
 
     !> K0: a chain of n DOFs with springs between neighbours and to ground (SPD);
     !> the tangent's pattern adds one block coupling `cdofs`.

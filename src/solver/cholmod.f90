@@ -19,7 +19,7 @@ module voiga_solver_cholmod
     implicit none
     private
 
-    public :: cholmod_t
+    public :: cholmod_t, cholmod_runs_serial
 
     !> A Cholesky factorization L L^T of a symmetric positive definite `csc_matrix_t`.
     type, extends(linear_solver_t) :: cholmod_t
@@ -66,6 +66,11 @@ module voiga_solver_cholmod
             integer(c_int) :: status
         end function voiga_cholmod_solve
 
+        function voiga_cholmod_serial() result(serial) bind(c, name='voiga_cholmod_serial')
+            import :: c_int
+            integer(c_int) :: serial
+        end function voiga_cholmod_serial
+
         subroutine voiga_cholmod_free(handle) bind(c, name='voiga_cholmod_free')
             import :: c_ptr
             type(c_ptr), value :: handle
@@ -73,6 +78,13 @@ module voiga_solver_cholmod
     end interface
 
 contains
+
+    !> CHOLMOD's OpenMP loops run on the calling thread: OpenMP allows fewer threads
+    !> than the fixed number CHOLMOD was compiled to ask for (voiga's default of one
+    !> thread, or `OMP_NUM_THREADS` below it), or there is no OpenMP (cholmod_shim.c).
+    logical function cholmod_runs_serial()
+        cholmod_runs_serial = voiga_cholmod_serial() /= 0
+    end function cholmod_runs_serial
 
     !> Factorize `a` (its lower triangle; a new ordering each time). A matrix that
     !> is not positive definite is an error with code `numeric`.

@@ -3,11 +3,68 @@
  * versions) stay on this side, so the Fortran interface is scalars and arrays.
  * Every function returns 0 on success, 1 when the matrix is not positive
  * definite, -1 on any other CHOLMOD failure (out of memory, invalid input).
- * Nothing is printed: Common->print = 0. */
+ * Nothing is printed: Common->print = 0.
+ *
+ * CHOLMOD 5.x runs the small loops of its supernodal factorization (scattering A
+ * into each supernode) on CHOLMOD_OMP_NUM_THREADS threads, a number fixed when it
+ * was compiled (4 in Debian 12's 5.12), whatever OMP_NUM_THREADS says. On hertz m4
+ * NN2.2 (2 cores, OMP_NUM_THREADS=1) those threads, woken and put to sleep per
+ * supernode, cost about 0.15 s of a 0.6 s run (docs/performance.md, "Threads").
+ * When OpenMP allows fewer threads than CHOLMOD asks for, voiga runs those loops
+ * serially: with max-active-levels 0 every parallel region is inactive, so it runs
+ * on the calling thread. The OpenMP functions are looked up with dlsym, so a
+ * CHOLMOD built without OpenMP needs nothing. */
+#define _GNU_SOURCE
+#include <dlfcn.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
 #include <suitesparse/cholmod.h>
+
+typedef struct {
+    int (*max_threads)(void);
+    int (*max_levels)(void);
+    void (*set_max_levels)(int);
+} openmp_calls;
+
+/* The OpenMP runtime's calls, or NULLs when no OpenMP runtime is loaded. */
+static openmp_calls openmp(void)
+{
+    openmp_calls o;
+    o.max_threads = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_threads");
+    o.max_levels = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_active_levels");
+    o.set_max_levels = (void (*)(int))dlsym(RTLD_DEFAULT, "omp_set_max_active_levels");
+    if (!o.max_threads || !o.max_levels || !o.set_max_levels) o.max_threads = NULL;
+    return o;
+}
+
+/* Make CHOLMOD's parallel regions run serially when OpenMP allows fewer threads
+ * than CHOLMOD_OMP_NUM_THREADS; returns the max-active-levels to restore (-1: none
+ * changed). */
+static int serial_begin(void)
+{
+    openmp_calls o = openmp();
+    int levels;
+    if (!o.max_threads || o.max_threads() >= CHOLMOD_OMP_NUM_THREADS) return -1;
+    levels = o.max_levels();
+    o.set_max_levels(0);
+    return levels;
+}
+
+static void serial_end(int levels)
+{
+    openmp_calls o;
+    if (levels < 0) return;
+    o = openmp();
+    o.set_max_levels(levels);
+}
+
+/* 1 when CHOLMOD's loops would run serially now (the rule of serial_begin), for the tests. */
+int voiga_cholmod_serial(void)
+{
+    openmp_calls o = openmp();
+    return !o.max_threads || o.max_threads() < CHOLMOD_OMP_NUM_THREADS;
+}
 
 typedef struct {
     cholmod_common common;
@@ -43,7 +100,7 @@ int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const doub
 {
     voiga_cholmod *h;
     cholmod_sparse *a;
-    int j, k, nnz = 0, status;
+    int j, k, nnz = 0, status, levels;
     *handle = NULL;
     h = calloc(1, sizeof *h);
     if (!h) return -1;
@@ -73,9 +130,11 @@ int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const doub
         }
         ap[n] = q;
     }
+    levels = serial_begin();
     h->factor = cholmod_analyze(a, &h->common);
     status = h->factor ? 0 : -1;
     if (status == 0 && !cholmod_factorize(a, h->factor, &h->common)) status = -1;
+    serial_end(levels);
     if (status == 0 && (h->common.status == CHOLMOD_NOT_POSDEF || h->factor->minor < (size_t)n)) status = 1;
     if (status == 0 && h->common.status < CHOLMOD_OK) status = -1;
     cholmod_free_sparse(&a, &h->common);
@@ -98,10 +157,13 @@ int voiga_cholmod_solve(void *handle, int nrhs, const double *b, double *x)
     voiga_cholmod *h = handle;
     cholmod_dense *bd, *xd;
     size_t size = (size_t)h->n * (size_t)nrhs;
+    int levels;
     bd = cholmod_allocate_dense(h->n, nrhs, h->n, CHOLMOD_REAL, &h->common);
     if (!bd) return -1;
     memcpy(bd->x, b, size * sizeof(double));
+    levels = serial_begin();
     xd = cholmod_solve(CHOLMOD_A, h->factor, bd, &h->common);
+    serial_end(levels);
     cholmod_free_dense(&bd, &h->common);
     if (!xd) return -1;
     memcpy(x, xd->x, size * sizeof(double));
