@@ -39,6 +39,7 @@ contains
         testsuite = [ &
                     new_unittest('update_solves_as_whole_lu', test_update_vs_lu), &
                     new_unittest('update_beyond_max_rank_factorizes_whole', test_whole), &
+                    new_unittest('update_outside_reach_factorizes_whole', test_outside_reach), &
                     new_unittest('linear_gpts_factorizes_once', test_gpts), &
                     new_unittest('linear_mortar_factorizes_once', test_mortar), &
                     new_unittest('linear_alm_factorizes_once', test_alm), &
@@ -64,13 +65,13 @@ contains
         if (allocated(error)) return
         p = k0%index_of(3, 2)
         k0%values(p) = k0%values(p) + 2.0e-9_dp
-        call new_bulk_update(solver, k0, [(.false., p=1, 6)], refused)
+        call new_bulk_update(solver, k0, [(.false., p=1, 6)], [2, 3], refused)
         call check(error, allocated(refused), 'an unsymmetric K0 is refused')
         if (allocated(error)) return
         call check(error, index(refused%message, 'not symmetric') > 0, refused%message)
         if (allocated(error)) return
         k0%values(k0%index_of(2, 3)) = k0%values(k0%index_of(3, 2))
-        call new_bulk_update(solver, k0, [(.false., p=1, 6)], error)
+        call new_bulk_update(solver, k0, [(.false., p=1, 6)], [2, 3], error)
     end subroutine test_unsymmetric
 
     !> With one OpenMP thread allowed (OMP_NUM_THREADS=1, as `make test` sets, or
@@ -195,36 +196,30 @@ contains
         call k%add_element(cdofs, d)
     end subroutine tangent
 
-    !> Three tangents with updates on different DOFs: each solve equals UMFPACK's of
-    !> the whole tangent, and so does the determinant; K0 is factorized once. With
-    !> the columns of K0^-1 kept (one solve with K0 per solve) and without (two).
+    !> Three tangents with updates on different DOFs within the reach (which holds
+    !> more DOFs, unsorted): each solve, of one column and of three at once, equals
+    !> UMFPACK's of the whole tangent, and so does the determinant; K0 is factorized
+    !> once, with the reach ordered last.
     subroutine test_update_vs_lu(error)
         type(error_t), allocatable, intent(out) :: error
-        call update_vs_lu(2.0_dp**24, error)
-        if (allocated(error)) return
-        call update_vs_lu(0.0_dp, error)
-    end subroutine test_update_vs_lu
-
-    subroutine update_vs_lu(max_kept, error)
-        real(dp), intent(in) :: max_kept
-        type(error_t), allocatable, intent(out) :: error
         integer, parameter :: n = 60
-        integer, parameter :: cdofs(5) = [7, 8, 31, 32, 50]
+        integer, parameter :: cdofs(5) = [7, 8, 31, 32, 50], reach(7) = [50, 7, 8, 12, 31, 32, 44]
         type(csc_matrix_t) :: k0, k
         type(bulk_update_t) :: fast
         type(umfpack_t) :: lu
         type(lcg_t) :: rng
-        real(dp) :: b(n), x(n), y(n), log_fast, log_lu
+        real(dp) :: b(n, 3), x(n, 3), y(n, 3), log_fast, log_lu
         integer :: trial, i, s_fast, s_lu, sym, num
         logical :: fixed(n)
         call chain(n, cdofs, k0, k, error)
         if (allocated(error)) return
         fixed = .false.
         fixed(1) = .true.
-        call new_bulk_update(fast, k0, fixed, error)
+        call new_bulk_update(fast, k0, fixed, reach, error)
         if (allocated(error)) return
-        fast%max_kept = max_kept
         call check(error, fast%max_rank >= size(cdofs), 'an update of 5 DOFs is within max_rank')
+        if (allocated(error)) return
+        call check(error, fast%reach(), size(reach), 'the reach ordered last')
         if (allocated(error)) return
         do trial = 1, 3
             call tangent(k0, cdofs(trial:), rng, k)
@@ -233,14 +228,21 @@ contains
             if (allocated(error)) return
             call lu%factor(k, error)
             if (allocated(error)) return
-            b = [(rng%uniform() - 0.5_dp, i=1, n)]
-            b(1) = 0.0_dp
-            call fast%solve(k, b, x, error)
+            b = reshape([(rng%uniform() - 0.5_dp, i=1, 3*n)], [n, 3])
+            b(1, :) = 0.0_dp
+            call fast%solve(k, b(:, 1), x(:, 1), error)
             if (allocated(error)) return
-            call lu%solve(k, b, y, error)
+            call lu%solve(k, b(:, 1), y(:, 1), error)
             if (allocated(error)) return
             ! both backward stable; cond(K) ~ 1e6 (penalty 1e4 against springs of 1)
-            call check(error, maxval(abs(x - y)) <= 1.0e-11_dp*maxval(abs(y)), 'the update solves as LU does')
+            call check(error, maxval(abs(x(:, 1) - y(:, 1))) <= 1.0e-11_dp*maxval(abs(y(:, 1))), &
+                       'the update solves as LU does')
+            if (allocated(error)) return
+            call fast%solve_columns(k, b, x, error)
+            if (allocated(error)) return
+            call lu%solve_columns(k, b, y, error)
+            if (allocated(error)) return
+            call check(error, maxval(abs(x - y)) <= 1.0e-11_dp*maxval(abs(y)), 'three columns as LU solves them')
             if (allocated(error)) return
             call check(error, fast%rank(), size(cdofs(trial:)), 'the update has the contact DOFs')
             if (allocated(error)) return
@@ -255,9 +257,41 @@ contains
         end do
         call fast%factorizations(sym, num)
         call check(error, num, 1, 'K0 factorized once for three tangents')
+    end subroutine test_update_vs_lu
+
+    !> A tangent that differs from K0 on a DOF outside the reach (as a bulk that
+    !> changed would) is factorized whole and solves as UMFPACK does.
+    subroutine test_outside_reach(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: n = 30
+        integer, parameter :: cdofs(3) = [3, 4, 20]
+        type(csc_matrix_t) :: k0, k
+        type(bulk_update_t) :: fast
+        type(umfpack_t) :: lu
+        type(lcg_t) :: rng
+        real(dp) :: b(n), x(n), y(n)
+        integer :: i, sym, num
+        call chain(n, cdofs, k0, k, error)
         if (allocated(error)) return
-        call check(error, fast%known_dofs(), size(cdofs), 'each contact DOF learned once')
-    end subroutine update_vs_lu
+        call new_bulk_update(fast, k0, [(.false., i=1, n)], cdofs(:2), error)
+        if (allocated(error)) return
+        call tangent(k0, cdofs, rng, k)
+        call fast%factor(k, error)
+        if (allocated(error)) return
+        call check(error, fast%rank(), -1, 'factorized whole')
+        if (allocated(error)) return
+        call lu%factor(k, error)
+        if (allocated(error)) return
+        b = [(rng%uniform() - 0.5_dp, i=1, n)]
+        call fast%solve(k, b, x, error)
+        if (allocated(error)) return
+        call lu%solve(k, b, y, error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(x - y)), 0.0_dp, 'the same LU', abs=0.0_dp)
+        if (allocated(error)) return
+        call fast%factorizations(sym, num)
+        call check(error, num, 2, 'K0 and the whole tangent')
+    end subroutine test_outside_reach
 
     !> An update on more DOFs than `max_rank` is factorized whole, and still solves.
     subroutine test_whole(error)
@@ -274,7 +308,7 @@ contains
         call chain(n, cdofs, k0, k, error)
         if (allocated(error)) return
         fixed = .false.
-        call new_bulk_update(fast, k0, fixed, error)
+        call new_bulk_update(fast, k0, fixed, cdofs, error)
         if (allocated(error)) return
         fast%max_rank = 4
         call tangent(k0, cdofs, rng, k)

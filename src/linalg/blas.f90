@@ -9,7 +9,7 @@ module voiga_linalg_blas
     implicit none
     private
 
-    public :: gemm_tn, gemm_nt, warm_up_blas, default_library_threads, library_threads
+    public :: gemm_tn, gemm_nt, triangular_solve, warm_up_blas, default_library_threads, library_threads
     public :: choose_blas_kernels, blas_kernels, kernels_for
     !> The BLAS routine itself, for kernels that pass leading dimensions of sub-blocks.
     public :: dgemm
@@ -32,6 +32,14 @@ module voiga_linalg_blas
             real(dp), intent(in) :: a(lda, *), b(ldb, *)
             real(dp), intent(inout) :: c(ldc, *)
         end subroutine dgemm
+        pure subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
+            import :: dp
+            character(len=1), intent(in) :: side, uplo, transa, diag
+            integer, intent(in) :: m, n, lda, ldb
+            real(dp), intent(in) :: alpha
+            real(dp), intent(in) :: a(lda, *)
+            real(dp), intent(inout) :: b(ldb, *)
+        end subroutine dtrsm
         subroutine c_blas_kernels(buf, len) bind(c, name='voiga_blas_kernels')
             import :: c_int, c_char
             character(kind=c_char), intent(out) :: buf(*)
@@ -55,6 +63,17 @@ module voiga_linalg_blas
     end interface
 
 contains
+
+    !> b := l^-1 b, or l^-T b when `transposed`, for a lower triangular l [m, m]
+    !> (upper triangle not referenced) and b [m, n] (BLAS dtrsm).
+    pure subroutine triangular_solve(l, b, transposed)
+        real(dp), intent(in) :: l(:, :)
+        real(dp), intent(inout) :: b(:, :)
+        logical, intent(in) :: transposed
+        if (size(b, 1) == 0 .or. size(b, 2) == 0) return
+        call dtrsm('L', 'L', merge('T', 'N', transposed), 'N', size(b, 1), size(b, 2), 1.0_dp, l, &
+                   size(l, 1), b, size(b, 1))
+    end subroutine triangular_solve
 
     !> c = beta c + a^T b, with a [k, m], b [k, n], c [m, n] (contiguous arrays).
     pure subroutine gemm_tn(a, b, c, beta)

@@ -4,7 +4,7 @@ module voiga_linalg_lapack
     implicit none
     private
 
-    public :: solve_spd, solve_general, band_factor, lu_factor, lu_solve
+    public :: solve_spd, solve_general, band_factor, lu_factor, lu_solve, triangular_inverse
 
     interface
         pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
@@ -35,6 +35,13 @@ module voiga_linalg_lapack
             real(dp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine dgetrs
+        pure subroutine dtrtri(uplo, diag, n, a, lda, info)
+            import :: dp
+            character(len=1), intent(in) :: uplo, diag
+            integer, intent(in) :: n, lda
+            real(dp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dtrtri
         pure subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
             import :: dp
             integer, intent(in) :: m, n, kl, ku, ldab
@@ -89,6 +96,16 @@ contains
         integer, intent(out) :: info
         call dgetrs('N', size(lu, 1), size(b, 2), lu, max(1, size(lu, 1)), ipiv, b, max(1, size(b, 1)), info)
     end subroutine lu_solve
+
+    !> Inverse of a lower triangular `a` [n, n] in place (LAPACK dtrtri; the upper
+    !> triangle is not referenced). `info` > 0: diagonal entry `info` is zero.
+    pure subroutine triangular_inverse(a, info)
+        real(dp), intent(inout) :: a(:, :)
+        integer, intent(out) :: info
+        info = 0
+        if (size(a, 1) == 0) return
+        call dtrtri('L', 'N', size(a, 1), a, size(a, 1), info)
+    end subroutine triangular_inverse
 
     !> LU factorization with partial pivoting of an n x n band matrix with `kl`
     !> sub- and `ku` superdiagonals (LAPACK dgbtrf). `ab` has shape [2 kl + ku + 1, n]

@@ -17,7 +17,7 @@ module voiga_model
     implicit none
     private
 
-    public :: model_t, new_model, set_prescribed, reference_coordinates, move_obstacles
+    public :: model_t, new_model, set_prescribed, reference_coordinates, move_obstacles, contact_reach
 
     !> Everything the solver needs to know of the physics.
     type :: model_t
@@ -262,5 +262,21 @@ contains
             x0(model%bodies(ib)%dof0 + 1:model%bodies(ib)%dof0 + n) = reshape(model%bodies(ib)%disc%x, [n])
         end do
     end function reference_coordinates
+
+    !> The DOFs contact can couple (ascending, once each): those of every pair's
+    !> slave control points on the contact edge and of all control points of a
+    !> deformable master (whatever part of it the pattern holds now).
+    pure function contact_reach(model) result(dofs)
+        type(model_t), intent(in) :: model
+        integer, allocatable :: dofs(:)
+        logical :: mark(model%ndof)
+        integer :: ip, i
+        mark = .false.
+        do ip = 1, size(model%pairs)
+            mark(model%pairs(ip)%pair%master%all_dofs()) = .true.
+            mark(pack(model%pairs(ip)%pair%slave%dofs, .true.)) = .true.
+        end do
+        dofs = pack([(i, i=1, model%ndof)], mark)
+    end function contact_reach
 
 end module voiga_model

@@ -1,28 +1,29 @@
 !> Direct solves with tangents K = K0 + D whose bulk part K0 never changes: every
 !> body linear-elastic, so only the contact adds to the tangent, and only on the
 !> DOFs C it couples. K0 (the bodies' stiffness, Dirichlet DOFs eliminated) is
-!> LU-factorized once per run, and each tangent is solved through its update
-!> D = K - K0, a low-rank one. With x0 = K0^-1 b and S = (K0^-1)_CC,
+!> Cholesky-factorized once per run, with the DOFs contact can reach, R (C is in
+!> R), ordered last: P K0 P^T = L L^T, and L's trailing block L_RR is theirs. Then
+!> S = (K0^-1)_RR = L_RR^-T L_RR^-1 (dense, order |R|, once per run), and with
+!> w = L^-1 P b, x0_C = (L_RR^-T w_R)_C,
 !>
-!>     (I + S D_CC) y = x0_C,    x = K0^-1 (b - E D_CC y)        (y = x_C)
+!>     (I + S_CC D_CC) y = x0_C,    x = P^T L^-T (w - [0; L_RR^-1 E D_CC y])
 !>
 !> solves K x = b exactly in exact arithmetic (Woodbury's identity in the form that
-!> needs no inverse of D, which is singular wherever a contact point is inactive).
-!> S is kept over the run for every DOF that was ever in C: a DOF entering C costs
-!> one solve with K0 and one with K0^T (its column and its row of K0^-1); a
-!> tangent then costs a dense LU of order |C|, and a solve two solves with K0.
+!> needs no inverse of D, which is singular wherever a contact point is inactive):
+!> a tangent costs a dense LU of order |C|, a solve one solve with K0 and two
+!> triangular solves of order |R|. No column of K0^-1 is solved for.
 !>
 !> D is found entry by entry as K - K0 on the tangent's pattern, so the path is
-!> exact whatever the caller assembled: where the bulk part does change after all
-!> (a body that is not linear, another Dirichlet set), C grows until the dense
-!> work would cost more than a sparse LU of K, and K is then factorized whole.
+!> exact whatever the caller assembled: where it differs outside R (a body that is
+!> not linear after all, another Dirichlet set) or on more DOFs than the dense work
+!> pays for, K is factorized whole.
 module voiga_solver_bulk_update
     use, intrinsic :: iso_c_binding, only: c_int
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str, real_str
-    use voiga_linalg_lapack, only: lu_factor, lu_solve
-    use voiga_linalg_blas, only: dgemm
+    use voiga_linalg_lapack, only: lu_factor, lu_solve, triangular_inverse
+    use voiga_linalg_blas, only: dgemm, triangular_solve
     use voiga_solver_sparse, only: csc_matrix_t, pattern_positions
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     use voiga_solver_umfpack, only: umfpack_t
@@ -44,9 +45,6 @@ module voiga_solver_bulk_update
     !> megaflop, costs less than a millisecond whatever a sparse LU would.
     integer, parameter :: min_rank = 64
 
-    !> Columns of K0^-1 learned per multi-column solve (bounds the work arrays, n x this).
-    integer, parameter :: learn_block = 64
-
     !> K0 counts as symmetric when max |K0 - K0^T| <= this x max |K0| (rounding of
     !> the element integrals: each element matrix is symmetric but summed in the
     !> floating-point order of its loops); then K0^-1's rows are its columns.
@@ -58,9 +56,6 @@ module voiga_solver_bulk_update
         !> 8/3 m^3 flops, cost at most a numeric factorization of K0 (CHOLMOD's flop
         !> count; an LU of the whole tangent costs more), and at least `min_rank`.
         integer :: max_rank = 0
-        !> Most values of the whole columns of K0^-1 kept (default 2^24: 128 MiB;
-        !> hertz m4 NN2.2 keeps 171 columns of 7540, 1.3e6).
-        real(dp) :: max_kept = 2.0_dp**24
         !> The bulk stiffness on its own pattern, its Cholesky factor, and the LU of a whole tangent.
         type(csc_matrix_t), private :: k0
         type(cholmod_t), private :: chol
@@ -70,16 +65,12 @@ module voiga_solver_bulk_update
         !> K0's values on the pattern of the last tangent [nnz], and that pattern [n+1], [nnz].
         real(dp), allocatable, private :: base(:)
         integer(c_int), allocatable, private :: colptr(:), rowind(:)
-        !> DOFs whose rows and columns of K0^-1 are known, the first `ns` of `known`;
-        !> `slot(dof)`: position among them (0: none), shape [n].
-        integer, allocatable, private :: known(:), slot(:)
-        integer, private :: ns = 0
-        !> s(p, q) = K0^-1(known(p), known(q)); shape: [capacity, capacity].
-        real(dp), allocatable, private :: s(:, :)
-        !> z(:, q) = K0^-1 e_known(q), the whole columns, kept while they fit in
-        !> `max_kept` (then a solve needs one solve with K0, else two); shape: [n, capacity].
-        real(dp), allocatable, private :: z(:, :)
-        !> The update of the last tangent: C [m], D_CC [m, m], the LU of I + S_CC D_CC [m, m] and its pivots.
+        !> perm(k): the DOF at position k of the factor [n] (R: its last m);
+        !> at(dof): the DOF's position within R, 0 outside it [n].
+        integer, allocatable, private :: perm(:), at(:)
+        !> L_RR and S = (K0^-1)_RR; shapes [m, m].
+        real(dp), allocatable, private :: l_rr(:, :), s(:, :)
+        !> The update of the last tangent: C [k], D_CC [k, k], the LU of I + S_CC D_CC [k, k] and its pivots.
         integer, allocatable, private :: c(:), piv(:)
         real(dp), allocatable, private :: d(:, :), lu(:, :)
         integer, private :: sign_m = 0
@@ -91,24 +82,27 @@ module voiga_solver_bulk_update
         procedure :: has_determinant => bulk_has_determinant
         procedure :: determinant => bulk_determinant
         procedure :: factorizations => bulk_factorizations
-        !> |C| of the last tangent (-1: it was factorized whole) and the DOFs of K0^-1 known.
+        !> |C| of the last tangent (-1: it was factorized whole) and |R|.
         procedure :: rank => bulk_rank
-        procedure :: known_dofs => bulk_known_dofs
+        procedure :: reach => bulk_reach
     end type bulk_update_t
 
 contains
 
     !> Set up with the bulk stiffness `k0` (its values are those every tangent
-    !> starts from; Dirichlet DOFs `fixed` [n] eliminated here) and factorize it.
+    !> starts from; Dirichlet DOFs `fixed` [n] eliminated here) and the DOFs contact
+    !> can couple, `reach` (distinct); factorize it with them last and form S.
     !> K0 must be symmetric (to `symmetric_tol`) and positive definite, else an
     !> error with code `numeric`: the caller then factorizes whole tangents (a body
     !> that only contact holds in place has a singular K0).
-    subroutine new_bulk_update(self, k0, fixed, error)
+    subroutine new_bulk_update(self, k0, fixed, reach, error)
         type(bulk_update_t), intent(out) :: self
         type(csc_matrix_t), intent(in) :: k0
         logical, intent(in) :: fixed(:)
+        integer, intent(in) :: reach(:)
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: rel
+        integer :: m, k
         self%k0 = k0
         call self%k0%fix_dofs(fixed)
         rel = asymmetry(self%k0)
@@ -117,7 +111,7 @@ contains
                              real_str(rel, 'es9.2')//')', error_code%numeric)
             return
         end if
-        call self%chol%factor(self%k0, error)
+        call self%chol%factor_last(self%k0, reach, error)
         if (allocated(error)) return
         if (self%chol%rcond < singular_rcond) then
             call fatal_error(error, 'the bulk stiffness is singular (CHOLMOD''s reciprocal condition estimate '// &
@@ -125,10 +119,33 @@ contains
             return
         end if
         self%max_rank = max(min_rank, floor((3.0_dp*self%chol%flops/8.0_dp)**(1.0_dp/3.0_dp)))
-        allocate (self%slot(k0%n), source=0)
-        allocate (self%known(0), self%s(0, 0), self%z(k0%n, 0), self%c(0), self%piv(0), self%d(0, 0), &
-                  self%lu(0, 0))
+        m = size(reach)
+        self%perm = self%chol%permutation()
+        allocate (self%at(k0%n), source=0)
+        self%at(self%perm(k0%n - m + 1:)) = [(k, k=1, m)]
+        call reach_inverse(self, m, error)
+        allocate (self%c(0), self%piv(0), self%d(0, 0), self%lu(0, 0))
     end subroutine new_bulk_update
+
+    !> L_RR from the factor, and S = L_RR^-T L_RR^-1.
+    subroutine reach_inverse(self, m, error)
+        type(bulk_update_t), intent(inout) :: self
+        integer, intent(in) :: m
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: inv(:, :)
+        integer :: info
+        call self%chol%trailing(m, self%l_rr, error)
+        if (allocated(error)) return
+        inv = self%l_rr
+        call triangular_inverse(inv, info)
+        if (info /= 0) then
+            call fatal_error(error, 'the bulk stiffness''s factor is singular (pivot '//str(info)//')', &
+                             error_code%numeric)
+            return
+        end if
+        allocate (self%s(m, m))
+        if (m > 0) call dgemm('T', 'N', m, m, m, 1.0_dp, inv, m, inv, m, 0.0_dp, self%s, m)
+    end subroutine reach_inverse
 
     !> Prepare solves with the tangent `a`: find its update D = a - K0, learn the
     !> rows and columns of K0^-1 of the DOFs new to C, factorize I + S_CC D_CC; or,
@@ -143,6 +160,7 @@ contains
         if (allocated(error)) return
         self%c = update_dofs(a, self%base)
         self%whole = size(self%c) > self%max_rank
+        if (.not. self%whole) self%whole = any(self%at(self%c) == 0)
         if (self%whole) then
             call self%full%factor(a, error)
             return
@@ -150,8 +168,6 @@ contains
         self%sign_m = 1
         self%log_m = 0.0_dp
         if (size(self%c) == 0) return
-        call learn(self, self%c, error)
-        if (allocated(error)) return
         call update_matrix(self, a)
         if (allocated(self%piv)) deallocate (self%piv)
         allocate (self%piv(size(self%c)))
@@ -216,90 +232,30 @@ contains
         c = pack([(i, i=1, a%n)], mark)
     end function update_dofs
 
-    !> Learn the columns of K0^-1 of the DOFs of `c` not yet known, `learn_block`
-    !> at a time (K0 is symmetric: they are its rows too). When the known set would
-    !> outgrow four times `max_rank`, or its matrix S `max_kept` values, it is started
-    !> again from `c`.
-    subroutine learn(self, c, error)
-        type(bulk_update_t), intent(inout) :: self
-        integer, intent(in) :: c(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: new(:)
-        real(dp), allocatable :: e(:, :), x(:, :), grown(:, :)
-        integer :: k, k1, nb, q0, cap, limit
-
-        new = pack(c, self%slot(c) == 0)
-        if (size(new) == 0) return
-        limit = min(4*self%max_rank, floor(sqrt(self%max_kept)))
-        if (self%ns + size(new) > limit) then
-            self%slot(self%known(:self%ns)) = 0
-            self%ns = 0
-            new = c
-        end if
-        cap = size(self%s, 1)
-        if (self%ns + size(new) > cap) then
-            cap = max(min(2*cap, limit), self%ns + size(new))
-            allocate (grown(cap, cap), source=0.0_dp)
-            grown(:self%ns, :self%ns) = self%s(:self%ns, :self%ns)
-            call move_alloc(grown, self%s)
-            self%known = [self%known(:self%ns), [(0, k=self%ns + 1, cap)]]
-            if (allocated(self%z)) call grow_columns(self%z, self%ns, cap, self%max_kept)
-        end if
-        do k1 = 1, size(new), learn_block
-            nb = min(learn_block, size(new) - k1 + 1)
-            allocate (e(self%k0%n, nb), x(self%k0%n, nb), source=0.0_dp)
-            q0 = self%ns
-            do k = 1, nb
-                e(new(k1 + k - 1), k) = 1.0_dp
-                self%known(q0 + k) = new(k1 + k - 1)
-                self%slot(new(k1 + k - 1)) = q0 + k
-            end do
-            call self%chol%solve_columns(self%k0, e, x, error)
-            if (allocated(error)) return
-            self%ns = q0 + nb
-            if (allocated(self%z)) self%z(:, q0 + 1:self%ns) = x
-            self%s(:self%ns, q0 + 1:self%ns) = x(self%known(:self%ns), :)
-            self%s(q0 + 1:self%ns, :q0) = transpose(self%s(:q0, q0 + 1:self%ns))
-            deallocate (e, x)
-        end do
-    end subroutine learn
-
-    !> Room for `cap` columns of which the first `ns` are kept; none at all (the
-    !> array deallocated) beyond `max_kept` values.
-    pure subroutine grow_columns(z, ns, cap, max_kept)
-        real(dp), allocatable, intent(inout) :: z(:, :)
-        integer, intent(in) :: ns, cap
-        real(dp), intent(in) :: max_kept
-        real(dp), allocatable :: grown(:, :)
-        if (real(size(z, 1), dp)*real(cap, dp) > max_kept) then
-            deallocate (z)
-            return
-        end if
-        allocate (grown(size(z, 1), cap))
-        grown(:, :ns) = z(:, :ns)
-        call move_alloc(grown, z)
-    end subroutine grow_columns
-
     !> D_CC from the tangent `a` and the matrix I + S_CC D_CC to factorize.
     subroutine update_matrix(self, a)
         type(bulk_update_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         integer, allocatable :: at(:), idx(:)
+        real(dp) :: v
         integer :: m, q, p, i
         m = size(self%c)
         allocate (at(a%n), source=0)
         at(self%c) = [(q, q=1, m)]
+        idx = self%at(self%c)
         if (allocated(self%d)) deallocate (self%d)
-        allocate (self%d(m, m), source=0.0_dp)
+        if (allocated(self%lu)) deallocate (self%lu)
+        allocate (self%d(m, m), self%lu(m, m), source=0.0_dp)
+        ! S_CC D_CC column by column from D's nonzeros (a contact element couples a
+        ! few neighbouring DOFs: some 12 per column, against |C| for a dense product)
         do q = 1, m
             do p = a%colptr(self%c(q)) + 1, a%colptr(self%c(q) + 1)
                 i = at(a%rowind(p) + 1)
-                if (i > 0) self%d(i, q) = a%values(p) - self%base(p)
+                if (i == 0) cycle
+                v = a%values(p) - self%base(p)
+                self%d(i, q) = v
+                if (v /= 0.0_dp) self%lu(:, q) = self%lu(:, q) + v*self%s(idx, idx(i))
             end do
-        end do
-        idx = self%slot(self%c)
-        self%lu = matmul(self%s(idx, idx), self%d)
-        do q = 1, m
             self%lu(q, q) = self%lu(q, q) + 1.0_dp
         end do
     end subroutine update_matrix
@@ -365,43 +321,55 @@ contains
         call solve_one_column(self, a, b, x, error)
     end subroutine bulk_solve
 
-    !> Solve a X = B (shapes [n, nrhs]): X0 = K0^-1 B, (I + S D) Y = X0_C,
-    !> X = X0 - K0^-1 E D Y (from the kept columns of K0^-1, else by a second
-    !> solve), each solve with K0 for all columns at once.
+    !> Solve a X = B (shapes [n, nrhs]): W = L^-1 P B, (I + S D) Y = (L_RR^-T W_R)_C,
+    !> X = P^T L^-T (W - [0; L_RR^-1 E D Y]), each solve with L for all columns at once.
     subroutine bulk_solve_columns(self, a, b, x, error)
         class(bulk_update_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         real(dp), intent(in) :: b(:, :)
         real(dp), intent(out) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: y(:, :), rhs(:, :), w(:, :)
-        integer :: info
+        real(dp), allocatable :: w(:, :), t(:, :)
+        integer :: r0
 
         if (self%whole) then
             call self%full%solve_columns(a, b, x, error)
             return
         end if
-        call self%chol%solve_columns(self%k0, b, x, error)
-        if (allocated(error) .or. size(self%c) == 0) return
-        y = x(self%c, :)
+        allocate (w, mold=b)
+        call self%chol%forward(b(self%perm, :), w, error)
+        if (allocated(error)) return
+        r0 = size(w, 1) - size(self%l_rr, 1)
+        if (size(self%c) > 0) then
+            call reach_correction(self, w(r0 + 1:, :), error)
+            if (allocated(error)) return
+        end if
+        allocate (t, mold=b)
+        call self%chol%backward(w, t, error)
+        if (allocated(error)) return
+        x(self%perm, :) = t
+    end subroutine bulk_solve_columns
+
+    !> W_R := W_R - L_RR^-1 E D Y with (I + S D) Y = (L_RR^-T W_R)_C (`w_r`: [m, nrhs]).
+    subroutine reach_correction(self, w_r, error)
+        type(bulk_update_t), intent(in) :: self
+        real(dp), intent(inout) :: w_r(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: z(:, :), y(:, :)
+        integer :: info
+        z = w_r
+        call triangular_solve(self%l_rr, z, transposed=.true.)
+        y = z(self%at(self%c), :)
         call lu_solve(self%lu, self%piv, y, info)
         if (info /= 0) then
             call fatal_error(error, 'bulk update: dense solve failed (info '//str(info)//')')
             return
         end if
-        if (allocated(self%z)) then
-            ! K0^-1 E (D y) from the kept columns: one product with all of them, D y
-            ! scattered to their slots (zeros for the known DOFs outside C)
-            allocate (w(self%ns, size(x, 2)), source=0.0_dp)
-            w(self%slot(self%c), :) = matmul(self%d, y)
-            call dgemm('N', 'N', size(x, 1), size(x, 2), self%ns, -1.0_dp, self%z, size(self%z, 1), &
-                       w, self%ns, 1.0_dp, x, size(x, 1))
-            return
-        end if
-        rhs = b
-        rhs(self%c, :) = rhs(self%c, :) - matmul(self%d, y)
-        call self%chol%solve_columns(self%k0, rhs, x, error)
-    end subroutine bulk_solve_columns
+        z = 0.0_dp
+        z(self%at(self%c), :) = matmul(self%d, y)
+        call triangular_solve(self%l_rr, z, transposed=.false.)
+        w_r = w_r - z
+    end subroutine reach_correction
 
     pure logical function bulk_has_determinant(self)
         class(bulk_update_t), intent(in) :: self
@@ -435,9 +403,9 @@ contains
         m = merge(-1, size(self%c), self%whole)
     end function bulk_rank
 
-    pure integer function bulk_known_dofs(self) result(n)
+    pure integer function bulk_reach(self) result(n)
         class(bulk_update_t), intent(in) :: self
-        n = self%ns
-    end function bulk_known_dofs
+        n = size(self%l_rr, 1)
+    end function bulk_reach
 
 end module voiga_solver_bulk_update

@@ -90,49 +90,94 @@ static double log10_determinant(const cholmod_factor *f)
     return logdet;
 }
 
+/* The lower triangle of the n x n CSC matrix (0-based) as a CHOLMOD matrix (stype -1). */
+static cholmod_sparse *lower_triangle(int n, const int *colptr, const int *rowind, const double *values,
+                                      cholmod_common *common)
+{
+    cholmod_sparse *a;
+    int j, k, nnz = 0, q = 0, *ap, *ai;
+    double *ax;
+    for (j = 0; j < n; j++)
+        for (k = colptr[j]; k < colptr[j + 1]; k++)
+            if (rowind[k] >= j) nnz++;
+    a = cholmod_allocate_sparse(n, n, nnz, 1, 1, -1, CHOLMOD_REAL, common);
+    if (!a) return NULL;
+    ap = (int *)a->p;
+    ai = (int *)a->i;
+    ax = (double *)a->x;
+    for (j = 0; j < n; j++) {
+        ap[j] = q;
+        for (k = colptr[j]; k < colptr[j + 1]; k++)
+            if (rowind[k] >= j) {
+                ai[q] = rowind[k];
+                ax[q++] = values[k];
+            }
+    }
+    ap[n] = q;
+    return a;
+}
+
+/* The symbolic analysis of a with the nlast DOFs `last` (0-based, distinct) ordered
+ * after all others: CAMD's fill-reducing ordering with two constraint sets, taken
+ * as given (not postordered, which could interleave the sets). NULL when CAMD or the analysis fails, or the ordering
+ * does not end with `last`. */
+static cholmod_factor *analyze_last(cholmod_sparse *a, int nlast, const int *last, cholmod_common *common)
+{
+    int n = (int)a->nrow, k, ok = 1;
+    int *cmember = calloc((size_t)n, sizeof(int)), *perm = malloc((size_t)n * sizeof(int));
+    cholmod_factor *f = NULL;
+    if (cmember && perm) {
+        for (k = 0; k < nlast; k++) cmember[last[k]] = 1;
+        if (cholmod_camd(a, NULL, 0, cmember, perm, common)) {
+            common->nmethods = 1;
+            common->method[0].ordering = CHOLMOD_GIVEN;
+            common->postorder = 0;
+            f = cholmod_analyze_p(a, perm, NULL, 0, common);
+        }
+    }
+    if (f) {
+        const int *p = (const int *)f->Perm;
+        for (k = n - nlast; k < n; k++) ok = ok && cmember[p[k]] == 1;
+        if (!ok) cholmod_free_factor(&f, common);
+    }
+    free(cmember);
+    free(perm);
+    return f;
+}
+
 /* Cholesky factorization of the symmetric n x n matrix whose lower triangle is
  * given in CSC form (0-based colptr [n+1], rowind, values; entries above the
- * diagonal are ignored). On success *handle owns the factor; *flops is the
- * factorization's flop count, *log10_det log10 det A and *rcond CHOLMOD's
- * reciprocal condition estimate, (min / max diagonal of L)^2. */
-int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const double *values, void **handle,
-                         double *flops, double *log10_det, double *rcond)
+ * diagonal are ignored). With nlast > 0, the DOFs `last` [nlast] (0-based) come
+ * last in the fill-reducing ordering, so the trailing nlast x nlast block of L is
+ * theirs (voiga_cholmod_trailing); the status is -2 when that ordering fails. On
+ * success *handle owns the factor; *flops is the factorization's flop count,
+ * *log10_det log10 det A and *rcond CHOLMOD's reciprocal condition estimate,
+ * (min / max diagonal of L)^2. */
+int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const double *values, int nlast,
+                         const int *last, void **handle, double *flops, double *log10_det, double *rcond)
 {
     voiga_cholmod *h;
     cholmod_sparse *a;
-    int j, k, nnz = 0, status, levels;
+    int status, levels;
     *handle = NULL;
     h = calloc(1, sizeof *h);
     if (!h) return -1;
     cholmod_start(&h->common);
     h->common.print = 0;
     h->common.error_handler = NULL;
+    /* always L L^T, which the forward and backward solves (sys 1, 2) and
+     * voiga_cholmod_trailing take the factor to be */
+    h->common.supernodal = CHOLMOD_SUPERNODAL;
     h->n = n;
-    for (j = 0; j < n; j++)
-        for (k = colptr[j]; k < colptr[j + 1]; k++)
-            if (rowind[k] >= j) nnz++;
-    a = cholmod_allocate_sparse(n, n, nnz, 1, 1, -1, CHOLMOD_REAL, &h->common);
+    a = lower_triangle(n, colptr, rowind, values, &h->common);
     if (!a) {
         cholmod_finish(&h->common);
         free(h);
         return -1;
     }
-    {
-        int *ap = (int *)a->p, *ai = (int *)a->i, q = 0;
-        double *ax = (double *)a->x;
-        for (j = 0; j < n; j++) {
-            ap[j] = q;
-            for (k = colptr[j]; k < colptr[j + 1]; k++)
-                if (rowind[k] >= j) {
-                    ai[q] = rowind[k];
-                    ax[q++] = values[k];
-                }
-        }
-        ap[n] = q;
-    }
     levels = serial_begin();
-    h->factor = cholmod_analyze(a, &h->common);
-    status = h->factor ? 0 : -1;
+    h->factor = nlast > 0 ? analyze_last(a, nlast, last, &h->common) : cholmod_analyze(a, &h->common);
+    status = h->factor ? 0 : (nlast > 0 ? -2 : -1);
     if (status == 0 && !cholmod_factorize(a, h->factor, &h->common)) status = -1;
     serial_end(levels);
     if (status == 0 && (h->common.status == CHOLMOD_NOT_POSDEF || h->factor->minor < (size_t)n)) status = 1;
@@ -151,18 +196,50 @@ int voiga_cholmod_factor(int n, const int *colptr, const int *rowind, const doub
     return 0;
 }
 
-/* Solve A X = B for nrhs right-hand sides (B, X: n x nrhs, column-major). */
-int voiga_cholmod_solve(void *handle, int nrhs, const double *b, double *x)
+/* The fill-reducing ordering: position k of the factor holds DOF perm[k] (0-based, [n]). */
+void voiga_cholmod_perm(void *handle, int *perm)
 {
+    voiga_cholmod *h = handle;
+    memcpy(perm, h->factor->Perm, (size_t)h->n * sizeof(int));
+}
+
+/* The trailing m x m block of L (column-major, lower triangle; zeros above) of a
+ * supernodal factor; returns -1 for a simplicial one. */
+int voiga_cholmod_trailing(void *handle, int m, double *l)
+{
+    voiga_cholmod *h = handle;
+    const cholmod_factor *f = h->factor;
+    const int *super = (const int *)f->super, *pi = (const int *)f->pi, *px = (const int *)f->px;
+    const int *rows = (const int *)f->s;
+    const double *x = (const double *)f->x;
+    int n0 = h->n - m, s, k, i;
+    if (!f->is_super) return -1;
+    memset(l, 0, (size_t)m * (size_t)m * sizeof(double));
+    for (s = 0; s < (int)f->nsuper; s++) {
+        int k1 = super[s], k2 = super[s + 1], nsrow = pi[s + 1] - pi[s];
+        if (k2 <= n0) continue;
+        for (k = k1 > n0 ? k1 : n0; k < k2; k++)
+            for (i = k - k1; i < nsrow; i++)
+                l[(rows[pi[s] + i] - n0) + (size_t)(k - n0) * m] = x[px[s] + i + (size_t)(k - k1) * nsrow];
+    }
+    return 0;
+}
+
+/* Solve for nrhs right-hand sides (B, X: n x nrhs, column-major): sys 0 A X = B,
+ * 1 L X = B, 2 L^T X = B (L of the permuted matrix: no permutation applied). */
+int voiga_cholmod_solve(void *handle, int sys, int nrhs, const double *b, double *x)
+{
+    static const int systems[3] = {CHOLMOD_A, CHOLMOD_L, CHOLMOD_Lt};
     voiga_cholmod *h = handle;
     cholmod_dense *bd, *xd;
     size_t size = (size_t)h->n * (size_t)nrhs;
     int levels;
+    if (sys < 0 || sys > 2) return -1;
     bd = cholmod_allocate_dense(h->n, nrhs, h->n, CHOLMOD_REAL, &h->common);
     if (!bd) return -1;
     memcpy(bd->x, b, size * sizeof(double));
     levels = serial_begin();
-    xd = cholmod_solve(CHOLMOD_A, h->factor, bd, &h->common);
+    xd = cholmod_solve(systems[sys], h->factor, bd, &h->common);
     serial_end(levels);
     cholmod_free_dense(&bd, &h->common);
     if (!xd) return -1;

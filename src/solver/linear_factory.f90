@@ -1,7 +1,7 @@
 !> The linear solver a case names (`&solver linear_solver`), built once per run.
 module voiga_solver_linear_factory
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t
+    use voiga_model, only: model_t, contact_reach
     use voiga_model_assembly, only: bulk_stiffness
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t
@@ -62,7 +62,7 @@ contains
         allocate (bulk_update_t :: solver)
         select type (solver)
         type is (bulk_update_t)
-            call new_bulk_update(solver, k0, model%fixed, error)
+            call new_bulk_update(solver, k0, model%fixed, contact_reach(model), error)
         end select
         if (allocated(error)) deallocate (solver)
     end subroutine bulk_solver
