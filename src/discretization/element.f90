@@ -7,7 +7,7 @@ module voiga_discretization_element
     implicit none
     private
 
-    public :: element_basis, element_nfun
+    public :: element_basis, element_basis_grid, element_nfun
 
 contains
 
@@ -29,45 +29,109 @@ contains
         real(dp), intent(out) :: r(:), dr(:, :)
         !> Optional: second derivatives are only computed when asked for.
         real(dp), intent(out), optional :: d2r(:, :)
-        real(dp) :: bx(3, disc%bulk%degree(1) + 1), be(3, disc%bulk%degree(2) + 1)
-        real(dp), allocatable :: bl(:, :), d2b(:, :), d2rl(:, :)
-        real(dp) :: b(size(r)), db(2, size(r)), w(size(r))
-        integer :: p, q, i, j, a, nrow, k, ql, nd
+        real(dp) :: fx(3, xi_count(disc, e)), fe(3, disc%bulk%degree(2) + 1)
+        real(dp), allocatable :: d2rl(:, :)
+        integer :: nd
+        nd = merge(2, 1, present(d2r))
+        call xi_functions(disc, e, xi, nd, fx)
+        call eta_functions(disc, e, eta, nd, fe)
+        allocate (d2rl(3*(nd - 1), size(r)))
+        call combine(disc, e, fx, fe, nd, r, dr, d2rl)
+        if (present(d2r)) d2r = d2rl
+    end subroutine element_basis
 
+    !> `element_basis` (values and first derivatives) at the tensor grid of points
+    !> (xi(i), eta(j)), point k = i + (j - 1) size(xi): the same numbers, with each
+    !> univariate basis evaluated once per coordinate instead of once per point
+    !> (the quadrature data of a body: `voiga_model_body`). Shapes: `r` [nfun, npts],
+    !> `dr` [2, nfun, npts].
+    pure subroutine element_basis_grid(disc, e, xi, eta, r, dr)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: e
+        real(dp), intent(in) :: xi(:), eta(:)
+        real(dp), intent(out) :: r(:, :), dr(:, :, :)
+        real(dp) :: fx(3, xi_count(disc, e), size(xi)), fe(3, disc%bulk%degree(2) + 1, size(eta))
+        real(dp) :: none(0, size(r, 1))
+        integer :: i, j
+        do i = 1, size(xi)
+            call xi_functions(disc, e, xi(i), 1, fx(:, :, i))
+        end do
+        do j = 1, size(eta)
+            call eta_functions(disc, e, eta(j), 1, fe(:, :, j))
+        end do
+        do j = 1, size(eta)
+            do i = 1, size(xi)
+                associate (k => i + (j - 1)*size(xi))
+                    call combine(disc, e, fx(:, :, i), fe(:, :, j), 1, r(:, k), dr(:, :, k), none)
+                end associate
+            end do
+        end do
+    end subroutine element_basis_grid
+
+    !> How many univariate functions of xi element `e` has: the bulk's p + 1 and,
+    !> in a VO element, the layer's.
+    pure integer function xi_count(disc, e) result(n)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: e
+        n = disc%bulk%degree(1) + 1
+        if (disc%elements(e)%span_layer > 0) n = n + disc%layer%degree + 1
+    end function xi_count
+
+    !> The xi functions of element `e` at `xi` and their `nd` derivatives, rows
+    !> 1..nd+1 of `fx` [3, xi_count] (the rest zero): the bulk's, then the layer's.
+    pure subroutine xi_functions(disc, e, xi, nd, fx)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: e, nd
+        real(dp), intent(in) :: xi
+        real(dp), intent(out) :: fx(:, :)
+        integer :: p
+        associate (el => disc%elements(e))
+            p = disc%bulk%degree(1)
+            fx = 0.0_dp
+            fx(1:nd + 1, :p + 1) = basis_ders(disc%bulk%knots_xi, p, el%span_xi, xi, nd)
+            if (el%span_layer > 0) fx(1:nd + 1, p + 2:) = &
+                basis_ders(disc%layer%knots, disc%layer%degree, el%span_layer, xi, nd)
+        end associate
+    end subroutine xi_functions
+
+    !> The bulk's eta functions of element `e` at `eta`, as `xi_functions` ([3, q + 1]).
+    pure subroutine eta_functions(disc, e, eta, nd, fe)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: e, nd
+        real(dp), intent(in) :: eta
+        real(dp), intent(out) :: fe(:, :)
+        fe = 0.0_dp
+        fe(1:nd + 1, :) = basis_ders(disc%bulk%knots_eta, disc%bulk%degree(2), disc%elements(e)%span_eta, eta, nd)
+    end subroutine eta_functions
+
+    !> The NURBS functions of element `e` from its univariate ones: bulk tensor
+    !> products, and in a VO element the layer functions times the last eta
+    !> function M_m instead of that function's bulk products; then rationalized.
+    pure subroutine combine(disc, e, fx, fe, nd, r, dr, d2r)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: e, nd
+        real(dp), intent(in) :: fx(:, :), fe(:, :)
+        real(dp), intent(out) :: r(:), dr(:, :), d2r(:, :)
+        real(dp) :: b(size(r)), db(2, size(r)), d2b(3*(nd - 1), size(r))
+        integer :: p, q, i, j, a, nrow
         associate (el => disc%elements(e))
             p = disc%bulk%degree(1)
             q = disc%bulk%degree(2)
-            nd = merge(2, 1, present(d2r))
-            bx = 0.0_dp
-            be = 0.0_dp
-            bx(1:nd + 1, :) = basis_ders(disc%bulk%knots_xi, p, el%span_xi, xi, nd)
-            be(1:nd + 1, :) = basis_ders(disc%bulk%knots_eta, q, el%span_eta, eta, nd)
-            allocate (d2b(3*(nd - 1), size(r)), d2rl(3*(nd - 1), size(r)))
-            ! bulk tensor products; in a VO element the last eta function is left out
             nrow = merge(q, q + 1, el%span_layer > 0)
             a = 0
             do j = 1, nrow
                 do i = 1, p + 1
                     a = a + 1
-                    call tensor(bx(:, i), be(:, j), b(a), db(:, a), d2b(:, a), nd)
+                    call tensor(fx(:, i), fe(:, j), b(a), db(:, a), d2b(:, a), nd)
                 end do
             end do
-            if (el%span_layer > 0) then
-                ! layer functions times the last eta function M_m
-                ql = disc%layer%degree
-                allocate (bl(3, ql + 1))
-                bl = 0.0_dp
-                bl(1:nd + 1, :) = basis_ders(disc%layer%knots, ql, el%span_layer, xi, nd)
-                do k = 1, ql + 1
-                    a = a + 1
-                    call tensor(bl(:, k), be(:, q + 1), b(a), db(:, a), d2b(:, a), nd)
-                end do
-            end if
-            w = disc%w(el%conn)
+            do i = p + 2, size(fx, 2)
+                a = a + 1
+                call tensor(fx(:, i), fe(:, q + 1), b(a), db(:, a), d2b(:, a), nd)
+            end do
+            call rationalize(disc%w(el%conn), b, db, d2b, r, dr, d2r)
         end associate
-        call rationalize(w, b, db, d2b, r, dr, d2rl)
-        if (present(d2r)) d2r = d2rl
-    end subroutine element_basis
+    end subroutine combine
 
     !> Product of univariate functions f(xi) g(eta) and its derivatives.
     pure subroutine tensor(f, g, b, db, d2b, nd)

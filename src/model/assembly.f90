@@ -357,19 +357,29 @@ contains
         end do
     end function refit_contact_ranges
 
-    !> The stiffness of the bodies alone, on a pattern without contact couplings,
-    !> at u = 0: for linear-elastic bodies, the bulk part of every tangent, the same
-    !> numbers as `assemble` adds (the same elements summed in the same order).
-    subroutine bulk_stiffness(model, k, error)
+    !> The stiffness of the bodies alone at u = 0, `k0`, on a pattern without
+    !> contact couplings: for linear-elastic bodies, the bulk part of every tangent.
+    !> It is assembled into the tangent `k` with `map` (the same elements summed in
+    !> the same order as `assemble` does), so that with `map%keep_linear` the
+    !> linear bodies' stiffness is kept there and the first assembly of the loop
+    !> does not integrate them again; `k`'s values are then those of k0. The
+    !> quadrature points and time count in `stats`.
+    subroutine bulk_stiffness(model, k, map, k0, stats, error)
         type(model_t), intent(in) :: model
-        type(csc_matrix_t), intent(out) :: k
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(inout) :: map
+        type(csc_matrix_t), intent(out) :: k0
+        type(assembly_stats_t), intent(inout) :: stats
         type(error_t), allocatable, intent(out) :: error
-        type(assembly_stats_t) :: stats
         real(dp), allocatable :: u(:), r(:)
-        call stiffness_pattern(model, k, error, contact=.false.)
-        if (allocated(error)) return
+        integer, allocatable :: pos(:)
         allocate (u(model%ndof), r(model%ndof), source=0.0_dp)
-        call assemble_bulk(model, u, 0.0_dp, r, stats, error, k)
+        call assemble_bulk(model, u, 0.0_dp, r, stats, error, k, map)
+        if (allocated(error)) return
+        call stiffness_pattern(model, k0, error, contact=.false.)
+        if (allocated(error)) return
+        call pattern_positions(k0, k, pos)
+        k0%values = k%values(pos)
     end subroutine bulk_stiffness
 
     !> The bulk part of `assemble`: every element's internal force and tangent, and

@@ -8,7 +8,7 @@ module voiga_model_body
     use voiga_material_factory, only: new_material
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t
-    use voiga_discretization_element, only: element_basis, element_nfun
+    use voiga_discretization_element, only: element_basis_grid, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: element_points_t, reference_gradients
     implicit none
@@ -77,28 +77,29 @@ contains
     !> it; call it again after changing the body's reference control points.
     pure subroutine body_points(body)
         type(body_t), intent(inout) :: body
-        real(dp), allocatable :: r(:), dr(:, :), x0(:, :)
-        real(dp) :: xi, eta, det, hx, he
-        integer :: e, i, j, q, nen
+        real(dp), allocatable :: r(:, :), dr(:, :, :), x0(:, :), xis(:), etas(:)
+        real(dp) :: det, hx, he
+        integer :: e, i, j, q, nen, npts
 
         if (allocated(body%points)) deallocate (body%points)
         allocate (body%points(body%disc%nel))
+        npts = size(body%gx)*size(body%ge)
         do e = 1, body%disc%nel
             associate (el => body%disc%elements(e), pts => body%points(e))
                 nen = element_nfun(body%disc, e)
-                allocate (r(nen), dr(2, nen))
+                allocate (r(nen, npts), dr(2, nen, npts))
                 x0 = body%disc%x(:, el%conn)
-                allocate (pts%dndx(2, nen, size(body%gx)*size(body%ge)), pts%wdv(size(body%gx)*size(body%ge)))
+                allocate (pts%dndx(2, nen, npts), pts%wdv(npts))
                 hx = 0.5_dp*(el%xi(2) - el%xi(1))
                 he = 0.5_dp*(el%eta(2) - el%eta(1))
+                xis = el%xi(1) + hx*(body%gx + 1.0_dp)
+                etas = el%eta(1) + he*(body%ge + 1.0_dp)
+                call element_basis_grid(body%disc, e, xis, etas, r, dr)
                 q = 0
                 do j = 1, size(body%ge)
-                    eta = el%eta(1) + he*(body%ge(j) + 1.0_dp)
                     do i = 1, size(body%gx)
-                        xi = el%xi(1) + hx*(body%gx(i) + 1.0_dp)
                         q = q + 1
-                        call element_basis(body%disc, e, xi, eta, r, dr)
-                        call reference_gradients(x0, dr, pts%dndx(:, :, q), det)
+                        call reference_gradients(x0, dr(:, :, q), pts%dndx(:, :, q), det)
                         pts%wdv(q) = body%wx(i)*body%we(j)*hx*he*abs(det)
                     end do
                 end do

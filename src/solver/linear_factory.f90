@@ -2,7 +2,6 @@
 module voiga_solver_linear_factory
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, contact_reach
-    use voiga_model_assembly, only: bulk_stiffness
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t
     use voiga_solver_umfpack, only: umfpack_t
@@ -21,21 +20,19 @@ contains
 
     !> The linear solver `name` for the tangents of `model`: 'direct' (UMFPACK LU)
     !> or 'multigrid' (GMRES with the multigrid preconditioner, whose hierarchy of
-    !> spaces is built here, once). With 'direct', `reuse_bulk` (default true) and
-    !> only linear-elastic bodies, the bodies' stiffness is factorized here, once,
-    !> and every tangent solved as an update of it (`voiga_solver_bulk_update`).
-    subroutine new_linear_solver(solver, name, model, error, reuse_bulk)
+    !> spaces is built here, once). With 'direct' and `bulk`, the bodies' stiffness
+    !> when every body is linear-elastic (`voiga_model_assembly%bulk_stiffness`), it is
+    !> factorized here, once, and every tangent solved as an update of it
+    !> (`voiga_solver_bulk_update`).
+    subroutine new_linear_solver(solver, name, model, error, bulk)
         class(linear_solver_t), allocatable, intent(out) :: solver
         character(len=*), intent(in) :: name
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
-        logical, intent(in), optional :: reuse_bulk
-        logical :: reuse
+        type(csc_matrix_t), intent(in), optional :: bulk
         select case (trim(name))
         case ('direct')
-            reuse = .true.
-            if (present(reuse_bulk)) reuse = reuse_bulk
-            if (reuse .and. .not. model%finite_strain) call bulk_solver(solver, model)
+            if (present(bulk)) call bulk_solver(solver, model, bulk)
             if (.not. allocated(solver)) allocate (supernodal_lu_t :: solver)
         case ('multigrid')
             allocate (multigrid_t :: solver)
@@ -49,16 +46,14 @@ contains
         end select
     end subroutine new_linear_solver
 
-    !> The bulk-update solver of a model whose bodies are all linear-elastic; not
-    !> allocated when the bodies' stiffness alone is singular (a body that only
-    !> contact holds in place): every tangent is then factorized whole.
-    subroutine bulk_solver(solver, model)
+    !> The bulk-update solver of a model whose bodies are all linear-elastic, with
+    !> their stiffness `k0`; not allocated when it alone is singular (a body that
+    !> only contact holds in place): every tangent is then factorized whole.
+    subroutine bulk_solver(solver, model, k0)
         class(linear_solver_t), allocatable, intent(inout) :: solver
         type(model_t), intent(in) :: model
-        type(csc_matrix_t) :: k0
+        type(csc_matrix_t), intent(in) :: k0
         type(error_t), allocatable :: error
-        call bulk_stiffness(model, k0, error)
-        if (allocated(error)) return
         allocate (bulk_update_t :: solver)
         select type (solver)
         type is (bulk_update_t)

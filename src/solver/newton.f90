@@ -12,7 +12,8 @@ module voiga_solver_newton
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, reference_coordinates
-    use voiga_model_assembly, only: assemble, stiffness_pattern, assembly_map_t, new_assembly_map
+    use voiga_model_assembly, only: assemble, stiffness_pattern, assembly_map_t, new_assembly_map, bulk_stiffness, &
+                                    assembly_stats_t
     use voiga_contact_law, only: state_stick, state_slip
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
@@ -96,19 +97,30 @@ module voiga_solver_newton
 contains
 
     !> Set up the attempts of a run of `model`: the tangent's pattern, the element
-    !> map, the linear solver the settings name.
-    subroutine new_newton(self, model, settings, error)
+    !> map, the linear solver the settings name. The bodies' stiffness assembled
+    !> here (every body linear) counts in `assembly`.
+    subroutine new_newton(self, model, settings, assembly, error)
         type(newton_t), intent(out) :: self
         type(model_t), intent(in) :: model
         type(solver_settings_t), intent(in) :: settings
+        type(assembly_stats_t), intent(inout) :: assembly
         type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t) :: k0
         self%settings = settings
         call stiffness_pattern(model, self%k, error)
         if (allocated(error)) return
         call new_assembly_map(model, self%k, self%map, error)
         if (allocated(error)) return
         self%map%keep_linear = settings%reuse_linear_bulk
-        call new_linear_solver(self%linear, settings%linear_solver, model, error, settings%reuse_linear_bulk)
+        if (settings%reuse_linear_bulk .and. .not. model%finite_strain) then
+            ! every body linear: their stiffness, kept in the map for the loop's assemblies
+            ! and factorized once by a direct solver
+            call bulk_stiffness(model, self%k, self%map, k0, assembly, error)
+            if (allocated(error)) return
+            call new_linear_solver(self%linear, settings%linear_solver, model, error, k0)
+        else
+            call new_linear_solver(self%linear, settings%linear_solver, model, error)
+        end if
         if (allocated(error)) return
         self%natural = trim(settings%damping) == 'natural'
         self%x0 = reference_coordinates(model)

@@ -95,7 +95,7 @@ contains
         if (present(t0)) sp%start = t0
         sp%settings = settings
         if (.not. allocated(sp%settings%n_steps)) sp%settings%n_steps = [1]
-        call new_newton(sp%newton, model, sp%settings, error)
+        call new_newton(sp%newton, model, sp%settings, stats%assembly, error)
         if (allocated(error)) return
         stats%multigrid_levels = sp%newton%linear%level_dofs()
         if (size(stats%multigrid_levels) > 0) call out%set_up(stats%multigrid_levels, error)
