@@ -274,7 +274,10 @@ def _cmd_figures(args: argparse.Namespace) -> int:
 
     from .figures import make_all
 
-    for path in make_all(Path(args.results), Path(args.out)):
+    if args.jobs is not None and args.jobs < 1:
+        print(f"python -m post figures: --jobs must be at least 1, not {args.jobs}", file=sys.stderr)
+        return 2
+    for path in make_all(Path(args.results), Path(args.out), args.jobs):
         print(path)
     return 0
 
@@ -381,6 +384,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("figures", help="validation figures and tables from a sweep")
     s.add_argument("--results", default="results", help="the sweep's folder (default: results)")
     s.add_argument("--out", default="docs/validation", help="where to write (default: docs/validation)")
+    s.add_argument("--jobs", type=int, default=None,
+                   help="processes drawing the figures (default: one per core)")
     s.set_defaults(func=_cmd_figures)
 
     s = sub.add_parser("hertz", help="cylinder on a rigid flat against analytic Hertz "
