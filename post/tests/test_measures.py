@@ -62,7 +62,10 @@ def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
         assert all(up_to_date(r, binary) for r in runs)
         again = run_all(runs, binary, client, timeout=300, progress=False)
     assert all(o.message == "up to date" for o in again.values())
-    csv_path, md_path = write_summary(summarize(runs), tmp_path)
+    serial = summarize(runs, jobs=1)
+    # the result files read by two processes: the same rows, in the runs' order
+    assert summarize(runs, jobs=2) == serial
+    csv_path, md_path = write_summary(serial, tmp_path)
     rows = list(csv.DictReader(csv_path.open()))
     assert [int(r["dofs"]) for r in rows] == [980, 1078]
     assert all(r["status"] == "converged" for r in rows)
