@@ -267,30 +267,12 @@ contains
         integer, parameter :: cdofs(3) = [3, 4, 20]
         type(csc_matrix_t) :: k0, k
         type(bulk_update_t) :: fast
-        type(umfpack_t) :: lu
-        type(lcg_t) :: rng
-        real(dp) :: b(n), x(n), y(n)
-        integer :: i, sym, num
+        integer :: i
         call chain(n, cdofs, k0, k, error)
         if (allocated(error)) return
         call new_bulk_update(fast, k0, [(.false., i=1, n)], cdofs(:2), error)
         if (allocated(error)) return
-        call tangent(k0, cdofs, rng, k)
-        call fast%factor(k, error)
-        if (allocated(error)) return
-        call check(error, fast%rank(), -1, 'factorized whole')
-        if (allocated(error)) return
-        call lu%factor(k, error)
-        if (allocated(error)) return
-        b = [(rng%uniform() - 0.5_dp, i=1, n)]
-        call fast%solve(k, b, x, error)
-        if (allocated(error)) return
-        call lu%solve(k, b, y, error)
-        if (allocated(error)) return
-        call check(error, maxval(abs(x - y)), 0.0_dp, 'the same LU', abs=0.0_dp)
-        if (allocated(error)) return
-        call fast%factorizations(sym, num)
-        call check(error, num, 2, 'K0 and the whole tangent')
+        call whole_as_lu(fast, k0, k, cdofs, error)
     end subroutine test_outside_reach
 
     !> An update on more DOFs than `max_rank` is factorized whole, and still solves.
@@ -300,10 +282,6 @@ contains
         integer, parameter :: cdofs(6) = [3, 4, 5, 20, 21, 22]
         type(csc_matrix_t) :: k0, k
         type(bulk_update_t) :: fast
-        type(umfpack_t) :: lu
-        type(lcg_t) :: rng
-        real(dp) :: b(n), x(n), y(n)
-        integer :: i, sym, num
         logical :: fixed(n)
         call chain(n, cdofs, k0, k, error)
         if (allocated(error)) return
@@ -311,6 +289,22 @@ contains
         call new_bulk_update(fast, k0, fixed, cdofs, error)
         if (allocated(error)) return
         fast%max_rank = 4
+        call whole_as_lu(fast, k0, k, cdofs, error)
+    end subroutine test_whole
+
+    !> A tangent `k` updating `cdofs` that `fast` factorizes whole: its solve equals
+    !> UMFPACK's of the same tangent to the bit, after two factorizations (K0 and it).
+    subroutine whole_as_lu(fast, k0, k, cdofs, error)
+        type(bulk_update_t), intent(inout) :: fast
+        type(csc_matrix_t), intent(in) :: k0
+        !> The tangent's pattern (from `chain`); its values are set here.
+        type(csc_matrix_t), intent(inout) :: k
+        integer, intent(in) :: cdofs(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(umfpack_t) :: lu
+        type(lcg_t) :: rng
+        real(dp) :: b(k0%n), x(k0%n), y(k0%n)
+        integer :: i, sym, num
         call tangent(k0, cdofs, rng, k)
         call fast%factor(k, error)
         if (allocated(error)) return
@@ -318,7 +312,7 @@ contains
         if (allocated(error)) return
         call lu%factor(k, error)
         if (allocated(error)) return
-        b = [(rng%uniform() - 0.5_dp, i=1, n)]
+        b = [(rng%uniform() - 0.5_dp, i=1, k0%n)]
         call fast%solve(k, b, x, error)
         if (allocated(error)) return
         call lu%solve(k, b, y, error)
@@ -327,7 +321,7 @@ contains
         if (allocated(error)) return
         call fast%factorizations(sym, num)
         call check(error, num, 2, 'K0 and the whole tangent')
-    end subroutine test_whole
+    end subroutine whole_as_lu
 
     !> A linear block (NN2.2, 4 x 2 elements) pressed 0.02 onto a rigid plane in 4
     !> steps, then pushed by `push` (friction `mu`), by `method`: solved with and

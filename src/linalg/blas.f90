@@ -11,8 +11,8 @@ module voiga_linalg_blas
 
     public :: gemm_tn, gemm_nt, triangular_solve, warm_up_blas, default_library_threads, library_threads
     public :: choose_blas_kernels, blas_kernels, kernels_for
-    !> The BLAS routine itself, for kernels that pass leading dimensions of sub-blocks.
-    public :: dgemm
+    !> The BLAS routines themselves, for kernels that pass leading dimensions of sub-blocks.
+    public :: dgemm, dtrsm
 
     !> The environment variables through which a user chooses the thread counts of
     !> OpenBLAS and OpenMP; when none is set, voiga runs them on one thread.

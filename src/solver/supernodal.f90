@@ -35,7 +35,7 @@ module voiga_solver_supernodal
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_umfpack, only: umfpack_t
-    use voiga_linalg_blas, only: dgemm
+    use voiga_linalg_blas, only: dgemm, dtrsm
     implicit none
     private
 
@@ -137,15 +137,6 @@ module voiga_solver_supernodal
             real(dp), intent(inout) :: a(lda, *)
             integer, intent(in) :: ipiv(*)
         end subroutine dlaswp
-
-        pure subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
-            import :: dp
-            character(len=1), intent(in) :: side, uplo, transa, diag
-            integer, intent(in) :: m, n, lda, ldb
-            real(dp), intent(in) :: alpha
-            real(dp), intent(in) :: a(lda, *)
-            real(dp), intent(inout) :: b(ldb, *)
-        end subroutine dtrsm
 
     end interface
 
