@@ -221,6 +221,15 @@ contains
         if (allocated(error)) return
         call check(error, fast%reach(), size(reach), 'the reach ordered last')
         if (allocated(error)) return
+        block
+            type(bulk_update_t) :: small
+            type(error_t), allocatable :: refused
+            call new_bulk_update(small, k0, fixed, reach, refused, max_reach=6)
+            call check(error, allocated(refused), 'a reach beyond max_reach is refused')
+            if (allocated(error)) return
+            call check(error, index(refused%message, 'contact can reach 7 DOFs') > 0, refused%message)
+            if (allocated(error)) return
+        end block
         do trial = 1, 3
             call tangent(k0, cdofs(trial:), rng, k)
             call k%fix_dofs(fixed)
