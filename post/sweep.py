@@ -188,6 +188,8 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
     tasks = [(run, refs.get((run.scene, run.changes)), measures or {}, (failures or {}).get(run.label, (0, "")))
              for run in runs]
     jobs = min(len(tasks), jobs or os.cpu_count() or 1)
+    # references read by an earlier summary may have been rewritten since
+    _REFERENCE.clear()
     if jobs > 1:
         with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as pool:
             rows = list(pool.map(_row, tasks, chunksize=4))
@@ -208,6 +210,7 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
     return rows
 
 
+#: The reference results read by :func:`_row` in this process during one summary.
 _REFERENCE: dict[Path, Any] = {}
 
 
