@@ -161,9 +161,8 @@ contains
         if (m > 0) call dgemm('T', 'N', m, m, m, 1.0_dp, inv, m, inv, m, 0.0_dp, self%s, m)
     end subroutine reach_inverse
 
-    !> Prepare solves with the tangent `a`: find its update D = a - K0, learn the
-    !> rows and columns of K0^-1 of the DOFs new to C, factorize I + S_CC D_CC; or,
-    !> when C is too large, factorize `a` whole.
+    !> Prepare solves with the tangent `a`: find its update D = a - K0 and factorize
+    !> I + S_CC D_CC; or, when C is too large or leaves the reach, factorize `a` whole.
     subroutine bulk_factor(self, a, error)
         class(bulk_update_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a

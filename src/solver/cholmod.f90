@@ -1,10 +1,11 @@
 !> Sparse Cholesky solves with CHOLMOD (SuiteSparse) for symmetric positive
 !> definite matrices, many right-hand sides at once.
 !>
-!> Used for the bulk stiffness of linear-elastic bodies (`voiga_solver_bulk_update`):
-!> its supernodal solve of many right-hand sides runs as dense matrix-matrix
-!> products, far cheaper per column than one sparse solve after another, and the
-!> update needs one column of K0^-1 per DOF that comes into contact. CHOLMOD is
+!> Used for the bulk stiffness of linear-elastic bodies (`voiga_solver_bulk_update`),
+!> factorized once per run: with the DOFs contact can reach ordered last
+!> (`factor_last`), L's trailing block gives their part of K0^-1 without any solve,
+!> and a tangent's solve is a forward and a backward solve with L (`forward`,
+!> `backward`) around a small dense correction. CHOLMOD is
 !> reached through the C functions of `cholmod_shim.c` (its structs stay in C);
 !> the raw interfaces are private here. Only the lower triangle of the matrix is
 !> read. Not copyable: assigning one `cholmod_t` to another leaves the target
