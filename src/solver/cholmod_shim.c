@@ -27,43 +27,45 @@ typedef struct {
     void (*set_max_levels)(int);
 } openmp_calls;
 
-/* The OpenMP runtime's calls, or NULLs when no OpenMP runtime is loaded. */
-static openmp_calls openmp(void)
+/* The OpenMP runtime's calls, looked up once; max_threads NULL when no OpenMP
+ * runtime is loaded. */
+static const openmp_calls *openmp(void)
 {
-    openmp_calls o;
-    o.max_threads = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_threads");
-    o.max_levels = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_active_levels");
-    o.set_max_levels = (void (*)(int))dlsym(RTLD_DEFAULT, "omp_set_max_active_levels");
-    if (!o.max_threads || !o.max_levels || !o.set_max_levels) o.max_threads = NULL;
-    return o;
+    static openmp_calls o;
+    static int looked = 0;
+    if (!looked) {
+        o.max_threads = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_threads");
+        o.max_levels = (int (*)(void))dlsym(RTLD_DEFAULT, "omp_get_max_active_levels");
+        o.set_max_levels = (void (*)(int))dlsym(RTLD_DEFAULT, "omp_set_max_active_levels");
+        if (!o.max_threads || !o.max_levels || !o.set_max_levels) o.max_threads = NULL;
+        looked = 1;
+    }
+    return &o;
 }
 
-/* Make CHOLMOD's parallel regions run serially when OpenMP allows fewer threads
- * than CHOLMOD_OMP_NUM_THREADS; returns the max-active-levels to restore (-1: none
- * changed). */
+/* 1 when CHOLMOD's loops run serially now: no OpenMP, or OpenMP allows fewer
+ * threads than CHOLMOD_OMP_NUM_THREADS (then serial_begin makes them serial). */
+int voiga_cholmod_serial(void)
+{
+    const openmp_calls *o = openmp();
+    return !o->max_threads || o->max_threads() < CHOLMOD_OMP_NUM_THREADS;
+}
+
+/* Make CHOLMOD's parallel regions run serially when voiga_cholmod_serial says so;
+ * returns the max-active-levels to restore (-1: none changed). */
 static int serial_begin(void)
 {
-    openmp_calls o = openmp();
+    const openmp_calls *o = openmp();
     int levels;
-    if (!o.max_threads || o.max_threads() >= CHOLMOD_OMP_NUM_THREADS) return -1;
-    levels = o.max_levels();
-    o.set_max_levels(0);
+    if (!o->max_threads || !voiga_cholmod_serial()) return -1;
+    levels = o->max_levels();
+    o->set_max_levels(0);
     return levels;
 }
 
 static void serial_end(int levels)
 {
-    openmp_calls o;
-    if (levels < 0) return;
-    o = openmp();
-    o.set_max_levels(levels);
-}
-
-/* 1 when CHOLMOD's loops would run serially now (the rule of serial_begin), for the tests. */
-int voiga_cholmod_serial(void)
-{
-    openmp_calls o = openmp();
-    return !o.max_threads || o.max_threads() < CHOLMOD_OMP_NUM_THREADS;
+    if (levels >= 0) openmp()->set_max_levels(levels);
 }
 
 typedef struct {
