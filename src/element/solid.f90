@@ -20,11 +20,11 @@ module voiga_element_solid
     end type element_points_t
 
     !> Work arrays of `solid_element` kept by its caller over the elements of a body
-    !> (gfortran puts automatic arrays on the heap: three allocations per element):
-    !> G [ld, 2 npts], R [4 ld, 2 npts] and the blocks of K [ld, 4 ld], grown to the
-    !> largest element they met.
+    !> (gfortran puts automatic arrays on the heap: an allocation per array and element):
+    !> G [ld, 2 npts], R [4 ld, 2 npts], the blocks of K [ld, 4 ld] and each point's
+    !> M^yx [4, npts], grown to the largest element they met.
     type :: element_work_t
-        real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :)
+        real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :), myx(:, :)
     end type element_work_t
 
 contains
@@ -88,12 +88,12 @@ contains
             if (size(work%gt, 1) >= nen .and. size(work%gt, 2) >= ncol) return
             ld = max(nen, size(work%gt, 1))
             nc = max(ncol, size(work%gt, 2))
-            deallocate (work%gt, work%rt, work%k4)
+            deallocate (work%gt, work%rt, work%k4, work%myx)
         else
             ld = nen
             nc = ncol
         end if
-        allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld))
+        allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld), work%myx(4, (nc + 1)/2))
     end subroutine fit_work
 
     !> `solid_element` on the work arrays `wk`.
@@ -110,7 +110,8 @@ contains
         nen = size(u, 2)
         np = size(pts%wdv)
         ld = size(wk%gt, 1)
-        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, sym, wk%gt, ld, wk%rt, size(wk%rt, 1))
+        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, sym, wk%gt, ld, wk%rt, size(wk%rt, 1), &
+                           wk%myx)
         if (.not. ok) return
         ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
         ! symmetry at every point (hyperelastic and linear laws)
@@ -140,8 +141,10 @@ contains
 
     !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
     !> of G and R of every point (explicit shapes, so that the loops over the
-    !> functions are plain vector loops).
-    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, sym, gt, ld, rt, ldr)
+    !> functions are plain vector loops). R's fourth block (for K^yx) is formed only
+    !> when the tangent is not symmetric at some point: `element_kernel` does not
+    !> use it otherwise (a quarter of R's work on hyperelastic laws).
+    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, sym, gt, ld, rt, ldr, myx)
         class(material_t), intent(in) :: mat
         integer, intent(in) :: nen, np, ld, ldr
         real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
@@ -150,8 +153,10 @@ contains
         !> The Voigt tangent was symmetric at every point (M^yx = (M^xy)^T).
         logical, intent(out) :: sym
         real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
+        !> Work: M^yx of every point (for R's fourth block).
+        real(dp), intent(inout) :: myx(2, 2, *)
         real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
-        real(dp) :: m(2, 2, 4), w
+        real(dp) :: m(2, 2, 4), w, g11, g21, g12, g22
         integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
         integer :: q, i, j, a, blk, off, c1, c2
 
@@ -162,11 +167,20 @@ contains
             w = wdv(q)
             c1 = 2*q - 1
             c2 = 2*q
-            grad_u = 0.0_dp
+            g11 = 0.0_dp
+            g21 = 0.0_dp
+            g12 = 0.0_dp
+            g22 = 0.0_dp
             do a = 1, nen
-                grad_u(:, 1) = grad_u(:, 1) + u(:, a)*dndx(1, a, q)
-                grad_u(:, 2) = grad_u(:, 2) + u(:, a)*dndx(2, a, q)
+                g11 = g11 + u(1, a)*dndx(1, a, q)
+                g21 = g21 + u(2, a)*dndx(1, a, q)
+                g12 = g12 + u(1, a)*dndx(2, a, q)
+                g22 = g22 + u(2, a)*dndx(2, a, q)
             end do
+            grad_u(1, 1) = g11
+            grad_u(2, 1) = g21
+            grad_u(1, 2) = g12
+            grad_u(2, 2) = g22
             call mat%stress(grad_u, s, c, ok)
             if (.not. ok) return
             ts = 0.0_dp
@@ -198,7 +212,8 @@ contains
             sym = sym .and. d(1, 2) == d(2, 1) .and. d(1, 3) == d(3, 1) .and. d(2, 3) == d(3, 2)
             ! M^xx, M^xy, M^yy, M^yx (rows: the gradient component of g_a, columns: of g_b)
             call coupling(d, ts, m)
-            do blk = 1, 4
+            myx(:, :, q) = m(:, :, 4)
+            do blk = 1, 3
                 off = (blk - 1)*nen
                 do a = 1, nen
                     rt(off + a, c1) = m(1, 1, blk)*gt(a, c1) + m(1, 2, blk)*gt(a, c2)
@@ -209,6 +224,16 @@ contains
             do a = 1, nen
                 fe(1, a) = fe(1, a) + sv(1)*gt(a, c1) + sv(3)*gt(a, c2)
                 fe(2, a) = fe(2, a) + sv(2)*gt(a, c2) + sv(3)*gt(a, c1)
+            end do
+        end do
+        if (sym) return
+        off = 3*nen
+        do q = 1, np
+            c1 = 2*q - 1
+            c2 = 2*q
+            do a = 1, nen
+                rt(off + a, c1) = myx(1, 1, q)*gt(a, c1) + myx(1, 2, q)*gt(a, c2)
+                rt(off + a, c2) = myx(2, 1, q)*gt(a, c1) + myx(2, 2, q)*gt(a, c2)
             end do
         end do
     end subroutine point_columns

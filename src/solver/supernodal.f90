@@ -511,10 +511,13 @@ contains
                 end do
             end if
             d = 1.0_dp/fr(j, j)
-            fr(j + 1:m, j) = fr(j + 1:m, j)*d
-            if (j < m) then
-                if (maxval(abs(fr(j + 1:m, j))) > max_multiplier) return
-            end if
+            ! L's column and its largest multiplier in one pass
+            big = 0.0_dp
+            do i = j + 1, m
+                fr(i, j) = fr(i, j)*d
+                big = max(big, abs(fr(i, j)))
+            end do
+            if (big > max_multiplier) return
             do c = j + 1, k
                 fr(j + 1:m, c) = fr(j + 1:m, c) - fr(j + 1:m, j)*fr(j, c)
             end do
@@ -560,13 +563,22 @@ contains
     end subroutine blocked_factor
 
     !> Add the update (rows and columns k+1..m) of a child's front `fc` [m, m] into
-    !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k].
+    !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k] (ascending:
+    !> when they are consecutive, each column is one vector add).
     pure subroutine extend_add(fp, mp, fc, m, k, rel)
         integer, intent(in) :: mp, m, k
         real(dp), intent(inout) :: fp(mp, mp)
         real(dp), intent(in) :: fc(m, m)
         integer, intent(in) :: rel(m - k)
-        integer :: a, b, cb
+        integer :: a, b, cb, r0
+        r0 = rel(1)
+        if (rel(m - k) - r0 == m - k - 1) then
+            do b = k + 1, m
+                cb = rel(b - k)
+                fp(r0:r0 + m - k - 1, cb) = fp(r0:r0 + m - k - 1, cb) + fc(k + 1:m, b)
+            end do
+            return
+        end if
         do b = k + 1, m
             cb = rel(b - k)
             do a = k + 1, m
