@@ -1,13 +1,19 @@
 !> The element kernel (`voiga_element_solid`) against the tangent written out
 !> term by term, for a law whose tangent lacks the major symmetry: the kernel then
-!> forms the fourth block of K (K^yx) instead of transposing K^xy.
+!> forms the fourth block of K (K^yx) instead of transposing K^xy; and the
+!> assembly that adds the kernel's blocks through the element map against the one
+!> that adds the interleaved element matrices by DOF numbers.
 module test_element_kernel
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_material, only: material_t
     use voiga_element_solid, only: solid_element, element_points_t, element_work_t
-    use voiga_test_fixtures, only: lcg_t
+    use voiga_test_fixtures, only: lcg_t, annulus_sector, paper_layout, scene_t, scene_model, body_settings
+    use voiga_discretization_patch, only: discretization_t, new_discretization
+    use voiga_model, only: model_t
+    use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, new_assembly_map
+    use voiga_solver_sparse, only: csc_matrix_t
     implicit none
     private
 
@@ -28,7 +34,8 @@ contains
 
     subroutine collect_element_kernel(testsuite)
         type(unittest_t), allocatable, intent(out) :: testsuite(:)
-        testsuite = [new_unittest('unsymmetric_tangent_blocks', test_unsymmetric)]
+        testsuite = [new_unittest('unsymmetric_tangent_blocks', test_unsymmetric), &
+                     new_unittest('mapped_blocks_match_element_matrices', test_mapped_blocks)]
     end subroutine collect_element_kernel
 
     pure subroutine skew_stress(self, grad_u, s, c, ok)
@@ -72,25 +79,11 @@ contains
         type(element_work_t) :: work
         type(lcg_t) :: rng
         real(dp) :: u(2, nen), fe(2*nen), ke(2*nen, 2*nen), fref(2*nen), kref(2*nen, 2*nen)
-        real(dp) :: d(3, 3), grad_u(2, 2), s(2, 2), c(2, 2, 2, 2)
-        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
-        integer :: i, j, k, l, a, b, q, m, n
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2)
+        integer :: i, j, k, l, a, b, q
         logical :: ok
 
-        do n = 1, 3
-            do m = 1, 3
-                d(m, n) = rng%uniform() + merge(2.0_dp, 0.0_dp, m == n)
-            end do
-        end do
-        ! c from the unsymmetric Voigt matrix d, with the minor symmetries
-        do n = 1, 3
-            do m = 1, 3
-                law%c(vi(m), vj(m), vi(n), vj(n)) = d(m, n)
-                law%c(vj(m), vi(m), vi(n), vj(n)) = d(m, n)
-                law%c(vi(m), vj(m), vj(n), vi(n)) = d(m, n)
-                law%c(vj(m), vi(m), vj(n), vi(n)) = d(m, n)
-            end do
-        end do
+        law = skew_law(rng)
         allocate (pts%dndx(2, nen, np), pts%wdv(np))
         do q = 1, np
             pts%wdv(q) = 0.5_dp + rng%uniform()
@@ -136,5 +129,95 @@ contains
         call check(error, maxval(abs(fe - fref))/maxval(abs(fref)), 0.0_dp, 'f against the written-out sum', &
                    abs=1.0e-13_dp)
     end subroutine test_unsymmetric
+
+    !> A law with minor but not major symmetry (random Voigt matrix d, made
+    !> diagonally dominant).
+    function skew_law(rng) result(law)
+        type(lcg_t), intent(inout) :: rng
+        type(skew_law_t) :: law
+        real(dp) :: d(3, 3)
+        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
+        integer :: m, n
+        do n = 1, 3
+            do m = 1, 3
+                d(m, n) = rng%uniform() + merge(2.0_dp, 0.0_dp, m == n)
+            end do
+        end do
+        do n = 1, 3
+            do m = 1, 3
+                law%c(vi(m), vj(m), vi(n), vj(n)) = d(m, n)
+                law%c(vj(m), vi(m), vi(n), vj(n)) = d(m, n)
+                law%c(vi(m), vj(m), vj(n), vi(n)) = d(m, n)
+                law%c(vj(m), vi(m), vj(n), vi(n)) = d(m, n)
+            end do
+        end do
+    end function skew_law
+
+    !> One body (NN2.2 on an annulus sector, its VO layer included) under a random
+    !> displacement: the stiffness assembled through the element map (the kernel's
+    !> blocks added in place) equals, entry by entry and exactly, the one assembled
+    !> from the interleaved element matrices, for the Neo-Hookean law (K^yx taken
+    !> as (K^xy)^T) and for a law without the major symmetry (K^yx formed).
+    subroutine test_mapped_blocks(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_t) :: c
+        type(discretization_t) :: discs(1)
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        type(csc_matrix_t) :: k_dofs, k_map
+        type(assembly_map_t) :: map
+        type(assembly_stats_t) :: stats
+        real(dp), allocatable :: u(:), r_dofs(:), r_map(:)
+        integer :: law, j
+
+        c%bodies = [body_settings('block', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [3, 2], 'outer'))]
+        call new_discretization(discs(1), annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, acos(-1.0_dp), 2), &
+                                c%bodies(1)%layout, '', error)
+        if (allocated(error)) return
+        call scene_model(c, discs, model, error)
+        if (allocated(error)) return
+        allocate (u(model%ndof), r_dofs(model%ndof), r_map(model%ndof))
+        do j = 1, model%ndof
+            u(j) = 0.02_dp*(rng%uniform() - 0.5_dp)
+        end do
+        do law = 1, 2
+            if (law == 2) then
+                deallocate (model%bodies(1)%mat)
+                allocate (model%bodies(1)%mat, source=skew_law(rng))
+            end if
+            call stiffness_pattern(model, k_dofs, error)
+            if (allocated(error)) return
+            k_map = k_dofs
+            call new_assembly_map(model, k_map, map, error)
+            if (allocated(error)) return
+            map%keep_linear = .false.
+            call assemble(model, u, 0.0_dp, r_dofs, stats, error, k_dofs)
+            if (allocated(error)) return
+            call assemble(model, u, 0.0_dp, r_map, stats, error, k_map, map)
+            if (allocated(error)) return
+            call check(error, maxval(abs(k_map%values)) > 0.0_dp .and. k_map%missed == 0 .and. k_dofs%missed == 0, &
+                       'both assemblies filled their pattern')
+            if (allocated(error)) return
+            call check(error, maxval(abs(k_map%values - k_dofs%values)), 0.0_dp, &
+                       'K through the map against K by DOF numbers, law '//achar(48 + law))
+            if (allocated(error)) return
+            call check(error, maxval(abs(r_map - r_dofs)), 0.0_dp, 'the residuals, law '//achar(48 + law))
+            if (allocated(error)) return
+        end do
+        call check(error, unsymmetric(k_map), 'the second law gives an unsymmetric K')
+    end subroutine test_mapped_blocks
+
+    !> Whether the stored entries of `k` differ from their transposes somewhere.
+    logical function unsymmetric(k)
+        type(csc_matrix_t), intent(in) :: k
+        integer :: j, p
+        unsymmetric = .false.
+        do j = 1, k%n
+            do p = k%colptr(j) + 1, k%colptr(j + 1)
+                if (abs(k%values(p) - k%values(k%index_of(j, k%rowind(p) + 1))) > 1.0e-8_dp*maxval(abs(k%values))) &
+                    unsymmetric = .true.
+            end do
+        end do
+    end function unsymmetric
 
 end module test_element_kernel

@@ -10,7 +10,7 @@ module voiga_element_solid
     implicit none
     private
 
-    public :: solid_element, reference_gradients, element_points_t, element_work_t
+    public :: solid_element, solid_element_blocks, reference_gradients, element_points_t, element_work_t
 
     !> The quadrature of one element in the reference configuration, computed once
     !> per discretization: reference gradients dN/dX [2, nen, npts] and weights
@@ -25,6 +25,9 @@ module voiga_element_solid
     !> M^yx [4, npts], grown to the largest element they met.
     type :: element_work_t
         real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :), myx(:, :)
+        !> The last element's tangent had the major symmetry at every point: `k4`
+        !> holds [K^xx K^xy K^yy] and K^yx = (K^xy)^T; else all four blocks.
+        logical :: sym = .true.
     end type element_work_t
 
 contains
@@ -71,13 +74,27 @@ contains
         type(element_work_t), intent(inout), optional :: work
         type(element_work_t) :: own
         if (present(work)) then
-            call fit_work(work, size(u, 2), 2*size(pts%wdv))
-            call element_kernel(mat, pts, u, fe, ke, ok, work)
+            call solid_element_blocks(mat, pts, u, fe, ok, work)
+            if (ok) call interleave(work, size(u, 2), ke)
         else
-            call fit_work(own, size(u, 2), 2*size(pts%wdv))
-            call element_kernel(mat, pts, u, fe, ke, ok, own)
+            call solid_element_blocks(mat, pts, u, fe, ok, own)
+            if (ok) call interleave(own, size(u, 2), ke)
         end if
     end subroutine solid_element
+
+    !> `solid_element` with K left in its blocks, `work%k4` = [K^xx K^xy K^yy K^yx]
+    !> [nen, 4 nen] (K^yx only when `work%sym` is false; else K^yx = (K^xy)^T): the
+    !> assembly adds them to the global matrix without the interleaved copy.
+    pure subroutine solid_element_blocks(mat, pts, u, fe, ok, work)
+        class(material_t), intent(in) :: mat
+        type(element_points_t), intent(in) :: pts
+        real(dp), intent(in) :: u(:, :)
+        real(dp), intent(out) :: fe(:)
+        logical, intent(out) :: ok
+        type(element_work_t), intent(inout) :: work
+        call fit_work(work, size(u, 2), 2*size(pts%wdv))
+        call element_kernel(mat, pts, u, fe, ok, work)
+    end subroutine solid_element_blocks
 
     !> `work` large enough for `nen` functions and `ncol` = 2 npts columns.
     pure subroutine fit_work(work, nen, ncol)
@@ -96,27 +113,34 @@ contains
         allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld), work%myx(4, (nc + 1)/2))
     end subroutine fit_work
 
-    !> `solid_element` on the work arrays `wk`.
-    pure subroutine element_kernel(mat, pts, u, fe, ke, ok, wk)
+    !> `solid_element_blocks` on the work arrays `wk`.
+    pure subroutine element_kernel(mat, pts, u, fe, ok, wk)
         class(material_t), intent(in) :: mat
         type(element_points_t), intent(in) :: pts
         real(dp), intent(in) :: u(:, :)
-        real(dp), intent(out) :: fe(:), ke(:, :)
+        real(dp), intent(out) :: fe(:)
         logical, intent(out) :: ok
         type(element_work_t), intent(inout) :: wk
-        integer :: nen, np, ld, a, b, nb
-        logical :: sym
+        integer :: nen, np, ld, nb
 
         nen = size(u, 2)
         np = size(pts%wdv)
         ld = size(wk%gt, 1)
-        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, sym, wk%gt, ld, wk%rt, size(wk%rt, 1), &
+        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, wk%sym, wk%gt, ld, wk%rt, size(wk%rt, 1), &
                            wk%myx)
         if (.not. ok) return
         ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
         ! symmetry at every point (hyperelastic and linear laws)
-        nb = merge(3, 4, sym)
+        nb = merge(3, 4, wk%sym)
         call dgemm('N', 'T', nen, nb*nen, 2*np, 1.0_dp, wk%gt, ld, wk%rt, size(wk%rt, 1), 0.0_dp, wk%k4, ld)
+    end subroutine element_kernel
+
+    !> The element matrix `ke` [2 nen, 2 nen] (local DOF order) from the blocks in `wk`.
+    pure subroutine interleave(wk, nen, ke)
+        type(element_work_t), intent(in) :: wk
+        integer, intent(in) :: nen
+        real(dp), intent(out) :: ke(:, :)
+        integer :: a, b
         do b = 1, nen
             do a = 1, nen
                 ke(2*a - 1, 2*b - 1) = wk%k4(a, b)
@@ -124,7 +148,7 @@ contains
                 ke(2*a, 2*b) = wk%k4(a, 2*nen + b)
             end do
         end do
-        if (sym) then
+        if (wk%sym) then
             do b = 1, nen
                 do a = 1, nen
                     ke(2*a, 2*b - 1) = wk%k4(b, nen + a)
@@ -137,7 +161,7 @@ contains
                 end do
             end do
         end if
-    end subroutine element_kernel
+    end subroutine interleave
 
     !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
     !> of G and R of every point (explicit shapes, so that the loops over the

@@ -9,7 +9,7 @@ module voiga_model_assembly
     use voiga_text, only: str
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: solid_element, element_work_t
+    use voiga_element_solid, only: solid_element, solid_element_blocks, element_work_t
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
     implicit none
     private
@@ -79,17 +79,23 @@ contains
         logical, intent(out) :: ok
         !> The element kernel's work arrays, kept by a caller that loops over elements.
         type(element_work_t), intent(inout), optional :: work
-        real(dp) :: ue(2, size(fe)/2)
-        integer :: a
+        call solid_element(body%mat, body%points(e), element_displacements(body, e, u), fe, ke, ok, work)
+    end subroutine body_element
 
+    !> Displacements [2, nen] of the control points of element `e` of `body`.
+    pure function element_displacements(body, e, u) result(ue)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        real(dp), intent(in) :: u(:)
+        real(dp) :: ue(2, size(body%disc%elements(e)%conn))
+        integer :: a
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
                 ue(1, a) = u(body%dof0 + 2*conn(a) - 1)
                 ue(2, a) = u(body%dof0 + 2*conn(a))
             end do
         end associate
-        call solid_element(body%mat, body%points(e), ue, fe, ke, ok, work)
-    end subroutine body_element
+    end function element_displacements
 
     !> The positions of every bulk element's entries in `k` (built on its pattern);
     !> an error when there is no memory for them (the largest array of a model).
@@ -427,7 +433,13 @@ contains
                         if (size(fe) /= n) deallocate (fe, ke)
                     end if
                     if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
-                    call body_element(body, e, u, fe, ke, ok, work)
+                    if (present(k) .and. present(map)) then
+                        ! K stays in the kernel's blocks, added through the map
+                        call solid_element_blocks(body%mat, body%points(e), element_displacements(body, e, u), fe, &
+                                                  ok, work)
+                    else
+                        call body_element(body, e, u, fe, ke, ok, work)
+                    end if
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
                                          ': the deformation is inverted (J <= 0 at a quadrature point)', &
@@ -438,7 +450,8 @@ contains
                     call add_force(body, e, fe, r)
                     if (present(k)) then
                         if (present(map)) then
-                            call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ke)
+                            call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), n/2, work%k4, &
+                                            size(work%k4, 1), work%sym)
                         else
                             dofs = body_dofs(body, e)
                             call k%add_element(dofs, ke)
@@ -507,18 +520,33 @@ contains
         end do
     end subroutine add_linear_body
 
-    !> values(pos(i)) += ke(i) for the entries of an element matrix in column-major
-    !> order (positions from `new_assembly_map`).
-    pure subroutine add_mapped(values, pos, ke)
+    !> values(pos) += K for the entries of an element matrix (positions from
+    !> `new_assembly_map`, column-major in the local DOF order 2(a-1) + i) from the
+    !> element kernel's blocks `k4` = [K^xx K^xy K^yy K^yx] [ld, 4 nen] (`sym`:
+    !> K^yx = (K^xy)^T, not stored). An element adds once to each of its entries, so
+    !> the sums are those of adding the interleaved matrix.
+    pure subroutine add_mapped(values, pos, nen, k4, ld, sym)
         real(dp), intent(inout) :: values(:)
-        integer, intent(in) :: pos(:)
-        real(dp), intent(in) :: ke(:, :)
-        integer :: a, b, i
-        i = 0
-        do b = 1, size(ke, 2)
-            do a = 1, size(ke, 1)
-                i = i + 1
-                values(pos(i)) = values(pos(i)) + ke(a, b)
+        integer, intent(in) :: nen, ld
+        integer, intent(in) :: pos(2*nen, 2*nen)
+        real(dp), intent(in) :: k4(ld, *)
+        logical, intent(in) :: sym
+        integer :: a, b
+        do b = 1, nen
+            if (sym) then
+                do a = 1, nen
+                    values(pos(2*a - 1, 2*b - 1)) = values(pos(2*a - 1, 2*b - 1)) + k4(a, b)
+                    values(pos(2*a, 2*b - 1)) = values(pos(2*a, 2*b - 1)) + k4(b, nen + a)
+                end do
+            else
+                do a = 1, nen
+                    values(pos(2*a - 1, 2*b - 1)) = values(pos(2*a - 1, 2*b - 1)) + k4(a, b)
+                    values(pos(2*a, 2*b - 1)) = values(pos(2*a, 2*b - 1)) + k4(a, 3*nen + b)
+                end do
+            end if
+            do a = 1, nen
+                values(pos(2*a - 1, 2*b)) = values(pos(2*a - 1, 2*b)) + k4(a, nen + b)
+                values(pos(2*a, 2*b)) = values(pos(2*a, 2*b)) + k4(a, 2*nen + b)
             end do
         end do
     end subroutine add_mapped
