@@ -82,3 +82,55 @@ def test_stages_table_of_a_run(run, tmp_path: Path) -> None:
     missing = subprocess.run([sys.executable, "-m", "bench.stages", str(tmp_path / "no.h5")],
                              cwd=REPO, capture_output=True, text=True, timeout=60)
     assert missing.returncode == 2 and "no such result file" in missing.stderr
+
+
+def _rows(**changes: str) -> list[dict[str, str]]:
+    row = {"scene": "ironing", "mesh": "m3", "layout": "NN2.2", "wall_s": "3.5", "assembly_s": "1.0",
+           "contact_s": "0.8", "factorization_s": "0.9", "solve_s": "0.1", "output_s": "0.2",
+           "osc_py": "0.0011"}
+    row.update(changes)
+    return [row, {**row, "mesh": "m4", "wall_s": "16.0", "assembly_s": "5.0"}]
+
+
+def test_paper_phases_from_stamped_lines() -> None:
+    """`bench.paper`'s phases: the study starts where the line before its first bar ended
+    (a bar line is stamped when the next replaces it), the runs end at the bar's last case,
+    the summary at the study's closing line."""
+    from bench.paper import phases
+    lines = [(0.2, "fpm install --profile release"), (0.4, "Project is up to date"), (2.0, ""),
+             (40.0, "study:   0%|          | 0/3 [00:00<?, ?case/s]"),
+             (90.0, "study:  67%|######    | 2/3 [01:28<00:44, 44.0s/case]"),
+             (200.0, "study: 100%|##########| 3/3 [03:18<00:00, 66.0s/case]"),
+             (204.0, "3 cases, 0 failed; summary in out/summary.csv and out/summary.md"),
+             (213.0, "docs/validation/x.png")]
+    ph = phases(lines, 213.5)
+    assert (ph.build, ph.runs, ph.summary, ph.end) == (2.0, 200.0, 204.0, 213.5)
+    with pytest.raises(ValueError, match="no study summary line"):
+        phases(lines[:5], 100.0)
+
+
+def test_paper_work_and_measures() -> None:
+    """The runs' work sums their times; the comparison skips the time columns and reports
+    a changed measure or a case only one run has."""
+    from bench.paper import differences, work
+    totals = work(_rows())
+    assert totals["wall_s"] == pytest.approx(19.5) and totals["assembly_s"] == pytest.approx(6.0)
+    assert differences(_rows(wall_s="4.0", solve_s="0.3"), _rows()) == []
+    assert differences(_rows(osc_py="0.0012"), _rows()) == [
+        "ironing/m3/NN2.2 osc_py: 0.0012 against 0.0011", "ironing/m4/NN2.2 osc_py: 0.0012 against 0.0011"]
+    assert differences(_rows()[:1], _rows()) == ["ironing/m4/NN2.2: only in the old run"]
+
+
+def test_paper_stamps_lines_and_keeps_results(tmp_path: Path) -> None:
+    """Carriage returns and newlines both end a stamped line (tqdm redraws with the
+    former), the log gets every line and the exit code; a PAPER_OUT that exists is
+    refused with exit code 2, before anything runs."""
+    from bench.paper import main, stamped_lines
+    lines, code, end = stamped_lines(["sh", "-c", "printf 'a\\rb\\nc'; exit 3"], tmp_path, tmp_path / "x.log")
+    assert [text for _, text in lines] == ["a", "b", "c"] and code == 3
+    assert end >= lines[-1][0] >= lines[0][0] >= 0.0
+    assert (tmp_path / "x.log").read_text().splitlines()[-1].endswith("END rc=3")
+    (tmp_path / "done").mkdir()
+    (tmp_path / "done" / "summary.csv").write_text("kept\n")
+    assert main([str(tmp_path / "done")]) == 2
+    assert (tmp_path / "done" / "summary.csv").read_text() == "kept\n"
