@@ -79,15 +79,17 @@ contains
         logical, intent(out) :: ok
         !> The element kernel's work arrays, kept by a caller that loops over elements.
         type(element_work_t), intent(inout), optional :: work
-        call solid_element(body%mat, body%points(e), element_displacements(body, e, u), fe, ke, ok, work)
+        real(dp) :: ue(2, size(fe)/2)
+        call gather_displacements(body, e, u, ue)
+        call solid_element(body%mat, body%points(e), ue, fe, ke, ok, work)
     end subroutine body_element
 
-    !> Displacements [2, nen] of the control points of element `e` of `body`.
-    pure function element_displacements(body, e, u) result(ue)
+    !> Displacements `ue` [2, nen] of the control points of element `e` of `body`.
+    pure subroutine gather_displacements(body, e, u, ue)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
         real(dp), intent(in) :: u(:)
-        real(dp) :: ue(2, size(body%disc%elements(e)%conn))
+        real(dp), intent(out) :: ue(:, :)
         integer :: a
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
@@ -95,7 +97,7 @@ contains
                 ue(2, a) = u(body%dof0 + 2*conn(a))
             end do
         end associate
-    end function element_displacements
+    end subroutine gather_displacements
 
     !> The positions of every bulk element's entries in `k` (built on its pattern);
     !> an error when there is no memory for them (the largest array of a model).
@@ -400,16 +402,19 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         !> With `k`: element positions; the linear bodies' stiffness is kept in it.
         type(assembly_map_t), intent(inout), optional :: map
-        real(dp), allocatable :: fe(:), ke(:, :)
+        real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
         integer, allocatable :: dofs(:)
         type(element_work_t) :: work
         integer :: ib, e, n, npts, idx
-        logical :: ok, keep
+        logical :: ok, keep, by_dofs
         integer(i8) :: c0, c1, rate
 
         call system_clock(c0, rate)
         r = 0.0_dp
         if (present(k)) call k%zero()
+        ! without the map, K is added element matrix by element matrix (by DOF numbers);
+        ! otherwise it stays in the kernel's blocks (added through the map, or not needed)
+        by_dofs = present(k) .and. .not. present(map)
         keep = .false.
         if (present(k) .and. present(map)) keep = map%keep_linear
         if (keep) then
@@ -430,15 +435,18 @@ contains
                 do e = 1, body%disc%nel
                     n = 2*size(body%disc%elements(e)%conn)
                     if (allocated(fe)) then
-                        if (size(fe) /= n) deallocate (fe, ke)
+                        if (size(fe) /= n) deallocate (fe, ue)
                     end if
-                    if (.not. allocated(fe)) allocate (fe(n), ke(n, n))
-                    if (present(k) .and. present(map)) then
-                        ! K stays in the kernel's blocks, added through the map
-                        call solid_element_blocks(body%mat, body%points(e), element_displacements(body, e, u), fe, &
-                                                  ok, work)
-                    else
+                    if (.not. allocated(fe)) allocate (fe(n), ue(2, n/2))
+                    if (by_dofs) then
+                        if (allocated(ke)) then
+                            if (size(ke, 1) /= n) deallocate (ke)
+                        end if
+                        if (.not. allocated(ke)) allocate (ke(n, n))
                         call body_element(body, e, u, fe, ke, ok, work)
+                    else
+                        call gather_displacements(body, e, u, ue)
+                        call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
                     end if
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
@@ -448,14 +456,12 @@ contains
                     end if
                     idx = idx + 1
                     call add_force(body, e, fe, r)
-                    if (present(k)) then
-                        if (present(map)) then
-                            call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), n/2, work%k4, &
-                                            size(work%k4, 1), work%sym)
-                        else
-                            dofs = body_dofs(body, e)
-                            call k%add_element(dofs, ke)
-                        end if
+                    if (by_dofs) then
+                        dofs = body_dofs(body, e)
+                        call k%add_element(dofs, ke)
+                    else if (present(k)) then
+                        call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), n/2, work%k4, &
+                                        size(work%k4, 1), work%sym)
                     end if
                 end do
                 if (body%mat%finite_strain) then
