@@ -17,13 +17,14 @@ them (``git checkout docs/validation`` to drop them).
 from __future__ import annotations
 
 import argparse
-import csv
 import re
 import subprocess
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
+from post.figures import read_summary
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -90,12 +91,6 @@ def phases(lines: list[tuple[float, str]], end: float) -> Phases:
     return Phases(build=start, runs=runs[0] if runs else start, summary=done, end=end)
 
 
-def read_rows(folder: Path) -> list[dict[str, str]]:
-    """The rows of ``folder/summary.csv``."""
-    with (folder / "summary.csv").open(newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def work(rows: list[dict[str, str]]) -> dict[str, float]:
     """The runs' summed wall seconds (``wall_s``) and stage seconds."""
     def total(key: str) -> float:
@@ -159,11 +154,11 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as err:
         print(f"bench.paper: {err} (exit code {code}; the log: {log})", file=sys.stderr)
         return 1
-    rows = read_rows(out)
+    rows = read_summary(out)
     print(report(ph, work(rows)))
     status = 0 if code == 0 else 1
     if args.against:
-        diff = differences(rows, read_rows(args.against))
+        diff = differences(rows, read_summary(args.against))
         print(f"  measures against {args.against}: {len(diff)} cells differ" + "".join(f"\n    {d}" for d in diff[:10]))
         status = status or (1 if diff else 0)
     return status
