@@ -87,11 +87,11 @@ module voiga_solver_supernodal
         !> go into its front (aptr [nsuper+1], apos: positions in `a`), so that a front
         !> is zeroed, filled and factorized while it is in cache.
         integer, allocatable, private :: cptr(:), kids(:), aptr(:), apos(:)
-        !> The fronts (after a factorization: L, U and the update of each), the local
-        !> pivot rows [n], the row scale factors and their reciprocals [n], a solve's
-        !> work vectors [n].
+        !> The fronts (after a factorization: L, U and the update of each), the row
+        !> scale factors and their reciprocals [n], a solve's work vectors [n].
         real(dp), allocatable, private :: f(:), scale(:), rscale(:), y(:), w(:)
-        integer, allocatable, private :: ipiv(:)
+        !> The local pivot rows [n]; work of the extend-adds [n + 1].
+        integer, allocatable, private :: ipiv(:), runs(:)
         integer, private :: det_sign = 0
         real(dp), private :: det_log10 = 0.0_dp
     contains
@@ -354,8 +354,9 @@ contains
         if (.not. ok) return
         if (allocated(self%f)) deallocate (self%f)
         allocate (self%f(self%fptr(self%nsuper + 1) - 1))
-        if (allocated(self%ipiv)) deallocate (self%ipiv, self%scale, self%rscale, self%y, self%w)
-        allocate (self%ipiv(a%n), self%scale(a%n), self%rscale(a%n), self%y(a%n), self%w(a%n))
+        if (allocated(self%ipiv)) deallocate (self%ipiv, self%runs, self%scale, self%rscale, self%y, self%w)
+        allocate (self%ipiv(a%n), self%runs(a%n + 1), self%scale(a%n), self%rscale(a%n), self%y(a%n), &
+                  self%w(a%n))
     end subroutine front_maps
 
     !> The children of every supernode (cptr, kids; ascending), from the parents.
@@ -468,7 +469,7 @@ contains
                 mc = self%rptr(c + 1) - self%rptr(c)
                 kc = self%super(c + 1) - self%super(c)
                 call extend_add(self%f(self%fptr(s):), m, self%f(self%fptr(c):), mc, kc, &
-                                self%rel(self%rptr(c) + kc:))
+                                self%rel(self%rptr(c) + kc:), self%runs)
             end do
             call partial_factor(self%f(self%fptr(s):), m, k, self%ipiv(self%super(s):), ok)
             if (.not. ok) return
@@ -563,26 +564,32 @@ contains
     end subroutine blocked_factor
 
     !> Add the update (rows and columns k+1..m) of a child's front `fc` [m, m] into
-    !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k] (ascending:
-    !> when they are consecutive, each column is one vector add).
-    pure subroutine extend_add(fp, mp, fc, m, k, rel)
+    !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k] (ascending).
+    !> The rows go in runs of consecutive positions (`runs` [m - k + 1]: work), each
+    !> column of a run one vector add: the same additions as entry by entry.
+    pure subroutine extend_add(fp, mp, fc, m, k, rel, runs)
         integer, intent(in) :: mp, m, k
         real(dp), intent(inout) :: fp(mp, mp)
         real(dp), intent(in) :: fc(m, m)
         integer, intent(in) :: rel(m - k)
-        integer :: a, b, cb, r0
-        r0 = rel(1)
-        if (rel(m - k) - r0 == m - k - 1) then
-            do b = k + 1, m
-                cb = rel(b - k)
-                fp(r0:r0 + m - k - 1, cb) = fp(r0:r0 + m - k - 1, cb) + fc(k + 1:m, b)
-            end do
-            return
-        end if
+        integer, intent(inout) :: runs(m - k + 1)
+        integer :: a, b, cb, nr, t, r0, a0, len
+        nr = 0
+        do a = 1, m - k
+            if (a > 1) then
+                if (rel(a) == rel(a - 1) + 1) cycle
+            end if
+            nr = nr + 1
+            runs(nr) = a
+        end do
+        runs(nr + 1) = m - k + 1
         do b = k + 1, m
             cb = rel(b - k)
-            do a = k + 1, m
-                fp(rel(a - k), cb) = fp(rel(a - k), cb) + fc(a, b)
+            do t = 1, nr
+                a0 = runs(t)
+                len = runs(t + 1) - a0
+                r0 = rel(a0)
+                fp(r0:r0 + len - 1, cb) = fp(r0:r0 + len - 1, cb) + fc(k + a0:k + a0 + len - 1, b)
             end do
         end do
     end subroutine extend_add
