@@ -32,7 +32,11 @@ module voiga_model_assembly
     type :: assembly_map_t
         !> Start of each element's entries in `pos`, over all bodies in order [nel_total + 1].
         integer, allocatable :: ptr(:)
-        !> Index into the matrix values of entry (a, b) of each element, column-major.
+        !> Index into the matrix values, for each column of each element's matrix
+        !> (local order 2(a-1) + i), of the first row of each run of its control points
+        !> with consecutive numbers (`cp_runs`) [nruns, 2 nen per element]: the rows
+        !> of a run are consecutive DOFs, so their entries are consecutive in any CSC
+        !> pattern that has them.
         integer, allocatable :: pos(:)
         !> Keep the linear-elastic bodies' stiffness (false: integrate every body at
         !> every assembly, as for nonlinear ones).
@@ -106,8 +110,9 @@ contains
         type(csc_matrix_t), intent(inout) :: k
         type(assembly_map_t), intent(out) :: map
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: dofs(:), pos(:, :)
-        integer :: ib, e, nel, n, m, idx, st
+        integer, allocatable :: dofs(:), pos(:, :), runs(:)
+        integer :: ib, e, nel, m, idx, st, nr
+        logical :: ok
         nel = sum([(model%bodies(ib)%disc%nel, ib=1, size(model%bodies))])
         allocate (map%ptr(nel + 1))
         map%ptr(1) = 1
@@ -115,8 +120,11 @@ contains
         do ib = 1, size(model%bodies)
             do e = 1, model%bodies(ib)%disc%nel
                 idx = idx + 1
-                n = 2*size(model%bodies(ib)%disc%elements(e)%conn)
-                map%ptr(idx + 1) = map%ptr(idx) + n*n
+                associate (conn => model%bodies(ib)%disc%elements(e)%conn)
+                    call reserve(runs, size(conn) + 1)
+                    call cp_runs(conn, runs, nr)
+                    map%ptr(idx + 1) = map%ptr(idx) + 2*size(conn)*nr
+                end associate
             end do
         end do
         allocate (map%pos(map%ptr(nel + 1) - 1), stat=st)
@@ -136,10 +144,66 @@ contains
                 end if
                 if (.not. allocated(pos)) allocate (pos(m, m))
                 call k%element_positions(dofs, pos)
-                map%pos(map%ptr(idx):map%ptr(idx + 1) - 1) = reshape(pos, [m*m])
+                call cp_runs(model%bodies(ib)%disc%elements(e)%conn, runs, nr)
+                call run_positions(pos, runs(1:nr + 1), map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ok)
+                if (.not. ok) then
+                    call fatal_error(error, 'new_assembly_map: the entries of a run of DOFs are not '// &
+                                     'consecutive in the stiffness pattern')
+                    return
+                end if
             end do
         end do
     end subroutine new_assembly_map
+
+    !> `a` with at least n entries.
+    pure subroutine reserve(a, n)
+        integer, allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: n
+        if (allocated(a)) then
+            if (size(a) >= n) return
+            deallocate (a)
+        end if
+        allocate (a(n))
+    end subroutine reserve
+
+    !> The runs of control points with consecutive numbers in an element's
+    !> connectivity `conn`: run t is conn(runs(t):runs(t + 1) - 1); `nr` runs
+    !> (`runs` [size(conn) + 1]: at least as many entries as there are runs, plus one).
+    pure subroutine cp_runs(conn, runs, nr)
+        integer, intent(in) :: conn(:)
+        integer, intent(out) :: runs(:)
+        integer, intent(out) :: nr
+        integer :: a
+        nr = 0
+        do a = 1, size(conn)
+            if (a > 1) then
+                if (conn(a) == conn(a - 1) + 1) cycle
+            end if
+            nr = nr + 1
+            runs(nr) = a
+        end do
+        runs(nr + 1) = size(conn) + 1
+    end subroutine cp_runs
+
+    !> `starts` [nr, m]: the position of each run's first row (2 runs(t) - 1) in each
+    !> column of the element positions `pos` [m, m]; false if a run's rows are not
+    !> at consecutive positions (a pattern that lacks one of them).
+    pure subroutine run_positions(pos, runs, starts, ok)
+        integer, intent(in) :: pos(:, :), runs(:)
+        integer, intent(out) :: starts(size(runs) - 1, size(pos, 2))
+        logical, intent(out) :: ok
+        integer :: c, t, r0, r
+        ok = .true.
+        do c = 1, size(pos, 2)
+            do t = 1, size(runs) - 1
+                r0 = 2*runs(t) - 1
+                starts(t, c) = pos(r0, c)
+                do r = r0 + 1, 2*runs(t + 1) - 2
+                    ok = ok .and. pos(r, c) == pos(r0, c) + (r - r0)
+                end do
+            end do
+        end do
+    end subroutine run_positions
 
     !> The stiffness pattern of all bodies (every element couples its DOFs) and,
     !> unless `contact` is false, of the contact pairs' couplings.
@@ -403,9 +467,9 @@ contains
         !> With `k`: element positions; the linear bodies' stiffness is kept in it.
         type(assembly_map_t), intent(inout), optional :: map
         real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
-        integer, allocatable :: dofs(:)
+        integer, allocatable :: dofs(:), runs(:)
         type(element_work_t) :: work
-        integer :: ib, e, n, npts, idx
+        integer :: ib, e, n, npts, idx, nr
         logical :: ok, keep, by_dofs
         integer(i8) :: c0, c1, rate
 
@@ -435,9 +499,9 @@ contains
                 do e = 1, body%disc%nel
                     n = 2*size(body%disc%elements(e)%conn)
                     if (allocated(fe)) then
-                        if (size(fe) /= n) deallocate (fe, ue)
+                        if (size(fe) /= n) deallocate (fe, ue, runs)
                     end if
-                    if (.not. allocated(fe)) allocate (fe(n), ue(2, n/2))
+                    if (.not. allocated(fe)) allocate (fe(n), ue(2, n/2), runs(n/2 + 1))
                     if (by_dofs) then
                         if (allocated(ke)) then
                             if (size(ke, 1) /= n) deallocate (ke)
@@ -460,8 +524,9 @@ contains
                         dofs = body_dofs(body, e)
                         call k%add_element(dofs, ke)
                     else if (present(k)) then
-                        call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), n/2, work%k4, &
-                                        size(work%k4, 1), work%sym)
+                        call cp_runs(body%disc%elements(e)%conn, runs, nr)
+                        call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), &
+                                        n/2, work%k4, size(work%k4, 1), work%sym)
                     end if
                 end do
                 if (body%mat%finite_strain) then
@@ -526,33 +591,38 @@ contains
         end do
     end subroutine add_linear_body
 
-    !> values(pos) += K for the entries of an element matrix (positions from
-    !> `new_assembly_map`, column-major in the local DOF order 2(a-1) + i) from the
-    !> element kernel's blocks `k4` = [K^xx K^xy K^yy K^yx] [ld, 4 nen] (`sym`:
-    !> K^yx = (K^xy)^T, not stored). An element adds once to each of its entries, so
-    !> the sums are those of adding the interleaved matrix.
-    pure subroutine add_mapped(values, pos, nen, k4, ld, sym)
+    !> values += K for the entries of an element matrix (the runs of its control
+    !> points `runs` and their first rows' positions `starts` from `new_assembly_map`)
+    !> from the element kernel's blocks `k4` = [K^xx K^xy K^yy K^yx] [ld, 4 nen]
+    !> (`sym`: K^yx = (K^xy)^T, not stored). A run's entries in a column are
+    !> consecutive values, x and y rows in turn. An element adds once to each of its
+    !> entries, so the sums are those of adding the interleaved matrix.
+    pure subroutine add_mapped(values, starts, runs, nen, k4, ld, sym)
         real(dp), intent(inout) :: values(:)
-        integer, intent(in) :: nen, ld
-        integer, intent(in) :: pos(2*nen, 2*nen)
+        integer, intent(in) :: runs(:), nen, ld
+        integer, intent(in) :: starts(size(runs) - 1, 2*nen)
         real(dp), intent(in) :: k4(ld, *)
         logical, intent(in) :: sym
-        integer :: a, b
+        integer :: a, b, t, p, q
         do b = 1, nen
-            if (sym) then
-                do a = 1, nen
-                    values(pos(2*a - 1, 2*b - 1)) = values(pos(2*a - 1, 2*b - 1)) + k4(a, b)
-                    values(pos(2*a, 2*b - 1)) = values(pos(2*a, 2*b - 1)) + k4(b, nen + a)
+            do t = 1, size(runs) - 1
+                p = starts(t, 2*b - 1) - 2*runs(t)
+                q = starts(t, 2*b) - 2*runs(t)
+                if (sym) then
+                    do a = runs(t), runs(t + 1) - 1
+                        values(p + 2*a) = values(p + 2*a) + k4(a, b)
+                        values(p + 2*a + 1) = values(p + 2*a + 1) + k4(b, nen + a)
+                    end do
+                else
+                    do a = runs(t), runs(t + 1) - 1
+                        values(p + 2*a) = values(p + 2*a) + k4(a, b)
+                        values(p + 2*a + 1) = values(p + 2*a + 1) + k4(a, 3*nen + b)
+                    end do
+                end if
+                do a = runs(t), runs(t + 1) - 1
+                    values(q + 2*a) = values(q + 2*a) + k4(a, nen + b)
+                    values(q + 2*a + 1) = values(q + 2*a + 1) + k4(a, 2*nen + b)
                 end do
-            else
-                do a = 1, nen
-                    values(pos(2*a - 1, 2*b - 1)) = values(pos(2*a - 1, 2*b - 1)) + k4(a, b)
-                    values(pos(2*a, 2*b - 1)) = values(pos(2*a, 2*b - 1)) + k4(a, 3*nen + b)
-                end do
-            end if
-            do a = 1, nen
-                values(pos(2*a - 1, 2*b)) = values(pos(2*a - 1, 2*b)) + k4(a, nen + b)
-                values(pos(2*a, 2*b)) = values(pos(2*a, 2*b)) + k4(a, 2*nen + b)
             end do
         end do
     end subroutine add_mapped
