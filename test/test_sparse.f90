@@ -5,7 +5,7 @@ module test_sparse
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, error_code
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, consecutive_runs
     use voiga_solver_umfpack, only: umfpack_t, dp_is_c_double
     use voiga_test_fixtures, only: lcg_t
     use voiga_linalg_blas, only: kernels_for
@@ -23,6 +23,7 @@ contains
                     new_unittest('chain_pattern', test_chain_pattern), &
                     new_unittest('bad_pattern_input', test_bad_pattern), &
                     new_unittest('pattern_positions', test_pattern_positions), &
+                    new_unittest('consecutive_runs', test_consecutive_runs), &
                     new_unittest('assembly_matvec_dense', test_assembly), &
                     new_unittest('missed_entries_counted', test_missed), &
                     new_unittest('fix_dofs', test_fix_dofs), &
@@ -55,6 +56,23 @@ contains
         if (allocated(error)) return
         call check(error, kernels_for('Zen', .true., .true., .true.) == '', 'Zen kept')
     end subroutine test_kernels_choice
+
+    !> Runs of consecutive integers: a control-point row of an element, a break
+    !> between rows, single entries, a descent (not a run), an empty list.
+    subroutine test_consecutive_runs(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: runs(10), nr
+        call consecutive_runs([4, 5, 6, 10, 11, 12, 20, 7, 8], runs, nr)
+        call check(error, nr == 4, 'four runs')
+        if (allocated(error)) return
+        call check(error, all(runs(1:5) == [1, 4, 7, 8, 10]), 'run starts 1 4 7 8, end 10')
+        if (allocated(error)) return
+        call consecutive_runs([3, 2, 1], runs, nr)
+        call check(error, nr == 3 .and. all(runs(1:4) == [1, 2, 3, 4]), 'a descent is three runs')
+        if (allocated(error)) return
+        call consecutive_runs([integer ::], runs, nr)
+        call check(error, nr == 0 .and. runs(1) == 1, 'no entries: no runs')
+    end subroutine test_consecutive_runs
 
     subroutine test_kinds(error)
         type(error_t), allocatable, intent(out) :: error

@@ -10,7 +10,8 @@ module voiga_model_assembly
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element, solid_element_blocks, element_work_t
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
+    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t, &
+                                   consecutive_runs
     implicit none
     private
 
@@ -34,7 +35,7 @@ module voiga_model_assembly
         integer, allocatable :: ptr(:)
         !> Index into the matrix values, for each column of each element's matrix
         !> (local order 2(a-1) + i), of the first row of each run of its control points
-        !> with consecutive numbers (`cp_runs`) [nruns, 2 nen per element]: the rows
+        !> with consecutive numbers (`consecutive_runs`) [nruns, 2 nen per element]: the rows
         !> of a run are consecutive DOFs, so their entries are consecutive in any CSC
         !> pattern that has them.
         integer, allocatable :: pos(:)
@@ -122,7 +123,7 @@ contains
                 idx = idx + 1
                 associate (conn => model%bodies(ib)%disc%elements(e)%conn)
                     call reserve(runs, size(conn) + 1)
-                    call cp_runs(conn, runs, nr)
+                    call consecutive_runs(conn, runs, nr)
                     map%ptr(idx + 1) = map%ptr(idx) + 2*size(conn)*nr
                 end associate
             end do
@@ -144,7 +145,7 @@ contains
                 end if
                 if (.not. allocated(pos)) allocate (pos(m, m))
                 call k%element_positions(dofs, pos)
-                call cp_runs(model%bodies(ib)%disc%elements(e)%conn, runs, nr)
+                call consecutive_runs(model%bodies(ib)%disc%elements(e)%conn, runs, nr)
                 call run_positions(pos, runs(1:nr + 1), map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ok)
                 if (.not. ok) then
                     call fatal_error(error, 'new_assembly_map: the entries of a run of DOFs are not '// &
@@ -165,25 +166,6 @@ contains
         end if
         allocate (a(n))
     end subroutine reserve
-
-    !> The runs of control points with consecutive numbers in an element's
-    !> connectivity `conn`: run t is conn(runs(t):runs(t + 1) - 1); `nr` runs
-    !> (`runs` [size(conn) + 1]: at least as many entries as there are runs, plus one).
-    pure subroutine cp_runs(conn, runs, nr)
-        integer, intent(in) :: conn(:)
-        integer, intent(out) :: runs(:)
-        integer, intent(out) :: nr
-        integer :: a
-        nr = 0
-        do a = 1, size(conn)
-            if (a > 1) then
-                if (conn(a) == conn(a - 1) + 1) cycle
-            end if
-            nr = nr + 1
-            runs(nr) = a
-        end do
-        runs(nr + 1) = size(conn) + 1
-    end subroutine cp_runs
 
     !> `starts` [nr, m]: the position of each run's first row (2 runs(t) - 1) in each
     !> column of the element positions `pos` [m, m]; false if a run's rows are not
@@ -524,7 +506,7 @@ contains
                         dofs = body_dofs(body, e)
                         call k%add_element(dofs, ke)
                     else if (present(k)) then
-                        call cp_runs(body%disc%elements(e)%conn, runs, nr)
+                        call consecutive_runs(body%disc%elements(e)%conn, runs, nr)
                         call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), &
                                         n/2, work%k4, size(work%k4, 1), work%sym)
                     end if

@@ -14,7 +14,7 @@ module voiga_solver_sparse
     implicit none
     private
 
-    public :: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t
+    public :: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t, consecutive_runs
 
     !> The positions in `values` of the last element `add_cached` was given (its
     !> DOFs and their entries' positions), for a caller that adds many element
@@ -63,6 +63,26 @@ module voiga_solver_sparse
     end type csc_matrix_t
 
 contains
+
+    !> The runs of consecutive integers in `v` (entries v(i) = v(i - 1) + 1 continue a
+    !> run): run t is v(runs(t):runs(t + 1) - 1), `nr` runs (`runs`: at least nr + 1
+    !> entries; size(v) + 1 always do). Consecutive row numbers of a CSC column, or
+    !> consecutive positions, are contiguous values: a run is one vector operation.
+    pure subroutine consecutive_runs(v, runs, nr)
+        integer, intent(in) :: v(:)
+        integer, intent(inout) :: runs(:)
+        integer, intent(out) :: nr
+        integer :: a
+        nr = 0
+        do a = 1, size(v)
+            if (a > 1) then
+                if (v(a) == v(a - 1) + 1) cycle
+            end if
+            nr = nr + 1
+            runs(nr) = a
+        end do
+        runs(nr + 1) = size(v) + 1
+    end subroutine consecutive_runs
 
     !> Build the sparsity pattern (values all zero) of an n x n matrix assembled
     !> from elements: element `e` couples every DOF of

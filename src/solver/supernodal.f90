@@ -32,7 +32,7 @@ module voiga_solver_supernodal
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error
     use voiga_text, only: str
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_solver_sparse, only: csc_matrix_t, consecutive_runs
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_linalg_blas, only: dgemm, dtrsm
@@ -573,16 +573,8 @@ contains
         real(dp), intent(in) :: fc(m, m)
         integer, intent(in) :: rel(m - k)
         integer, intent(inout) :: runs(m - k + 1)
-        integer :: a, b, cb, nr, t, r0, a0, len
-        nr = 0
-        do a = 1, m - k
-            if (a > 1) then
-                if (rel(a) == rel(a - 1) + 1) cycle
-            end if
-            nr = nr + 1
-            runs(nr) = a
-        end do
-        runs(nr + 1) = m - k + 1
+        integer :: b, cb, nr, t, r0, a0, len
+        call consecutive_runs(rel, runs, nr)
         do b = k + 1, m
             cb = rel(b - k)
             do t = 1, nr
