@@ -6,8 +6,9 @@ the start, writes them to ``OUT.log`` and prints the wall time of each phase: th
 check, the study's runs (until its bar reaches the last case), the summary and the
 figures; then the runs' work (the sum of their wall times, ``summary.csv``) and its
 stages. ``--against OLD`` compares every column of ``OUT/summary.csv`` but the times with
-``OLD/summary.csv`` (another run's folder) and counts the cells that differ: the paper's
-measures must not move when only the speed changes.
+``OLD/summary.csv`` (another run's folder) and counts the cells that differ (``--rtol
+1e-9``: numbers by more than that, relative): the paper's measures must not move when
+only the speed changes.
 
 Time old against new by alternating them (``--tree`` names another checkout, e.g. a
 ``git worktree`` of the old commit): the machine's speed drifts, and only runs made side
@@ -98,9 +99,23 @@ def work(rows: list[dict[str, str]]) -> dict[str, float]:
     return {key: total(key) for key in ("wall_s", *STAGE_COLUMNS)}
 
 
-def differences(new: list[dict[str, str]], old: list[dict[str, str]]) -> list[str]:
-    """Every cell but the times (``TIME_COLUMNS``) in which ``new`` and ``old`` differ, as
-    text; a case only one of them has counts as one difference."""
+def same_cell(a: str, b: str, rtol: float) -> bool:
+    """Equal text, or (``rtol`` > 0) two numbers within ``rtol`` of the larger's size."""
+    if a == b:
+        return True
+    if rtol <= 0.0:
+        return False
+    try:
+        x, y = float(a), float(b)
+    except ValueError:
+        return False
+    return abs(x - y) <= rtol * max(abs(x), abs(y))
+
+
+def differences(new: list[dict[str, str]], old: list[dict[str, str]], rtol: float = 0.0) -> list[str]:
+    """Every cell but the times (``TIME_COLUMNS``) in which ``new`` and ``old`` differ (as
+    text, or with ``rtol`` > 0 as numbers by more than ``rtol`` relative); a case only
+    one of them has counts as one difference."""
     def key(r: dict[str, str]) -> tuple[str, ...]:
         return tuple(r.get(k, "") for k in ("scene", "mesh", "layout", "case"))
     def name(k: tuple[str, ...]) -> str:
@@ -112,7 +127,7 @@ def differences(new: list[dict[str, str]], old: list[dict[str, str]]) -> list[st
         for col in sorted(a[k].keys() | b[k].keys()):
             if col in TIME_COLUMNS:
                 continue
-            if a[k].get(col, "") != b[k].get(col, ""):
+            if not same_cell(a[k].get(col, ""), b[k].get(col, ""), rtol):
                 out.append(f"{name(k)} {col}: {a[k].get(col, '')} against {b[k].get(col, '')}")
     return out
 
@@ -136,6 +151,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("out", type=Path, help="PAPER_OUT: the study's folder (must not exist)")
     ap.add_argument("--tree", type=Path, default=REPO, help="source tree whose make paper runs (default: this one)")
     ap.add_argument("--against", type=Path, help="folder of another make paper run to compare the measures with")
+    ap.add_argument("--rtol", type=float, default=0.0,
+                    help="numbers within this relative difference count as equal (default 0: the same text)")
     args = ap.parse_args(argv)
     out = args.out.resolve()
     if out.exists():
@@ -158,8 +175,9 @@ def main(argv: list[str] | None = None) -> int:
     print(report(ph, work(rows)))
     status = 0 if code == 0 else 1
     if args.against:
-        diff = differences(rows, read_summary(args.against))
-        print(f"  measures against {args.against}: {len(diff)} cells differ" + "".join(f"\n    {d}" for d in diff[:10]))
+        diff = differences(rows, read_summary(args.against), args.rtol)
+        tol = f" by more than {args.rtol:g} relative" if args.rtol > 0 else ""
+        print(f"  measures against {args.against}: {len(diff)} cells differ{tol}" + "".join(f"\n    {d}" for d in diff[:10]))
         status = status or (1 if diff else 0)
     return status
 

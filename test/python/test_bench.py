@@ -119,6 +119,10 @@ def test_paper_work_and_measures() -> None:
     assert differences(_rows(osc_py="0.0012"), _rows()) == [
         "ironing/m3/NN2.2 osc_py: 0.0012 against 0.0011", "ironing/m4/NN2.2 osc_py: 0.0012 against 0.0011"]
     assert differences(_rows()[:1], _rows()) == ["ironing/m4/NN2.2: only in the old run"]
+    # with a tolerance: a rounding-sized change passes, a larger one and changed text do not
+    assert differences(_rows(osc_py="0.00110000000001"), _rows(), rtol=1e-9) == []
+    assert len(differences(_rows(osc_py="0.0011001"), _rows(), rtol=1e-9)) == 2
+    assert len(differences(_rows(osc_py="nan?"), _rows(), rtol=1e-9)) == 2
 
 
 def test_paper_stamps_lines_and_keeps_results(tmp_path: Path) -> None:
