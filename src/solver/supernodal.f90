@@ -87,9 +87,18 @@ module voiga_solver_supernodal
         !> go into its front (aptr [nsuper+1], apos: positions in `a`), so that a front
         !> is zeroed, filled and factorized while it is in cache.
         integer, allocatable, private :: cptr(:), kids(:), aptr(:), apos(:)
-        !> The fronts (after a factorization: L, U and the update of each), the row
-        !> scale factors and their reciprocals [n], a solve's work vectors [n].
+        !> The fronts' L and U parts (front s at fptr(s): its first k columns [m, k],
+        !> then U12, the rest of its first k rows [k, m - k]; after a factorization:
+        !> L and U), the row scale factors and their reciprocals [n], a solve's work
+        !> vectors [n].
         real(dp), allocatable, private :: f(:), scale(:), rscale(:), y(:), w(:)
+        !> The fronts' update blocks [(m - k) x (m - k)], each at uoff(s) in `upool`,
+        !> alive from its front's elimination to its parent's assembly: two stacks,
+        !> one for the supernodes at even depths of the tree and one for the odd, so
+        !> that a front's block and its children's never overlap and the pool stays
+        !> small (in cache) where all the update blocks in `f` were not.
+        integer, allocatable, private :: uoff(:)
+        real(dp), allocatable, private :: upool(:)
         !> The local pivot rows [n]; work of the extend-adds [n + 1].
         integer, allocatable, private :: ipiv(:), runs(:)
         integer, private :: det_sign = 0
@@ -335,7 +344,7 @@ contains
             r0 = self%rptr(s)
             m = self%rptr(s + 1) - r0
             k = self%super(s + 1) - self%super(s)
-            self%fptr(s + 1) = self%fptr(s) + m*m
+            self%fptr(s + 1) = self%fptr(s) + m*k + k*(m - k)
             self%parent(s) = 0
             if (m == k) cycle
             par = owner(self%rows(r0 + k))
@@ -350,6 +359,7 @@ contains
             pos(self%rows(self%rptr(par):self%rptr(par + 1) - 1)) = 0
         end do
         call children(self)
+        call update_offsets(self)
         call entry_positions(self, a, pos, ok)
         if (.not. ok) return
         if (allocated(self%f)) deallocate (self%f)
@@ -358,6 +368,57 @@ contains
         allocate (self%ipiv(a%n), self%runs(a%n + 1), self%scale(a%n), self%rscale(a%n), self%y(a%n), &
                   self%w(a%n))
     end subroutine front_maps
+
+    !> The update blocks' places in the pool (uoff, upool): supernodes are in
+    !> postorder, so when a front is assembled its children's blocks are the top of
+    !> the stack of their depth's parity; its own block goes on the other stack.
+    !> Should the tree not be in postorder, every block gets its own place.
+    subroutine update_offsets(self)
+        class(supernodal_lu_t), intent(inout) :: self
+        integer :: parity(self%nsuper), size_of(self%nsuper)
+        integer :: top(0:1), peak(0:1), s, p, t, low, held
+        logical :: stacked
+        if (allocated(self%uoff)) deallocate (self%uoff)
+        allocate (self%uoff(self%nsuper))
+        do s = 1, self%nsuper
+            size_of(s) = (self%rptr(s + 1) - self%rptr(s) - self%super(s + 1) + self%super(s))**2
+        end do
+        stacked = all(self%parent == 0 .or. self%parent > [(s, s=1, self%nsuper)])
+        parity = 0
+        do s = self%nsuper, 1, -1
+            if (self%parent(s) > 0) parity(s) = 1 - parity(self%parent(s))
+        end do
+        top = 0
+        peak = 0
+        do s = 1, self%nsuper
+            p = parity(s)
+            self%uoff(s) = top(p)
+            top(p) = top(p) + size_of(s)
+            peak(p) = max(peak(p), top(p))
+            if (self%cptr(s + 1) == self%cptr(s)) cycle
+            ! the children's blocks, read by this front's assembly, are then free
+            low = minval(self%uoff(self%kids(self%cptr(s):self%cptr(s + 1) - 1)))
+            held = sum(size_of(self%kids(self%cptr(s):self%cptr(s + 1) - 1)))
+            if (top(1 - p) - low /= held) stacked = .false.
+            top(1 - p) = low
+        end do
+        if (stacked) then
+            do s = 1, self%nsuper
+                self%uoff(s) = self%uoff(s) + 1 + merge(0, peak(0), parity(s) == 0)
+            end do
+        else
+            self%uoff(1) = 1
+            do s = 2, self%nsuper
+                self%uoff(s) = self%uoff(s - 1) + size_of(s - 1)
+            end do
+            peak = [sum(size_of), 0]
+        end if
+        do t = 1, self%nsuper
+            if (size_of(t) == 0) self%uoff(t) = 1
+        end do
+        if (allocated(self%upool)) deallocate (self%upool)
+        allocate (self%upool(max(1, peak(0) + peak(1))))
+    end subroutine update_offsets
 
     !> The children of every supernode (cptr, kids; ascending), from the parents.
     pure subroutine children(self)
@@ -392,7 +453,7 @@ contains
         integer, intent(inout) :: pos(:)
         logical, intent(out) :: ok
         integer, allocatable :: iperm(:)
-        integer :: s, c, j, p, i, pi, r, m, f0, base, q
+        integer :: s, c, j, p, i, pi, r, m, k, f0, base, q
 
         ok = .false.
         q = 0
@@ -405,6 +466,7 @@ contains
         do s = 1, self%nsuper
             f0 = self%super(s)
             m = self%rptr(s + 1) - self%rptr(s)
+            k = self%super(s + 1) - f0
             base = self%fptr(s)
             do r = 1, m
                 pos(self%rows(self%rptr(s) + r - 1)) = r
@@ -421,12 +483,17 @@ contains
                         pos(self%rows(self%rptr(s):self%rptr(s + 1) - 1)) = 0
                         return
                     end if
-                    ! F(r, c - f0 + 1) and, above the diagonal, F(c - f0 + 1, r)
+                    ! F(r, c - f0 + 1) and, above the diagonal, F(c - f0 + 1, r): in
+                    ! the front's first k columns, or for r > k in U12
                     self%dest(p) = base + (c - f0)*m + r - 1
                     q = q + 1
                     self%apos(q) = p
                     if (pi /= c) then
-                        self%dest(self%tpos(p)) = base + (r - 1)*m + c - f0
+                        if (r <= k) then
+                            self%dest(self%tpos(p)) = base + (r - 1)*m + c - f0
+                        else
+                            self%dest(self%tpos(p)) = base + m*k + (r - k - 1)*k + c - f0
+                        end if
                         q = q + 1
                         self%apos(q) = self%tpos(p)
                     end if
@@ -445,7 +512,7 @@ contains
         class(supernodal_lu_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         logical, intent(out) :: ok
-        integer :: s, p, m, k, t, c, mc, kc
+        integer :: s, p, m, k, t, c, nc, u0, f0
 
         ! UMFPACK's default scaling: each row divided by the sum of its absolute values
         self%scale = 0.0_dp
@@ -454,41 +521,50 @@ contains
         end do
         where (self%scale == 0.0_dp) self%scale = 1.0_dp
         self%rscale = 1.0_dp/self%scale
-        ! front by front (postorder): zero it, write a's entries, add the children's
-        ! updates, eliminate
+        ! front by front (postorder): zero its L and U parts and its update block,
+        ! write a's entries (all in the L and U parts), add the children's updates,
+        ! eliminate
         do s = 1, self%nsuper
             m = self%rptr(s + 1) - self%rptr(s)
             k = self%super(s + 1) - self%super(s)
-            self%f(self%fptr(s):self%fptr(s + 1) - 1) = 0.0_dp
+            u0 = self%uoff(s)
+            f0 = self%fptr(s)
+            self%f(f0:self%fptr(s + 1) - 1) = 0.0_dp
+            self%upool(u0:u0 + (m - k)**2 - 1) = 0.0_dp
             do t = self%aptr(s), self%aptr(s + 1) - 1
                 p = self%apos(t)
                 self%f(self%dest(p)) = a%values(p)*self%rscale(a%rowind(p) + 1)
             end do
             do t = self%cptr(s), self%cptr(s + 1) - 1
                 c = self%kids(t)
-                mc = self%rptr(c + 1) - self%rptr(c)
-                kc = self%super(c + 1) - self%super(c)
-                call extend_add(self%f(self%fptr(s):), m, self%f(self%fptr(c):), mc, kc, &
-                                self%rel(self%rptr(c) + kc:), self%runs)
+                nc = self%rptr(c + 1) - self%rptr(c) - self%super(c + 1) + self%super(c)
+                call extend_add(self%f(f0:f0 + m*k - 1), self%f(f0 + m*k:self%fptr(s + 1) - 1), &
+                                self%upool(u0:u0 + (m - k)**2 - 1), m, k, &
+                                self%upool(self%uoff(c):self%uoff(c) + nc**2 - 1), nc, &
+                                self%rel(self%rptr(c + 1) - nc:), self%runs)
             end do
-            call partial_factor(self%f(self%fptr(s):), m, k, self%ipiv(self%super(s):), ok)
+            call partial_factor(self%f(f0:f0 + m*k - 1), self%f(f0 + m*k:self%fptr(s + 1) - 1), m, k, &
+                                self%ipiv(self%super(s):), self%upool(u0:u0 + (m - k)**2 - 1), ok)
             if (.not. ok) return
         end do
     end subroutine numeric
 
-    !> Eliminate the first k columns of the m x m front `fr`: pivots from the
+    !> Eliminate the first k columns of an m x m front (its first k columns `fr`
+    !> [m, k], the rest of its first k rows `u12` [k, m - k]): pivots from the
     !> diagonal block (row swaps inside it, recorded in `piv`), L below and U right
-    !> of it, and the remainder updated to the Schur complement (one dgemm).
-    subroutine partial_factor(fr, m, k, piv, ok)
+    !> of it, and the update block `upd` [m - k, m - k] (the front's remainder)
+    !> updated to the Schur complement (one dgemm).
+    subroutine partial_factor(fr, u12, m, k, piv, upd, ok)
         integer, intent(in) :: m, k
-        real(dp), intent(inout) :: fr(m, m)
+        real(dp), intent(inout) :: fr(m, k), u12(k, m - k)
         integer, intent(out) :: piv(k)
+        real(dp), intent(inout) :: upd(m - k, m - k)
         logical, intent(out) :: ok
         real(dp) :: big, d, t
         integer :: j, i, c, p
 
         if (k >= blas_from) then
-            call blocked_factor(fr, m, k, piv, ok)
+            call blocked_factor(fr, u12, m, k, piv, upd, ok)
             return
         end if
         ok = .false.
@@ -505,10 +581,15 @@ contains
             if (abs(fr(j, j)) >= prefer_diagonal*big) p = j
             piv(j) = p
             if (p /= j) then
-                do c = 1, m
+                do c = 1, k
                     t = fr(j, c)
                     fr(j, c) = fr(p, c)
                     fr(p, c) = t
+                end do
+                do c = 1, m - k
+                    t = u12(j, c)
+                    u12(j, c) = u12(p, c)
+                    u12(p, c) = t
                 end do
             end if
             d = 1.0_dp/fr(j, j)
@@ -526,14 +607,13 @@ contains
         if (m > k) then
             ! U12 = L11^-1 F12 (its rows swapped with the block's) column by column (BLAS's
             ! dtrsm costs more than the flops at these sizes), then the Schur complement
-            do c = k + 1, m
+            do c = 1, m - k
                 do j = 1, k - 1
-                    t = fr(j, c)
-                    if (t /= 0.0_dp) fr(j + 1:k, c) = fr(j + 1:k, c) - fr(j + 1:k, j)*t
+                    t = u12(j, c)
+                    if (t /= 0.0_dp) u12(j + 1:k, c) = u12(j + 1:k, c) - fr(j + 1:k, j)*t
                 end do
             end do
-            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
-                       fr(k + 1, k + 1), m)
+            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, u12, k, 1.0_dp, upd, m - k)
         end if
         ok = .true.
     end subroutine partial_factor
@@ -543,45 +623,63 @@ contains
     !> swaps applied to U's part, L21 = F21 U11^-1 and U12 = L11^-1 F12 by dtrsm, the
     !> Schur complement by dgemm; `ok` false for a zero pivot or a multiplier of L21
     !> above `max_multiplier`.
-    subroutine blocked_factor(fr, m, k, piv, ok)
+    subroutine blocked_factor(fr, u12, m, k, piv, upd, ok)
         integer, intent(in) :: m, k
-        real(dp), intent(inout) :: fr(m, m)
+        real(dp), intent(inout) :: fr(m, k), u12(k, m - k)
         integer, intent(out) :: piv(k)
+        real(dp), intent(inout) :: upd(m - k, m - k)
         logical, intent(out) :: ok
         integer :: info
         ok = .false.
         call dgetrf(k, k, fr, m, piv, info)
         if (info /= 0) return
         if (m > k) then
-            call dlaswp(m - k, fr(1, k + 1), m, 1, k, piv, 1)
+            call dlaswp(m - k, u12, k, 1, k, piv, 1)
             call dtrsm('R', 'U', 'N', 'N', m - k, k, 1.0_dp, fr, m, fr(k + 1, 1), m)
             if (maxval(abs(fr(k + 1:m, 1:k))) > max_multiplier) return
-            call dtrsm('L', 'L', 'N', 'U', k, m - k, 1.0_dp, fr, m, fr(1, k + 1), m)
-            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, fr(1, k + 1), m, 1.0_dp, &
-                       fr(k + 1, k + 1), m)
+            call dtrsm('L', 'L', 'N', 'U', k, m - k, 1.0_dp, fr, m, u12, k)
+            call dgemm('N', 'N', m - k, m - k, k, -1.0_dp, fr(k + 1, 1), m, u12, k, 1.0_dp, upd, m - k)
         end if
         ok = .true.
     end subroutine blocked_factor
 
-    !> Add the update (rows and columns k+1..m) of a child's front `fc` [m, m] into
-    !> its parent's front `fp` [mp, mp] at the positions `rel` [m - k] (ascending).
-    !> The rows go in runs of consecutive positions (`runs` [m - k + 1]: work), each
-    !> column of a run one vector add: the same additions as entry by entry.
-    pure subroutine extend_add(fp, mp, fc, m, k, rel, runs)
-        integer, intent(in) :: mp, m, k
-        real(dp), intent(inout) :: fp(mp, mp)
-        real(dp), intent(in) :: fc(m, m)
-        integer, intent(in) :: rel(m - k)
-        integer, intent(inout) :: runs(m - k + 1)
-        integer :: b, cb, nr, t, r0, a0, len
-        call consecutive_runs(rel, runs, nr)
-        do b = k + 1, m
-            cb = rel(b - k)
+    !> Add a child's update block `uc` [nc, nc] into its parent's front (kp pivots:
+    !> its first kp columns `fp` [mp, kp], the rest of its first kp rows `fu`
+    !> [kp, mp - kp], its update block `up` [mp - kp, mp - kp]) at the front
+    !> positions `rel` [nc] (ascending: the rows 1..na land in the parent's pivot
+    !> rows). The rows go in runs of consecutive positions (`runs` [nc + 1]: work),
+    !> split at the pivot rows' end, each column of a run one vector add: the same
+    !> additions as entry by entry.
+    pure subroutine extend_add(fp, fu, up, mp, kp, uc, nc, rel, runs)
+        integer, intent(in) :: mp, kp, nc
+        real(dp), intent(inout) :: fp(mp, kp), fu(kp, mp - kp), up(mp - kp, mp - kp)
+        real(dp), intent(in) :: uc(nc, nc)
+        integer, intent(in) :: rel(nc)
+        integer, intent(inout) :: runs(nc + 1)
+        integer :: b, cb, na, n1, nr, t, r0, a0, len
+        na = 0
+        do while (na < nc)
+            if (rel(na + 1) > kp) exit
+            na = na + 1
+        end do
+        call consecutive_runs(rel(1:na), runs, n1)
+        call consecutive_runs(rel(na + 1:nc), runs(n1 + 1:), nr)
+        runs(n1 + 1:n1 + nr + 1) = runs(n1 + 1:n1 + nr + 1) + na
+        nr = n1 + nr
+        do b = 1, nc
+            cb = rel(b)
             do t = 1, nr
                 a0 = runs(t)
                 len = runs(t + 1) - a0
                 r0 = rel(a0)
-                fp(r0:r0 + len - 1, cb) = fp(r0:r0 + len - 1, cb) + fc(k + a0:k + a0 + len - 1, b)
+                if (cb <= kp) then
+                    fp(r0:r0 + len - 1, cb) = fp(r0:r0 + len - 1, cb) + uc(a0:a0 + len - 1, b)
+                else if (t <= n1) then
+                    fu(r0:r0 + len - 1, cb - kp) = fu(r0:r0 + len - 1, cb - kp) + uc(a0:a0 + len - 1, b)
+                else
+                    up(r0 - kp:r0 - kp + len - 1, cb - kp) = up(r0 - kp:r0 - kp + len - 1, cb - kp) + &
+                                                             uc(a0:a0 + len - 1, b)
+                end if
             end do
         end do
     end subroutine extend_add
@@ -644,7 +742,7 @@ contains
         class(supernodal_lu_t), intent(inout) :: self
         real(dp), intent(in) :: b(:)
         real(dp), intent(out) :: x(:)
-        integer :: s, c
+        integer :: s, c, m, k
         do c = 1, self%n
             self%y(c) = b(self%perm(c))*self%rscale(self%perm(c))
         end do
@@ -653,8 +751,10 @@ contains
                          self%rows(self%rptr(s):), self%ipiv(self%super(s):), self%y, self%w)
         end do
         do s = self%nsuper, 1, -1
-            call backward(self%f(self%fptr(s):), self%rptr(s + 1) - self%rptr(s), self%super(s + 1) - self%super(s), &
-                          self%rows(self%rptr(s):), self%y, self%w)
+            m = self%rptr(s + 1) - self%rptr(s)
+            k = self%super(s + 1) - self%super(s)
+            call backward(self%f(self%fptr(s):), self%f(self%fptr(s) + m*k:), m, k, self%rows(self%rptr(s):), &
+                          self%y, self%w)
         end do
         x(self%perm) = self%y
     end subroutine apply_inverse
@@ -663,7 +763,7 @@ contains
     !> then its rows below the block, summed in `w` [m - k] and scattered once.
     pure subroutine forward(fr, m, k, rows, piv, y, w)
         integer, intent(in) :: m, k, rows(m), piv(k)
-        real(dp), intent(in) :: fr(m, m)
+        real(dp), intent(in) :: fr(m, k)
         real(dp), intent(inout) :: y(:)
         real(dp), intent(out) :: w(:)
         real(dp) :: t
@@ -699,9 +799,10 @@ contains
 
     !> One supernode of the backward substitution: the rows of U right of the
     !> diagonal block against the solution gathered in `w` [m - k], then the block.
-    pure subroutine backward(fr, m, k, rows, y, w)
+    pure subroutine backward(fr, fu, m, k, rows, y, w)
         integer, intent(in) :: m, k, rows(m)
-        real(dp), intent(in) :: fr(m, m)
+        !> The front's first k columns [m, k] and the rest of its first k rows [k, m - k].
+        real(dp), intent(in) :: fr(m, k), fu(k, m - k)
         real(dp), intent(inout) :: y(:)
         real(dp), intent(out) :: w(:)
         real(dp) :: t
@@ -714,7 +815,7 @@ contains
             t = w(c - k)
             if (t == 0.0_dp) cycle
             do j = 1, k
-                y(f0 + j - 1) = y(f0 + j - 1) - fr(j, c)*t
+                y(f0 + j - 1) = y(f0 + j - 1) - fu(j, c - k)*t
             end do
         end do
         do j = k, 1, -1
