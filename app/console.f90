@@ -50,9 +50,15 @@ contains
         type(iteration_report_t), intent(in) :: report
         integer :: ip
         if (.not. self%verbose) return
-        write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4,a,es9.2)', advance='no') '  step ', report%step, &
+        write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4,a)', advance='no') '  step ', report%step, &
             ' it ', report%iteration, '  |r|=', report%residual, '  |du.r|=', report%energy, '  step length ', &
-            report%step_length, '  floor ', report%floor
+            report%step_length, '  floor '
+        ! a converged iterate evaluated without its tangent has no floor (it needs K)
+        if (report%floor >= 0.0_dp) then
+            write (*, '(es9.2)', advance='no') report%floor
+        else
+            write (*, '(a)', advance='no') '    (n/a)'
+        end if
         do ip = 1, size(report%points)
             write (*, '(a,i0,a,i0,a,i0)', advance='no') '  stick=', report%stick(ip), ' slip=', report%slip(ip), &
                 ' of ', report%points(ip)

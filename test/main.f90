@@ -20,6 +20,7 @@ program voiga_tests
     use test_files, only: collect_files
     use test_bulk_update, only: collect_bulk_update
     use test_supernodal, only: collect_supernodal
+    use test_newton, only: collect_newton
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -42,7 +43,8 @@ program voiga_tests
              new_testsuite('fields', collect_fields), &
              new_testsuite('files', collect_files), &
              new_testsuite('bulk_update', collect_bulk_update), &
-             new_testsuite('supernodal', collect_supernodal) &
+             new_testsuite('supernodal', collect_supernodal), &
+             new_testsuite('newton', collect_newton) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -27,7 +27,8 @@ module test_contact
     implicit none
     private
 
-    public :: collect_contact, two_body_model, penetrating_state, contact_fd, bc, build_model, run_fd
+    public :: collect_contact, two_body_model, penetrating_state, contact_fd, bc, build_model, run_fd, &
+              small_ironing
 
     real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -724,17 +725,7 @@ contains
         real(dp) :: floor
         integer :: i
 
-        c%bodies = [body_settings('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
-                    body_settings('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
-        ! press 0.5 in 10 steps, then 5 of the 200 sliding steps of 0.02
-        c%solver%n_steps = [10, 5]
-        c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &
-                       bc('slab', 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))]
-        allocate (c%contact(1))
-        c%contact(1) = contact_settings_t(slave='die', master='slab', penalty_normal=100.0_dp, &
-                                       penalty_tangent=100.0_dp, friction=0.3_dp, method=method)
-        call build_model(c, [annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
-                             rectangle(0.0_dp, -3.0_dp, 9.0_dp, 3.0_dp)], model, error)
+        call small_ironing(method, c, model, error)
         if (allocated(error)) return
         ! the tangent is what is tested: every step starts from the last state
         c%solver%predictor = .false.
@@ -763,6 +754,25 @@ contains
             end if
         end do
     end subroutine ironing_quadratic
+
+    !> A small frictional ironing scene (Neo-Hookean die on a slab, NN2.2, mu = 0.3):
+    !> pressed 0.5 in 10 steps, then 5 of the paper's 200 sliding steps of 0.02.
+    subroutine small_ironing(method, c, model, error)
+        character(len=*), intent(in) :: method
+        type(scene_t), intent(out) :: c
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        c%bodies = [body_settings('die', 'neo-hookean', 10.0_dp, paper_layout('NN2.2', [6, 1], 'outer')), &
+                    body_settings('slab', 'neo-hookean', 1.0_dp, paper_layout('NN2.2', [8, 2], 'top'))]
+        c%solver%n_steps = [10, 5]
+        c%dirichlet = [bc('die', 'inner', [.true., .true.], reshape([0.0_dp, -0.5_dp, 0.1_dp, -0.5_dp], [2, 2])), &
+                       bc('slab', 'bottom', [.true., .true.], reshape([0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2]))]
+        allocate (c%contact(1))
+        c%contact(1) = contact_settings_t(slave='die', master='slab', penalty_normal=100.0_dp, &
+                                       penalty_tangent=100.0_dp, friction=0.3_dp, method=method)
+        call build_model(c, [annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2), &
+                             rectangle(0.0_dp, -3.0_dp, 9.0_dp, 3.0_dp)], model, error)
+    end subroutine small_ironing
 
     !> The contact part of the stiffness pattern fitted to the configuration
     !> (assemble with refit) is smaller than the whole-master coupling but loses

@@ -10,7 +10,8 @@ module voiga_element_solid
     implicit none
     private
 
-    public :: solid_element, solid_element_blocks, reference_gradients, element_points_t, element_work_t
+    public :: solid_element, solid_element_blocks, solid_element_force, reference_gradients, element_points_t, &
+              element_work_t
 
     !> The quadrature of one element in the reference configuration, computed once
     !> per discretization: reference gradients dN/dX [2, nen, npts] and weights
@@ -95,6 +96,69 @@ contains
         call fit_work(work, size(u, 2), 2*size(pts%wdv))
         call element_kernel(mat, pts, u, fe, ok, work)
     end subroutine solid_element_blocks
+
+    !> The internal force `fe` [2 nen] of an element without its tangent: the
+    !> operations of `solid_element`'s force in the same order, so the same numbers
+    !> (a residual whose tangent is not wanted: a Newton iterate expected to have
+    !> converged). `ok` is false if J <= 0 at a point.
+    pure subroutine solid_element_force(mat, pts, u, fe, ok, work)
+        class(material_t), intent(in) :: mat
+        type(element_points_t), intent(in) :: pts
+        real(dp), intent(in) :: u(:, :)
+        real(dp), intent(out) :: fe(:)
+        logical, intent(out) :: ok
+        type(element_work_t), intent(inout) :: work
+        call fit_work(work, size(u, 2), 2*size(pts%wdv))
+        call point_forces(mat, size(u, 2), size(pts%wdv), pts%dndx, pts%wdv, u, fe, ok, work%gt)
+    end subroutine solid_element_force
+
+    !> The quadrature-point loop of `solid_element_force` (`g` [nen, 2]: work): the
+    !> force part of `point_columns`, written out again so that the hot kernel keeps
+    !> it inline (a shared per-point call cost 0.5 % of an ironing run); the same
+    !> expressions in the same order, checked bit for bit by test_newton.
+    pure subroutine point_forces(mat, nen, np, dndx, wdv, u, fe, ok, g)
+        class(material_t), intent(in) :: mat
+        integer, intent(in) :: nen, np
+        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
+        real(dp), intent(out) :: fe(2, nen)
+        logical, intent(out) :: ok
+        real(dp), intent(inout) :: g(:, :)
+        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, sv(3), w
+        integer :: q, a
+        fe = 0.0_dp
+        ok = .true.
+        do q = 1, np
+            w = wdv(q)
+            grad_u = 0.0_dp
+            do a = 1, nen
+                grad_u(1, 1) = grad_u(1, 1) + u(1, a)*dndx(1, a, q)
+                grad_u(2, 1) = grad_u(2, 1) + u(2, a)*dndx(1, a, q)
+                grad_u(1, 2) = grad_u(1, 2) + u(1, a)*dndx(2, a, q)
+                grad_u(2, 2) = grad_u(2, 2) + u(2, a)*dndx(2, a, q)
+            end do
+            call mat%stress(grad_u, s, c, ok)
+            if (.not. ok) return
+            if (mat%finite_strain) then
+                f = grad_u
+                f(1, 1) = f(1, 1) + 1.0_dp
+                f(2, 2) = f(2, 2) + 1.0_dp
+                det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
+                finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
+                do a = 1, nen
+                    g(a, 1) = finv(1, 1)*dndx(1, a, q) + finv(2, 1)*dndx(2, a, q)
+                    g(a, 2) = finv(1, 2)*dndx(1, a, q) + finv(2, 2)*dndx(2, a, q)
+                end do
+            else
+                g(1:nen, 1) = dndx(1, :, q)
+                g(1:nen, 2) = dndx(2, :, q)
+            end if
+            sv = w*[s(1, 1), s(2, 2), s(1, 2)]
+            do a = 1, nen
+                fe(1, a) = fe(1, a) + sv(1)*g(a, 1) + sv(3)*g(a, 2)
+                fe(2, a) = fe(2, a) + sv(2)*g(a, 2) + sv(3)*g(a, 1)
+            end do
+        end do
+    end subroutine point_forces
 
     !> `work` large enough for `nen` functions and `ncol` = 2 npts columns.
     pure subroutine fit_work(work, nen, ncol)

@@ -9,13 +9,13 @@ module voiga_model_assembly
     use voiga_text, only: str
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_element_solid, only: solid_element, solid_element_blocks, element_work_t
+    use voiga_element_solid, only: solid_element, solid_element_blocks, solid_element_force, element_work_t
     use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t, &
                                    consecutive_runs
     implicit none
     private
 
-    public :: assembly_stats_t, body_element, assemble, external_forces, stiffness_pattern, body_dofs
+    public :: assembly_stats_t, body_element, assemble, assemble_residual, external_forces, stiffness_pattern, body_dofs
     public :: assembly_map_t, new_assembly_map, bulk_stiffness
 
     !> The stiffness of one linear-elastic body on the tangent's pattern: the values
@@ -336,6 +336,38 @@ contains
                          'after two rebuilds', error_code%numeric)
     end subroutine assemble
 
+    !> The residual r = f_int(u) - f_ext alone, the same numbers as `assemble`'s
+    !> with a tangent: the elements' forces without their stiffness, a kept linear
+    !> body's K u on the pattern `k` (whose values are left as they are), the contact
+    !> pairs evaluated as with a stiffness (each point's fit to the pattern checked)
+    !> but nothing added. `fits` is false when a point fell outside the pattern,
+    !> where `assemble` would have rebuilt it and evaluated again: the pairs' ranges
+    !> are then widened, and the caller restores the pairs or assembles in full.
+    !> For an iterate whose tangent is not wanted (a Newton iterate expected to be
+    !> the converged one).
+    subroutine assemble_residual(model, u, t, r, stats, error, k, map, fits)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(in) :: t
+        real(dp), intent(out) :: r(:)
+        type(assembly_stats_t), intent(inout) :: stats
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout) :: k
+        type(assembly_map_t), intent(inout) :: map
+        logical, intent(out) :: fits
+        integer :: ip
+        fits = .false.
+        call move_obstacles(model, t)
+        call assemble_bulk(model, u, t, r, stats, error, k, map, forces_only=.true.)
+        if (allocated(error)) return
+        call assemble_contact(model, u, r, stats, error, fit_only=.true.)
+        do ip = 1, size(model%pairs)
+            model%pairs(ip)%pair%warm = .true.
+        end do
+        if (allocated(error)) return
+        fits = .not. any([(model%pairs(ip)%pair%pattern_miss, ip=1, size(model%pairs))])
+    end subroutine assemble_residual
+
     !> Rebuild the stiffness pattern `k` (values lost) and, if given, `map`. The
     !> map's positions are translated from the old pattern to the new one (every
     !> bulk entry is in both); `k_bulk` [nnz of the old pattern], if given, is carried
@@ -437,8 +469,9 @@ contains
     end subroutine bulk_stiffness
 
     !> The bulk part of `assemble`: every element's internal force and tangent, and
-    !> the external forces (r = f_int - f_ext; `k` zeroed first).
-    subroutine assemble_bulk(model, u, t, r, stats, error, k, map)
+    !> the external forces (r = f_int - f_ext; `k` zeroed first). With `forces_only`
+    !> the forces alone (`k`: the pattern of a kept linear body's K u, not changed).
+    subroutine assemble_bulk(model, u, t, r, stats, error, k, map, forces_only)
         type(model_t), intent(in) :: model
         real(dp), intent(in) :: u(:)
         real(dp), intent(in) :: t
@@ -448,19 +481,22 @@ contains
         type(csc_matrix_t), intent(inout), optional :: k
         !> With `k`: element positions; the linear bodies' stiffness is kept in it.
         type(assembly_map_t), intent(inout), optional :: map
+        logical, intent(in), optional :: forces_only
         real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
         integer, allocatable :: dofs(:), runs(:)
         type(element_work_t) :: work
         integer :: ib, e, n, npts, idx, nr
-        logical :: ok, keep, by_dofs
+        logical :: ok, keep, by_dofs, tangent
         integer(i8) :: c0, c1, rate
 
         call system_clock(c0, rate)
         r = 0.0_dp
-        if (present(k)) call k%zero()
+        tangent = present(k)
+        if (present(forces_only)) tangent = tangent .and. .not. forces_only
+        if (tangent) call k%zero()
         ! without the map, K is added element matrix by element matrix (by DOF numbers);
         ! otherwise it stays in the kernel's blocks (added through the map, or not needed)
-        by_dofs = present(k) .and. .not. present(map)
+        by_dofs = tangent .and. .not. present(map)
         keep = .false.
         if (present(k) .and. present(map)) keep = map%keep_linear
         if (keep) then
@@ -472,7 +508,7 @@ contains
                 if (keep) then
                     ! a linear body's stiffness is constant: f_int = K u
                     if (allocated(map%linear(ib)%values)) then
-                        call add_linear_body(map%linear(ib), u, k, r)
+                        call add_linear_body(map%linear(ib), u, k, r, tangent)
                         idx = idx + body%disc%nel
                         cycle
                     end if
@@ -490,9 +526,12 @@ contains
                         end if
                         if (.not. allocated(ke)) allocate (ke(n, n))
                         call body_element(body, e, u, fe, ke, ok, work)
-                    else
+                    else if (tangent) then
                         call gather_displacements(body, e, u, ue)
                         call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
+                    else
+                        call gather_displacements(body, e, u, ue)
+                        call solid_element_force(body%mat, body%points(e), ue, fe, ok, work)
                     end if
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
@@ -505,7 +544,7 @@ contains
                     if (by_dofs) then
                         dofs = body_dofs(body, e)
                         call k%add_element(dofs, ke)
-                    else if (present(k)) then
+                    else if (tangent) then
                         call consecutive_runs(body%disc%elements(e)%conn, runs, nr)
                         call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), &
                                         n/2, work%k4, size(work%k4, 1), work%sym)
@@ -515,7 +554,8 @@ contains
                     stats%finite_strain_points = stats%finite_strain_points + int(npts, i8)*body%disc%nel
                 else
                     stats%small_strain_points = stats%small_strain_points + int(npts, i8)*body%disc%nel
-                    if (keep) call keep_linear_body(k, body%dof0 + 1, body%dof0 + 2*body%disc%ncp, map%linear(ib))
+                    if (keep .and. tangent) &
+                        call keep_linear_body(k, body%dof0 + 1, body%dof0 + 2*body%disc%ncp, map%linear(ib))
                 end if
             end associate
         end do
@@ -558,14 +598,16 @@ contains
 
     !> A kept linear body's part of the assembly: its stiffness into `k`, its
     !> internal force K u into `r` (the same as integrating it, to round-off).
-    pure subroutine add_linear_body(kept, u, k, r)
+    pure subroutine add_linear_body(kept, u, k, r, tangent)
         type(body_stiffness_t), intent(in) :: kept
         real(dp), intent(in) :: u(:)
         type(csc_matrix_t), intent(inout) :: k
         real(dp), intent(inout) :: r(:)
+        !> Copy the stiffness into `k` (else only its pattern is read).
+        logical, intent(in) :: tangent
         integer :: j, p, p0
         p0 = k%colptr(kept%first)
-        k%values(p0 + 1:k%colptr(kept%last + 1)) = kept%values
+        if (tangent) k%values(p0 + 1:k%colptr(kept%last + 1)) = kept%values
         do j = kept%first, kept%last
             do p = k%colptr(j) + 1, k%colptr(j + 1)
                 r(k%rowind(p) + 1) = r(k%rowind(p) + 1) + kept%values(p - p0)*u(j)
@@ -610,23 +652,30 @@ contains
     end subroutine add_mapped
 
     !> The contact part of `assemble`: every pair's residual and tangent, added to
-    !> `r` and `k`.
-    subroutine assemble_contact(model, u, r, stats, error, k)
+    !> `r` and `k`. With `fit_only` the pairs evaluate as with a stiffness (checking
+    !> their points' fit to the pattern) but add none.
+    subroutine assemble_contact(model, u, r, stats, error, k, fit_only)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: u(:)
         real(dp), intent(inout) :: r(:)
         type(assembly_stats_t), intent(inout) :: stats
         type(error_t), allocatable, intent(out) :: error
         type(csc_matrix_t), intent(inout), optional :: k
+        logical, intent(in), optional :: fit_only
         integer :: ip
         integer(i8) :: c0, c1, rate
+        logical :: fit
         ! the positions of the last point's entries (the next point of a slave element
         ! often projects onto the same master span: the same DOFs)
         type(position_cache_t) :: cache
 
         call system_clock(c0, rate)
+        fit = .false.
+        if (present(fit_only)) fit = fit_only
         do ip = 1, size(model%pairs)
-            if (present(k)) then
+            if (fit) then
+                call model%pairs(ip)%pair%evaluate(u, r, error, add_nothing)
+            else if (present(k)) then
                 call model%pairs(ip)%pair%evaluate(u, r, error, add_to_k)
             else
                 call model%pairs(ip)%pair%evaluate(u, r, error)
@@ -641,6 +690,10 @@ contains
             real(dp), intent(in) :: kl(:, :)
             call k%add_cached(dofs, kl, cache)
         end subroutine add_to_k
+        subroutine add_nothing(dofs, kl)
+            integer, intent(in) :: dofs(:)
+            real(dp), intent(in) :: kl(:, :)
+        end subroutine add_nothing
     end subroutine assemble_contact
 
     !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the

@@ -12,9 +12,10 @@ module voiga_solver_newton
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, reference_coordinates
-    use voiga_model_assembly, only: assemble, stiffness_pattern, assembly_map_t, new_assembly_map, bulk_stiffness, &
-                                    assembly_stats_t
+    use voiga_model_assembly, only: assemble, assemble_residual, stiffness_pattern, assembly_map_t, new_assembly_map, &
+                                    bulk_stiffness, assembly_stats_t
     use voiga_contact_law, only: state_stick, state_slip
+    use voiga_contact_pair, only: pair_slot_t
     use voiga_solver_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_linear_factory, only: new_linear_solver
@@ -87,6 +88,9 @@ module voiga_solver_newton
         !> The step was cut to a contact crossing; the simplified correction of the
         !> accepted point is known.
         logical :: closing = .false., have_bar = .false.
+        !> The caller wants the tangent at the converged iterate (else an iterate
+        !> expected to converge is first evaluated without one).
+        logical :: keep_tangent = .false.
         real(dp), allocatable :: du(:), u_prev(:), rhs(:), du_bar(:), du_bar_acc(:)
         !> Residual before each iteration and after the last; |du.r| of each.
         real(dp), allocatable :: norms(:), energies(:)
@@ -133,8 +137,11 @@ contains
     !> error with code `numeric` and its reason; an interrupt sets stats%signal and
     !> returns a generic error. With `r0_ref` the relative tests (tol_residual,
     !> energy, divergence) use it instead of the first residual (the Tresca solves of
-    !> a fixed point, measured against the substep's).
-    subroutine newton_attempt(self, model, step, t, u, stats, rec, progress, attempt, error, r0_ref)
+    !> a fixed point, measured against the substep's). `keep_tangent`: `self%k` holds
+    !> the tangent at the converged iterate on return (else it may be an earlier
+    !> iterate's: the converged one's is not assembled when it is not needed).
+    subroutine newton_attempt(self, model, step, t, u, stats, rec, progress, attempt, error, r0_ref, &
+                              keep_tangent)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
         integer, intent(in) :: step
@@ -146,10 +153,12 @@ contains
         type(attempt_t), intent(out) :: attempt
         type(error_t), allocatable, intent(out) :: error
         real(dp), intent(in), optional :: r0_ref
+        logical, intent(in), optional :: keep_tangent
         type(iterate_t) :: st
         logical :: done
 
         call start_iterate(self, model, st)
+        if (present(keep_tangent)) st%keep_tangent = keep_tangent
         do
             if (caught_signal() /= 0) then
                 stats%signal = caught_signal()
@@ -198,7 +207,9 @@ contains
     end subroutine start_iterate
 
     !> Residual and tangent at the trial point `u`, and the round-off floor there.
-    !> The substep's first assembly also fits the contact pattern to its start.
+    !> The substep's first assembly also fits the contact pattern to its start. A
+    !> trial point expected to converge (`expect_converged`) is first evaluated
+    !> without the tangent (`converged_without_tangent`).
     subroutine evaluate(self, model, t, u, st, stats, rec, error)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
@@ -208,6 +219,9 @@ contains
         type(step_record_t), intent(inout) :: rec
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: bulk0, contact0
+        if (expect_converged(self, st)) then
+            if (converged_without_tangent(self, model, t, u, st, stats, rec)) return
+        end if
         bulk0 = stats%assembly%seconds_bulk
         contact0 = stats%assembly%seconds_contact
         call assemble(model, u, t, self%r, stats%assembly, error, self%k, self%map, &
@@ -223,6 +237,69 @@ contains
         st%c%floor = residual_floor(self%k, self%x0 + u, model%fixed)
         st%have_bar = .false.
     end subroutine evaluate
+
+    !> Whether the trial point `u` is expected to be the converged iterate, so that
+    !> its tangent (and the round-off floor, which needs it) will not be wanted: a
+    !> full Newton step after two or more, whose residual, falling by the factor of
+    !> the last step again, would be below the tolerance (convergence is at least
+    !> that fast near the solution), or whose last correction already meets the
+    !> energy test. Not with natural damping (its step test needs the floor) nor
+    !> when the caller keeps the tangent.
+    pure logical function expect_converged(self, st) result(expect)
+        type(newton_t), intent(in) :: self
+        type(iterate_t), intent(in) :: st
+        real(dp) :: last, before
+        expect = .false.
+        if (st%it < 2 .or. st%nls > 0 .or. st%closing .or. self%natural .or. st%keep_tangent) return
+        last = st%norms(st%it)
+        before = st%norms(st%it - 1)
+        if (before > 0.0_dp) expect = last*(last/before) <= self%settings%tol_residual*st%c%first
+        expect = expect .or. st%c%energy <= self%settings%tol_energy*st%c%first_energy
+    end function expect_converged
+
+    !> Evaluate the trial point `u` without the tangent (`assemble_residual`) and
+    !> tell whether that is enough: the iterate has converged by a test that needs
+    !> no round-off floor (`converged` with none), its residual is not above the last
+    !> one (the step rules do not backtrack) and the contact points fit the
+    !> stiffness pattern. Then `st%c` holds the residual and no floor (-1: not
+    !> computed); else the contact pairs are as before the call, for the full
+    !> evaluation to follow, which gives the same numbers as without this one.
+    logical function converged_without_tangent(self, model, t, u, st, stats, rec) result(enough)
+        type(newton_t), intent(inout) :: self
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: t, u(:)
+        type(iterate_t), intent(inout) :: st
+        type(solver_stats_t), intent(inout) :: stats
+        type(step_record_t), intent(inout) :: rec
+        type(pair_slot_t), allocatable :: saved(:)
+        type(error_t), allocatable :: error
+        type(convergence_t) :: c
+        real(dp) :: bulk0, contact0
+        logical :: fits
+        saved = model%pairs
+        bulk0 = stats%assembly%seconds_bulk
+        contact0 = stats%assembly%seconds_contact
+        call assemble_residual(model, u, t, self%r, stats%assembly, error, self%k, self%map, fits)
+        rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
+        rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+        enough = .false.
+        if (.not. allocated(error) .and. fits) then
+            c = st%c
+            c%residual = norm2(merge(0.0_dp, self%r, model%fixed))
+            c%iteration = st%it
+            c%scale = max(c%first, stats%r0_max)
+            c%floor = -1.0_dp
+            enough = ieee_is_finite(c%residual) .and. c%residual <= st%rn_prev .and. &
+                     converged(c, self%settings%tol_residual, self%settings%tol_energy)
+        end if
+        if (enough) then
+            st%c%residual = c%residual
+            st%c%floor = c%floor
+            st%have_bar = .false.
+        else
+            call move_alloc(saved, model%pairs)
+        end if
+    end function converged_without_tangent
 
     !> Whether the step-length rules shorten the step to the trial point (then
     !> `st%alpha` is the new length); `voiga_solver_step_length`.

@@ -87,9 +87,11 @@ contains
             ! after the first solve, Newton's tolerance is relative to the substep's
             ! first residual (a multiplier update leaves a small one)
             if (k == 1) then
-                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error)
+                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, &
+                                    keep_tangent=.true.)
             else
-                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, r0)
+                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, r0, &
+                                    keep_tangent=.true.)
             end if
             attempt%iterations = attempt%iterations + inner%iterations
             attempt%residual = inner%residual

@@ -17,7 +17,8 @@ module voiga_solver_progress
     public :: progress_t, iteration_report_t, fixed_point_report_t, step_report_t
 
     !> One Newton iteration: its residual, energy norm, accepted step length, the
-    !> round-off floor, and the contact states of every pair.
+    !> round-off floor (negative: not computed, a converged iterate evaluated
+    !> without its tangent), and the contact states of every pair.
     type :: iteration_report_t
         integer :: step = 0, iteration = 0
         real(dp) :: residual = 0.0_dp, energy = 0.0_dp, step_length = 0.0_dp, floor = 0.0_dp
