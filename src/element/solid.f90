@@ -114,8 +114,9 @@ contains
 
     !> The quadrature-point loop of `solid_element_force` (`g` [nen, 2]: work): the
     !> force part of `point_columns`, written out again so that the hot kernel keeps
-    !> it inline (a shared per-point call cost 0.5 % of an ironing run); the same
-    !> expressions in the same order, checked bit for bit by test_newton.
+    !> it inline (a shared per-point helper was not inlined: about 0.5 % of
+    !> ironing-deep m4 N6's perf samples); the same expressions in the same order,
+    !> checked bit for bit by test_newton.
     pure subroutine point_forces(mat, nen, np, dndx, wdv, u, fe, ok, g)
         class(material_t), intent(in) :: mat
         integer, intent(in) :: nen, np

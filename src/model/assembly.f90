@@ -526,12 +526,13 @@ contains
                         end if
                         if (.not. allocated(ke)) allocate (ke(n, n))
                         call body_element(body, e, u, fe, ke, ok, work)
-                    else if (tangent) then
-                        call gather_displacements(body, e, u, ue)
-                        call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
                     else
                         call gather_displacements(body, e, u, ue)
-                        call solid_element_force(body%mat, body%points(e), ue, fe, ok, work)
+                        if (tangent) then
+                            call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
+                        else
+                            call solid_element_force(body%mat, body%points(e), ue, fe, ok, work)
+                        end if
                     end if
                     if (.not. ok) then
                         call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &

@@ -376,7 +376,7 @@ contains
     subroutine update_offsets(self)
         class(supernodal_lu_t), intent(inout) :: self
         integer :: parity(self%nsuper), size_of(self%nsuper)
-        integer :: top(0:1), peak(0:1), s, p, t, low, held
+        integer :: top(0:1), peak(0:1), s, p, low, held
         logical :: stacked
         if (allocated(self%uoff)) deallocate (self%uoff)
         allocate (self%uoff(self%nsuper))
@@ -413,9 +413,7 @@ contains
             end do
             peak = [sum(size_of), 0]
         end if
-        do t = 1, self%nsuper
-            if (size_of(t) == 0) self%uoff(t) = 1
-        end do
+        where (size_of == 0) self%uoff = 1
         if (allocated(self%upool)) deallocate (self%upool)
         allocate (self%upool(max(1, peak(0) + peak(1))))
     end subroutine update_offsets
