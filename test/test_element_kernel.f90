@@ -2,12 +2,15 @@
 !> term by term, for a law whose tangent lacks the major symmetry: the kernel then
 !> forms the fourth block of K (K^yx) instead of transposing K^xy; and the
 !> assembly that adds the kernel's blocks through the element map against the one
-!> that adds the interleaved element matrices by DOF numbers.
+!> that adds the interleaved element matrices by DOF numbers; and a law at many
+!> points at once (`stress_points`) against the same law point by point.
 module test_element_kernel
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_material, only: material_t
+    use, intrinsic :: iso_fortran_env, only: int64
+    use voiga_material, only: material_t, voigt_i, voigt_j
+    use voiga_material_factory, only: new_material
     use voiga_element_solid, only: solid_element, element_points_t, element_work_t
     use voiga_test_fixtures, only: lcg_t, annulus_sector, paper_layout, scene_t, scene_model, body_settings
     use voiga_discretization_patch, only: discretization_t, new_discretization
@@ -35,7 +38,8 @@ contains
     subroutine collect_element_kernel(testsuite)
         type(unittest_t), allocatable, intent(out) :: testsuite(:)
         testsuite = [new_unittest('unsymmetric_tangent_blocks', test_unsymmetric), &
-                     new_unittest('mapped_blocks_match_element_matrices', test_mapped_blocks)]
+                     new_unittest('mapped_blocks_match_element_matrices', test_mapped_blocks), &
+                     new_unittest('law_at_points_is_law_point_by_point', test_law_points)]
     end subroutine collect_element_kernel
 
     pure subroutine skew_stress(self, grad_u, s, c, ok)
@@ -129,6 +133,59 @@ contains
         call check(error, maxval(abs(fe - fref))/maxval(abs(fref)), 0.0_dp, 'f against the written-out sum', &
                    abs=1.0e-13_dp)
     end subroutine test_unsymmetric
+
+    !> `stress_points` at 37 random points (more than one of the Neo-Hookean law's
+    !> chunks of 16, and a partial one) gives, bit for bit, what `stress` gives point
+    !> by point: the stress and the Voigt entries of the tangent, for the Neo-Hookean
+    !> law (its own loop over the points) and for a law that has only `stress` (the
+    !> default); and `ok` false when J <= 0 at one point of the last chunk.
+    subroutine test_law_points(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: n = 37
+        class(material_t), allocatable :: neo
+        type(skew_law_t) :: skew
+        type(lcg_t) :: rng
+        real(dp) :: gu(n, 2, 2), s(n, 2, 2), cv(n, 3, 3), sq(2, 2), c(2, 2, 2, 2), g(2, 2)
+        integer :: q, i, j, law, wrong
+        logical :: ok
+
+        call new_material(neo, 'neo-hookean', 3.0_dp, 0.3_dp, error)
+        if (allocated(error)) return
+        skew = skew_law(rng)
+        do q = 1, n
+            do j = 1, 2
+                do i = 1, 2
+                    gu(q, i, j) = 0.6_dp*(rng%uniform() - 0.5_dp)
+                end do
+            end do
+        end do
+        gu(5, :, :) = 0.0_dp
+        wrong = 0
+        do law = 1, 2
+            if (law == 1) call neo%stress_points(n, gu, s, cv, ok)
+            if (law == 2) call skew%stress_points(n, gu, s, cv, ok)
+            call check(error, ok, 'stress_points refused admissible gradients')
+            if (allocated(error)) return
+            do q = 1, n
+                g = gu(q, :, :)
+                if (law == 1) call neo%stress(g, sq, c, ok)
+                if (law == 2) call skew%stress(g, sq, c, ok)
+                if (any(transfer(sq, 1_int64, 4) /= transfer(s(q, :, :), 1_int64, 4))) wrong = wrong + 1
+                do j = 1, 3
+                    do i = 1, 3
+                        if (transfer(c(voigt_i(i), voigt_j(i), voigt_i(j), voigt_j(j)), 1_int64) /= &
+                            transfer(cv(q, i, j), 1_int64)) wrong = wrong + 1
+                    end do
+                end do
+            end do
+        end do
+        call check(error, wrong, 0, 'entries that differ from the law point by point')
+        if (allocated(error)) return
+        ! F = diag(-1, 1) at point 35: J = -1
+        gu(35, :, :) = reshape([-2.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], [2, 2])
+        call neo%stress_points(n, gu, s, cv, ok)
+        call check(error, .not. ok, 'J <= 0 at one point not refused')
+    end subroutine test_law_points
 
     !> A law with minor but not major symmetry (random Voigt matrix d, made
     !> diagonally dominant).

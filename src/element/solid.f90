@@ -23,9 +23,11 @@ module voiga_element_solid
     !> Work arrays of `solid_element` kept by its caller over the elements of a body
     !> (gfortran puts automatic arrays on the heap: an allocation per array and element):
     !> G [ld, 2 npts], R [4 ld, 2 npts], the blocks of K [ld, 4 ld] and each point's
-    !> M^yx [4, npts], grown to the largest element they met.
+    !> M^yx [4, npts], grown to the largest element they met; the points' displacement
+    !> gradients, stresses, Voigt tangents and F^-1 [npts, ...] (`point_stresses`).
     type :: element_work_t
         real(dp), allocatable :: gt(:, :), rt(:, :), k4(:, :), myx(:, :)
+        real(dp), allocatable :: gu(:, :, :), s(:, :, :), cv(:, :, :), finv(:, :, :)
         !> The last element's tangent had the major symmetry at every point: `k4`
         !> holds [K^xx K^xy K^yy] and K^yx = (K^xy)^T; else all four blocks.
         logical :: sym = .true.
@@ -93,7 +95,7 @@ contains
         real(dp), intent(out) :: fe(:)
         logical, intent(out) :: ok
         type(element_work_t), intent(inout) :: work
-        call fit_work(work, size(u, 2), 2*size(pts%wdv))
+        call fit_work(work, size(u, 2), size(pts%wdv))
         call element_kernel(mat, pts, u, fe, ok, work)
     end subroutine solid_element_blocks
 
@@ -108,52 +110,78 @@ contains
         real(dp), intent(out) :: fe(:)
         logical, intent(out) :: ok
         type(element_work_t), intent(inout) :: work
-        call fit_work(work, size(u, 2), 2*size(pts%wdv))
-        call point_forces(mat, size(u, 2), size(pts%wdv), pts%dndx, pts%wdv, u, fe, ok, work%gt)
+        integer :: nen, np
+        nen = size(u, 2)
+        np = size(pts%wdv)
+        call fit_work(work, nen, np)
+        call point_stresses(mat, nen, np, pts%dndx, u, work%gu, work%s, work%cv, work%finv, ok)
+        if (.not. ok) return
+        call point_forces(mat%finite_strain, nen, np, pts%dndx, pts%wdv, work%s, work%finv, fe, work%gt)
     end subroutine solid_element_force
 
-    !> The quadrature-point loop of `solid_element_force` (`g` [nen, 2]: work): the
-    !> force part of `point_columns`, written out again so that the hot kernel keeps
-    !> it inline (a shared per-point helper was not inlined: about 0.5 % of
-    !> ironing-deep m4 N6's perf samples); the same expressions in the same order,
-    !> checked bit for bit by test_newton.
-    pure subroutine point_forces(mat, nen, np, dndx, wdv, u, fe, ok, g)
+    !> The displacement gradients `gu` (q, i, j) at the `np` points, each summed over
+    !> the functions in their order as a loop point by point would (one vector loop
+    !> over the points per function instead of a chain of dependent additions per
+    !> point), the law's stress `s` and Voigt tangent `cv` there and, at finite
+    !> strain, F^-1 (`finv`). `ok` is false if J <= 0 at a point.
+    pure subroutine point_stresses(mat, nen, np, dndx, u, gu, s, cv, finv, ok)
         class(material_t), intent(in) :: mat
         integer, intent(in) :: nen, np
-        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
-        real(dp), intent(out) :: fe(2, nen)
+        real(dp), intent(in) :: dndx(2, nen, np), u(2, nen)
+        real(dp), intent(out) :: gu(np, 2, 2), s(np, 2, 2), cv(np, 3, 3), finv(np, 2, 2)
         logical, intent(out) :: ok
+        real(dp) :: f11, f21, f12, f22, det
+        integer :: a, q
+        gu = 0.0_dp
+        do a = 1, nen
+            do q = 1, np
+                gu(q, 1, 1) = gu(q, 1, 1) + u(1, a)*dndx(1, a, q)
+                gu(q, 2, 1) = gu(q, 2, 1) + u(2, a)*dndx(1, a, q)
+                gu(q, 1, 2) = gu(q, 1, 2) + u(1, a)*dndx(2, a, q)
+                gu(q, 2, 2) = gu(q, 2, 2) + u(2, a)*dndx(2, a, q)
+            end do
+        end do
+        call mat%stress_points(np, gu, s, cv, ok)
+        if (.not. ok .or. .not. mat%finite_strain) return
+        do q = 1, np
+            f11 = gu(q, 1, 1) + 1.0_dp
+            f21 = gu(q, 2, 1)
+            f12 = gu(q, 1, 2)
+            f22 = gu(q, 2, 2) + 1.0_dp
+            det = f11*f22 - f12*f21
+            finv(q, 1, 1) = f22/det
+            finv(q, 2, 1) = -f21/det
+            finv(q, 1, 2) = -f12/det
+            finv(q, 2, 2) = f11/det
+        end do
+    end subroutine point_stresses
+
+    !> The quadrature-point loop of `solid_element_force` after `point_stresses`
+    !> (`g` [nen, 2]: work): the force part of `point_columns`, written out again so
+    !> that the hot kernel keeps it inline (a shared per-point helper was not
+    !> inlined: about 0.5 % of ironing-deep m4 N6's perf samples); the same
+    !> expressions in the same order, checked bit for bit by test_newton.
+    pure subroutine point_forces(finite_strain, nen, np, dndx, wdv, s, finv, fe, g)
+        logical, intent(in) :: finite_strain
+        integer, intent(in) :: nen, np
+        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), s(np, 2, 2), finv(np, 2, 2)
+        real(dp), intent(out) :: fe(2, nen)
         real(dp), intent(inout) :: g(:, :)
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, sv(3), w
+        real(dp) :: sv(3), w
         integer :: q, a
         fe = 0.0_dp
-        ok = .true.
         do q = 1, np
             w = wdv(q)
-            grad_u = 0.0_dp
-            do a = 1, nen
-                grad_u(1, 1) = grad_u(1, 1) + u(1, a)*dndx(1, a, q)
-                grad_u(2, 1) = grad_u(2, 1) + u(2, a)*dndx(1, a, q)
-                grad_u(1, 2) = grad_u(1, 2) + u(1, a)*dndx(2, a, q)
-                grad_u(2, 2) = grad_u(2, 2) + u(2, a)*dndx(2, a, q)
-            end do
-            call mat%stress(grad_u, s, c, ok)
-            if (.not. ok) return
-            if (mat%finite_strain) then
-                f = grad_u
-                f(1, 1) = f(1, 1) + 1.0_dp
-                f(2, 2) = f(2, 2) + 1.0_dp
-                det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-                finv = reshape([f(2, 2), -f(2, 1), -f(1, 2), f(1, 1)], [2, 2])/det
+            if (finite_strain) then
                 do a = 1, nen
-                    g(a, 1) = finv(1, 1)*dndx(1, a, q) + finv(2, 1)*dndx(2, a, q)
-                    g(a, 2) = finv(1, 2)*dndx(1, a, q) + finv(2, 2)*dndx(2, a, q)
+                    g(a, 1) = finv(q, 1, 1)*dndx(1, a, q) + finv(q, 2, 1)*dndx(2, a, q)
+                    g(a, 2) = finv(q, 1, 2)*dndx(1, a, q) + finv(q, 2, 2)*dndx(2, a, q)
                 end do
             else
                 g(1:nen, 1) = dndx(1, :, q)
                 g(1:nen, 2) = dndx(2, :, q)
             end if
-            sv = w*[s(1, 1), s(2, 2), s(1, 2)]
+            sv = w*[s(q, 1, 1), s(q, 2, 2), s(q, 1, 2)]
             do a = 1, nen
                 fe(1, a) = fe(1, a) + sv(1)*g(a, 1) + sv(3)*g(a, 2)
                 fe(2, a) = fe(2, a) + sv(2)*g(a, 2) + sv(3)*g(a, 1)
@@ -161,19 +189,25 @@ contains
         end do
     end subroutine point_forces
 
-    !> `work` large enough for `nen` functions and `ncol` = 2 npts columns.
-    pure subroutine fit_work(work, nen, ncol)
+    !> `work` large enough for `nen` functions and `np` points (the per-point
+    !> arrays exactly `np` long: explicit shapes in the kernels).
+    pure subroutine fit_work(work, nen, np)
         type(element_work_t), intent(inout) :: work
-        integer, intent(in) :: nen, ncol
+        integer, intent(in) :: nen, np
         integer :: ld, nc
+        if (allocated(work%gu)) then
+            if (size(work%gu, 1) /= np) deallocate (work%gu, work%s, work%cv, work%finv)
+        end if
+        if (.not. allocated(work%gu)) allocate (work%gu(np, 2, 2), work%s(np, 2, 2), work%cv(np, 3, 3), &
+                                                 work%finv(np, 2, 2))
         if (allocated(work%gt)) then
-            if (size(work%gt, 1) >= nen .and. size(work%gt, 2) >= ncol) return
+            if (size(work%gt, 1) >= nen .and. size(work%gt, 2) >= 2*np) return
             ld = max(nen, size(work%gt, 1))
-            nc = max(ncol, size(work%gt, 2))
+            nc = max(2*np, size(work%gt, 2))
             deallocate (work%gt, work%rt, work%k4, work%myx)
         else
             ld = nen
-            nc = ncol
+            nc = 2*np
         end if
         allocate (work%gt(ld, nc), work%rt(4*ld, nc), work%k4(ld, 4*ld), work%myx(4, (nc + 1)/2))
     end subroutine fit_work
@@ -191,9 +225,10 @@ contains
         nen = size(u, 2)
         np = size(pts%wdv)
         ld = size(wk%gt, 1)
-        call point_columns(mat, nen, np, pts%dndx, pts%wdv, u, fe, ok, wk%sym, wk%gt, ld, wk%rt, size(wk%rt, 1), &
-                           wk%myx)
+        call point_stresses(mat, nen, np, pts%dndx, u, wk%gu, wk%s, wk%cv, wk%finv, ok)
         if (.not. ok) return
+        call point_columns(mat%finite_strain, nen, np, pts%dndx, pts%wdv, wk%s, wk%cv, wk%finv, fe, wk%sym, &
+                           wk%gt, ld, wk%rt, size(wk%rt, 1), wk%myx)
         ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
         ! symmetry at every point (hyperelastic and linear laws)
         nb = merge(3, 4, wk%sym)
@@ -228,65 +263,38 @@ contains
         end if
     end subroutine interleave
 
-    !> The quadrature-point loop of `solid_element`: the force `fe` and the columns
-    !> of G and R of every point (explicit shapes, so that the loops over the
-    !> functions are plain vector loops). R's fourth block (for K^yx) is formed only
-    !> when the tangent is not symmetric at some point: `element_kernel` does not
-    !> use it otherwise (a quarter of R's work on hyperelastic laws).
-    pure subroutine point_columns(mat, nen, np, dndx, wdv, u, fe, ok, sym, gt, ld, rt, ldr, myx)
-        class(material_t), intent(in) :: mat
+    !> The quadrature-point loop of `solid_element` after `point_stresses`: the force
+    !> `fe` and the columns of G and R of every point (explicit shapes, so that the
+    !> loops over the functions are plain vector loops). R's fourth block (for K^yx)
+    !> is formed only when the tangent is not symmetric at some point:
+    !> `element_kernel` does not use it otherwise (a quarter of R's work on
+    !> hyperelastic laws).
+    pure subroutine point_columns(finite_strain, nen, np, dndx, wdv, s, cv, finv, fe, sym, gt, ld, rt, ldr, myx)
+        logical, intent(in) :: finite_strain
         integer, intent(in) :: nen, np, ld, ldr
-        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), u(2, nen)
+        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), s(np, 2, 2), cv(np, 3, 3), finv(np, 2, 2)
         real(dp), intent(out) :: fe(2, nen)
-        logical, intent(out) :: ok
         !> The Voigt tangent was symmetric at every point (M^yx = (M^xy)^T).
         logical, intent(out) :: sym
         real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
         !> Work: M^yx of every point (for R's fourth block).
         real(dp), intent(inout) :: myx(2, 2, *)
-        real(dp) :: grad_u(2, 2), s(2, 2), c(2, 2, 2, 2), f(2, 2), finv(2, 2), det, d(3, 3), sv(3), ts(2, 2)
-        real(dp) :: m(2, 2, 4), w, g11, g21, g12, g22
-        integer, parameter :: vi(3) = [1, 2, 1], vj(3) = [1, 2, 2]
+        real(dp) :: d(3, 3), sv(3), ts(2, 2), m(2, 2, 4), w
         integer :: q, i, j, a, blk, off, c1, c2
 
         fe = 0.0_dp
-        ok = .true.
         sym = .true.
         do q = 1, np
             w = wdv(q)
             c1 = 2*q - 1
             c2 = 2*q
-            g11 = 0.0_dp
-            g21 = 0.0_dp
-            g12 = 0.0_dp
-            g22 = 0.0_dp
-            do a = 1, nen
-                g11 = g11 + u(1, a)*dndx(1, a, q)
-                g21 = g21 + u(2, a)*dndx(1, a, q)
-                g12 = g12 + u(1, a)*dndx(2, a, q)
-                g22 = g22 + u(2, a)*dndx(2, a, q)
-            end do
-            grad_u(1, 1) = g11
-            grad_u(2, 1) = g21
-            grad_u(1, 2) = g12
-            grad_u(2, 2) = g22
-            call mat%stress(grad_u, s, c, ok)
-            if (.not. ok) return
             ts = 0.0_dp
             ! g = F^-T dN/dX (dN/dX for small strain)
-            if (mat%finite_strain) then
-                f = grad_u
-                f(1, 1) = f(1, 1) + 1.0_dp
-                f(2, 2) = f(2, 2) + 1.0_dp
-                det = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-                finv(1, 1) = f(2, 2)/det
-                finv(2, 1) = -f(2, 1)/det
-                finv(1, 2) = -f(1, 2)/det
-                finv(2, 2) = f(1, 1)/det
-                ts = w*s
+            if (finite_strain) then
+                ts = w*s(q, :, :)
                 do a = 1, nen
-                    gt(a, c1) = finv(1, 1)*dndx(1, a, q) + finv(2, 1)*dndx(2, a, q)
-                    gt(a, c2) = finv(1, 2)*dndx(1, a, q) + finv(2, 2)*dndx(2, a, q)
+                    gt(a, c1) = finv(q, 1, 1)*dndx(1, a, q) + finv(q, 2, 1)*dndx(2, a, q)
+                    gt(a, c2) = finv(q, 1, 2)*dndx(1, a, q) + finv(q, 2, 2)*dndx(2, a, q)
                 end do
             else
                 gt(1:nen, c1) = dndx(1, :, q)
@@ -294,10 +302,10 @@ contains
             end if
             do j = 1, 3
                 do i = 1, 3
-                    d(i, j) = w*c(vi(i), vj(i), vi(j), vj(j))
+                    d(i, j) = w*cv(q, i, j)
                 end do
             end do
-            sv = w*[s(1, 1), s(2, 2), s(1, 2)]
+            sv = w*[s(q, 1, 1), s(q, 2, 2), s(q, 1, 2)]
             sym = sym .and. d(1, 2) == d(2, 1) .and. d(1, 3) == d(3, 1) .and. d(2, 3) == d(3, 2)
             ! M^xx, M^xy, M^yy, M^yx (rows: the gradient component of g_a, columns: of g_b)
             call coupling(d, ts, m)

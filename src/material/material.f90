@@ -12,11 +12,15 @@ module voiga_material
     implicit none
     private
 
-    public :: material_t, lame_from_young, delta, identity2, von_mises
+    public :: material_t, lame_from_young, delta, identity2, von_mises, voigt_i, voigt_j
 
     !> The 2 x 2 identity: delta(i, j) as a constant array, for the inner loops of
     !> the laws (a lookup instead of a call; same values as `delta`).
     real(dp), parameter :: identity2(2, 2) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2])
+
+    !> The index pairs (i, j) of the Voigt components 11, 22, 12: `stress_points`'
+    !> tangent cv(q, I, J) = c(voigt_i(I), voigt_j(I), voigt_i(J), voigt_j(J)).
+    integer, parameter :: voigt_i(3) = [1, 2, 1], voigt_j(3) = [1, 2, 2]
 
     !> A material law.
     type, abstract :: material_t
@@ -27,6 +31,7 @@ module voiga_material
         logical :: finite_strain = .false.
     contains
         procedure(stress_interface), deferred :: stress
+        procedure :: stress_points => material_stress_points
         procedure(fields_interface), deferred :: fields
         procedure(strain_name_interface), deferred, nopass :: strain_name
     end type material_t
@@ -64,6 +69,35 @@ module voiga_material
     end interface
 
 contains
+
+    !> `stress` at the `n` quadrature points of an element, point index first (the
+    !> element kernel's loops over the points are then vector loops): `gu`(q, i, j) =
+    !> du_i/dX_j at point q, the stress `s`(q, i, j) and the Voigt tangent
+    !> `cv`(q, I, J) (`voigt_i`, `voigt_j`: the components the element uses).
+    !> `ok` is false when the state is inadmissible at a point (the rest is then
+    !> undefined). This default calls `stress` point by point; a law overrides it
+    !> when its own loop over the points is faster, with the same numbers.
+    pure subroutine material_stress_points(self, n, gu, s, cv, ok)
+        class(material_t), intent(in) :: self
+        integer, intent(in) :: n
+        real(dp), intent(in) :: gu(n, 2, 2)
+        real(dp), intent(out) :: s(n, 2, 2), cv(n, 3, 3)
+        logical, intent(out) :: ok
+        real(dp) :: g(2, 2), sq(2, 2), c(2, 2, 2, 2)
+        integer :: q, i, j
+        ok = .true.
+        do q = 1, n
+            g = gu(q, :, :)
+            call self%stress(g, sq, c, ok)
+            if (.not. ok) return
+            s(q, :, :) = sq
+            do j = 1, 3
+                do i = 1, 3
+                    cv(q, i, j) = c(voigt_i(i), voigt_j(i), voigt_i(j), voigt_j(j))
+                end do
+            end do
+        end do
+    end subroutine material_stress_points
 
     !> Fill the Lame constants and the bulk modulus from E and nu (3D relations;
     !> plane strain uses them unchanged).

@@ -8,7 +8,7 @@
 module voiga_material_neohookean
     use, intrinsic :: iso_c_binding, only: c_double
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, identity2
+    use voiga_material, only: material_t
     implicit none
     private
 
@@ -23,85 +23,142 @@ module voiga_material_neohookean
         end function cbrt
     end interface
 
+    !> Points `neo_hookean_points` takes at once: its per-point arrays have this
+    !> fixed size (on the stack; its loops over them are vector loops).
+    integer, parameter :: chunk = 16
+
     !> Compressible Neo-Hookean solid.
     type, extends(material_t) :: neo_hookean_t
     contains
         procedure :: stress => neo_hookean_stress
+        procedure :: stress_points => neo_hookean_points
         procedure :: fields => neo_hookean_fields
         procedure, nopass :: strain_name => neo_hookean_strain_name
     end type neo_hookean_t
 
+    !> The kinematics and stress at up to `chunk` points: J, the isochoric left
+    !> Cauchy-Green tensor bbar (in plane, [11, 22, 12]; bbar33 = J^(-2/3)), its 3D
+    !> trace and the Kirchhoff stress tau [11, 22, 12] (both symmetric to the bit).
+    type :: kirchhoff_t
+        real(dp) :: jac(chunk), bbar(chunk, 3), trbbar(chunk), tau(chunk, 3)
+    end type kirchhoff_t
+
 contains
 
-    !> Deformation gradient, J, the isochoric left Cauchy-Green tensor bbar (in
-    !> plane, bbar33 = J^(-2/3)), its 3D trace and the Kirchhoff stress tau (in plane)
-    !> at `grad_u`; `ok` false (and the rest undefined) when J <= 0.
-    pure subroutine kirchhoff(self, grad_u, f, jac, bbar, trbbar, tau, ok)
+    !> J, bbar, tr(bbar) and tau (`k`) at the points q0 .. q0 + n - 1 (n <= chunk) of
+    !> the displacement gradients `gu` (q, i, j); `ok` false (and `k` undefined) when
+    !> J <= 0 at one of them.
+    pure subroutine kirchhoff(self, gu, q0, n, k, ok)
         class(neo_hookean_t), intent(in) :: self
-        real(dp), intent(in) :: grad_u(2, 2)
-        real(dp), intent(out) :: f(2, 2), jac, bbar(2, 2), trbbar, tau(2, 2)
+        real(dp), intent(in) :: gu(:, :, :)
+        integer, intent(in) :: q0, n
+        type(kirchhoff_t), intent(out) :: k
         logical, intent(out) :: ok
-        real(dp) :: b(2, 2), j23
-        integer :: i
-        f = grad_u
-        f(1, 1) = f(1, 1) + 1.0_dp
-        f(2, 2) = f(2, 2) + 1.0_dp
-        jac = f(1, 1)*f(2, 2) - f(1, 2)*f(2, 1)
-        ok = jac > 0.0_dp
+        real(dp) :: j23(chunk), f11, f21, f12, f22
+        integer :: i, q
+        do i = 1, n
+            q = q0 + i - 1
+            k%jac(i) = (gu(q, 1, 1) + 1.0_dp)*(gu(q, 2, 2) + 1.0_dp) - gu(q, 1, 2)*gu(q, 2, 1)
+        end do
+        ok = all(k%jac(1:n) > 0.0_dp)
         if (.not. ok) return
-        b = matmul(f, transpose(f))
-        ! J^(-2/3) from C's cbrt (half the time of pow, a per-quadrature-point cost)
-        j23 = cbrt(jac)
-        j23 = 1.0_dp/(j23*j23)
-        bbar = j23*b
-        ! out-of-plane b33 = 1 enters the trace
-        trbbar = bbar(1, 1) + bbar(2, 2) + j23
-        tau = self%mu*bbar
-        do i = 1, 2
-            tau(i, i) = tau(i, i) - self%mu*trbbar/3.0_dp + 0.5_dp*self%kappa*(jac**2 - 1.0_dp)
+        ! J^(-2/3) from C's cbrt (half the time of pow), a call per point outside the
+        ! vector loop
+        do i = 1, n
+            j23(i) = cbrt(k%jac(i))
+        end do
+        do i = 1, n
+            q = q0 + i - 1
+            f11 = gu(q, 1, 1) + 1.0_dp
+            f21 = gu(q, 2, 1)
+            f12 = gu(q, 1, 2)
+            f22 = gu(q, 2, 2) + 1.0_dp
+            j23(i) = 1.0_dp/(j23(i)*j23(i))
+            ! bbar = J^(-2/3) F F^T, the product summed from zero as matmul does it
+            k%bbar(i, 1) = j23(i)*(0.0_dp + f11*f11 + f12*f12)
+            k%bbar(i, 2) = j23(i)*(0.0_dp + f21*f21 + f22*f22)
+            k%bbar(i, 3) = j23(i)*(0.0_dp + f11*f21 + f12*f22)
+            ! out-of-plane b33 = 1 enters the trace
+            k%trbbar(i) = k%bbar(i, 1) + k%bbar(i, 2) + j23(i)
+            k%tau(i, 1) = self%mu*k%bbar(i, 1) - self%mu*k%trbbar(i)/3.0_dp + 0.5_dp*self%kappa*(k%jac(i)**2 - 1.0_dp)
+            k%tau(i, 2) = self%mu*k%bbar(i, 2) - self%mu*k%trbbar(i)/3.0_dp + 0.5_dp*self%kappa*(k%jac(i)**2 - 1.0_dp)
+            k%tau(i, 3) = self%mu*k%bbar(i, 3)
         end do
     end subroutine kirchhoff
 
+    !> tau and its spatial tangent at one point (`neo_hookean_points` at it).
     pure subroutine neo_hookean_stress(self, grad_u, s, c, ok)
         class(neo_hookean_t), intent(in) :: self
         real(dp), intent(in) :: grad_u(2, 2)
         real(dp), intent(out) :: s(2, 2), c(2, 2, 2, 2)
         logical, intent(out) :: ok
-        real(dp) :: f(2, 2), bbar(2, 2), jac, trbbar, a1, b1, m3, shear
-
-        call kirchhoff(self, grad_u, f, jac, bbar, trbbar, s, ok)
+        integer, parameter :: voigt(2, 2) = reshape([1, 3, 3, 2], [2, 2])
+        real(dp) :: gu(1, 2, 2), sp(1, 2, 2), cv(1, 3, 3)
+        integer :: i, j, m, l
+        gu(1, :, :) = grad_u
+        call neo_hookean_points(self, 1, gu, sp, cv, ok)
         if (.not. ok) then
             s = 0.0_dp
             c = 0.0_dp
             return
         end if
-        ! the tensor above written out entry by entry (the same terms in the same order
-        ! as a loop over i, j, k, l with the identities' ones and zeros; that loop was
-        ! half of the element kernel's time)
-        a1 = self%kappa*jac**2
-        b1 = self%kappa*(jac**2 - 1.0_dp)
-        m3 = 2.0_dp*self%mu/3.0_dp
-        c(1, 1, 1, 1) = a1 - b1 + m3*(trbbar*(1.0_dp + 1.0_dp/3.0_dp) - bbar(1, 1) - bbar(1, 1))
-        c(2, 2, 2, 2) = a1 - b1 + m3*(trbbar*(1.0_dp + 1.0_dp/3.0_dp) - bbar(2, 2) - bbar(2, 2))
-        c(1, 1, 2, 2) = a1 + m3*(trbbar*(1.0_dp/3.0_dp) - bbar(1, 1) - bbar(2, 2))
-        ! (the tensor's major symmetry exactly: the element then needs three of the four
-        ! blocks of K, voiga_element_solid)
-        c(2, 2, 1, 1) = c(1, 1, 2, 2)
-        shear = -b1*0.5_dp + m3*(trbbar*0.5_dp)
-        c(1, 2, 1, 2) = shear
-        c(2, 1, 2, 1) = shear
-        c(1, 2, 2, 1) = shear
-        c(2, 1, 1, 2) = shear
-        ! one of i = j, k = l, the other pair mixed: only a bbar term
-        c(1, 1, 1, 2) = m3*(-bbar(1, 2))
-        c(1, 1, 2, 1) = m3*(-bbar(2, 1))
-        c(2, 2, 1, 2) = m3*(-bbar(1, 2))
-        c(2, 2, 2, 1) = m3*(-bbar(2, 1))
-        c(1, 2, 1, 1) = m3*(-bbar(1, 2))
-        c(2, 1, 1, 1) = m3*(-bbar(2, 1))
-        c(1, 2, 2, 2) = m3*(-bbar(1, 2))
-        c(2, 1, 2, 2) = m3*(-bbar(2, 1))
+        s = sp(1, :, :)
+        ! the tensor has both minor symmetries exactly
+        do l = 1, 2
+            do m = 1, 2
+                do j = 1, 2
+                    do i = 1, 2
+                        c(i, j, m, l) = cv(1, voigt(i, j), voigt(m, l))
+                    end do
+                end do
+            end do
+        end do
     end subroutine neo_hookean_stress
+
+    !> tau and the Voigt tangent at `n` points (`material_t%stress_points`), a chunk
+    !> of points at a time: the per-point latency chain (cbrt, two divisions) of
+    !> one point overlaps the next's, and the loops are vector loops.
+    pure subroutine neo_hookean_points(self, n, gu, s, cv, ok)
+        class(neo_hookean_t), intent(in) :: self
+        integer, intent(in) :: n
+        real(dp), intent(in) :: gu(n, 2, 2)
+        real(dp), intent(out) :: s(n, 2, 2), cv(n, 3, 3)
+        logical, intent(out) :: ok
+        type(kirchhoff_t) :: k
+        real(dp) :: a1, b1, m3, mixed
+        integer :: q0, m, i, q
+        ok = .true.
+        m3 = 2.0_dp*self%mu/3.0_dp
+        do q0 = 1, n, chunk
+            m = min(chunk, n - q0 + 1)
+            call kirchhoff(self, gu, q0, m, k, ok)
+            if (.not. ok) return
+            do i = 1, m
+                q = q0 + i - 1
+                s(q, 1, 1) = k%tau(i, 1)
+                s(q, 2, 1) = k%tau(i, 3)
+                s(q, 1, 2) = k%tau(i, 3)
+                s(q, 2, 2) = k%tau(i, 2)
+                ! c = K J^2 I(x)I - K (J^2 - 1) I_s + 2 mu/3 [tr(bbar) (I_s + I(x)I/3)
+                ! - bbar(x)I - I(x)bbar], its Voigt entries (11, 22, 12)
+                a1 = self%kappa*k%jac(i)**2
+                b1 = self%kappa*(k%jac(i)**2 - 1.0_dp)
+                cv(q, 1, 1) = a1 - b1 + m3*(k%trbbar(i)*(1.0_dp + 1.0_dp/3.0_dp) - k%bbar(i, 1) - k%bbar(i, 1))
+                cv(q, 2, 2) = a1 - b1 + m3*(k%trbbar(i)*(1.0_dp + 1.0_dp/3.0_dp) - k%bbar(i, 2) - k%bbar(i, 2))
+                cv(q, 1, 2) = a1 + m3*(k%trbbar(i)*(1.0_dp/3.0_dp) - k%bbar(i, 1) - k%bbar(i, 2))
+                ! (the major symmetry exactly: the element then needs three of the four
+                ! blocks of K, voiga_element_solid)
+                cv(q, 2, 1) = cv(q, 1, 2)
+                cv(q, 3, 3) = -b1*0.5_dp + m3*(k%trbbar(i)*0.5_dp)
+                ! one of i = j, k = l, the other pair mixed: only a bbar term
+                mixed = m3*(-k%bbar(i, 3))
+                cv(q, 3, 1) = mixed
+                cv(q, 1, 3) = mixed
+                cv(q, 3, 2) = mixed
+                cv(q, 2, 3) = mixed
+            end do
+        end do
+    end subroutine neo_hookean_points
 
     !> The Cauchy stress sigma = tau/J (sigma_zz from tau33 = mu (J^(-2/3) -
     !> tr(bbar)/3) + K/2 (J^2 - 1)) and the logarithmic (Hencky) strain ln V =
@@ -113,13 +170,19 @@ contains
         real(dp), intent(in) :: grad_u(2, 2)
         real(dp), intent(out) :: stress(4), strain(4)
         logical, intent(out) :: ok
-        real(dp) :: f(2, 2), bbar(2, 2), jac, trbbar, tau(2, 2), b(2, 2), theta, c, s, l1, l2
-        call kirchhoff(self, grad_u, f, jac, bbar, trbbar, tau, ok)
+        type(kirchhoff_t) :: k
+        real(dp) :: gu(1, 2, 2), f(2, 2), jac, b(2, 2), theta, c, s, l1, l2
+        gu(1, :, :) = grad_u
+        call kirchhoff(self, gu, 1, 1, k, ok)
         stress = 0.0_dp
         strain = 0.0_dp
         if (.not. ok) return
-        stress = [tau(1, 1), tau(2, 2), self%mu*(jac**(-2.0_dp/3.0_dp) - trbbar/3.0_dp) + &
-                  0.5_dp*self%kappa*(jac**2 - 1.0_dp), tau(1, 2)]/jac
+        jac = k%jac(1)
+        stress = [k%tau(1, 1), k%tau(1, 2), self%mu*(jac**(-2.0_dp/3.0_dp) - k%trbbar(1)/3.0_dp) + &
+                  0.5_dp*self%kappa*(jac**2 - 1.0_dp), k%tau(1, 3)]/jac
+        f = grad_u
+        f(1, 1) = f(1, 1) + 1.0_dp
+        f(2, 2) = f(2, 2) + 1.0_dp
         b = matmul(f, transpose(f))
         theta = 0.5_dp*atan2(2.0_dp*b(1, 2), b(1, 1) - b(2, 2))
         c = cos(theta)
