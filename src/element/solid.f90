@@ -116,7 +116,8 @@ contains
         call fit_work(work, nen, np)
         call point_stresses(mat, nen, np, pts%dndx, u, work%gu, work%s, work%cv, work%finv, ok)
         if (.not. ok) return
-        call point_forces(mat%finite_strain, nen, np, pts%dndx, pts%wdv, work%s, work%finv, fe, work%gt)
+        call point_forces(mat%finite_strain, nen, np, pts%dndx, pts%wdv, work%s, work%finv, fe, work%gt, &
+                          size(work%gt, 1))
     end subroutine solid_element_force
 
     !> The displacement gradients `gu` (q, i, j) at the `np` points, each summed over
@@ -156,35 +157,35 @@ contains
         end do
     end subroutine point_stresses
 
-    !> The quadrature-point loop of `solid_element_force` after `point_stresses`
-    !> (`g` [nen, 2]: work): the force part of `point_columns`, written out again so
-    !> that the hot kernel keeps it inline (a shared per-point helper was not
-    !> inlined: about 0.5 % of ironing-deep m4 N6's perf samples); the same
-    !> expressions in the same order, checked bit for bit by test_newton.
-    pure subroutine point_forces(finite_strain, nen, np, dndx, wdv, s, finv, fe, g)
+    !> The gradients g = F^-T dN/dX (dN/dX for small strain) of every point as the
+    !> columns of G (`gt` [ld, 2 np]: columns 2q - 1 and 2q for point q) and the
+    !> force f_a = sum_q w_q tau g_a (`fe`), from `point_stresses`' results. The
+    !> force alone for `solid_element_force`; `point_columns` goes on from G.
+    pure subroutine point_forces(finite_strain, nen, np, dndx, wdv, s, finv, fe, gt, ld)
         logical, intent(in) :: finite_strain
-        integer, intent(in) :: nen, np
+        integer, intent(in) :: nen, np, ld
         real(dp), intent(in) :: dndx(2, nen, np), wdv(np), s(np, 2, 2), finv(np, 2, 2)
         real(dp), intent(out) :: fe(2, nen)
-        real(dp), intent(inout) :: g(:, :)
-        real(dp) :: sv(3), w
-        integer :: q, a
+        real(dp), intent(inout) :: gt(ld, *)
+        real(dp) :: sv(3)
+        integer :: q, a, c1, c2
         fe = 0.0_dp
         do q = 1, np
-            w = wdv(q)
+            c1 = 2*q - 1
+            c2 = 2*q
             if (finite_strain) then
                 do a = 1, nen
-                    g(a, 1) = finv(q, 1, 1)*dndx(1, a, q) + finv(q, 2, 1)*dndx(2, a, q)
-                    g(a, 2) = finv(q, 1, 2)*dndx(1, a, q) + finv(q, 2, 2)*dndx(2, a, q)
+                    gt(a, c1) = finv(q, 1, 1)*dndx(1, a, q) + finv(q, 2, 1)*dndx(2, a, q)
+                    gt(a, c2) = finv(q, 1, 2)*dndx(1, a, q) + finv(q, 2, 2)*dndx(2, a, q)
                 end do
             else
-                g(1:nen, 1) = dndx(1, :, q)
-                g(1:nen, 2) = dndx(2, :, q)
+                gt(1:nen, c1) = dndx(1, :, q)
+                gt(1:nen, c2) = dndx(2, :, q)
             end if
-            sv = w*[s(q, 1, 1), s(q, 2, 2), s(q, 1, 2)]
+            sv = wdv(q)*[s(q, 1, 1), s(q, 2, 2), s(q, 1, 2)]
             do a = 1, nen
-                fe(1, a) = fe(1, a) + sv(1)*g(a, 1) + sv(3)*g(a, 2)
-                fe(2, a) = fe(2, a) + sv(2)*g(a, 2) + sv(3)*g(a, 1)
+                fe(1, a) = fe(1, a) + sv(1)*gt(a, c1) + sv(3)*gt(a, c2)
+                fe(2, a) = fe(2, a) + sv(2)*gt(a, c2) + sv(3)*gt(a, c1)
             end do
         end do
     end subroutine point_forces
@@ -227,8 +228,9 @@ contains
         ld = size(wk%gt, 1)
         call point_stresses(mat, nen, np, pts%dndx, u, wk%gu, wk%s, wk%cv, wk%finv, ok)
         if (.not. ok) return
-        call point_columns(mat%finite_strain, nen, np, pts%dndx, pts%wdv, wk%s, wk%cv, wk%finv, fe, wk%sym, &
-                           wk%gt, ld, wk%rt, size(wk%rt, 1), wk%myx)
+        call point_forces(mat%finite_strain, nen, np, pts%dndx, pts%wdv, wk%s, wk%finv, fe, wk%gt, ld)
+        call point_columns(mat%finite_strain, nen, np, pts%wdv, wk%s, wk%cv, wk%sym, wk%gt, ld, wk%rt, &
+                           size(wk%rt, 1), wk%myx)
         ! [K^xx K^xy K^yy K^yx] = G R^T; K^yx = (K^xy)^T when the tangent has the major
         ! symmetry at every point (hyperelastic and linear laws)
         nb = merge(3, 4, wk%sym)
@@ -263,49 +265,37 @@ contains
         end if
     end subroutine interleave
 
-    !> The quadrature-point loop of `solid_element` after `point_stresses`: the force
-    !> `fe` and the columns of G and R of every point (explicit shapes, so that the
-    !> loops over the functions are plain vector loops). R's fourth block (for K^yx)
-    !> is formed only when the tangent is not symmetric at some point:
-    !> `element_kernel` does not use it otherwise (a quarter of R's work on
-    !> hyperelastic laws).
-    pure subroutine point_columns(finite_strain, nen, np, dndx, wdv, s, cv, finv, fe, sym, gt, ld, rt, ldr, myx)
+    !> The columns of R of every point from G (`point_forces`) and the law's tangent:
+    !> R's blocks are G M^T for M^xx, M^xy, M^yy (explicit shapes, so that the loops
+    !> over the functions are plain vector loops). R's fourth block (for K^yx) is
+    !> formed only when the tangent is not symmetric at some point: `element_kernel`
+    !> does not use it otherwise (a quarter of R's work on hyperelastic laws).
+    pure subroutine point_columns(finite_strain, nen, np, wdv, s, cv, sym, gt, ld, rt, ldr, myx)
         logical, intent(in) :: finite_strain
         integer, intent(in) :: nen, np, ld, ldr
-        real(dp), intent(in) :: dndx(2, nen, np), wdv(np), s(np, 2, 2), cv(np, 3, 3), finv(np, 2, 2)
-        real(dp), intent(out) :: fe(2, nen)
+        real(dp), intent(in) :: wdv(np), s(np, 2, 2), cv(np, 3, 3)
         !> The Voigt tangent was symmetric at every point (M^yx = (M^xy)^T).
         logical, intent(out) :: sym
-        real(dp), intent(inout) :: gt(ld, *), rt(ldr, *)
+        real(dp), intent(in) :: gt(ld, *)
+        real(dp), intent(inout) :: rt(ldr, *)
         !> Work: M^yx of every point (for R's fourth block).
         real(dp), intent(inout) :: myx(2, 2, *)
-        real(dp) :: d(3, 3), sv(3), ts(2, 2), m(2, 2, 4), w
+        real(dp) :: d(3, 3), ts(2, 2), m(2, 2, 4), w
         integer :: q, i, j, a, blk, off, c1, c2
 
-        fe = 0.0_dp
         sym = .true.
         do q = 1, np
             w = wdv(q)
             c1 = 2*q - 1
             c2 = 2*q
+            ! the geometric part (finite strain)
             ts = 0.0_dp
-            ! g = F^-T dN/dX (dN/dX for small strain)
-            if (finite_strain) then
-                ts = w*s(q, :, :)
-                do a = 1, nen
-                    gt(a, c1) = finv(q, 1, 1)*dndx(1, a, q) + finv(q, 2, 1)*dndx(2, a, q)
-                    gt(a, c2) = finv(q, 1, 2)*dndx(1, a, q) + finv(q, 2, 2)*dndx(2, a, q)
-                end do
-            else
-                gt(1:nen, c1) = dndx(1, :, q)
-                gt(1:nen, c2) = dndx(2, :, q)
-            end if
+            if (finite_strain) ts = w*s(q, :, :)
             do j = 1, 3
                 do i = 1, 3
                     d(i, j) = w*cv(q, i, j)
                 end do
             end do
-            sv = w*[s(q, 1, 1), s(q, 2, 2), s(q, 1, 2)]
             sym = sym .and. d(1, 2) == d(2, 1) .and. d(1, 3) == d(3, 1) .and. d(2, 3) == d(3, 2)
             ! M^xx, M^xy, M^yy, M^yx (rows: the gradient component of g_a, columns: of g_b)
             call coupling(d, ts, m)
@@ -316,11 +306,6 @@ contains
                     rt(off + a, c1) = m(1, 1, blk)*gt(a, c1) + m(1, 2, blk)*gt(a, c2)
                     rt(off + a, c2) = m(2, 1, blk)*gt(a, c1) + m(2, 2, blk)*gt(a, c2)
                 end do
-            end do
-            ! f_a = B_a^T sv
-            do a = 1, nen
-                fe(1, a) = fe(1, a) + sv(1)*gt(a, c1) + sv(3)*gt(a, c2)
-                fe(2, a) = fe(2, a) + sv(2)*gt(a, c2) + sv(3)*gt(a, c1)
             end do
         end do
         if (sym) return
