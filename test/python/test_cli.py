@@ -230,3 +230,21 @@ def test_reoriented_contact_edge_matches_pre(run, tmp_path: Path, ironing_copy: 
                                        atol=1e-12, err_msg=key)
         for attr in ("interface_dofs", "bulk_dofs", "total_dofs"):
             assert a["bodies/slab"].attrs[attr] == b["bodies/slab"].attrs[attr]
+
+
+def test_automatic_penalty_raises_no_floating_point_note(run, tmp_path: Path) -> None:
+    """The automatic penalty (no penalty_normal) is marked by a NaN until the factory
+    computes it; comparing that NaN raised IEEE_INVALID, which gfortran reports as
+    `Note: The following floating-point exceptions are signalling` when the program
+    ends (issue 35, item 4): neither --check nor a frictional run may print it."""
+    import shutil
+    shutil.copy(REPO / "cases" / "hertz" / "geometry.h5", tmp_path / "geometry.h5")
+    case = tmp_path / "case.nml"
+    shutil.copy(REPO / "cases" / "hertz" / "m1-NN2.2.nml", case)
+    text = case.read_text()
+    assert "penalty_normal = 1000.0" in text and "friction = 0.0" in text
+    case.write_text(text.replace("penalty_normal = 1000.0", "").replace("friction = 0.0", "friction = 0.3"))
+    for args in (("--check",), ("--quiet",)):
+        res = run(case, *args, cwd=tmp_path)
+        assert res.returncode == 0, res.stderr
+        assert "floating-point" not in res.stdout + res.stderr, (args, res.stdout, res.stderr)

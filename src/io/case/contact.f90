@@ -153,14 +153,12 @@ contains
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: e_max
-        if (.not. is_unset(c%penalty_normal) .and. &
-            .not. (c%penalty_normal > 0.0_dp .and. ieee_is_finite(c%penalty_normal))) then
+        if (given_not_positive(c%penalty_normal)) then
             call fatal_error(error, where//'penalty_normal must be finite and > 0 (or not given: automatic)', &
                              error_code%input)
         else if (.not. (c%friction >= 0.0_dp .and. ieee_is_finite(c%friction))) then
             call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
-        else if (c%friction > 0.0_dp .and. (.not. is_unset(c%penalty_tangent)) .and. &
-                 .not. (c%penalty_tangent > 0.0_dp .and. ieee_is_finite(c%penalty_tangent))) then
+        else if (c%friction > 0.0_dp .and. given_not_positive(c%penalty_tangent)) then
             call fatal_error(error, where//'penalty_tangent must be finite and > 0 (or not given)', &
                              error_code%input)
         else if (.not. (c%tolerance > 0.0_dp .and. c%tolerance < 1.0_dp)) then
@@ -174,12 +172,34 @@ contains
         if (allocated(error)) return
         ! conditioning: a penalty above 1e12 x E leaves the stiffness matrix with fewer
         ! than 4 significant digits in double precision
+        ! (an automatic penalty, the `unset` NaN, is never compared: an ordered comparison
+        ! with a NaN raises IEEE_INVALID, which gfortran reports when the program ends)
         e_max = bodies(body_index(bodies, c%slave))%youngs_modulus
         if (trim(c%master) /= 'rigid') e_max = max(e_max, bodies(body_index(bodies, c%master))%youngs_modulus)
-        if (c%penalty_normal > 1.0e12_dp*e_max .or. (c%friction > 0.0_dp .and. c%penalty_tangent > 1.0e12_dp*e_max)) &
+        if (given_above(c%penalty_normal, 1.0e12_dp*e_max) .or. &
+            (c%friction > 0.0_dp .and. given_above(c%penalty_tangent, 1.0e12_dp*e_max))) &
             call fatal_error(error, where//'penalty_normal and penalty_tangent must not exceed 1e12 times '// &
                              "the largest Young's modulus of the two bodies (the stiffness matrix would "// &
                              'lose its significant digits)', error_code%input)
     end subroutine check_law
+
+    !> Is `x` given (not `unset`) but not a finite positive number? Tested without
+    !> comparing a NaN.
+    elemental logical function given_not_positive(x)
+        real(dp), intent(in) :: x
+        given_not_positive = .false.
+        if (is_unset(x)) return
+        given_not_positive = .true.
+        if (.not. ieee_is_finite(x)) return
+        given_not_positive = x <= 0.0_dp
+    end function given_not_positive
+
+    !> Is `x` given (not `unset`) and above `limit`? Tested without comparing the NaN.
+    elemental logical function given_above(x, limit)
+        real(dp), intent(in) :: x, limit
+        given_above = .false.
+        if (is_unset(x)) return
+        given_above = x > limit
+    end function given_above
 
 end module voiga_io_case_contact
