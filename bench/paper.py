@@ -18,6 +18,7 @@ them (``git checkout docs/validation`` to drop them).
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import subprocess
 import sys
@@ -25,12 +26,14 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from post.cost import COST_COLUMNS
 from post.figures import read_summary
 
 REPO = Path(__file__).resolve().parents[1]
 
-TIME_COLUMNS = ("wall_s", "assembly_s", "contact_s", "factorization_s", "solve_s", "output_s", "time_norm")
-"""Columns of ``summary.csv`` that are times (or scaled by them): left out of ``--against``."""
+TIME_COLUMNS = (*COST_COLUMNS, "assembly_s", "contact_s", "factorization_s", "solve_s", "output_s", "time_norm")
+"""Columns of ``summary.csv`` that are times (or scaled by them, or counted by them, as
+the repeats): left out of ``--against``."""
 
 STAGE_COLUMNS = ("assembly_s", "contact_s", "factorization_s", "solve_s", "output_s")
 
@@ -132,16 +135,33 @@ def differences(new: list[dict[str, str]], old: list[dict[str, str]], rtol: floa
     return out
 
 
-def report(ph: Phases, totals: dict[str, float]) -> str:
+def repeats_work(out: Path) -> dict[str, float]:
+    """Every run's timing samples in a study's folder (``*/*.cost.json``, repeats
+    included): their count and summed wall and CPU seconds."""
+    runs, wall, cpu = 0, 0.0, 0.0
+    for path in sorted(out.glob("*/*.cost.json")):
+        try:
+            data = json.loads(path.read_text())
+            runs, wall, cpu = runs + len(data["wall_s"]), wall + sum(data["wall_s"]), cpu + sum(data["cpu_s"])
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+    return {"runs": runs, "wall_s": wall, "cpu_s": cpu}
+
+
+def report(ph: Phases, totals: dict[str, float], repeats: dict[str, float] | None = None) -> str:
     """The phases and the runs' work, as printed."""
     stages = ", ".join(f"{k[:-2]} {v:.1f}" for k, v in totals.items() if k != "wall_s")
-    return "\n".join([
+    lines = [
         f"make paper: {ph.end:.1f} s",
         f"  build check and set-up {ph.build:.1f} s, runs {ph.runs - ph.build:.1f} s,"
         f" summary {ph.summary - ph.runs:.1f} s,"
         f" figures {ph.end - ph.summary:.1f} s",
         f"  the runs' work: {totals['wall_s']:.1f} s ({stages})",
-    ])
+    ]
+    if repeats and repeats["runs"]:
+        lines.append(f"  with the repeats: {repeats['runs']:.0f} runs of voiga, {repeats['wall_s']:.1f} s wall, "
+                     f"{repeats['cpu_s']:.1f} s CPU")
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -172,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"bench.paper: {err} (exit code {code}; the log: {log})", file=sys.stderr)
         return 1
     rows = read_summary(out)
-    print(report(ph, work(rows)))
+    print(report(ph, work(rows), repeats_work(out)))
     status = 0 if code == 0 else 1
     if args.against:
         diff = differences(rows, read_summary(args.against), args.rtol)

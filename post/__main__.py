@@ -188,6 +188,17 @@ def _positive(text: str) -> float:
     return value
 
 
+def _at_least_one(text: str) -> int:
+    """``--repeats``: a whole number, at least 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be at least 1")
+    return value
+
+
 def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
     """Run ``study`` as the command line asks (shared by ``study`` and ``sweep``):
     derive the cases, solve those not up to date on Dask, write the table (and the
@@ -219,7 +230,7 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
                 outcome = run_all(runs, binary, client, args.timeout or study.timeout, args.force,
                                   progress=not args.no_progress,
                                   times=previous_times(study.out / "summary.csv"),
-                                  shared=not args.no_shared_fs)
+                                  shared=not args.no_shared_fs, policy=study.policy())
         except OSError as err:
             print(f"{prog}: {err}", file=sys.stderr)
             return 2
@@ -249,6 +260,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
     except StudyError as err:
         print(f"{prog}: {err}", file=sys.stderr)
         return 2
+    if args.repeats is not None:
+        study.repeats = args.repeats
     for key in ("scenes", "meshes", "layouts"):
         if getattr(args, key) is not None:
             if study.base is not None:
@@ -265,7 +278,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from .study import Study
 
     study = Study(out=Path(args.out), cases=Path(args.cases), scenes=args.scenes, meshes=args.meshes,
-                  layouts=args.layouts, figures=False)
+                  layouts=args.layouts, figures=False, repeats=args.repeats or 1)
     return _run_study(study, args, "python -m post sweep")
 
 
@@ -298,6 +311,9 @@ def _engine_options(s: argparse.ArgumentParser, timeout_default: float) -> None:
                    help="seconds per case (default: " + ("the study file's, else 3600)"
                                                           if not timeout_default else "3600)"))
     s.add_argument("--force", action="store_true", help="rerun up-to-date cases too")
+    s.add_argument("--repeats", type=_at_least_one, default=None,
+                   help="runs of each short case (under 3 CPU seconds) to time it: median and range "
+                        "of their CPU and wall times in the table (default: the study file's, else 1)")
     s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
     s.add_argument("--list", action="store_true", help="only list the cases (their case files)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")

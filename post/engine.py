@@ -14,18 +14,18 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from tqdm import tqdm
 
+from .cost import ONCE, RepeatPolicy, Sample, cost_path, timed_run, write_costs
 from .sweep import Run, longest_first, up_to_date
 
 CONNECT_TIMEOUT = 30.0
@@ -47,6 +47,8 @@ class Task:
     timeout: float
     dest: str | None
     """Where the worker moves the result file (shared file system), or None: return it."""
+    policy: RepeatPolicy = ONCE
+    """How often a short run is repeated to time it (the first run's result is kept)."""
 
 
 @dataclass
@@ -61,6 +63,8 @@ class Outcome:
     seconds: float = 0.0
     data: bytes | None = None
     """The result file, when it is returned rather than moved."""
+    samples: list[Sample] = field(default_factory=list)
+    """Wall and CPU seconds of every run of the case (the repeats included)."""
 
 
 def single_thread_env() -> dict[str, str]:
@@ -75,38 +79,41 @@ def single_thread_env() -> dict[str, str]:
 
 
 def run_task(task: Task) -> Outcome:
-    """Solve one case in a fresh scratch folder (runs on a worker). Never raises: any
-    failure becomes the outcome's code and message."""
+    """Solve one case in a fresh scratch folder (runs on a worker), then, if it
+    converged and ``task.policy`` asks, run it again to time it (those results are
+    dropped). Never raises: any failure becomes the outcome's code and message."""
     start = time.perf_counter()
-    data = None
+    data, samples = None, []
     try:
         with tempfile.TemporaryDirectory(prefix="voiga-") as scratch:
             folder = Path(scratch)
             (folder / task.name).write_text(task.text)
             (folder / task.geometry_name).write_bytes(task.geometry)
-            try:
-                proc = subprocess.run([task.binary, task.name, "--quiet"], cwd=folder, capture_output=True,
-                                      text=True, timeout=task.timeout, env=single_thread_env(),
-                                      stdin=subprocess.DEVNULL)
-                lines = (proc.stderr or "").strip().splitlines()
-                code, message = proc.returncode, lines[-1] if lines else ""
-            except subprocess.TimeoutExpired:
-                code, message = -1, f"timed out after {task.timeout:g} s"
+            cmd, env = [task.binary, task.name, "--quiet"], single_thread_env()
+            code, message, sample = timed_run(cmd, folder, env, task.timeout)
+            samples.append(sample)
             result = folder / (Path(task.name).stem + ".h5")
             if not result.exists():
                 if code == 0:
                     code, message = -2, f"voiga wrote no {result.name}"
             elif task.dest is None:
                 data = result.read_bytes()
+                result.unlink()
             else:
                 dest = Path(task.dest)
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 part = dest.with_name(dest.name + ".part")
                 shutil.move(result, part)     # keeps voiga's modification time
                 os.replace(part, dest)
+            while code == 0 and task.policy.more(samples):
+                again, _, sample = timed_run(cmd, folder, env, task.timeout)
+                result.unlink(missing_ok=True)
+                if again != 0:                # timed on runs that did the same work only
+                    break
+                samples.append(sample)
     except Exception as err:  # noqa: BLE001 -- one case's trouble must not stop the study
         code, message = -2, f"{type(err).__name__}: {err}"
-    return Outcome(task.label, code, message, time.perf_counter() - start, data)
+    return Outcome(task.label, code, message, time.perf_counter() - start, data, samples)
 
 
 def write_if_changed(path: Path, text: str) -> None:
@@ -126,11 +133,11 @@ def prepare(run: Run) -> None:
         shutil.copy2(run.geometry, target)
 
 
-def task_for(run: Run, binary: Path, timeout: float, shared: bool) -> Task:
+def task_for(run: Run, binary: Path, timeout: float, shared: bool, policy: RepeatPolicy = ONCE) -> Task:
     """The task of ``run`` (after :func:`prepare`)."""
     return Task(label=run.label, name=run.work.name, text=run.case_text(), geometry_name=run.geometry.name,
                 geometry=run.geometry.read_bytes(), binary=str(binary), timeout=timeout,
-                dest=str(run.result.resolve()) if shared else None)
+                dest=str(run.result.resolve()) if shared else None, policy=policy)
 
 
 @contextmanager
@@ -161,11 +168,13 @@ def connect(scheduler: str | None = None, jobs: int = 0) -> Iterator[object]:
 
 def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force: bool = False,
             progress: bool = True, times: dict[str, float] | None = None,
-            shared: bool = True) -> dict[str, Outcome]:
+            shared: bool = True, policy: RepeatPolicy = ONCE) -> dict[str, Outcome]:
     """Solve every run whose result is not up to date (all with ``force``) on the
     client's cluster, longest first (:func:`post.sweep.longest_first`, ``times``: wall
-    seconds of a previous summary, label -> s); label -> outcome (``'up to date'`` for
-    the skipped ones). A tqdm bar shows the count, the failures so far and the ETA."""
+    seconds of a previous summary, label -> s), each short run repeated as ``policy``
+    says; the times of every run of a case go beside its result
+    (:func:`post.cost.write_costs`). Label -> outcome (``'up to date'`` for the skipped
+    ones). A tqdm bar shows the count, the failures so far and the ETA."""
     from distributed import as_completed
 
     outcome: dict[str, Outcome] = {}
@@ -176,13 +185,14 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
             outcome[run.label] = Outcome(run.label, 0, "up to date")
         else:
             run.result.unlink(missing_ok=True)     # a failed rerun leaves no stale result
+            cost_path(run.result).unlink(missing_ok=True)
             todo.append(run)
     todo = longest_first(todo, times)
     by_key, futures = {}, []
     for rank, run in enumerate(todo):
         key = f"voiga-{run.label}-{uuid.uuid4().hex[:8]}"
         by_key[key] = run
-        futures.append(client.submit(run_task, task_for(run, binary, timeout, shared),  # type: ignore[attr-defined]
+        futures.append(client.submit(run_task, task_for(run, binary, timeout, shared, policy),  # type: ignore[attr-defined]
                                      key=key, priority=len(todo) - rank, pure=False))
     failed = 0
     with tqdm(total=len(todo), desc="study", unit="case", disable=not progress, file=sys.stderr) as bar:
@@ -198,6 +208,8 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
                 part.write_bytes(out.data)
                 os.replace(part, run.result)
                 out.data = None
+            if out.samples and run.result.exists():
+                write_costs(run.result, out.samples)
             outcome[run.label] = out
             failed += out.code != 0
             bar.set_postfix_str(f"{failed} failed, last {run.label}")

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .cost import Spread, cheapest, ratio
 from .reader import read_result
 from .sweep import SUMMARY_COLUMNS
 
@@ -105,6 +106,18 @@ def hertz_pressure(results: Path, out: Path, mesh: str = "m3") -> Path | None:
     return path
 
 
+def _normalised_times(rows: list[dict[str, str]], key: str) -> tuple[list[float], np.ndarray]:
+    """``time_norm`` of each row and its error bars (below, above: the range of the
+    repeats of ``<key>_s`` on the same scale), for ``errorbar``'s ``xerr``."""
+    xs, bars = [], []
+    for r in rows:
+        x, cost = _num(r, "time_norm"), run_cost(r, key)
+        scale = x / cost.median if cost is not None and cost.median > 0 else 0.0
+        xs.append(x)
+        bars.append((scale * (cost.median - cost.lo), scale * (cost.hi - cost.median)) if cost else (0.0, 0.0))
+    return xs, np.array(bars, dtype=float).T.reshape(2, len(rows))
+
+
 def error_plots(rows: list[dict[str, str]], out: Path, scene: str, error: str,
                 label: str) -> list[Path]:
     """Error against mesh level and against normalised time, one line per layout."""
@@ -114,15 +127,21 @@ def error_plots(rows: list[dict[str, str]], out: Path, scene: str, error: str,
            and np.isfinite(_num(r, error)) and r["mesh"].startswith("m")]
     if not sel:
         return paths
-    for xkey, xlabel, name in (("mesh", "mesh", "mesh"), ("time_norm", "time / most expensive run", "time")):
+    key = "cpu" if all(run_cost(r, "cpu") for r in sel) else "wall"
+    time_label = f"{'CPU' if key == 'cpu' else 'wall'} time / most expensive run's (bars: range of repeats)"
+    for xkey, xlabel, name in (("mesh", "mesh", "mesh"), ("time_norm", time_label, "time")):
         fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
         for lay in LAYOUT_ORDER:
             pts = [r for r in sel if r["layout"] == lay]
             if not pts:
                 continue
             pts.sort(key=lambda r: r["mesh"])
-            xs = [int(r["mesh"][1:]) for r in pts] if xkey == "mesh" else [_num(r, "time_norm") for r in pts]
-            ax.plot(xs, [_num(r, error) for r in pts], "o-", ms=4, label=lay)
+            ys = [_num(r, error) for r in pts]
+            if xkey == "mesh":
+                ax.plot([int(r["mesh"][1:]) for r in pts], ys, "o-", ms=4, label=lay)
+                continue
+            xs, bars = _normalised_times(pts, key)
+            ax.errorbar(xs, ys, xerr=bars, fmt="o-", ms=4, capsize=2, elinewidth=0.8, label=lay)
         ax.set_yscale("log")
         if xkey == "time_norm":
             ax.set_xscale("log")
@@ -137,10 +156,45 @@ def error_plots(rows: list[dict[str, str]], out: Path, scene: str, error: str,
     return paths
 
 
+def run_cost(row: dict[str, str] | dict[str, object], key: str = "cpu") -> Spread | None:
+    """The cost of a summary row as a :class:`post.cost.Spread` of ``<key>_s`` (``key``
+    ``cpu`` or ``wall``): its median and range over the repeats (a run timed once, or a
+    summary without the range, has the one value as its range); None without it."""
+    median = _num(row, f"{key}_s")
+    if not np.isfinite(median):
+        return None
+    lo, hi, n = _num(row, f"{key}_lo_s"), _num(row, f"{key}_hi_s"), _num(row, "repeats")
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        lo = hi = median
+    return Spread(median, lo, hi, int(n) if np.isfinite(n) else 1)
+
+
+def _seconds(s: Spread) -> str:
+    """``0.0310 s [0.0301-0.0322]``, or ``16.2 s (1 run)``."""
+    if s.n <= 1 and s.lo == s.hi:
+        return f"{s.median:.3g} s (1 run)"
+    return f"{s.median:.3g} s [{s.lo:.3g}-{s.hi:.3g}]"
+
+
+def _fraction(x: float) -> str:
+    """Two decimals, or two significant digits below 0.1."""
+    return f"{x:.2f}" if x >= 0.1 else f"{x:.2g}"
+
+
+def _pick(names: list[str], costs: dict[str, Spread], errors: dict[str, float]) -> str:
+    """The cell naming the cheapest run, or every run of a tie."""
+    cells = [f"{k} ({errors[k]:.3g}): {_seconds(costs[k])}" for k in names]
+    return cells[0] if len(cells) == 1 else "tie: " + "; ".join(cells)
+
+
 def accuracy_cost(rows: list[dict[str, str]], scene: str, error: str,
                   levels: tuple[float, ...] = (0.10, 0.03, 0.01, 0.003, 0.001)) -> str:
-    """Markdown table: for each error level, the cheapest run reaching it, its time, and
-    its time relative to the cheapest N2 run reaching it."""
+    """Markdown table: for each error level, the cheapest run reaching it and the
+    cheapest N2 run reaching it, by their CPU time (median [min-max] of the repeats;
+    the wall time when a run has no CPU time), and the cost of the cheapest run relative
+    to the cheapest N2's with its range. Runs whose ranges overlap are a tie and all of
+    them are named (:func:`post.cost.cheapest`): the table says only what the repeats
+    can tell apart."""
     from .sweep import REFERENCES
 
     ref = REFERENCES.get(scene, "")
@@ -148,23 +202,27 @@ def accuracy_cost(rows: list[dict[str, str]], scene: str, error: str,
     sel = [r for r in rows if r["scene"] == scene and r.get("status") == "converged"
            and np.isfinite(_num(r, error)) and r["mesh"].startswith("m")
            and not (f"{r['mesh']}-{r['layout']}" == ref and error.endswith(("_ref", "_ref_field")))]
-    lines = [f"| {error} <= | cheapest run | its wall s | cheapest N2 | N2 wall s | time / N2's |",
-             "|---|---|---|---|---|---|"]
+    key = "cpu" if all(run_cost(r, "cpu") for r in sel) else "wall"
+    what = "CPU" if key == "cpu" else "wall"
+    lines = [f"| {error} <= | cheapest run ({error}): {what} time, median [range] | cheapest N2 | "
+             f"{what} time / N2's [range] |",
+             "|---|---|---|---|"]
     for level in levels:
         ok = [r for r in sel if _num(r, error) <= level]
         if not ok:
-            lines.append(f"| {level:g} | none reaches it | | | | |")
+            lines.append(f"| {level:g} | none reaches it | | |")
             continue
-        best = min(ok, key=lambda r: _num(r, "wall_s"))
-        n2 = [r for r in ok if r["layout"] == "N2"]
-        n2b = min(n2, key=lambda r: _num(r, "wall_s")) if n2 else None
-        ratio = f"{_num(best, 'wall_s') / _num(n2b, 'wall_s'):.2f}" if n2b else "N2 does not reach it"
-        lines.append(f"| {level:g} | {best['mesh']}-{best['layout']} ({_num(best, error):.3g}) | "
-                     f"{_num(best, 'wall_s'):.3g} | "
-                     f"{(n2b['mesh'] + '-N2 (' + format(_num(n2b, error), '.3g') + ')') if n2b else '-'} | "
-                     f"{_num(n2b, 'wall_s'):.3g} | {ratio} |" if n2b else
-                     f"| {level:g} | {best['mesh']}-{best['layout']} ({_num(best, error):.3g}) | "
-                     f"{_num(best, 'wall_s'):.3g} | - | - | {ratio} |")
+        costs = {f"{r['mesh']}-{r['layout']}": run_cost(r, key) for r in ok}
+        costs = {k: v for k, v in costs.items() if v is not None}
+        errors = {f"{r['mesh']}-{r['layout']}": _num(r, error) for r in ok}
+        n2 = {k: v for k, v in costs.items() if k.endswith("-N2")}
+        best = _pick(cheapest(costs), costs, errors)
+        if not n2:
+            lines.append(f"| {level:g} | {best} | - | N2 does not reach it |")
+            continue
+        r = ratio({k: v for k, v in costs.items() if k not in n2}, n2)
+        lines.append(f"| {level:g} | {best} | {_pick(cheapest(n2), n2, errors)} | "
+                     f"{_fraction(r.median)} [{_fraction(r.lo)}-{_fraction(r.hi)}] |")
     return "\n".join(lines) + "\n"
 
 
@@ -262,8 +320,9 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
     """For every measure (a numeric column other than SUMMARY_COLUMNS and ``params``): the
     measure against each parameter that takes more than one value (one line per
     combination of the other parameters; ``scene``, ``mesh`` and ``layout`` count as
-    parameters when they vary) and against the wall time of the run (one point per
-    case, labelled with its parameters). PNG files ``<measure>-vs-<parameter>.png`` and
+    parameters when they vary) and against the CPU time of the run (the wall time
+    when a run has none; one point per case, labelled with its parameters, with the
+    range of its repeats). PNG files ``<measure>-vs-<parameter>.png`` and
     ``<measure>-vs-time.png`` in ``out``; the converged runs only."""
     ok = [r for r in rows if r.get("status") == "converged"]
     axes = [p for p in ["scene", "mesh", "layout", *params]
@@ -278,6 +337,8 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
     out.mkdir(parents=True, exist_ok=True)
     plt = _plt()
     paths = []
+    key = "cpu" if all(run_cost(r, "cpu") for r in ok) else "wall"
+    what = "CPU" if key == "cpu" else "wall"
 
     def label(row: dict[str, object], names: list[str]) -> str:
         return ", ".join(f"{n.rsplit('.', 1)[-1]}={_cell(row, n)}" for n in names)
@@ -312,16 +373,18 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
             plt.close(fig)
             paths.append(path)
         fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
-        walls = [_num(r, "wall_s") for r in ok]
+        costs = [run_cost(r, key) for r in ok]
+        walls = [c.median if c else float("nan") for c in costs]
+        bars = np.array([(c.median - c.lo, c.hi - c.median) if c else (0.0, 0.0) for c in costs]).T
         values = [_num(r, m) for r in ok]
-        ax.plot(walls, values, "o", ms=5)
+        ax.errorbar(walls, values, xerr=bars, fmt="o", ms=5, capsize=2, elinewidth=0.8)
         for r, w, v in zip(ok, walls, values):
             ax.annotate(label(r, axes), (w, v), fontsize=7, xytext=(3, 3), textcoords="offset points")
         if min(walls) > 0 and max(walls) > 10 * min(walls):
             ax.set_xscale("log")
-        ax.set_xlabel("wall time of the run, s")
+        ax.set_xlabel(f"{what} time of the run, s (median; bars: range of repeats)")
         ax.set_ylabel(m)
-        ax.set_title(f"{m} against the run's wall time")
+        ax.set_title(f"{m} against the run's {what} time")
         path = out / f"{_safe(m)}-vs-time.png"
         fig.savefig(path, dpi=110)
         plt.close(fig)

@@ -24,6 +24,7 @@ from typing import Any
 
 import f90nml
 
+from .cost import ONCE, RepeatPolicy
 from .measures import parse_file_measure
 from .sweep import REPO, SUMMARY_COLUMNS, Run, find_cases
 
@@ -54,7 +55,7 @@ FIXED = {"case.output": "the engine names each case's result file",
 """Variables a study may not change, and why."""
 
 KEYS = {"base", "cases", "scenes", "meshes", "layouts", "generate", "out", "timeout",
-        "measures", "figures", "grid", "list"}
+        "measures", "figures", "grid", "list", "repeats", "repeat_below"}
 """The top-level keys of a study file."""
 
 _PATH = re.compile(r"^([A-Za-z_]\w*)(?:\[([^\]]+)\])?\.([A-Za-z_]\w*)$")
@@ -232,12 +233,24 @@ class Study:
     """Column name -> measure read from the result file (:func:`post.measures.file_measure`)."""
     timeout: float = 3600.0
     figures: bool = True
+    repeats: int = 1
+    """Runs of each short case to time it (1: each case once)."""
+    repeat_below: float = 3.0
+    """A case is short when its first run took less CPU time than this (seconds)."""
     source: Path | None = None
     """The study file."""
 
     @property
     def where(self) -> str:
         return str(self.source) if self.source else "study"
+
+    def policy(self) -> RepeatPolicy:
+        """How the engine repeats the short cases: at least ``repeats`` runs, more (up
+        to three times as many) while they took less than 0.5 CPU seconds together."""
+        if self.repeats <= 1:
+            return ONCE
+        return RepeatPolicy(short_s=self.repeat_below, min_repeats=self.repeats, max_repeats=3 * self.repeats,
+                            budget_s=0.5)
 
     def change_sets(self) -> list[Changes]:
         """Every combination of the grid, for every list entry (one empty change set
@@ -389,6 +402,15 @@ def load_study(path: Path, out: Path | None = None) -> Study:
         if not isinstance(data["timeout"], (int, float)) or data["timeout"] <= 0:
             raise StudyError(f"{where}: timeout must be a positive number of seconds")
         study.timeout = float(data["timeout"])
+    if "repeats" in data:
+        if not isinstance(data["repeats"], int) or isinstance(data["repeats"], bool) or data["repeats"] < 1:
+            raise StudyError(f"{where}: repeats must be a whole number of runs, at least 1")
+        study.repeats = data["repeats"]
+    if "repeat_below" in data:
+        below = data["repeat_below"]
+        if not isinstance(below, (int, float)) or isinstance(below, bool) or not 0 < below < float("inf"):
+            raise StudyError(f"{where}: repeat_below must be a positive number of CPU seconds")
+        study.repeat_below = float(below)
     grid = data.get("grid", {})
     if not isinstance(grid, dict):
         raise StudyError(f"{where}: grid must be a table ([grid])")

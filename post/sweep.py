@@ -4,7 +4,8 @@ A :class:`Run` is one case: a committed case file copied into ``<out>/<scene>/``
 case derived from one by a study (``post/study.py``). The engine (``post/engine.py``)
 solves them; a case whose result is converged and newer than its inputs and the binary
 is skipped. The summary (CSV, markdown, Parquet) lists DOFs, Newton iterations,
-load-step cuts, wall time per stage, status and the scene's error measures
+load-step cuts, the run's CPU and wall time (median and range over its repeats,
+``post/cost.py``), wall time per stage, status and the scene's error measures
 (``post/measures.py``).
 """
 
@@ -17,6 +18,8 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from .cost import COST_COLUMNS, cost_columns, read_costs
 
 REPO = Path(__file__).resolve().parents[1]
 STAGES = ("assembly", "contact", "factorization", "solve", "output")
@@ -160,8 +163,8 @@ def longest_first(runs: list[Run], times: dict[str, float] | None = None) -> lis
 
 
 SUMMARY_COLUMNS = frozenset({"scene", "mesh", "layout", "case", "dofs", "interface_dofs", "steps", "iterations",
-                             "cuts", "wall_s", *(f"{s}_s" for s in STAGES), "status", "exit_code", "error",
-                             "measure_error", "time_norm"})
+                             "cuts", *COST_COLUMNS, *(f"{s}_s" for s in STAGES), "status", "exit_code",
+                             "error", "measure_error", "time_norm"})
 """The summary's columns that are not measures."""
 
 REFERENCES = {"hertz": "m6-N2", "rings": "ref-N2"}
@@ -175,9 +178,12 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
     name and the value of every variable the study changes), DOFs, iterations, cuts,
     seconds, status, the scene's measures and the ``measures`` named by the study
     (column -> :func:`post.measures.file_measure`); ironing amplitudes as % of N2 on the
-    same mesh with the same changes; time normalised by the scene's most expensive run
-    (the paper's Eq. 36). ``failures``: label -> (exit code, message) of the runs that
-    failed in this study, recorded in ``exit_code`` and ``error``. The error measures
+    same mesh with the same changes; the cost (repeats, CPU and wall seconds: median,
+    lo, hi; :func:`post.cost.cost_columns`) and the median CPU time normalised by the
+    scene's most expensive run's (``time_norm``, the paper's Eq. 36; by the wall time
+    when a run of the scene has no CPU time). ``failures``: label -> (exit code,
+    message) of the runs that failed in this study, recorded in ``exit_code`` and
+    ``error``. The error measures
     compare with the scene's reference run (REFERENCES) with the same changes. The
     result files are read by ``jobs`` processes (default: one per core; reading them
     is most of a summary's time: 7.7 s of 9.4 s for ``make paper``'s 113 runs on one core)."""
@@ -203,10 +209,12 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
                 row["px_pct_n2"] = 100.0 * float(row["amp_px"]) / float(n2[0]["amp_px"])
                 row["py_pct_n2"] = 100.0 * float(row["amp_py"]) / float(n2[0]["amp_py"])
     for scene in {str(r["scene"]) for r in rows}:
-        times = [float(r["wall_s"]) for r in rows if r["scene"] == scene and "wall_s" in r]
-        for r in rows:
-            if r["scene"] == scene and "wall_s" in r and times:
-                r["time_norm"] = float(r["wall_s"]) / max(times)
+        timed = [r for r in rows if r["scene"] == scene and "wall_s" in r]
+        key = "cpu_s" if all("cpu_s" in r for r in timed) else "wall_s"
+        most = max((float(r[key]) for r in timed), default=0.0)
+        for r in timed:
+            if most > 0:
+                r["time_norm"] = float(r[key]) / most
     return rows
 
 
@@ -241,7 +249,11 @@ def _row(task: tuple[Run, Path | None, dict[str, str], tuple[int, str]]) -> dict
     row["steps"] = len(res.steps)
     row["iterations"] = sum(s.iterations for s in res.steps)
     row["cuts"] = int(sum(int(getattr(s, "cuts", 0) or 0) for s in res.steps))
-    row["wall_s"] = round(res.wall_time, 4)
+    samples = read_costs(run.result)
+    if samples:
+        row.update(cost_columns(samples))
+    else:       # no times kept by the engine (a result made by hand): voiga's own clock
+        row["wall_s"] = round(res.wall_time, 4)
     for stage in STAGES:
         row[f"{stage}_s"] = round(sum(s.seconds.get(stage, 0.0) for s in res.steps), 4)
     row["status"] = res.status

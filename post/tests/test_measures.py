@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from post.cost import RepeatPolicy
 from post.figures import accuracy_cost
 from post.measures import detrended_amplitude, profile_error
 from post.engine import connect, run_all
@@ -56,11 +57,12 @@ def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
         pytest.skip(f"no voiga binary at {binary}")
     runs = find_cases(REPO / "cases", tmp_path, ["hertz"], ["m1"], ["L1", "N2"])
     assert [r.label for r in runs] == ["hertz/m1-L1", "hertz/m1-N2"]
+    policy = RepeatPolicy(short_s=3.0, min_repeats=3, max_repeats=3)
     with connect(jobs=2) as client:
-        outcome = run_all(runs, binary, client, timeout=300, progress=False)
+        outcome = run_all(runs, binary, client, timeout=300, progress=False, policy=policy)
         assert all(o.code == 0 for o in outcome.values()), outcome
         assert all(up_to_date(r, binary) for r in runs)
-        again = run_all(runs, binary, client, timeout=300, progress=False)
+        again = run_all(runs, binary, client, timeout=300, progress=False, policy=policy)
     assert all(o.message == "up to date" for o in again.values())
     serial = summarize(runs, jobs=1)
     # the result files read by two processes: the same rows, in the runs' order
@@ -69,6 +71,12 @@ def test_sweep_runs_skips_and_summarizes(tmp_path: Path) -> None:
     rows = list(csv.DictReader(csv_path.open()))
     assert [int(r["dofs"]) for r in rows] == [980, 1078]
     assert all(r["status"] == "converged" for r in rows)
+    # three runs each (hertz m1 takes well under 3 CPU seconds), kept through the skipped rerun
+    for r in rows:
+        assert r["repeats"] == "3"
+        assert 0 < float(r["cpu_lo_s"]) <= float(r["cpu_s"]) <= float(r["cpu_hi_s"])
+        assert 0 < float(r["wall_lo_s"]) <= float(r["wall_s"]) <= float(r["wall_hi_s"])
+    assert max(float(r["time_norm"]) for r in rows) == 1.0
     assert float(rows[1]["l2_analytic"]) < 0.1 and abs(float(rows[1]["a_err"])) < 0.02
     assert "| hertz | m1 | N2 |" in md_path.read_text()
 

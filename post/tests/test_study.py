@@ -13,7 +13,8 @@ import pytest
 from post.__main__ import main
 from post.measures import file_measure, parse_file_measure
 from post.reader import read_result
-from post.study import NAMELISTS, case_stem, load_study
+from post.cost import ONCE
+from post.study import NAMELISTS, Study, case_stem, load_study
 
 REPO = Path(__file__).resolve().parents[2]
 HERTZ = REPO / "cases" / "hertz" / "m1-N2.nml"
@@ -95,6 +96,9 @@ def test_long_case_names_are_hashed() -> None:
     ('base = "{hertz}"\nmeasures = { cuts = "n_cuts" }\n', "is a column of the table already"),
     ('cases = "../.."\nscenes = ["nosuch"]\n', "no committed case"),
     ('base = "{hertz}"\n[grid\n', "not a TOML file"),
+    ('base = "{hertz}"\nrepeats = 0\n', "repeats must be a whole number of runs, at least 1"),
+    ('base = "{hertz}"\nrepeats = 2.5\n', "repeats must be a whole number of runs, at least 1"),
+    ('base = "{hertz}"\nrepeat_below = -1\n', "repeat_below must be a positive number"),
 ])
 def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                           text: str, cause: str) -> None:
@@ -102,6 +106,12 @@ def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.Capture
     assert main(["study", str(path), "--list", "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and cause in err and "Traceback" not in err, err
+
+
+def test_repeats_must_be_at_least_one(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    with pytest.raises(SystemExit) as stop:
+        main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--list", "--repeats", "0"])
+    assert stop.value.code == 2 and "'0': must be at least 1" in capsys.readouterr().err
 
 
 def test_malformed_scheduler_address(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -126,6 +136,14 @@ def test_paper_study_is_every_committed_case() -> None:
     # unchanged: the committed text is solved as it is
     assert all(r.text is None and not r.changes for r in runs)
     assert {r.work.parent.name for r in runs} == {"hertz", "ironing", "ironing-deep", "rings"}
+    # a run under 3 CPU seconds is timed over 3 to 9 runs, a longer one once
+    policy = study.policy()
+    assert (policy.short_s, policy.min_repeats, policy.max_repeats) == (3.0, 3, 9)
+    # a study that names no repeats runs each case once; --repeats sets them
+    plain = Study(out=Path("out"))
+    assert plain.policy() == ONCE
+    plain.repeats = 2
+    assert plain.policy().min_repeats == 2
 
 
 def test_generated_cases_where_none_is_committed(tmp_path: Path) -> None:
@@ -162,11 +180,14 @@ def test_friction_study(voiga: Path, tmp_path: Path) -> None:
     friction; the table, Parquet and the figures are written."""
     out = tmp_path / "friction"
     code = main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(out),
-                 "--binary", str(voiga), "--no-progress"])
+                 "--binary", str(voiga), "--no-progress", "--repeats", "2"])
     assert code == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert [float(r["contact.friction"]) for r in rows] == [0.0, 0.1, 0.3, 0.5]
     assert all(r["status"] == "converged" for r in rows)
+    # --repeats 2: each case (about 0.6 CPU s, more than the 0.5 s budget in two runs) twice
+    assert [r["repeats"] for r in rows] == ["2"] * 4
+    assert all(float(r["cpu_lo_s"]) <= float(r["cpu_s"]) <= float(r["cpu_hi_s"]) for r in rows)
     px = np.array([float(r["mean_px"]) for r in rows])
     py = np.array([float(r["mean_py"]) for r in rows])
     assert abs(px[0]) < 0.01 * abs(py[0])

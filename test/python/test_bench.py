@@ -116,6 +116,9 @@ def test_paper_work_and_measures() -> None:
     totals = work(_rows())
     assert totals["wall_s"] == pytest.approx(19.5) and totals["assembly_s"] == pytest.approx(6.0)
     assert differences(_rows(wall_s="4.0", solve_s="0.3"), _rows()) == []
+    # the cost columns (CPU and wall time over the repeats, their number) are times too
+    assert differences(_rows(cpu_s="1.0", cpu_hi_s="1.2", repeats="5", wall_lo_s="0.9"),
+                       _rows(cpu_s="1.1", cpu_hi_s="1.3", repeats="3", wall_lo_s="1.0")) == []
     assert differences(_rows(osc_py="0.0012"), _rows()) == [
         "ironing/m3/NN2.2 osc_py: 0.0012 against 0.0011", "ironing/m4/NN2.2 osc_py: 0.0012 against 0.0011"]
     assert differences(_rows()[:1], _rows()) == ["ironing/m4/NN2.2: only in the old run"]
@@ -138,3 +141,15 @@ def test_paper_stamps_lines_and_keeps_results(tmp_path: Path) -> None:
     (tmp_path / "done" / "summary.csv").write_text("kept\n")
     assert main([str(tmp_path / "done")]) == 2
     assert (tmp_path / "done" / "summary.csv").read_text() == "kept\n"
+
+
+def test_paper_work_of_the_repeats(tmp_path: Path) -> None:
+    """Every run of voiga, the repeats included, from the times kept beside the results."""
+    from bench.paper import repeats_work
+    (tmp_path / "hertz").mkdir()
+    (tmp_path / "hertz" / "m1-N2.cost.json").write_text('{"wall_s": [0.05, 0.04], "cpu_s": [0.03, 0.02]}')
+    (tmp_path / "hertz" / "m2-N2.cost.json").write_text('{"wall_s": [1.0], "cpu_s": [0.9]}')
+    (tmp_path / "hertz" / "m3-N2.cost.json").write_text("{ torn")
+    totals = repeats_work(tmp_path)
+    assert totals["runs"] == 3
+    assert totals["wall_s"] == pytest.approx(1.09) and totals["cpu_s"] == pytest.approx(0.95)
