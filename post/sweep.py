@@ -128,14 +128,14 @@ def estimated_cost(case: Path, text: str | None = None) -> float:
 
 def previous_times(summary: Path) -> dict[str, float]:
     """label (``scene/<case>``) -> wall seconds of a previous sweep's
-    ``summary.csv`` (empty when there is none)."""
+    ``summary.csv``, times its repeats (empty when there is none)."""
     times: dict[str, float] = {}
     if not summary.is_file():
         return times
     with summary.open(newline="") as fh:
         for row in csv.DictReader(fh):
             try:
-                wall = float(row.get("wall_s") or "nan")
+                wall = float(row.get("wall_s") or "nan") * float(row.get("repeats") or 1)
             except ValueError:
                 continue
             if wall == wall and wall > 0 and row.get("status") == "converged":

@@ -143,13 +143,14 @@ def test_longest_first_from_previous_times_and_estimates(tmp_path: Path) -> None
     # measured times override the estimate; the others are scaled by the median ratio
     summary = tmp_path / "summary.csv"
     with summary.open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=["scene", "mesh", "layout", "wall_s", "status"])
+        w = csv.DictWriter(fh, fieldnames=["scene", "mesh", "layout", "wall_s", "repeats", "status"])
         w.writeheader()
-        w.writerow({"scene": "hertz", "mesh": "m1", "layout": "N2", "wall_s": "100", "status": "converged"})
+        w.writerow({"scene": "hertz", "mesh": "m1", "layout": "N2", "wall_s": "25", "repeats": "4",
+                    "status": "converged"})
         w.writerow({"scene": "ironing", "mesh": "m1", "layout": "N2", "wall_s": "1", "status": "converged"})
         w.writerow({"scene": "hertz", "mesh": "m4", "layout": "N2", "wall_s": "5", "status": "failed: x"})
     times = previous_times(summary)
-    assert times == {"hertz/m1-N2": 100.0, "ironing/m1-N2": 1.0}
+    assert times == {"hertz/m1-N2": 100.0, "ironing/m1-N2": 1.0}         # a case's time: all its runs
     order = [r.label for r in longest_first(runs, times)]
     assert order.index("hertz/m1-N2") < order.index("ironing/m1-N2")
     assert order.index("ironing/m4-N6") < order.index("ironing/m4-N2")

@@ -136,9 +136,9 @@ def test_paper_study_is_every_committed_case() -> None:
     # unchanged: the committed text is solved as it is
     assert all(r.text is None and not r.changes for r in runs)
     assert {r.work.parent.name for r in runs} == {"hertz", "ironing", "ironing-deep", "rings"}
-    # a run under 3 CPU seconds is timed over 3 to 9 runs, a longer one once
+    # a run under 2 CPU seconds is timed over 3 to 9 runs, a longer one once
     policy = study.policy()
-    assert (policy.short_s, policy.min_repeats, policy.max_repeats) == (3.0, 3, 9)
+    assert (policy.short_s, policy.min_repeats, policy.max_repeats) == (2.0, 3, 9)
     # a study that names no repeats runs each case once; --repeats sets them
     plain = Study(out=Path("out"))
     assert plain.policy() == ONCE
