@@ -1,9 +1,10 @@
 """What a run costs, measured so that a comparison survives a rerun on a busy machine.
 
 A run's cost is the CPU time of its ``voiga`` process (user + sys, from the kernel's
-accounting of that one child, ``os.wait4``): unlike the wall time it hardly changes when
-other processes share the cores. Wall time (process start to exit) is kept beside it.
-A short run is repeated (:class:`RepeatPolicy`) and described by the median and the
+accounting of that one child, ``os.wait4``): it changes far less than the wall time when
+other processes share the cores (the wall time counts their turns too), though not
+nothing (they share the caches and memory). Wall time (process start to exit) is kept
+beside it. A short run is repeated (:class:`RepeatPolicy`) and described by the median and the
 range (min, max) of its repeats (:class:`Spread`); the engine (``post/engine.py``) keeps
 the first repeat's result file and writes the times of all repeats beside it
 (:func:`write_costs`, ``<result stem>.cost.json``), where the summary reads them back
@@ -73,7 +74,7 @@ class RepeatPolicy:
     short_s: float = 3.0
     min_repeats: int = 3
     max_repeats: int = 9
-    budget_s: float = 0.5
+    budget_s: float = 1.0
 
     def more(self, samples: Sequence[Sample]) -> bool:
         """Whether to run once more after ``samples``."""

@@ -246,11 +246,11 @@ class Study:
 
     def policy(self) -> RepeatPolicy:
         """How the engine repeats the short cases: at least ``repeats`` runs, more (up
-        to three times as many) while they took less than 0.5 CPU seconds together."""
+        to three times as many) while they took less than 1 CPU second together."""
         if self.repeats <= 1:
             return ONCE
         return RepeatPolicy(short_s=self.repeat_below, min_repeats=self.repeats, max_repeats=3 * self.repeats,
-                            budget_s=0.5)
+                            budget_s=1.0)
 
     def change_sets(self) -> list[Changes]:
         """Every combination of the grid, for every list entry (one empty change set

@@ -185,8 +185,8 @@ def test_friction_study(voiga: Path, tmp_path: Path) -> None:
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert [float(r["contact.friction"]) for r in rows] == [0.0, 0.1, 0.3, 0.5]
     assert all(r["status"] == "converged" for r in rows)
-    # --repeats 2: each case (about 0.6 CPU s, more than the 0.5 s budget in two runs) twice
-    assert [r["repeats"] for r in rows] == ["2"] * 4
+    # --repeats 2: each case (under 3 CPU s) at least twice, at most 6 times
+    assert all(2 <= int(r["repeats"]) <= 6 for r in rows)
     assert all(float(r["cpu_lo_s"]) <= float(r["cpu_s"]) <= float(r["cpu_hi_s"]) for r in rows)
     px = np.array([float(r["mean_px"]) for r in rows])
     py = np.array([float(r["mean_py"]) for r in rows])
