@@ -20,7 +20,7 @@ import time
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from tqdm import tqdm
@@ -47,8 +47,8 @@ class Task:
     timeout: float
     dest: str | None
     """Where the worker moves the result file (shared file system), or None: return it."""
-    policy: RepeatPolicy = ONCE
-    """How often a short run is repeated to time it (the first run's result is kept)."""
+    keep: bool = True
+    """False: a repeat that only times the case (its result is dropped)."""
 
 
 @dataclass
@@ -64,7 +64,8 @@ class Outcome:
     data: bytes | None = None
     """The result file, when it is returned rather than moved."""
     samples: list[Sample] = field(default_factory=list)
-    """Wall and CPU seconds of every run of the case (the repeats included)."""
+    """Wall and CPU seconds of the run (of every run of the case, in :func:`run_all`'s
+    answer)."""
 
 
 def single_thread_env() -> dict[str, str]:
@@ -79,9 +80,9 @@ def single_thread_env() -> dict[str, str]:
 
 
 def run_task(task: Task) -> Outcome:
-    """Solve one case in a fresh scratch folder (runs on a worker), then, if it
-    converged and ``task.policy`` asks, run it again to time it (those results are
-    dropped). Never raises: any failure becomes the outcome's code and message."""
+    """Solve one case in a fresh scratch folder (runs on a worker) and time it; keep
+    its result (``task.keep``) or drop it (a repeat). Never raises: any failure becomes
+    the outcome's code and message."""
     start = time.perf_counter()
     data, samples = None, []
     try:
@@ -89,28 +90,23 @@ def run_task(task: Task) -> Outcome:
             folder = Path(scratch)
             (folder / task.name).write_text(task.text)
             (folder / task.geometry_name).write_bytes(task.geometry)
-            cmd, env = [task.binary, task.name, "--quiet"], single_thread_env()
-            code, message, sample = timed_run(cmd, folder, env, task.timeout)
+            code, message, sample = timed_run([task.binary, task.name, "--quiet"], folder, single_thread_env(),
+                                              task.timeout)
             samples.append(sample)
             result = folder / (Path(task.name).stem + ".h5")
             if not result.exists():
                 if code == 0:
                     code, message = -2, f"voiga wrote no {result.name}"
+            elif not task.keep:
+                pass                          # the scratch folder goes with it
             elif task.dest is None:
                 data = result.read_bytes()
-                result.unlink()
             else:
                 dest = Path(task.dest)
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 part = dest.with_name(dest.name + ".part")
                 shutil.move(result, part)     # keeps voiga's modification time
                 os.replace(part, dest)
-            while code == 0 and task.policy.more(samples):
-                again, _, sample = timed_run(cmd, folder, env, task.timeout)
-                result.unlink(missing_ok=True)
-                if again != 0:                # timed on runs that did the same work only
-                    break
-                samples.append(sample)
     except Exception as err:  # noqa: BLE001 -- one case's trouble must not stop the study
         code, message = -2, f"{type(err).__name__}: {err}"
     return Outcome(task.label, code, message, time.perf_counter() - start, data, samples)
@@ -133,11 +129,11 @@ def prepare(run: Run) -> None:
         shutil.copy2(run.geometry, target)
 
 
-def task_for(run: Run, binary: Path, timeout: float, shared: bool, policy: RepeatPolicy = ONCE) -> Task:
+def task_for(run: Run, binary: Path, timeout: float, shared: bool) -> Task:
     """The task of ``run`` (after :func:`prepare`)."""
     return Task(label=run.label, name=run.work.name, text=run.case_text(), geometry_name=run.geometry.name,
                 geometry=run.geometry.read_bytes(), binary=str(binary), timeout=timeout,
-                dest=str(run.result.resolve()) if shared else None, policy=policy)
+                dest=str(run.result.resolve()) if shared else None)
 
 
 @contextmanager
@@ -171,12 +167,14 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
             shared: bool = True, policy: RepeatPolicy = ONCE) -> dict[str, Outcome]:
     """Solve every run whose result is not up to date (all with ``force``) on the
     client's cluster, longest first (:func:`post.sweep.longest_first`, ``times``: wall
-    seconds of a previous summary, label -> s), each short run repeated as ``policy``
-    says; the times of every run of a case go beside its result
-    (:func:`post.cost.write_costs`). Label -> outcome (``'up to date'`` for the skipped
-    ones). A tqdm bar shows the count, the failures so far and the ETA."""
-    from distributed import as_completed
-
+    seconds of a previous summary, label -> s), then repeat the short ones as
+    ``policy`` says, in rounds after all first runs (round 2 of every short case, then
+    round 3, ...): a case's runs are apart, with other cases run between them, rather
+    than back to back, so that its range takes in more of how the machine's load
+    changes (:func:`_rounds`). The times of
+    every run of a case go beside its result (:func:`post.cost.write_costs`).
+    Label -> outcome (``'up to date'`` for the skipped ones; ``samples``: every run's).
+    A tqdm bar shows the runs done, the failures so far and the ETA."""
     outcome: dict[str, Outcome] = {}
     todo = []
     for run in runs:
@@ -187,31 +185,56 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
             run.result.unlink(missing_ok=True)     # a failed rerun leaves no stale result
             cost_path(run.result).unlink(missing_ok=True)
             todo.append(run)
-    todo = longest_first(todo, times)
-    by_key, futures = {}, []
-    for rank, run in enumerate(todo):
+    outcome.update(_rounds(longest_first(todo, times), binary, client, timeout, shared, policy, progress))
+    return outcome
+
+
+def _rounds(todo: list[Run], binary: Path, client: object, timeout: float, shared: bool,
+            policy: RepeatPolicy, progress: bool) -> dict[str, Outcome]:
+    """Run every case of ``todo`` once, in this order, keeping its result; each one that
+    converged and ``policy`` finds short is run again, as a repeat that only times it,
+    with a priority below every first run and every repeat of an earlier round."""
+    from distributed import as_completed
+
+    width = len(todo) + 1
+    rank = {run.label: k for k, run in enumerate(todo)}
+    outcome: dict[str, Outcome] = {}
+    tasks: dict[str, tuple[Run, Task]] = {}
+
+    def submit(run: Run, task: Task, round_: int) -> object:
         key = f"voiga-{run.label}-{uuid.uuid4().hex[:8]}"
-        by_key[key] = run
-        futures.append(client.submit(run_task, task_for(run, binary, timeout, shared, policy),  # type: ignore[attr-defined]
-                                     key=key, priority=len(todo) - rank, pure=False))
+        tasks[key] = (run, task)
+        # round 1: width - rank (1 .. width); round r > 1: below all of round r - 1
+        return client.submit(run_task, task, key=key, pure=False,  # type: ignore[attr-defined]
+                             priority=width - rank[run.label] - (round_ - 1) * 2 * width)
+
+    pending = as_completed([submit(run, task_for(run, binary, timeout, shared), 1) for run in todo])
     failed = 0
-    with tqdm(total=len(todo), desc="study", unit="case", disable=not progress, file=sys.stderr) as bar:
-        for fut in as_completed(futures):
-            run = by_key[fut.key]
+    with tqdm(total=len(todo), desc="study", unit="run", disable=not progress, file=sys.stderr) as bar:
+        for fut in pending:
+            run, task = tasks.pop(fut.key)    # type: ignore[attr-defined]
             try:
-                out = fut.result()
+                out = fut.result()            # type: ignore[attr-defined]
             except Exception as err:  # noqa: BLE001 -- a worker lost or killed: recorded
                 out = Outcome(run.label, -3, f"lost on the cluster: {type(err).__name__}: {err}")
-            fut.release()
-            if out.data is not None:
-                part = run.result.with_name(run.result.name + ".part")
-                part.write_bytes(out.data)
-                os.replace(part, run.result)
-                out.data = None
-            if out.samples and run.result.exists():
-                write_costs(run.result, out.samples)
-            outcome[run.label] = out
-            failed += out.code != 0
+            fut.release()                     # type: ignore[attr-defined]
+            if task.keep:
+                if out.data is not None:
+                    part = run.result.with_name(run.result.name + ".part")
+                    part.write_bytes(out.data)
+                    os.replace(part, run.result)
+                    out.data = None
+                outcome[run.label] = out
+                failed += out.code != 0
+            elif out.code == 0:               # a failed repeat times nothing
+                outcome[run.label].samples += out.samples
+            first = outcome[run.label]
+            again = first.code == 0 and (task.keep or out.code == 0) and policy.more(first.samples)
+            if again:
+                pending.add(submit(run, replace(task, keep=False, dest=None), len(first.samples) + 1))
+                bar.total += 1
+            elif first.samples and run.result.exists():
+                write_costs(run.result, first.samples)
             bar.set_postfix_str(f"{failed} failed, last {run.label}")
             bar.update()
     return outcome

@@ -11,7 +11,8 @@ import pytest
 
 from post.cost import (ONCE, RepeatPolicy, Sample, Spread, cheapest, cost_columns, cost_path, ratio,
                        read_costs, timed_run, write_costs)
-from post.engine import Task, run_task
+from post.engine import Task, connect, run_all, run_task
+from post.sweep import find_cases
 from post.figures import accuracy_cost
 
 BURN = "import time\nwhile time.process_time() < {0}: pass\n"
@@ -157,54 +158,81 @@ def test_timed_run_kills_at_the_timeout(tmp_path: Path) -> None:
 
 
 FAKE = """#!/bin/sh
-# a stand-in for voiga: counts its runs, writes the run's number into the result
-n=$(($(cat {counter} 2>/dev/null || echo 0) + 1))
-echo $n > {counter}
-case "$n" in {fail}) exit 3;; esac
+# a stand-in for voiga: logs its runs, writes the case's run number into the result
+n=$(($(cat {counter}-${{1%.nml}} 2>/dev/null || echo 0) + 1))
+echo $n > {counter}-${{1%.nml}}
+echo "${{1%.nml}} $n" >> {log}
+case "${{1%.nml}}:$n" in {fail}) exit 3;; esac
 echo "run $n" > "${{1%.nml}}.h5"
 """
 
 
-def _fake(tmp_path: Path, fail: str = "0") -> tuple[Path, Path]:
-    counter = tmp_path / "counter"
+def _fake(tmp_path: Path, fail: str = "none") -> Path:
+    """The fake binary; ``fail``: a shell pattern of ``<case>:<run number>`` that fails."""
     binary = tmp_path / "fake-voiga"
-    binary.write_text(FAKE.format(counter=counter, fail=fail))
+    binary.write_text(FAKE.format(counter=tmp_path / "counter", log=tmp_path / "log", fail=fail))
     binary.chmod(0o755)
-    return binary, counter
+    return binary
 
 
-def _task(binary: Path, dest: Path | None, policy: RepeatPolicy) -> Task:
+def _task(binary: Path, dest: Path | None, keep: bool = True) -> Task:
     return Task(label="s/m1-N2", name="m1-N2.nml", text="&case /\n", geometry_name="geometry.h5",
-                geometry=b"", binary=str(binary), timeout=60,
-                dest=str(dest) if dest else None, policy=policy)
+                geometry=b"", binary=str(binary), timeout=60, dest=str(dest) if dest else None, keep=keep)
 
 
-def test_run_task_repeats_a_short_run_and_keeps_the_first_result(tmp_path: Path) -> None:
-    binary, counter = _fake(tmp_path)
-    policy = RepeatPolicy(short_s=3.0, min_repeats=4, max_repeats=4, budget_s=0.0)
+def test_run_task_keeps_or_drops_the_result(tmp_path: Path) -> None:
+    binary = _fake(tmp_path)
     dest = tmp_path / "out" / "m1-N2.h5"
-    out = run_task(_task(binary, dest, policy))
-    assert out.code == 0 and len(out.samples) == 4 and counter.read_text().strip() == "4"
-    assert dest.read_text() == "run 1\n"                       # the first run's result, not a repeat's
-    # returned through the scheduler: the same
-    counter.unlink()
-    out = run_task(_task(binary, None, policy))
-    assert out.code == 0 and len(out.samples) == 4 and out.data == b"run 1\n"
-    # each case once
-    counter.unlink()
-    out = run_task(_task(binary, None, ONCE))
-    assert len(out.samples) == 1 and counter.read_text().strip() == "1"
+    out = run_task(_task(binary, dest))
+    assert out.code == 0 and len(out.samples) == 1 and dest.read_text() == "run 1\n"
+    out = run_task(_task(binary, None))                     # returned through the scheduler
+    assert out.code == 0 and out.data == b"run 2\n"                # the case's second run
+    out = run_task(_task(binary, tmp_path / "other.h5", keep=False))     # a repeat: timed only
+    assert out.code == 0 and out.data is None and not (tmp_path / "other.h5").exists()
+    assert len(out.samples) == 1 and out.samples[0].wall > 0
 
 
-def test_run_task_stops_repeating_at_a_failed_repeat(tmp_path: Path) -> None:
-    """A repeat that fails times nothing (it may have stopped early); the first run's
-    result and times stay. A first run that fails is not repeated."""
-    binary, counter = _fake(tmp_path, fail="3")
-    policy = RepeatPolicy(short_s=3.0, min_repeats=5, max_repeats=5, budget_s=0.0)
-    out = run_task(_task(binary, tmp_path / "m1-N2.h5", policy))
-    assert out.code == 0 and len(out.samples) == 2 and counter.read_text().strip() == "3"
-    assert (tmp_path / "m1-N2.h5").read_text() == "run 1\n"
-    (tmp_path / "f").mkdir()
-    binary, counter = _fake(tmp_path / "f", fail="1")
-    out = run_task(_task(binary, tmp_path / "f" / "m1-N2.h5", policy))
-    assert out.code == 3 and len(out.samples) == 1 and counter.read_text().strip() == "1"
+def _cases(tmp_path: Path, names: list[str]) -> list:
+    folder = tmp_path / "cases" / "s"
+    folder.mkdir(parents=True)
+    (folder / "geometry.h5").write_bytes(b"")
+    for name in names:
+        (folder / f"{name}.nml").write_text(f"&case output = '{name}.h5' /\n")
+    return find_cases(tmp_path / "cases", tmp_path / "out")
+
+
+def test_short_runs_are_repeated_in_rounds_after_the_first_runs(tmp_path: Path) -> None:
+    """Every case runs once first; the repeats follow in rounds (every case's second
+    run, then every case's third), each case keeps its first run's result and its
+    times are kept beside it."""
+    binary = _fake(tmp_path)
+    runs = _cases(tmp_path, ["m1-N2", "m2-N2"])
+    policy = RepeatPolicy(short_s=3.0, min_repeats=3, max_repeats=3)
+    with connect(jobs=1) as client:
+        outcome = run_all(runs, binary, client, timeout=60, progress=False, policy=policy)
+    order = (tmp_path / "log").read_text().split()[::2]
+    assert sorted(order[:2]) == ["m1-N2", "m2-N2"] and order[2:4] == order[:2] and order[4:] == order[:2]
+    for run in runs:
+        assert outcome[run.label].code == 0 and len(outcome[run.label].samples) == 3
+        assert run.result.read_text() == "run 1\n"                     # the first run's, not a repeat's
+        assert read_costs(run.result) == outcome[run.label].samples
+    # each case once: no repeats, one time each
+    (tmp_path / "log").unlink()
+    with connect(jobs=1) as client:
+        outcome = run_all(runs, binary, client, timeout=60, progress=False, force=True)
+    assert len((tmp_path / "log").read_text().split()) == 4
+    assert all(len(read_costs(run.result) or []) == 1 for run in runs)
+
+
+def test_a_failed_repeat_ends_the_repeats(tmp_path: Path) -> None:
+    """A repeat that fails times nothing (it may have stopped early): the case keeps its
+    first result and the times it has. A first run that fails is not repeated."""
+    runs = _cases(tmp_path, ["m1-N2", "m2-N2"])
+    binary = _fake(tmp_path, fail="m1-N2:[34]|m2-N2:1")
+    policy = RepeatPolicy(short_s=3.0, min_repeats=5, max_repeats=5)
+    with connect(jobs=1) as client:
+        outcome = run_all(runs, binary, client, timeout=60, progress=False, policy=policy)
+    a, b = (outcome[run.label] for run in runs)
+    assert a.code == 0 and len(a.samples) == 2 and read_costs(runs[0].result) == a.samples
+    assert runs[0].result.read_text() == "run 1\n" and (tmp_path / "counter-m2-N2").read_text() == "1\n"
+    assert b.code == 3 and len(b.samples) == 1 and not runs[1].result.exists()
