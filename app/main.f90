@@ -8,8 +8,7 @@ program voiga_main
     use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_dump, only: write_dump
     use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
-    use voiga_io_outputs, only: check_outputs, resolve_restart
-    use voiga_io_os, only: canonical_path
+    use voiga_io_outputs, only: check_outputs, resolve_restart, restart_file
     use voiga_io_provenance, only: check_restart
     use voiga_io_results, only: restart_case, read_restart
     use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
@@ -91,7 +90,7 @@ program voiga_main
     if (allocated(error)) call fail(error)
 
     if (len(dump_path) > 0) then
-        call write_dump(dump_path, case, discs, error)
+        call write_dump(dump_path, case, discs, overwrite .or. case%overwrite, error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
@@ -112,7 +111,7 @@ program voiga_main
     if (allocated(restart_path)) then
         call restart_in_place()
     else
-        call results%open(case, model, error)
+        call results%open(case, model, overwrite .or. case%overwrite, error)
         ! a write that failed (a full disk): no exit handler may flush the rest
         if (allocated(error) .and. results%h5%is_open()) call stop_writing(error)
         if (allocated(error)) call fail(error)
@@ -222,14 +221,16 @@ contains
         if (force_restart .and. .not. allocated(restart_path)) call fail_usage('--force-restart needs --restart')
     end subroutine parse_arguments
 
-    !> Take the writer's lock of the result file `restart_path` when it exists (by
-    !> its canonical name, as the run writing it took it); a missing file is reported
-    !> by its reader.
+    !> Take the writer's lock of the result file `restart_path` (by its canonical
+    !> name, as the run writing it took it) before anything reads it: it may be
+    !> mid-step. It must be a regular file (a FIFO or a device is refused before it
+    !> is opened); its lock file is created without following links and replaces
+    !> only a lock file a killed run left, so nothing is written before the case
+    !> is known and compared with it (`resolve_restart`).
     subroutine claim_restart_file()
         character(len=:), allocatable :: resolved
-        type(error_t), allocatable :: missing
-        call canonical_path(restart_path, resolved, missing)
-        if (allocated(missing)) return
+        call restart_file(restart_path, resolved, error)
+        if (allocated(error)) call fail(error)
         call results%h5%claim(resolved, error)
         if (allocated(error)) call fail(error)
     end subroutine claim_restart_file
@@ -262,26 +263,27 @@ contains
         call stop_writing(finish_error)
     end subroutine finish
 
-    !> Where the steps of this run are: 'are in <file>', or, when it wrote none and
-    !> an earlier result was there, that this one is kept.
+    !> Where the steps of this run are: 'are in <file>', or why they are not
+    !> (none written and the earlier result kept; the file moved or removed under
+    !> the run).
     function where_kept() result(text)
         character(len=:), allocatable :: text
-        if (results%h5%kept_earlier) then
-            text = '(none) are not written: the earlier '//case%output//' is kept as it was'
-        else
-            text = 'are in '//case%output
-        end if
+        text = results%h5%where_steps()
     end function where_kept
 
     !> A write to the result file failed: say so and what is on disk, and leave
     !> without exit handlers (HDF5's would write the half-written step).
     subroutine stop_writing(err)
         type(error_t), intent(in) :: err
+        character(len=:), allocatable :: text
         write (0, '(a)') 'voiga: error: '//err%message
         call results%h5%abandon()
-        if (results%h5%in_place) then
+        text = results%h5%where_steps()
+        if (results%h5%in_place .and. index(text, 'are in ') == 1) then
             write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before are readable in '// &
                 case%output//" (its status may still say 'running')"
+        else if (results%h5%in_place .or. results%h5%lost .or. results%h5%stuck) then
+            write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before '//text
         else if (results%h5%kept_earlier) then
             write (0, '(a)') 'voiga: '//case%output//' is kept as it was'
         end if

@@ -58,11 +58,14 @@ module voiga_io_results
 
 contains
 
-    !> Create the file (status 'running') with metadata and the discretization of each body.
-    subroutine results_open(self, case, model, error)
+    !> Create the file (status 'running') with metadata and the discretization of
+    !> each body; it replaces an earlier file at its name (once it has a step) only
+    !> when `replace` (`--overwrite`).
+    subroutine results_open(self, case, model, replace, error)
         class(results_t), intent(inout) :: self
         type(case_t), intent(in) :: case
         type(model_t), intent(in) :: model
+        logical, intent(in) :: replace
         type(error_t), allocatable, intent(out) :: error
         integer :: i, k
         character(len=:), allocatable :: g
@@ -70,7 +73,7 @@ contains
 
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
-        call self%h5%create(case%output, error)
+        call self%h5%create(case%output, replace, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
         if (allocated(error)) return
@@ -586,14 +589,16 @@ contains
         if (done == 0) return
         write (buf, '(i6.6)') done
         g = '/steps/'//trim(buf)
-        call h5%read(g//'/displacement', state%u, error)
+        ! (at most the model's DOFs are read: a file that claims more is refused
+        ! before anything is allocated)
+        call h5%read(g//'/displacement', state%u, error, int(model%ndof, int64))
         if (allocated(error)) return
         ! the step before (the predictor extrapolates the last step's increment)
         allocate (state%u_before(size(state%u)))
         state%u_before = 0.0_dp
         if (done > 1) then
             write (buf, '(i6.6)') done - 1
-            call h5%read('/steps/'//trim(buf)//'/displacement', state%u_before, error)
+            call h5%read('/steps/'//trim(buf)//'/displacement', state%u_before, error, int(model%ndof, int64))
             if (allocated(error)) return
         end if
         if (size(state%u) /= model%ndof) then
@@ -640,14 +645,19 @@ contains
         class(contact_pair_t), intent(inout) :: pair
         type(error_t), allocatable, intent(out) :: error
         type(history_item_t), allocatable :: history(:)
+        integer(int64) :: most
         integer :: i
         history = pair%history()
         if (size(history) == 0) return
         do i = 1, size(history)
+            ! (at most as many values as the pair keeps: counted before the read
+            ! reallocates the array)
             if (allocated(history(i)%values)) then
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error)
+                most = size(history(i)%values, kind=int64)
+                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error, most)
             else
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error)
+                most = size(history(i)%flags, kind=int64)
+                call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error, most)
             end if
             if (allocated(error)) return
         end do
