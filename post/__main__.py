@@ -198,6 +198,10 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
     from .study import StudyError
     from .sweep import default_binary, previous_times, summarize, write_summary
 
+    problem = engine_option_problem(args)
+    if problem:
+        print(f"{prog}: {problem}", file=sys.stderr)
+        return 2
     binary = Path(args.binary) if args.binary else default_binary()
     if not binary.exists() and not (args.list or args.summary_only):
         print(f"{prog}: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
@@ -211,6 +215,10 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
         for run in runs:
             print(run.work)
         return 0
+    if study.out.exists() and not study.out.is_dir():
+        print(f"{prog}: {study.out} is not a folder (the study's cases, results and table go there)",
+              file=sys.stderr)
+        return 2
     failures: dict[str, tuple[int, str]] = {}
     if not args.summary_only:
         try:
@@ -236,6 +244,29 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
             print(f"{len(made)} figures in {study.out / 'figures'}")
     print(f"{len(runs)} cases, {len(failures)} failed; summary in {csv_path} and {md_path}")
     return 1 if failures else 0
+
+
+def max_jobs() -> int:
+    """Most workers of a local cluster: 8 per core (each runs one voiga)."""
+    import os
+
+    return 8 * (os.cpu_count() or 1)
+
+
+def engine_option_problem(args: argparse.Namespace) -> str | None:
+    """Why the options ``study`` and ``sweep`` share cannot be used (None when they
+    can): a number of workers out of range, a time limit that is not a positive
+    finite number of seconds."""
+    from .study import timeout_problem
+
+    if not 0 <= args.jobs <= max_jobs():
+        return (f"--jobs must be 0 (one worker per core) or 1 to {max_jobs()} "
+                f"(8 per core), not {args.jobs}")
+    if args.timeout:      # (0: the study file's)
+        problem = timeout_problem(args.timeout)
+        if problem:
+            return f"--timeout {problem}"
+    return None
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
@@ -274,8 +305,9 @@ def _cmd_figures(args: argparse.Namespace) -> int:
 
     from .figures import make_all
 
-    if args.jobs is not None and args.jobs < 1:
-        print(f"python -m post figures: --jobs must be at least 1, not {args.jobs}", file=sys.stderr)
+    if args.jobs is not None and not 1 <= args.jobs <= max_jobs():
+        print(f"python -m post figures: --jobs must be at least 1 and at most {max_jobs()} (8 per core), "
+              f"not {args.jobs}", file=sys.stderr)
         return 2
     for path in make_all(Path(args.results), Path(args.out), args.jobs):
         print(path)

@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 
+from pre.files import save_figure  # noqa: E402
 from pre.nurbs import curve_to_splipy  # noqa: E402
 
 from .field import displacement, evaluate_grid  # noqa: E402
@@ -296,6 +297,6 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
     cbar = fig.colorbar(mesh, ax=[ax] if axz is None else [ax, axz], shrink=0.9, pad=0.02)
     cbar.set_label(f"displacement magnitude |u| [{unit}]")
     output.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(output, dpi=150)
+    save_figure(fig, output, dpi=150)
     plt.close(fig)
     return output

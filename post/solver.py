@@ -15,6 +15,8 @@ from pathlib import Path
 
 import f90nml
 
+from pre.files import new_file
+
 CHECKOUT_BINARY = Path(__file__).resolve().parents[1] / "build" / "install" / "bin" / "voiga"
 """Where ``make build`` installs the program, when this package runs from a checkout."""
 
@@ -68,8 +70,9 @@ def stage_case(case: Path, folder: Path) -> Path:
     if copy.resolve() == case.resolve():
         return case
     relative = os.path.relpath(geometry_path, folder.resolve())
-    f90nml.patch(str(case), {"case": {"geometry": relative}}, str(copy) + ".tmp")
-    os.replace(str(copy) + ".tmp", copy)
+    with new_file(copy) as tmp:
+        tmp.unlink()      # f90nml writes the patched copy itself
+        f90nml.patch(str(case), {"case": {"geometry": relative}}, str(tmp))
     return copy
 
 

@@ -23,6 +23,11 @@ def _cmd_geometry(args: argparse.Namespace) -> int:
     except (SpecError, FileNotFoundError, OSError) as err:
         print(f"python -m pre geometry: {err}", file=sys.stderr)
         return 2
+    except (ValueError, TypeError, KeyError, IndexError, ArithmeticError, RuntimeError) as err:
+        # what the checks of spec_check.py and the builders did not name (a spline
+        # library's own refusal): still one line, still bad input
+        print(f"python -m pre geometry: {args.spec}: {type(err).__name__}: {err}", file=sys.stderr)
+        return 2
     print(f"wrote {geometry}")
     print(f"wrote {case}" if written else f"kept {case} (exists; --force to overwrite)")
     return 0

@@ -90,8 +90,9 @@ def annular_sector(centre: Point, r_in: float, r_out: float, angles: Sequence[fl
     a0, a1 = float(angles[0]), float(angles[1])
     if not 0 < r_in < r_out:
         raise ValueError(f"annular sector: need 0 < r_in < r_out, got {r_in}, {r_out}")
-    if not 0 < abs(a1 - a0) <= 360:
-        raise ValueError(f"annular sector: angles {a0}, {a1} must differ by at most 360 degrees")
+    if a0 == a1 or not abs(a1 - a0) <= 360:
+        raise ValueError(f"annular sector: angles {a0:g}, {a1:g}: a sector spans more than 0 and at most "
+                         f"360 degrees ({abs(a1 - a0):g} given)")
     names = _named(SECTOR_SIDES, edges)
     if a0 % 90 == 0 and a1 % 90 == 0 and a1 > a0:  # the scenes' exact construction
         return _quarter_sector(centre, r_in, r_out, list(range(int(a0), int(a1) + 1, 90)), names)
@@ -287,9 +288,9 @@ def obstacle_arc(centre: Point, radius: float, angles: Sequence[float], side: st
     round punch) or what surrounds the circle (``"outside"``: a round seat or groove).
     The contact zone should not include the ends of the arc."""
     a0, a1 = float(angles[0]), float(angles[1])
-    if radius <= 0 or not 0 < abs(a1 - a0) <= 360:
-        raise ValueError(f"obstacle arc: need radius > 0 and angles at most 360 degrees apart, "
-                         f"got {radius}, {list(angles)}")
+    if not radius > 0 or a0 == a1 or not abs(a1 - a0) <= 360:
+        raise ValueError(f"obstacle arc: need radius > 0 and angles that differ by more than 0 and at "
+                         f"most 360 degrees, got {radius}, {list(angles)}")
     if side not in ("inside", "outside"):
         raise ValueError(f"obstacle arc: side must be 'inside' or 'outside', got {side!r}")
     lo, hi = min(a0, a1), max(a0, a1)

@@ -21,10 +21,12 @@ from pathlib import Path
 from typing import Any
 
 from .cases import to_namelist_text
+from .files import write_text
 from .geometry import (annular_sector, body, check_curve, check_patch, edge_length, obstacle,
                        obstacle_arc, obstacle_polyline, polygon, read_g2, rectangle, write_bodies)
 from .layouts import parse_layout
 from .nurbs import Curve, Patch
+from .spec_check import MAX_ELEMENTS, SpecCheckError, check_spec, check_table
 
 DEFAULTS: dict[str, Any] = {
     "layout": "NN2.2",
@@ -99,6 +101,10 @@ def read_spec(path: str | Path) -> Spec:
         raise SpecError(f"{path}: unknown table(s) {sorted(unknown)}")
     if not data.get("body"):
         raise SpecError(f"{path}: no [[body]]")
+    try:
+        check_spec(data)
+    except SpecCheckError as err:
+        raise SpecError(f"{path}: {err}") from None
     return Spec(path, data)
 
 
@@ -112,11 +118,17 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
     """The patch of one ``[[body]]`` table (``folder``: where relative files are)."""
     name = _need(b, "name")
     shape = _need(b, "shape")
+    if not isinstance(name, str) or not isinstance(shape, str):
+        raise SpecError(f"body {name!r}: name and shape must be strings")
     if shape not in SHAPE_KEYS:
         raise SpecError(f"body {name!r}: unknown shape {shape!r} (known: {sorted(SHAPE_KEYS)})")
     unknown = set(b) - BODY_KEYS - SHAPE_KEYS[shape]
     if unknown:
         raise SpecError(f"body {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
+    try:
+        check_table(b, "body")
+    except SpecCheckError as err:
+        raise SpecError(str(err)) from None
     edges = b.get("edges")
     try:
         if shape == "rectangle":
@@ -148,11 +160,17 @@ def build_curve(c: dict[str, Any], folder: Path) -> Curve:
     "left" or "right" of the direction of travel: required)."""
     name = _need(c, "name", "curve")
     shape = _need(c, "shape", "curve")
+    if not isinstance(name, str) or not isinstance(shape, str):
+        raise SpecError(f"curve {name!r}: name and shape must be strings")
     if shape not in CURVE_SHAPE_KEYS:
         raise SpecError(f"curve {name!r}: unknown shape {shape!r} (known: {sorted(CURVE_SHAPE_KEYS)})")
     unknown = set(c) - CURVE_KEYS - CURVE_SHAPE_KEYS[shape]
     if unknown:
         raise SpecError(f"curve {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
+    try:
+        check_table(c, "curve")
+    except SpecCheckError as err:
+        raise SpecError(str(err)) from None
     try:
         if shape == "arc":
             return obstacle_arc(_need(c, "centre", "curve"), float(_need(c, "radius", "curve")),
@@ -209,7 +227,11 @@ def body_group(b: dict[str, Any], patch: Patch, defaults: dict[str, Any]) -> dic
             h = float(opt["element_size"])
             if h <= 0:
                 raise SpecError(f"body {name!r}: element_size must be positive")
-            nel = [max(1, math.ceil(L / h - 1e-9)) for L in lengths]
+            nel = [max(1, math.ceil(L / h - 1e-9)) if L / h < MAX_ELEMENTS else MAX_ELEMENTS + 1
+                   for L in lengths]
+            if max(nel) > MAX_ELEMENTS:
+                raise SpecError(f"body {name!r}: element_size {h:g} gives more than {MAX_ELEMENTS} elements "
+                                f"along an edge (edges {lengths[0]:g} and {lengths[1]:g} long)")
         else:
             n = int(opt["elements"])
             h = max(lengths) / n
@@ -293,5 +315,5 @@ def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
         first = spec.bodies[0]["name"]
         edge = sorted(patches[first].edges.values())[0]
         text += TEMPLATE_HELP.format(body=first, edge=edge)
-    case.write_text(text)
+    write_text(case, text)
     return geometry, case, True
