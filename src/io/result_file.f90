@@ -157,13 +157,14 @@ contains
         class(result_file_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: error
         ! (a file opened by hand, without `claim`, `create` or `resume`, has neither)
-        if (self%lost .or. .not. self%is_open() .or. self%identity%kind == kind_missing) return
+        if (.not. self%is_open() .or. self%identity%kind == kind_missing) return
         if (self%writer%fd >= 0 .and. .not. lock_intact(self%writer)) then
             self%broken = .true.
             call fatal_error(error, "the lock file '"//self%writer%path//"' was removed or replaced while "// &
                              "this run wrote '"//self%final_path//"': another run may be writing it now; "// &
                              'this run stopped writing it')
-        else if (.not. self%at_name()) then
+        else if (self%lost .or. .not. self%at_name()) then
+            ! (once lost, always: nothing more is written to it)
             self%lost = .true.
             call fatal_error(error, "'"//self%path//"' is no longer the file this run writes: it was moved, "// &
                              'replaced or removed while the run wrote it')

@@ -435,8 +435,9 @@ contains
     !> run's counters of `stats` (every cut as /cuts when there is one, the Tresca
     !> fixed point's, the multiplier updates), and close. The file is closed whatever fails (the first error is returned)
     !> and given its name (`result_file_t%settle`); a broken file is not touched
-    !> (`abandon`), nor one with no room left for the status (it stays 'running',
-    !> every step written readable).
+    !> (`abandon`), nor one with no room left for the status, nor one moved, replaced
+    !> or removed under the run (`lost`; they stay 'running', every step written
+    !> readable).
     subroutine results_finish(self, status, wall, stats, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
@@ -445,6 +446,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         if (self%h5%broken) then
             call self%h5%abandon()
+            return
+        end if
+        if (self%h5%lost) then
+            ! the run's error says so: the file is closed as its last flush left it
+            call self%h5%settle(self%n_written > 0, error)
             return
         end if
         if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)

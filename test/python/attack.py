@@ -1,4 +1,4 @@
-"""The attack suite of issue 19 (docs/robustness.md, "Attack suite"): namelist texts,
+"""The attack suite of issues 19 and 36 (docs/attack.md): namelist texts,
 geometry files, output paths and damaged result files (`attack_inputs.py`), each run
 through voiga (or `python -m post`) and judged by oracles that do not trust the
 program:

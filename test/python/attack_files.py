@@ -28,9 +28,9 @@ from pathlib import Path
 from typing import Callable
 
 import h5py
-import numpy as np
 
 from attack_inputs import BASE, GEOMETRY, REFUSED, RUNS, Attack, Setup, stage
+from test_restart import truncate
 
 ROOT = os.geteuid() == 0
 """Device nodes can be made (mknod) only as root; without, those attacks are left out."""
@@ -64,16 +64,11 @@ def staged(text: str = BASE, *args: str, prep: Callable[[Path], None] | None = N
     return setup
 
 
-def interrupted(work: Path) -> None:
-    """out.h5: the base case's result cut back to 2 steps, as a killed run leaves it."""
+def interrupted(work: Path, keep: int = 2) -> None:
+    """out.h5: the result of case.nml cut back to `keep` steps, as a killed run leaves it."""
     subprocess.run([os.environ["ATTACK_VOIGA"], "case.nml", "--quiet"], cwd=work, capture_output=True,
-                   timeout=120, check=True)
-    with h5py.File(work / "out.h5", "r+") as f:
-        for k in list(f["steps"]):
-            if int(k) > 2:
-                del f["steps"][k]
-        f.attrs["n_steps_done"] = np.int32(2)
-        f.attrs["status"] = np.bytes_("interrupted")
+                   timeout=300, check=True)
+    truncate(work / "out.h5", keep)
 
 
 # --- link ---------------------------------------------------------------------------------
@@ -235,17 +230,10 @@ def swap_attacks() -> list[Attack]:
                           example=name in ("result-replaced", "lock-removed-second-run")))
     # the same under a restart, which writes the file in place from its start
     def restart_setup(work: Path) -> list[str]:
-        case = stage(work, LONG)
+        stage(work, LONG)
         shutil.copy(GEOMETRY, work / "other.h5")
         copy_other(work)
-        subprocess.run([os.environ["ATTACK_VOIGA"], case.name, "--quiet"], cwd=work, capture_output=True,
-                       timeout=300, check=True)
-        with h5py.File(work / "out.h5", "r+") as f:
-            for k in list(f["steps"]):
-                if int(k) > 1:
-                    del f["steps"][k]
-            f.attrs["n_steps_done"] = np.int32(1)
-            f.attrs["status"] = np.bytes_("interrupted")
+        interrupted(work, keep=1)
         return ["--restart", "out.h5"]
     out.append(Attack("swap", "restart-result-replaced", restart_setup, FAILS, ("moved, replaced or removed",),
                       same_as=(("out.h5", "keep.h5"),), during=lambda w: os.replace(w / "other.h5", w / "out.h5")))

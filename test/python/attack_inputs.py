@@ -1,4 +1,4 @@
-"""The inputs of the attack suite (`attack.py`, docs/robustness.md "Attack suite"):
+"""The inputs of the attack suite (`attack.py`, docs/attack.md):
 namelist texts, geometry files, output paths and result files a user could give,
 deterministically generated, each with what it may do.
 

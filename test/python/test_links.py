@@ -18,10 +18,10 @@ import subprocess
 from pathlib import Path
 
 import h5py
-import numpy as np
 import pytest
 
 from test_outputs import block, refused
+from test_restart import truncate
 
 TIMEOUT = 60
 
@@ -42,12 +42,7 @@ def interrupted(voiga_bin: Path, tmp: Path) -> Path:
     """A result of the block case cut back to 2 steps, as a killed run leaves it."""
     case = block(tmp)
     assert voiga(voiga_bin, case, "--quiet").returncode == 0
-    with h5py.File(tmp / "out.h5", "r+") as f:
-        for k in list(f["steps"]):
-            if int(k) > 2:
-                del f["steps"][k]
-        f.attrs["n_steps_done"] = np.int32(2)
-        f.attrs["status"] = np.bytes_("interrupted")
+    truncate(tmp / "out.h5", 2)
     return tmp / "out.h5"
 
 
