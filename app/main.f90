@@ -303,7 +303,7 @@ contains
             '       voiga [CASE.nml] --restart RESULT.h5 [--force-restart] [--quiet] [--verbose]', &
             '  (no option)       solve the case and write the result file it names', &
             '  --check           validate the case, build the discretization, print DOF counts', &
-            '  --overwrite       replace an existing result file (else refused)', &
+            '  --overwrite       replace an existing result or dump file (else refused)', &
             '  --restart R.h5    continue the interrupted or failed run whose result file is R.h5', &
             '  --force-restart   continue it although its case or geometry file changed', &
             '  --dump FILE       write the refined discretization of every body to FILE (HDF5)', &

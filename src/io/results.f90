@@ -56,6 +56,27 @@ module voiga_io_results
         procedure :: warning => results_warning
     end type results_t
 
+    interface
+        !> The case file recorded in the result file `path`.
+        module subroutine restart_case(path, case_file, error)
+            character(len=*), intent(in) :: path
+            character(len=:), allocatable, intent(out) :: case_file
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine restart_case
+
+        !> The state after the last written step of the result file `path` (as
+        !> `write_step` wrote it): displacement, the solver's substep fraction, force
+        !> scale and det K sign, and the committed history of each contact pair of
+        !> `model`, which is set on the pairs. The file is only read; it must hold
+        !> no more values than the model has (checked before anything is read).
+        module subroutine read_restart(path, model, state, error)
+            character(len=*), intent(in) :: path
+            type(model_t), intent(inout) :: model
+            type(resume_t), intent(out) :: state
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine read_restart
+    end interface
+
 contains
 
     !> Create the file (status 'running') with metadata and the discretization of
@@ -533,141 +554,5 @@ contains
         call self%h5%write('/multigrid_level_dofs', level_dofs, error)
         call self%h5%end_write(error)
     end subroutine results_write_multigrid
-
-    !> The case file recorded in the result file `path`.
-    subroutine restart_case(path, case_file, error)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable, intent(out) :: case_file
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: f
-        character(len=:), allocatable :: absolute
-        call f%open(path, 'r', error)
-        if (allocated(error)) return
-        call f%read_attr_str('/', 'case_file', case_file, error)
-        ! run from another folder: the absolute path recorded beside it
-        if (.not. allocated(error) .and. .not. path_exists(case_file) .and. f%has_attr('/', 'case_path')) then
-            call f%read_attr_str('/', 'case_path', absolute, error)
-            if (.not. allocated(error)) case_file = absolute
-        end if
-        call close_read(f, error)
-        if (allocated(error)) error%message = '--restart: '//error%message
-    end subroutine restart_case
-
-    !> The state after the last written step of the result file `path` (as
-    !> `write_step` wrote it): displacement, the solver's substep fraction, force
-    !> scale and det K sign, and the committed history of each contact pair of
-    !> `model`, which is set on the pairs. The file is only read.
-    subroutine read_restart(path, model, state, error)
-        character(len=*), intent(in) :: path
-        type(model_t), intent(inout) :: model
-        type(resume_t), intent(out) :: state
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: h5
-        call h5%open(path, 'r', error)
-        if (allocated(error)) return
-        call read_state(h5, model, state, error)
-        call close_read(h5, error)
-    end subroutine read_restart
-
-    !> Close a file that was only read; `error` keeps the first error.
-    subroutine close_read(h5, error)
-        type(h5file_t), intent(inout) :: h5
-        type(error_t), allocatable, intent(inout) :: error
-        type(error_t), allocatable :: close_error
-        call h5%close(close_error)
-        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
-    end subroutine close_read
-
-    subroutine read_state(h5, model, state, error)
-        type(h5file_t), intent(inout) :: h5
-        type(model_t), intent(inout) :: model
-        type(resume_t), intent(out) :: state
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: g
-        character(len=16) :: buf
-        integer :: done, ip
-
-        call h5%read_attr_int('/', 'n_steps_done', done, error)
-        if (allocated(error)) return
-        state%step = done
-        allocate (state%u(model%ndof))
-        state%u = 0.0_dp
-        if (done == 0) return
-        write (buf, '(i6.6)') done
-        g = '/steps/'//trim(buf)
-        ! (at most the model's DOFs are read: a file that claims more is refused
-        ! before anything is allocated)
-        call h5%read(g//'/displacement', state%u, error, int(model%ndof, int64))
-        if (allocated(error)) return
-        ! the step before (the predictor extrapolates the last step's increment)
-        allocate (state%u_before(size(state%u)))
-        state%u_before = 0.0_dp
-        if (done > 1) then
-            write (buf, '(i6.6)') done - 1
-            call h5%read('/steps/'//trim(buf)//'/displacement', state%u_before, error, int(model%ndof, int64))
-            if (allocated(error)) return
-        end if
-        if (size(state%u) /= model%ndof) then
-            call fatal_error(error, h5%path//': --restart: the result file does not belong to this '// &
-                             'case (different number of DOFs)', error_code%input)
-            return
-        end if
-        if (h5%has_attr(g, 'next_fraction')) call h5%read_attr_real(g, 'next_fraction', state%fraction, error)
-        if (allocated(error)) return
-        if (h5%has_attr(g, 'r0_max')) call h5%read_attr_real(g, 'r0_max', state%r0_max, error)
-        if (allocated(error)) return
-        if (h5%has_attr(g, 'tangent_det_sign')) &
-            call h5%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
-        if (allocated(error)) return
-        do ip = 1, size(model%pairs)
-            write (buf, '(i0)') ip
-            call read_history(h5, g//'/contact/'//trim(buf)//'/history', model%pairs(ip)%pair, error)
-            if (allocated(error)) return
-            call read_penalties(h5, g//'/contact/'//trim(buf), model%pairs(ip)%pair, error)
-            if (allocated(error)) return
-        end do
-    end subroutine read_state
-
-    !> The penalties a pair with multipliers used at the step of group `c` (it may
-    !> have softened them, `alm_soften`): a restart goes on with them, as the run
-    !> did. Other pairs keep the case's (a user may restart with another penalty);
-    !> so do files without the attributes.
-    subroutine read_penalties(h5, c, pair, error)
-        type(h5file_t), intent(inout) :: h5
-        character(len=*), intent(in) :: c
-        class(contact_pair_t), intent(inout) :: pair
-        type(error_t), allocatable, intent(out) :: error
-        if (.not. pair%has_multipliers()) return
-        if (h5%has_attr(c, 'penalty_normal')) call h5%read_attr_real(c, 'penalty_normal', pair%law%eps_n, error)
-        if (allocated(error)) return
-        if (h5%has_attr(c, 'penalty_tangent')) call h5%read_attr_real(c, 'penalty_tangent', pair%law%eps_t, error)
-    end subroutine read_penalties
-
-    !> Read the committed history `pair` keeps (its `history` names the arrays) from
-    !> group `c` and set it on the pair.
-    subroutine read_history(h5, c, pair, error)
-        type(h5file_t), intent(inout) :: h5
-        character(len=*), intent(in) :: c
-        class(contact_pair_t), intent(inout) :: pair
-        type(error_t), allocatable, intent(out) :: error
-        type(history_item_t), allocatable :: history(:)
-        integer(int64) :: most
-        integer :: i
-        history = pair%history()
-        if (size(history) == 0) return
-        do i = 1, size(history)
-            ! (at most as many values as the pair keeps: counted before the read
-            ! reallocates the array)
-            if (allocated(history(i)%values)) then
-                most = size(history(i)%values, kind=int64)
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error, most)
-            else
-                most = size(history(i)%flags, kind=int64)
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error, most)
-            end if
-            if (allocated(error)) return
-        end do
-        call pair%set_history(history, error)
-    end subroutine read_history
 
 end module voiga_io_results

@@ -7,6 +7,7 @@ its Python sources, so the test neither touches the checkout nor needs the netwo
 Skipped only when no virtual environment can be created here."""
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -35,23 +36,25 @@ def test_pip_install_and_run_from_elsewhere(tmp_path: Path) -> None:
     python = env_dir / "bin" / "python"
     if not python.exists():
         pytest.skip("the virtual environment has no python")
+    # (a PYTHONPATH naming a checkout would put it before the installed copy)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     src = tmp_path / "src"
     _copy_sources(src)
     install = subprocess.run([str(python), "-m", "pip", "install", "-q", "--no-deps",
                               "--no-build-isolation", str(src)], capture_output=True, text=True,
-                             timeout=300)
+                             timeout=300, env=env)
     assert install.returncode == 0, install.stdout + install.stderr
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     for args in (["-m", "post", "--help"], ["-m", "pre", "--help"]):
         res = subprocess.run([str(python), *args], capture_output=True, text=True, cwd=elsewhere,
-                             timeout=120)
+                             timeout=120, env=env)
         assert res.returncode == 0, res.stderr
         assert "usage:" in res.stdout
     where = subprocess.run([str(python), "-c", "import post, pre; print(post.__file__, pre.__file__)"],
-                           capture_output=True, text=True, cwd=elsewhere, timeout=60)
+                           capture_output=True, text=True, cwd=elsewhere, timeout=60, env=env)
     assert where.stdout.count(str(env_dir)) == 2, where.stdout  # the installed copy, not the checkout
     for script in ("voiga-post", "voiga-pre"):
         res = subprocess.run([str(env_dir / "bin" / script), "--help"], capture_output=True,
-                             text=True, cwd=elsewhere, timeout=120)
+                             text=True, cwd=elsewhere, timeout=120, env=env)
         assert res.returncode == 0 and "usage:" in res.stdout, res.stderr
