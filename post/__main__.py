@@ -133,7 +133,16 @@ def _cmd_plot_contact(args: argparse.Namespace) -> int:
         print(f"python -m post: {args.result} has no converged step with contact output",
               file=sys.stderr)
         return 1
-    index = args.step if args.step < 0 else [s.step for s in result.steps].index(args.step)
+    if args.step == 0:
+        print(f"python -m post plot-contact: step 0 is the reference configuration, which has no "
+              f"contact output; give a step >= 1 or -1 for the last", file=sys.stderr)
+        return 1
+    try:
+        chosen = result.select_step(args.step)
+    except IndexError as err:
+        print(f"python -m post plot-contact: {err}", file=sys.stderr)
+        return 1
+    index = result.steps.index(chosen)
     print(plot_contact(result, step=index, output=args.output, axis=args.axis, out=args.out))
     return 0
 

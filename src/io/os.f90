@@ -13,6 +13,8 @@ module voiga_io_os
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_sha256, only: sha256_text
+    use voiga_kinds, only: dp
+    use voiga_text, only: fixed_str
     implicit none
     private
 
@@ -465,7 +467,6 @@ contains
         integer(c_int) :: fd, st
         integer(c_int64_t) :: size
         integer :: e
-        character(len=32) :: buf
         fd = c_open(c_str(path), ior(o_wronly, o_cloexec), 0_c_int)
         if (fd < 0) then
             call fatal_error(error, "cannot open '"//path//"' to reserve space: "//strerror(errno()))
@@ -475,8 +476,8 @@ contains
         st = c_fallocate(fd, falloc_fl_keep_size, max(size, 0_c_int64_t), int(bytes, c_int64_t))
         e = errno()
         if (st /= 0 .and. e /= eopnotsupp) then
-            write (buf, '(f0.1)') real(bytes, 8)/2.0d0**20
-            call fatal_error(error, path//': no room for the next '//trim(buf)//' MB: '//strerror(e))
+            call fatal_error(error, path//': no room for the next '//fixed_str(real(bytes, dp)/2.0_dp**20, 1)// &
+                             ' MB: '//strerror(e))
         end if
         st = c_close(fd)
     end subroutine reserve_space

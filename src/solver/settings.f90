@@ -29,6 +29,11 @@ module voiga_solver_settings
         !> ... and doubled (never beyond the nominal step) after a substep that
         !> converged in at most grow_iterations Newton iterations.
         integer :: grow_iterations = 5
+        !> A nominal step is given up as hopeless when its failed attempts since the
+        !> last converged substep have taken this many Newton iterations (all
+        !> attempts, Tresca retries included; 0: no such budget): the run then ends
+        !> suggesting more load steps instead of cutting on (docs/robustness.md).
+        integer :: max_stalled_iterations = 1000
         !> Start each substep from the last step's increment, extrapolated (within a
         !> load phase; docs/robustness.md).
         logical :: predictor = .true.
