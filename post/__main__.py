@@ -203,14 +203,27 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
     figures); 2 for bad input, 1 if a case failed, else 0."""
     from pathlib import Path
 
-    from .engine import connect, run_all
+    from .solver import InputError, voiga_binary
     from .study import StudyError
-    from .sweep import default_binary, previous_times, summarize, write_summary
+    from .sweep import previous_times, summarize, write_summary
 
-    binary = Path(args.binary) if args.binary else default_binary()
-    if not binary.exists() and not (args.list or args.summary_only):
-        print(f"{prog}: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
+    try:
+        from .engine import connect, run_all
+        if not (args.list or args.summary_only):
+            import dask  # noqa: F401  (imported by the engine when it connects)
+            import distributed  # noqa: F401
+    except ModuleNotFoundError as err:
+        print(f"{prog}: no module {err.name!r}: a study runs its cases on Dask; install the study "
+              "extra: pip install 'voiga[study]' (from a checkout: pip install '.[study]')",
+              file=sys.stderr)
         return 2
+    try:
+        binary = voiga_binary(args.binary)
+    except InputError as err:
+        if not (args.list or args.summary_only):
+            print(f"{prog}: {err}", file=sys.stderr)
+            return 2
+        binary = Path(args.binary or "voiga")
     try:
         runs = study.runs()
     except StudyError as err:
@@ -310,7 +323,8 @@ def _engine_options(s: argparse.ArgumentParser, timeout_default: float) -> None:
     s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
     s.add_argument("--list", action="store_true", help="only list the cases (their case files)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--binary", default=None, help="voiga binary (default: $VOIGA_BIN or build/install)")
+    s.add_argument("--binary", default=None,
+                   help="voiga program (default: $VOIGA_BIN, voiga on the PATH, or build/install)")
 
 
 def build_parser() -> argparse.ArgumentParser:
