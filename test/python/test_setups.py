@@ -101,9 +101,9 @@ def build(folder: Path, name: str, text: str) -> Path:
 
     spec = folder / f"{name}.toml"
     spec.write_text(text)
-    _, case, written = write_from_spec(spec)
-    assert written
-    return case
+    done = write_from_spec(spec)
+    assert done.written
+    return done.case
 
 
 def line_case(folder: Path, normal: str) -> Path:
