@@ -3,7 +3,7 @@
 Subcommands:
   run            solve a case with voiga, print what it found, write figures and ParaView files
   summary        what a result file says, in a few lines
-  plot-deformed  draw every body deformed, coloured by |u| (PNG)
+  plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG)
   plot-contact   p_N and p_T along the contact (PNG)
   history        reactions and contact forces against the load time (CSV and PNG)
   vtk            ParaView time series (.pvd + .vtu)
@@ -104,7 +104,7 @@ def _cmd_vtk(args: argparse.Namespace) -> int:
 
 def _cmd_plot_deformed(args: argparse.Namespace) -> int:
     from .naming import output_path
-    from .plot import plot_deformed
+    from .plot import figure_name, plot_deformed
 
     result = _result(args)
     if not result.steps and args.step != 0:
@@ -114,10 +114,11 @@ def _cmd_plot_deformed(args: argparse.Namespace) -> int:
         return 1
     try:
         s = result.select_step(args.step)
-        output = args.output or output_path(result.path, "deformed", 0 if s is None else s.step,
-                                            args.out)
+        output = args.output or output_path(result.path, figure_name(args.field),
+                                            0 if s is None else s.step, args.out)
         path = plot_deformed(result, step=args.step, output=output, scale=args.scale,
-                             length_unit=args.unit, reference=args.reference)
+                             length_unit=args.unit, reference=args.reference, field=args.field,
+                             colour_scale=args.colour_scale)
     except IndexError as err:
         print(f"python -m post: {err}", file=sys.stderr)
         return 1
@@ -365,7 +366,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "least 48 per body and direction)")
     s.set_defaults(func=_cmd_vtk)
 
-    s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|")
+    s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|, "
+                                             "a displacement component or a stress or strain")
     s.add_argument("result", help="result file (.h5) written by voiga")
     s.add_argument("--step", type=int, default=-1,
                    help="step number (>= 1), -k for the k-th last, 0 = reference (default: -1)")
@@ -379,6 +381,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--unit", default=None,
                    help="length unit for the labels (default: the result file's units)")
     s.add_argument("--reference", action="store_true", help="also draw the undeformed outlines")
+    s.add_argument("--field", default="u", metavar="NAME",
+                   help="the colouring: u (|u|, default), ux, uy, von_mises, stress_xx, stress_yy, "
+                        "stress_zz, stress_xy, strain_xx, ... (stress and strain: steps with &output "
+                        "fields); files <result>-<NAME>-<step>.png (u: -deformed-)")
+    s.add_argument("--colour-scale", choices=("body", "shared"), default="body",
+                   help="a colour scale per body (default) or one shared by all bodies")
     s.set_defaults(func=_cmd_plot_deformed)
 
     s = sub.add_parser("plot-contact", help="p_N and p_T along the contact")

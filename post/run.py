@@ -30,8 +30,13 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
     written: list[Path] = []
     if not result.steps:
         return written
-    written.append(plot_deformed(result, output=output_path(result.path, "deformed",
-                                                            result.steps[-1].step, out)))
+    last = result.steps[-1]
+    written.append(plot_deformed(result, output=output_path(result.path, "deformed", last.step, out)))
+    if last.fields:  # the case asked for stresses (&output): the von Mises stress too
+        field = "von_mises" if all("von_mises" in f for f in last.fields.values()) else "stress_yy"
+        if field == "von_mises" or all("stress" in f for f in last.fields.values()):
+            written.append(plot_deformed(result, output=output_path(result.path, field, last.step, out),
+                                         field=field))
     written += [write_history_csv(result, out=out), plot_history(result, out=out)]
     if result.steps[-1].contact:
         written.append(plot_contact(result, out=out))
