@@ -385,8 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the colouring: u (|u|, default), ux, uy, von_mises, stress_xx, stress_yy, "
                         "stress_zz, stress_xy, strain_xx, ... (stress and strain: steps with &output "
                         "fields); files <result>-<NAME>-<step>.png (u: -deformed-)")
-    s.add_argument("--colour-scale", choices=("body", "shared"), default="body",
-                   help="a colour scale per body (default) or one shared by all bodies")
+    s.add_argument("--colour-scale", choices=("body", "shared"), default=None,
+                   help="a colour scale per body or one shared by all bodies (default: per body "
+                        "for u, ux, uy; shared for a stress or strain)")
     s.set_defaults(func=_cmd_plot_deformed)
 
     s = sub.add_parser("plot-contact", help="p_N and p_T along the contact")

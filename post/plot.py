@@ -30,7 +30,7 @@ from pre.nurbs import curve_to_splipy  # noqa: E402
 
 from .field import displacement, evaluate_grid  # noqa: E402
 from .naming import output_path  # noqa: E402
-from .quantity import check_name, displacement_quantity, label, sampled_quantity, signed  # noqa: E402
+from .quantity import DISPLACEMENT, check_name, displacement_quantity, label, sampled_quantity, signed  # noqa: E402
 from .reader import Body, ContactOutput, Result, Step, body_displacement, read_result  # noqa: E402
 
 CMAP = "turbo"
@@ -255,7 +255,7 @@ def _zoom_window(pairs: list[ContactOutput], size: float) -> tuple[np.ndarray, n
 def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Path | None = None,
                   scale: float | str = "auto", length_unit: str | None = None,
                   reference: bool = False, minimum: int = MIN_SAMPLES,
-                  zoom: bool = True, field: str = "u", colour_scale: str = "body") -> Path:
+                  zoom: bool = True, field: str = "u", colour_scale: str | None = None) -> Path:
     """Draw every body of ``result`` deformed at ``step`` (selection as in
     :meth:`post.reader.Result.select_step`) and write a PNG (:func:`deformed_figure`).
     ``output`` defaults to ``<result>-<deformed or the field>-<step>.png`` next to
@@ -275,7 +275,7 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
 def deformed_figure(result: Result, step: int = -1, scale: float | str = "auto",
                     length_unit: str | None = None, reference: bool = False, minimum: int = MIN_SAMPLES,
                     zoom: bool = True, field: str = "u",
-                    colour_scale: str = "body") -> tuple[plt.Figure, dict]:
+                    colour_scale: str | None = None) -> tuple[plt.Figure, dict]:
     """The figure of every body of ``result`` deformed at ``step`` (selection as in
     :meth:`post.reader.Result.select_step`) and each body's coloured mesh on the
     main panel.
@@ -287,12 +287,15 @@ def deformed_figure(result: Result, step: int = -1, scale: float | str = "auto",
     ``field``: the colouring (:data:`post.quantity.QUANTITIES`; a stress or strain
     needs a step with sampled fields). ``colour_scale``: ``'body'`` (each body its
     own range and colour bar: a body that translates far does not flatten the
-    others) or ``'shared'``. Rigid masters (lines, curves) are drawn in both panels,
+    others) or ``'shared'``; default ``'body'`` for a displacement, ``'shared'``
+    for a stress or strain (continuous across bodies in contact). Rigid masters (lines, curves) are drawn in both panels,
     in the first moved by their prescribed motion times ``scale``.
     """
     if not result.bodies:
         raise ValueError(f"{result.path}: no bodies")
     check_name(field)
+    if colour_scale is None:
+        colour_scale = "body" if field in DISPLACEMENT else "shared"
     if colour_scale not in ("body", "shared"):
         raise ValueError(f"colour scale {colour_scale!r}: 'body' or 'shared'")
     s = result.select_step(step)
