@@ -10,7 +10,7 @@
 module voiga_model_fields
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_text, only: str
+    use voiga_text, only: str, real_str
     use voiga_material, only: von_mises
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_solid, only: reference_gradients
@@ -114,7 +114,12 @@ contains
                         call body%mat%fields(grad_u, out%stress(:, q), out%strain(:, q), ok)
                         if (.not. ok) then
                             call fatal_error(error, "fields: body '"//trim(body%name)//"' element "//str(e)// &
-                                             ': the deformation is inverted (J <= 0)', error_code%numeric)
+                                             ': the deformation is inverted (J <= 0) at the sample (xi, eta) = ('// &
+                                             trim(adjustl(real_str(xi, 'f8.5')))//', '// &
+                                             trim(adjustl(real_str(eta, 'f8.5')))//'), between the quadrature '// &
+                                             'points, which are not (a corner of 180 degrees in the patch, a '// &
+                                             'coarse mesh): a finer mesh there, or &output samples = 1 (the '// &
+                                             'element centres)', error_code%numeric)
                             return
                         end if
                         out%von_mises(q) = von_mises(out%stress(:, q))

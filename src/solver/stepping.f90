@@ -1,4 +1,4 @@
-!> Quasi-static load stepping with adaptive load increments (docs/robustness.md).
+!> Quasi-static load stepping with adaptive load increments (docs/stepping.md).
 !>
 !> Per (sub)step the prescribed displacements are set to their values at the load
 !> time and a Newton attempt (`voiga_solver_newton`) solves the step. A substep
