@@ -123,6 +123,7 @@ def test_rigid_normal_into_the_slave_is_refused(run, tmp_path: Path) -> None:
                "their length" in error, error
         assert "rigid_normal = (0.0, 1.0) points into the slave" in error, error
         assert "give rigid_normal = 0.0, -1.0" in error and "--allow-overlap" in error, error
+        assert "floating-point" not in res.stdout + res.stderr
     assert not (tmp_path / "line.h5").exists() and not list(tmp_path.glob("line.h5*"))
     # the normal the message names is the one that works
     case.write_text(case.read_text().replace("rigid_normal = 0.0, 1.0", "rigid_normal = 0.0, -1.0"))
@@ -183,6 +184,7 @@ def test_failure_points_back_to_the_warning(run, tmp_path: Path) -> None:
     case = line_case(tmp_path, "[0.0, 1.0]")
     res = run(case, "--allow-overlap", "--quiet", cwd=tmp_path)
     assert res.returncode == 3, res.stderr
+    assert "floating-point" not in res.stdout + res.stderr
     error = res.stderr.split("voiga: error: ")[1]
     assert "It may follow from the warning reported before (stderr, and in the result file: post summary): " \
            "contact 'block' on 'rigid': the bodies overlap at the start" in error, error

@@ -42,6 +42,7 @@ def test_the_tutorial_runs_as_written(voiga_bin: Path, tmp_path: Path) -> None:
         assert line in out, line
     # the case runs without a warning (issue 38: the text hid one behind "...")
     assert "warning" not in run.stderr, run.stderr
+    assert "floating-point" not in out + run.stderr  # no IEEE note at exit (issue 38, item 2)
     assert "kept " not in out  # every file written once
 
     # sections 3-4: the run converged and the cylinder slides with Coulomb's mu = 0.2
