@@ -428,8 +428,8 @@ class Result:
         for s in self.steps:
             if s.step == step:
                 return s
-        raise IndexError(f"{self.path}: no converged step {step} "
-                         f"(have {[s.step for s in self.steps]}, status {self.status!r})")
+        raise IndexError(f"{self.path}: no converged step {step} ({_steps_text(self.steps)}, "
+                         f"status {self.status!r}; -1 is the last)")
 
     def dirichlet_index(self, body: str, edge: str) -> int:
         """0-based index of the Dirichlet condition on ``body``'s ``edge``."""
@@ -437,6 +437,17 @@ class Result:
             if d.body == body and d.edge == edge:
                 return k
         raise KeyError(f"no Dirichlet condition on {body}/{edge}")
+
+
+def _steps_text(steps: list[Step]) -> str:
+    """Which steps a result has, in a few words: 'steps 1 to 25', 'steps 2, 5, 9'."""
+    numbers = [s.step for s in steps]
+    if not numbers:
+        return "no converged step"
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"steps {numbers[0]} to {numbers[-1]}" if len(numbers) > 1 else f"step {numbers[0]}"
+    shown = ", ".join(map(str, numbers[:8]))
+    return f"steps {shown}" + (f", ... {numbers[-1]}" if len(numbers) > 8 else "")
 
 
 @contextmanager

@@ -311,7 +311,3 @@ def write_parquet(rows: list[dict[str, object]], keys: list[str], path: Path) ->
         pq.write_table(pa.table(columns), tmp)
     return path
 
-
-def default_binary() -> Path:
-    """VOIGA_BIN, else build/install/bin/voiga."""
-    return Path(os.environ.get("VOIGA_BIN", REPO / "build" / "install" / "bin" / "voiga"))

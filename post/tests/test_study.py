@@ -116,6 +116,7 @@ def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.Capture
 def test_malformed_scheduler_address(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     fake = tmp_path / "voiga"
     fake.write_text("")
+    fake.chmod(0o755)  # (never run: the scheduler is refused first)
     assert main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(tmp_path / "out"),
                  "--binary", str(fake), "--scheduler", "foo"]) == 2
     err = capsys.readouterr().err

@@ -15,6 +15,8 @@ module voiga_io_os
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_sha256, only: sha256_text
+    use voiga_kinds, only: dp
+    use voiga_text, only: fixed_str
     implicit none
     private
 
@@ -530,11 +532,10 @@ contains
         integer(int64), intent(in) :: bytes
         type(error_t), allocatable, intent(out) :: error
         integer(c_int) :: st
-        character(len=32) :: buf
         st = c_reserve(fd, int(bytes, c_int64_t))
         if (st /= 0) then
-            write (buf, '(f0.1)') real(bytes, 8)/2.0d0**20
-            call fatal_error(error, path//': no room for the next '//trim(buf)//' MB: '//strerror(-int(st)))
+            call fatal_error(error, path//': no room for the next '//fixed_str(real(bytes, dp)/2.0_dp**20, 1)// &
+                             ' MB: '//strerror(-int(st)))
         end if
     end subroutine reserve_space
 

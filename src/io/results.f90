@@ -10,6 +10,7 @@ module voiga_io_results
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_version, only: voiga_version_string
+    use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization, write_curve, write_elements
@@ -18,8 +19,8 @@ module voiga_io_results
     use voiga_io_result_file, only: result_file_t
     use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
-    use voiga_model_fields, only: output_settings_t
-    use voiga_io_fields, only: write_fields
+    use voiga_model_fields, only: output_settings_t, field_samples_t
+    use voiga_io_fields, only: write_fields, sample_bodies
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_nurbs_curve, only: nurbs_curve_t
@@ -44,6 +45,8 @@ module voiga_io_results
         !> The sampled fields the case asks for (`&output`) and the run's last step.
         type(output_settings_t) :: fields
         integer :: last_step = 0
+        !> A step's fields could not be sampled (warned once; the steps are written).
+        logical :: fields_failed = .false.
     contains
         procedure :: open => results_open
         procedure :: reopen => results_reopen
@@ -222,12 +225,27 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> The model of `u` (its bodies' sampled fields, when `&output` asks for them).
         type(model_t), intent(in), optional :: model
+        type(field_samples_t), allocatable :: samples(:)
+        type(error_t), allocatable :: sampling
         if (self%h5%broken) return
+        if (present(model)) then
+            ! an output sample that cannot be evaluated does not undo a converged step:
+            ! the step is written without its fields, and the run says so once
+            if (self%fields%wants(rec%step, self%last_step)) &
+                call sample_bodies(self%fields, model, u, samples, sampling)
+            if (allocated(sampling)) then
+                deallocate (samples)
+                if (.not. self%fields_failed) call self%warning('step '//str(rec%step)// &
+                    ': its sampled fields are not written (nor those of a later step where this happens): '// &
+                    sampling%message)
+                self%fields_failed = .true.
+            end if
+        end if
         ! at least 1 MiB, and for the first step its displacement, contact output
         ! and metadata, generously
         call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
         if (allocated(error)) return
-        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
+        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
         if (.not. allocated(error)) call write_counters(self, wall, n_cuts, error)
         call self%h5%end_write(error)
         if (allocated(error)) return
@@ -235,7 +253,7 @@ contains
     end subroutine results_write_step
 
     !> Write one converged step and the current displacement; flush.
-    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
+    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -247,9 +265,10 @@ contains
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
         type(error_t), allocatable, intent(out) :: error
-        !> The model of `u`: its bodies' sampled fields are written when `&output`
-        !> asks for them at this step.
+        !> The model of `u` and its bodies' sampled fields (allocated when `&output`
+        !> asks for them at this step).
         type(model_t), intent(in), optional :: model
+        type(field_samples_t), allocatable, intent(in), optional :: samples(:)
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -302,8 +321,8 @@ contains
             call write_contact(self%h5, g, k, pairs(k)%pair, error)
             if (allocated(error)) return
         end do
-        if (present(model)) then
-            if (self%fields%wants(rec%step, self%last_step)) call write_fields(self%h5, g, self%fields, model, u, error)
+        if (present(model) .and. present(samples)) then
+            if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples, error)
             if (allocated(error)) return
         end if
         ! this step's own output time (the record was made before it was written)
@@ -488,6 +507,8 @@ contains
             call self%h5%write_attr('/', 'fixed_point_iterations', stats%fixed_point_iterations, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'newton_iterations', stats%iterations, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'status', status, error)
             if (allocated(error)) exit records
