@@ -20,8 +20,10 @@ set against another's with the range the measurements allow
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
+import stat as stat_module
 import statistics
 import subprocess
 import threading
@@ -29,6 +31,8 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+from pre.files import write_text
 
 COST_SUFFIX = ".cost.json"
 """The times of a result ``<stem>.h5`` are in ``<stem>.cost.json`` beside it."""
@@ -134,20 +138,21 @@ def write_costs(result: Path, samples: Sequence[Sample]) -> Path:
     """The samples of the runs that made ``result``, with the result file's size and
     modification time (a result rewritten since, e.g. by hand, no longer matches)."""
     stat = result.stat()
-    path = cost_path(result)
-    part = path.with_name(path.name + ".part")
-    part.write_text(json.dumps({"result_size": stat.st_size, "result_mtime_ns": stat.st_mtime_ns,
-                                "wall_s": [s.wall for s in samples], "cpu_s": [s.cpu for s in samples]},
-                               indent=1) + "\n")
-    os.replace(part, path)
-    return path
+    return write_text(cost_path(result),   # beside it and renamed, never through a link (pre/files.py)
+                      json.dumps({"result_size": stat.st_size, "result_mtime_ns": stat.st_mtime_ns,
+                                  "wall_s": [s.wall for s in samples], "cpu_s": [s.cpu for s in samples]},
+                                 indent=1) + "\n")
 
 
 def read_costs(result: Path) -> list[Sample] | None:
     """The samples written by :func:`write_costs` for this very result file, else None
-    (no file, a malformed one, or one written for another version of the result)."""
+    (no file, a malformed one, one that is not a regular file -- a link, or a FIFO that
+    would hang the read --, times that are not finite and >= 0, or one written for another version of
+    the result)."""
     path = cost_path(result)
     try:
+        if not stat_module.S_ISREG(os.lstat(path).st_mode):   # not through a link either
+            return None
         data = json.loads(path.read_text())
         stat = result.stat()
         if data["result_size"] != stat.st_size or data["result_mtime_ns"] != stat.st_mtime_ns:
@@ -155,6 +160,8 @@ def read_costs(result: Path) -> list[Sample] | None:
         samples = [Sample(float(w), float(c)) for w, c in zip(data["wall_s"], data["cpu_s"], strict=True)]
     except (OSError, ValueError, KeyError, TypeError):
         return None
+    if not all(math.isfinite(t) and t >= 0 for s in samples for t in (s.wall, s.cpu)):
+        return None     # no run takes NaN or negative seconds: not the engine's file
     return samples or None
 
 

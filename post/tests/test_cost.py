@@ -64,6 +64,38 @@ def test_cost_columns_and_sidecar(tmp_path: Path) -> None:
     assert read_costs(tmp_path / "none.h5") is None
 
 
+def test_sidecar_is_never_written_or_read_through_a_link_or_a_fifo(tmp_path: Path) -> None:
+    """The times follow the rules of every file post writes (issue 36, pre/files.py):
+    a link or FIFO at the ``.cost.json`` name is refused, not written through; and one
+    there is not read (a FIFO would hang the summary), nor are times no run takes."""
+    from pre.files import OutputError
+
+    result = tmp_path / "m1-N2.h5"
+    result.write_bytes(b"result")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    samples = [Sample(0.05, 0.031)]
+    cost_path(result).symlink_to(victim.name)
+    with pytest.raises(OutputError, match="symbolic link"):
+        write_costs(result, samples)
+    assert victim.read_text() == "precious" and read_costs(result) is None
+    # a link to a file of the right times is not followed either
+    cost_path(result).unlink()
+    write_costs(result, samples)
+    os.replace(cost_path(result), victim)
+    cost_path(result).symlink_to(victim.name)
+    assert read_costs(result) is None
+    cost_path(result).unlink()
+    os.mkfifo(cost_path(result))
+    with pytest.raises(OutputError, match="FIFO"):
+        write_costs(result, samples)
+    assert read_costs(result) is None                      # at once, not waiting on the FIFO
+    cost_path(result).unlink()
+    for bad in (Sample(float("nan"), 0.03), Sample(0.05, -1.0), Sample(float("inf"), 0.03)):
+        write_costs(result, [bad])
+        assert read_costs(result) is None
+
+
 def test_cheapest_orders_separated_runs_and_ties_overlapping_ones() -> None:
     separated = {"m2-N2": Spread(2.0, 1.9, 2.1, 5), "m1-NN2.2": Spread(1.0, 0.9, 1.1, 5)}
     assert cheapest(separated) == ["m1-NN2.2"]
