@@ -40,6 +40,7 @@ contains
                     new_unittest('tangent_fd_frictionless', test_fd_frictionless), &
                     new_unittest('tangent_fd_stick', test_fd_stick), &
                     new_unittest('tangent_fd_slip', test_fd_slip), &
+                    new_unittest('tangent_fd_touch', test_fd_touch), &
                     new_unittest('tangent_fd_rigid_master', test_fd_rigid), &
                     new_unittest('tangent_fd_tresca', test_fd_tresca), &
                     new_unittest('contact_patch_test', test_patch), &
@@ -194,7 +195,7 @@ contains
         end subroutine add_dense
     end subroutine contact_fd
 
-    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method, curve)
+    subroutine run_fd(layouts, mu, rigid, anchor_shift, want_state, error, tresca, method, curve, touch)
         character(len=*), intent(in) :: layouts(:)
         real(dp), intent(in) :: mu
         logical, intent(in) :: rigid
@@ -209,6 +210,10 @@ contains
         character(len=*), intent(in), optional :: method
         !> A rigid master bounded by this curve (with `rigid`).
         type(nurbs_curve_t), intent(in), optional :: curve
+        !> Every point (GPTS) or control point (mortar) was open at the last converged
+        !> state, its gap there this (> 0): it touched in this step (the slip after the
+        !> interpolated touch counts, and its derivative by the gap).
+        real(dp), intent(in), optional :: touch
         type(model_t) :: model
         real(dp), allocatable :: u(:), r(:)
         integer :: il
@@ -228,10 +233,20 @@ contains
                     pair%active_last = .true.
                     pair%anchor = pair%out%xi_m - anchor_shift
                     if (present(tresca)) pair%slip_bound = tresca*mu*max(0.0_dp, pair%out%pn)
+                    if (present(touch)) then
+                        pair%active_last = .false.
+                        pair%xi_last = pair%out%xi_m - anchor_shift
+                        pair%gap_last = touch
+                    end if
                 type is (mortar_pair_t)
                     pair%active_last = .true.
                     pair%xi_last = pair%out%xi_m - anchor_shift
                     pair%traction = 0.0_dp
+                    pair%node_active = .true.
+                    if (present(touch)) then
+                        pair%node_active = .false.
+                        pair%node_gap = touch
+                    end if
                 end select
                 deallocate (r)
             end if
@@ -253,6 +268,27 @@ contains
         call run_fd([character(len=5) :: 'N2', 'N3', 'N4', 'NN4', 'NN2.2'], 0.5_dp, .false., &
                     1.0e-4_dp, state_stick, error)
     end subroutine test_fd_stick
+
+    !> Points open at the last converged state (gap 1e-3 there) that touched in this
+    !> step: only their slip after the interpolated touch counts, f (xi - xi_last) with
+    !> f = -g / (g0 - g); the tangent carries the derivative of f by the gap. Sticking
+    !> and slipping, GPTS and mortar (per control point), deformable and rigid masters.
+    subroutine test_fd_touch(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_fd([character(len=5) :: 'N2', 'N4', 'NN2.2'], 0.5_dp, .false., 1.0e-4_dp, state_stick, error, &
+                    touch=1.0e-3_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N2', 'NN2.2'], 0.3_dp, .false., 0.05_dp, state_slip, error, &
+                    touch=1.0e-3_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N3', 'NN4'], 0.3_dp, .true., 1.0e-3_dp, state_stick, error, touch=1.0e-3_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N2', 'N4', 'NN2.2'], 0.5_dp, .false., 1.0e-4_dp, state_stick, error, &
+                    method='mortar', touch=1.0e-3_dp)
+        if (allocated(error)) return
+        call run_fd([character(len=5) :: 'N3', 'NN4'], 0.3_dp, .true., 1.0e-3_dp, state_stick, error, &
+                    method='mortar', touch=1.0e-3_dp)
+    end subroutine test_fd_touch
 
     subroutine test_fd_slip(error)
         type(error_t), allocatable, intent(out) :: error

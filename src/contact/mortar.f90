@@ -57,6 +57,13 @@ module voiga_contact_mortar
         !> Friction history (mu > 0) [nodes]: committed and trial tangential traction
         !> t_A (along the master tangent).
         real(dp), allocatable :: traction(:), trial_traction(:)
+        !> Friction history (mu > 0) [nodes]: the mean gap g_A / D_A (huge where
+        !> nothing projected) and whether the node was in contact, at the last converged
+        !> state; committed and trial. A node that was open there touched in this step
+        !> where its mean gap, interpolated linearly from there, vanished: only its slip
+        !> after that counts (`touch_factors`).
+        real(dp), allocatable :: node_gap(:), trial_node_gap(:)
+        logical, allocatable :: node_active(:), trial_node_active(:)
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
         type(mortar_snapshot_t) :: last, accepted
@@ -99,6 +106,10 @@ module voiga_contact_mortar
         !> projection in its support, states.
         real(dp), allocatable :: d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), t_tr(:), d_seen(:)
         integer, allocatable :: st_a(:)
+        !> Per node [nodes] (friction): the share f_A of its slip that counts (1, or
+        !> for a node open at the last converged state the part after it touched), the
+        !> weighted slip before that scaling, and d f_A / d(g_A / D_A).
+        real(dp), allocatable :: f_a(:), ds_raw(:), df_a(:)
     end type mortar_work_t
 
 contains
@@ -131,7 +142,13 @@ contains
         ! open where no point of its support has a projection: its weighted gap is
         ! then empty, not zero
         where (wk%d_seen <= 0.0_dp) wk%g_a = huge(1.0_dp)
+        if (allocated(self%node_gap)) then
+            call touch_factors(self, wk)
+            self%trial_node_gap = huge(1.0_dp)
+            where (wk%g_a < huge(1.0_dp) .and. wk%d_a > 0.0_dp) self%trial_node_gap = wk%g_a/wk%d_a
+        end if
         call self%control_laws(wk%g_a, wk%d_a, wk%ds_a, wk%p_a, wk%t_a, wk%st_a, wk%t_tr)
+        if (allocated(self%node_active)) self%trial_node_active = wk%st_a /= state_inactive
         call mortar_points(self, r, wk, miss, add)
         self%last = mortar_snapshot_t(wk%g_a, wk%d_a, wk%t_tr, wk%st_a)
         if (.not. present(add) .or. miss) return
@@ -193,6 +210,38 @@ contains
             end associate
         end do
     end subroutine mortar_project
+
+    !> The share of each node's weighted slip that counts (`mortar_work_t%f_a`): all
+    !> of it for a node in contact at the last converged state; for one open there
+    !> with mean gap g0 > 0 and now g < 0, the part after the linearly interpolated
+    !> touch, f = -g / (g0 - g) (0 when it is not closed now or had no projection
+    !> then: it touches here). Without it a node that closes in a step sticks where it
+    !> was at the step's start, and the motion of the open surface before it touched
+    !> (an elastic body's surface sliding along a rigid one under the growing load)
+    !> becomes a spurious stick traction.
+    pure subroutine touch_factors(self, wk)
+        class(mortar_pair_t), intent(in) :: self
+        type(mortar_work_t), intent(inout) :: wk
+        real(dp) :: g, g0
+        integer :: a, n
+        n = size(wk%g_a)
+        allocate (wk%f_a(n), wk%df_a(n))
+        wk%f_a = 1.0_dp
+        wk%df_a = 0.0_dp
+        wk%ds_raw = wk%ds_a
+        do a = 1, n
+            if (self%node_active(a)) cycle
+            g0 = self%node_gap(a)
+            if (.not. g0 > 0.0_dp) cycle
+            wk%f_a(a) = 0.0_dp
+            if (g0 >= huge(1.0_dp) .or. wk%g_a(a) >= huge(1.0_dp) .or. wk%d_a(a) <= 0.0_dp) cycle
+            g = wk%g_a(a)/wk%d_a(a)
+            if (g >= 0.0_dp) cycle
+            wk%f_a(a) = -g/(g0 - g)
+            wk%df_a(a) = -g0/(g0 - g)**2
+        end do
+        wk%ds_a = wk%f_a*wk%ds_raw
+    end subroutine touch_factors
 
     !> Pass 3: every point's interpolated traction: residual, resultant, output and
     !> (with `add`) geometric tangent; `miss`: a point fell outside the pattern.
@@ -283,6 +332,8 @@ contains
                     end if
                 end do
             end do
+            ! the counted slip f_A ds_A: d = f_A d ds_A + ds_A f_A' d(g_A / D_A)
+            if (allocated(wk%f_a)) mm = wk%f_a(a)*mm + wk%ds_raw(a)*wk%df_a(a)/wk%d_a(a)*v
             allocate (kc(size(blk), size(blk)))
             do j = 1, size(blk)
                 kc(:, j) = self%law%eps_n/wk%d_a(a)*v*v(j)
@@ -376,6 +427,12 @@ contains
         allocate (self%traction(size(self%node_first)), self%trial_traction(size(self%node_first)))
         self%traction = 0.0_dp
         self%trial_traction = 0.0_dp
+        allocate (self%node_gap(size(self%node_first)), self%trial_node_gap(size(self%node_first)))
+        allocate (self%node_active(size(self%node_first)), self%trial_node_active(size(self%node_first)))
+        self%node_gap = huge(1.0_dp)
+        self%trial_node_gap = huge(1.0_dp)
+        self%node_active = .false.
+        self%trial_node_active = .false.
     end subroutine mortar_setup_history
 
     !> The multiplier basis at the slave points and the supports of its nodes: the
@@ -426,13 +483,21 @@ contains
 
     pure subroutine mortar_commit(self)
         class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) self%traction = self%trial_traction
+        if (allocated(self%traction)) then
+            self%traction = self%trial_traction
+            self%node_gap = self%trial_node_gap
+            self%node_active = self%trial_node_active
+        end if
         call pair_commit(self)
     end subroutine mortar_commit
 
     pure subroutine mortar_reset_trial(self)
         class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) self%trial_traction = self%traction
+        if (allocated(self%traction)) then
+            self%trial_traction = self%traction
+            self%trial_node_gap = self%node_gap
+            self%trial_node_active = self%node_active
+        end if
         call pair_reset_trial(self)
     end subroutine mortar_reset_trial
 
@@ -440,12 +505,16 @@ contains
     pure function mortar_history(self) result(items)
         class(mortar_pair_t), intent(in) :: self
         type(history_item_t), allocatable :: items(:)
-        type(history_item_t) :: traction
+        type(history_item_t) :: traction, gap, active
         items = pair_history(self)
         if (.not. allocated(self%traction)) return
         traction%name = 'traction'
         traction%values = self%traction
-        items = [traction, items]
+        gap%name = 'node_gap'
+        gap%values = self%node_gap
+        active%name = 'node_active'
+        active%flags = merge(1, 0, self%node_active)
+        items = [traction, gap, active, items]
     end function mortar_history
 
     pure subroutine mortar_set_history(self, items, error)
@@ -456,14 +525,25 @@ contains
         call pair_set_history(self, items, error)
         if (allocated(error) .or. .not. allocated(self%traction)) return
         do i = 1, size(items)
-            if (trim(items(i)%name) /= 'traction') cycle
-            if (size(items(i)%values) /= size(self%traction)) then
-                call fatal_error(error, 'history traction: wrong length', error_code%input)
-                return
-            end if
-            self%traction = items(i)%values
-            self%trial_traction = self%traction
+            select case (trim(items(i)%name))
+            case ('traction', 'node_gap')
+                if (size(items(i)%values) /= size(self%traction)) then
+                    call fatal_error(error, 'history '//trim(items(i)%name)//': wrong length', error_code%input)
+                    return
+                end if
+                if (trim(items(i)%name) == 'traction') self%traction = items(i)%values
+                if (trim(items(i)%name) == 'node_gap') self%node_gap = items(i)%values
+            case ('node_active')
+                if (size(items(i)%flags) /= size(self%traction)) then
+                    call fatal_error(error, 'history node_active: wrong length', error_code%input)
+                    return
+                end if
+                self%node_active = items(i)%flags /= 0
+            end select
         end do
+        self%trial_traction = self%traction
+        self%trial_node_gap = self%node_gap
+        self%trial_node_active = self%node_active
     end subroutine mortar_set_history
 
     !> The last evaluation is an accepted Newton iterate: the reference of `step_limit`.

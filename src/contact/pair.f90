@@ -104,6 +104,10 @@ module voiga_contact_pair
         !> committed and trial.
         real(dp), allocatable :: xi_last(:), trial_xi(:)
         logical, allocatable :: active_last(:), trial_active(:)
+        !> The normal gap at the last converged state (huge without a projection),
+        !> committed and trial [npts]: where between that state and this one a point
+        !> that was open first touched (friction only).
+        real(dp), allocatable :: gap_last(:), trial_gap(:)
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
         !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
@@ -261,6 +265,9 @@ contains
         if (self%law%mu <= 0.0_dp) return
         n = size(self%xi)
         allocate (self%xi_last(n), self%trial_xi(n), self%active_last(n), self%trial_active(n))
+        allocate (self%gap_last(n), self%trial_gap(n))
+        self%gap_last = huge(1.0_dp)
+        self%trial_gap = huge(1.0_dp)
         self%xi_last = 0.0_dp
         self%trial_xi = 0.0_dp
         self%active_last = .false.
@@ -272,6 +279,7 @@ contains
         if (.not. allocated(self%xi_last)) return
         self%active_last = self%trial_active
         self%xi_last = self%trial_xi
+        self%gap_last = self%trial_gap
     end subroutine pair_commit
 
     pure subroutine pair_reset_trial(self)
@@ -279,6 +287,7 @@ contains
         if (.not. allocated(self%xi_last)) return
         self%trial_active = self%active_last
         self%trial_xi = self%xi_last
+        self%trial_gap = self%gap_last
     end subroutine pair_reset_trial
 
     !> The shared friction history: `xi_last`, `active_last` (empty without friction).
@@ -288,11 +297,13 @@ contains
         allocate (items(0))
         if (.not. allocated(self%xi_last)) return
         deallocate (items)
-        allocate (items(2))
+        allocate (items(3))
         items(1)%name = 'xi_last'
         items(1)%values = self%xi_last
         items(2)%name = 'active_last'
         items(2)%flags = merge(1, 0, self%active_last)
+        items(3)%name = 'gap_last'
+        items(3)%values = self%gap_last
     end function pair_history
 
     !> Set the committed (and trial) history from `items` (as `history` names them).
@@ -307,6 +318,9 @@ contains
             case ('xi_last')
                 call take(items(i)%values, self%xi_last, error)
                 if (allocated(error)) return
+            case ('gap_last')
+                call take(items(i)%values, self%gap_last, error)
+                if (allocated(error)) return
             case ('active_last')
                 if (size(items(i)%flags) /= size(self%active_last)) then
                     call fatal_error(error, 'history active_last: wrong length', error_code%input)
@@ -317,6 +331,7 @@ contains
         end do
         self%trial_xi = self%xi_last
         self%trial_active = self%active_last
+        self%trial_gap = self%gap_last
     contains
         pure subroutine take(values, target, error)
             real(dp), intent(in) :: values(:)
