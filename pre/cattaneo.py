@@ -154,6 +154,7 @@ class CattaneoScene:
     poisson_ratio: float = 0.49
     indentation: float = 0.01
     friction: float = 0.3
+    press_friction: float | None = None
     elements_per_a: float = 20.0
     master: str = "rigid"
     method: str = "gpts"
@@ -202,7 +203,10 @@ def cattaneo_case(scene: CattaneoScene, output: str) -> tuple[dict[str, Any], di
                        "ux": [0.0, 0.0], "uy": [-scene.indentation, -scene.indentation]}
                       for e in ("left", "right")],
     }
-    contact: dict[str, Any] = {"slave": "cylinder", "friction": scene.friction, "method": scene.method}
+    friction: Any = scene.friction
+    if scene.press_friction is not None and scene.press_friction != scene.friction:
+        friction = [float(scene.press_friction), float(scene.friction)]
+    contact: dict[str, Any] = {"slave": "cylinder", "friction": friction, "method": scene.method}
     if scene.master == "rigid":
         contact.update(master="rigid", rigid_point=[0.0, -r], rigid_normal=[0.0, 1.0],
                        rigid_ux=[0.0, scene.shear], rigid_uy=[0.0, 0.0])

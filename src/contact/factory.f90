@@ -35,8 +35,11 @@ module voiga_contact_factory
         !> [2, n_phases] (linear within a phase, zero at time 0); unallocated: fixed.
         real(dp), allocatable :: rigid_motion(:, :)
         !> Penalties (0: automatic, `automatic_penalty`; penalty_tangent 0: the normal
-        !> one) and the friction coefficient.
+        !> one) and the friction coefficient (the largest, when it changes with the phase).
         real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
+        !> The friction coefficient of each load phase [n_phases], when the case gives
+        !> one per phase (unallocated: `friction` in every phase).
+        real(dp), allocatable :: friction_phases(:)
         !> Gauss points per slave contact element (0: layer degree + 1).
         integer :: n_gauss = 0
         !> One of `contact_method_names`.

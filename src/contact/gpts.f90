@@ -452,7 +452,7 @@ contains
         else if (law%mu > 0.0_dp) then
             ! elastic predictor on the convected coordinate
             ttr = law%eps_t*abs(slip)*la
-            if (ttr <= law%mu*pn) then
+            if (ttr <= law%mu*pn .or. .not. law%return_map) then
                 t = t - law%eps_t*slip*mp%a
                 tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*dslip + slip*amat(1, :))
                 tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*dslip + slip*amat(2, :))

@@ -78,6 +78,7 @@ module voiga_contact_mortar
         procedure :: history => mortar_history
         procedure :: set_history => mortar_set_history
         procedure :: accept_iterate => mortar_accept_iterate
+        procedure :: contact_last => mortar_contact_last
         procedure :: step_limit => mortar_step_limit
         !> The law at every control point from its weighted gap and slip.
         procedure :: control_laws => mortar_control_laws
@@ -545,6 +546,13 @@ contains
         self%trial_node_gap = self%node_gap
         self%trial_node_active = self%node_active
     end subroutine mortar_set_history
+
+    !> A control point was in contact at the last converged state (friction only).
+    pure logical function mortar_contact_last(self)
+        class(mortar_pair_t), intent(in) :: self
+        mortar_contact_last = .false.
+        if (allocated(self%node_active)) mortar_contact_last = any(self%node_active)
+    end function mortar_contact_last
 
     !> The last evaluation is an accepted Newton iterate: the reference of `step_limit`.
     pure subroutine mortar_accept_iterate(self)

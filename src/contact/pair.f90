@@ -165,6 +165,11 @@ module voiga_contact_pair
         procedure :: constraint_test => pair_constraint_test
         procedure :: constraints => pair_constraints
         procedure :: update_multipliers => pair_update_multipliers
+        !> The stick predictor (`voiga_solver_newton`): while on, every active point
+        !> sticks (no return map); and whether any point (or control point) was in
+        !> contact at the last converged state (friction only).
+        procedure :: stick_trial => pair_stick_trial
+        procedure :: contact_last => pair_contact_last
         !> A substep failed: a pair whose penalties do not decide its solution may
         !> make them softer for the next attempt (default: not; `text` says what changed).
         procedure :: soften => pair_soften
@@ -398,6 +403,19 @@ contains
         class(contact_pair_t), intent(inout) :: self
         real(dp), intent(in) :: delta(:)
     end subroutine pair_update_multipliers
+
+    pure subroutine pair_stick_trial(self, on)
+        class(contact_pair_t), intent(inout) :: self
+        logical, intent(in) :: on
+        self%law%return_map = .not. on
+    end subroutine pair_stick_trial
+
+    !> Default (GPTS): a slave point was in contact at the last converged state.
+    pure logical function pair_contact_last(self)
+        class(contact_pair_t), intent(in) :: self
+        pair_contact_last = .false.
+        if (allocated(self%active_last)) pair_contact_last = any(self%active_last)
+    end function pair_contact_last
 
     pure subroutine pair_soften(self, changed, text)
         class(contact_pair_t), intent(inout) :: self
