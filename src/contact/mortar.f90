@@ -22,7 +22,7 @@ module voiga_contact_mortar
     use voiga_contact_surface, only: surface_point_t, surface_point
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
-    use voiga_contact_kinematics, only: point_operators
+    use voiga_contact_mortar_kernels, only: mortar_point, node_touch_factors
     use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
                                   pair_reset_trial, pair_history, pair_set_history
     implicit none
@@ -212,35 +212,14 @@ contains
         end do
     end subroutine mortar_project
 
-    !> The share of each node's weighted slip that counts (`mortar_work_t%f_a`): all
-    !> of it for a node in contact at the last converged state; for one open there
-    !> with mean gap g0 > 0 and now g < 0, the part after the linearly interpolated
-    !> touch, f = -g / (g0 - g) (0 when it is not closed now or had no projection
-    !> then: it touches here). Without it a node that closes in a step sticks where it
-    !> was at the step's start, and the motion of the open surface before it touched
-    !> (an elastic body's surface sliding along a rigid one under the growing load)
-    !> becomes a spurious stick traction.
+    !> The share of each node's weighted slip that counts (`node_touch_factors`), and
+    !> the weighted slips scaled by it.
     pure subroutine touch_factors(self, wk)
         class(mortar_pair_t), intent(in) :: self
         type(mortar_work_t), intent(inout) :: wk
-        real(dp) :: g, g0
-        integer :: a, n
-        n = size(wk%g_a)
-        allocate (wk%f_a(n), wk%df_a(n))
-        wk%f_a = 1.0_dp
-        wk%df_a = 0.0_dp
+        allocate (wk%f_a(size(wk%g_a)), wk%df_a(size(wk%g_a)))
+        call node_touch_factors(self%node_active, self%node_gap, wk%g_a, wk%d_a, wk%f_a, wk%df_a)
         wk%ds_raw = wk%ds_a
-        do a = 1, n
-            if (self%node_active(a)) cycle
-            g0 = self%node_gap(a)
-            if (.not. g0 > 0.0_dp) cycle
-            wk%f_a(a) = 0.0_dp
-            if (g0 >= huge(1.0_dp) .or. wk%g_a(a) >= huge(1.0_dp) .or. wk%d_a(a) <= 0.0_dp) cycle
-            g = wk%g_a(a)/wk%d_a(a)
-            if (g >= 0.0_dp) cycle
-            wk%f_a(a) = -g/(g0 - g)
-            wk%df_a(a) = -g0/(g0 - g)**2
-        end do
         wk%ds_a = wk%f_a*wk%ds_raw
     end subroutine touch_factors
 
@@ -591,53 +570,4 @@ contains
         end associate
     end function mortar_step_limit
 
-    !> Residual `r` and geometric tangent `k` of one slave point whose interpolated
-    !> pressure `pbar` and tangential traction `tbar` are held fixed; and the point's
-    !> derivative vectors (local DOFs), from which `voiga_contact_pair` forms the
-    !> coupling through the control-point tractions: `gn` = d g / du = G^T n,
-    !> `gt` = G^T t_hat, `m` = d ds / du with ds = dxi |a_m| the point's slip since
-    !> the last converged state (`dxi` = xi_m - xi_m,last; zero vector without
-    !> `slip`, a point that had no projection then).
-    pure subroutine mortar_point(w0, sp, mp, pbar, tbar, dxi, slip, friction, r, k, gn, gt, m)
-        !> Reference length weight: Gauss weight x |dX/dxi|.
-        real(dp), intent(in) :: w0
-        type(surface_point_t), intent(in) :: sp
-        type(master_point_t), intent(in) :: mp
-        real(dp), intent(in) :: pbar, tbar, dxi
-        logical, intent(in) :: slip
-        !> False: frictionless, `gt` and `m` are zero (no friction code runs).
-        logical, intent(in) :: friction
-        real(dp), intent(out) :: r(:), k(:, :), gn(:), gt(:), m(:)
-        real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r))
-        real(dp) :: c(size(r)), na(size(r)), dmt(size(r)), n(2), that(2), t(2), dt(2), la, g, den
-        integer :: a
-
-        call point_operators(sp, mp, gm, dm, ds)
-        n = mp%n
-        la = norm2(mp%a)
-        that = mp%a/la
-        g = dot_product(sp%x - mp%x, n)
-        ! linearization of the projection: dxi = c . du; master tangent A = Dm + a2 (x) c
-        den = dot_product(mp%a, mp%a) - g*dot_product(n, mp%a2)
-        c = (matmul(mp%a, gm) + g*matmul(n, dm))/den
-        amat(1, :) = dm(1, :) + mp%a2(1)*c
-        amat(2, :) = dm(2, :) + mp%a2(2)*c
-        na = matmul(n, amat)/la     ! dn = -t_hat na, dt_hat = n na
-        gn = matmul(n, gm)
-        gt = 0.0_dp
-        m = 0.0_dp
-        if (friction) then
-            gt = matmul(that, gm)
-            if (slip) m = la*c + dxi*matmul(that, amat)
-        end if
-        t = pbar*n + tbar*that
-        ! d t at fixed pbar, tbar: pbar dn + tbar dt_hat = (tbar n - pbar t_hat) na
-        dt = tbar*n - pbar*that
-        r = -w0*matmul(t, gm)
-        dmt = matmul(t, dm)
-        do a = 1, size(r)
-            ! K = -w0 G^T dt na^T + w0 (Dm^T t) c^T (the master functions move with xi)
-            k(:, a) = -w0*matmul(dt, gm)*na(a) + w0*dmt*c(a)
-        end do
-    end subroutine mortar_point
 end module voiga_contact_mortar

@@ -21,7 +21,8 @@ module voiga_solver_stepping
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, step_record_t, cut_record_t, append_cut, wall_seconds
     use voiga_solver_progress, only: progress_t, step_report_t
-    use voiga_solver_newton, only: newton_t, new_newton, attempt_t, stick_predictor
+    use voiga_solver_newton, only: newton_t, new_newton, attempt_t
+    use voiga_solver_stick_predictor, only: stick_predictor
     use voiga_solver_outer, only: tresca_fixed_point, frictional, substep_attempt
     use voiga_solver_diagnostics, only: fold_diagnosis, append_pair_diagnoses
     use voiga_model_checks, only: contact_watch_t, new_contact_watch, setup_warnings, warning_t
