@@ -259,8 +259,8 @@ contains
     !> The contact patch test of issue 35 on meshes 7 / 5 and 13 / 7 (slave / master
     !> elements along the interface) and matching 5 / 5, N2 and NN2.2, small
     !> (linear, p = 0.01) and large deformation (Neo-Hookean, p = 0.2 in 4 steps:
-    !> stretches 0.85 vertically and 1.066 along the interface), frictionless and mu = 0.3: the pressure is uniform to
-    !> 1e-6 and no point slips. Measured spread (max - min)/mean of the nominal
+    !> stretches 0.85 across and 1.066 along the interface), frictionless and
+    !> mu = 0.3: the pressure is uniform to 1e-6 and no point slips. Measured spread (max - min)/mean of the nominal
     !> pressure at the slave points and of the control points' p_A: 6e-12 or below
     !> (round-off, amplified by the penalty 1000 x E).
     subroutine test_patch(error)
