@@ -9,7 +9,7 @@ module test_segment
     use voiga_model, only: model_t
     use voiga_model_loads, only: pressure_settings_t
     use voiga_contact_factory, only: contact_settings_t
-    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_pair, only: contact_pair_t, history_item_t
     use voiga_contact_mortar, only: mortar_pair_t
     use voiga_contact_segment, only: segment_pair_t, default_segment_points
     use voiga_contact_master_nurbs, only: nurbs_master_t
@@ -31,6 +31,7 @@ contains
         testsuite = [ &
                     new_unittest('segment_cuts_at_master_breakpoints', test_cuts), &
                     new_unittest('segment_rigid_line_is_mortar', test_rigid_line_is_mortar), &
+                    new_unittest('segment_history_round_trip', test_history), &
                     new_unittest('segment_tangent_fd_frictionless', test_fd_frictionless), &
                     new_unittest('segment_tangent_fd_stick', test_fd_stick), &
                     new_unittest('segment_tangent_fd_slip', test_fd_slip), &
@@ -97,6 +98,47 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_cuts
+
+    !> The history (the points and the friction history) set on a fresh pair gives
+    !> the pair it came from: the same points and the same residual, to the bit; a
+    !> point outside the slave edge's elements is refused.
+    subroutine test_history(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: a, b
+        type(history_item_t), allocatable :: items(:)
+        real(dp), allocatable :: u(:), ra(:), rb(:)
+        logical :: refused
+        integer :: i
+        call segmented_die('NN2.2', 0.3_dp, .false., a, u, error)
+        if (allocated(error)) return
+        call two_body_model('NN2.2', 0.3_dp, .false., b, error, 'segment')
+        if (allocated(error)) return
+        items = a%pairs(1)%pair%history()
+        associate (xa => a%pairs(1)%pair%xi, xb => b%pairs(1)%pair%xi)
+            if (size(xa) == size(xb)) call check(error, any(xa /= xb), 'the fresh pair has other points')
+        end associate
+        if (allocated(error)) return
+        call b%pairs(1)%pair%set_history(items, error)
+        if (allocated(error)) return
+        call check(error, size(a%pairs(1)%pair%xi) == size(b%pairs(1)%pair%xi), 'as many points')
+        if (allocated(error)) return
+        call check(error, all(a%pairs(1)%pair%xi == b%pairs(1)%pair%xi), 'the same points')
+        if (allocated(error)) return
+        allocate (ra(size(u)), rb(size(u)), source=0.0_dp)
+        call a%pairs(1)%pair%evaluate(u, ra, error)
+        if (allocated(error)) return
+        call b%pairs(1)%pair%evaluate(u, rb, error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(ra)) > 0.0_dp .and. all(ra == rb), 'the same residual')
+        if (allocated(error)) return
+        do i = 1, size(items)
+            if (trim(items(i)%name) == 'point_element') items(i)%flags(1) = 0
+        end do
+        call b%pairs(1)%pair%set_history(items, error)
+        refused = .false.
+        if (allocated(error)) refused = index(error%message, 'point_element') > 0
+        call check(error, refused, 'a point outside the elements refused')
+    end subroutine test_history
 
     !> A rigid line has no breakpoints: the segment pair integrates on the mortar
     !> pair's points and gives its residual (the block pressed and slid on a plane).

@@ -477,6 +477,15 @@ contains
             call fatal_error(error, 'history point_xi, point_w, point_element: different lengths', error_code%input)
             return
         end if
+        if (any(elem < 1 .or. elem > size(self%slave%spans))) then
+            call fatal_error(error, 'history point_element: not an element of this slave edge', error_code%input)
+            return
+        end if
+        if (any(.not. (w > 0.0_dp)) .or. any(xi < self%slave%breaks(elem) .or. xi > self%slave%breaks(elem + 1))) then
+            call fatal_error(error, 'history point_xi, point_w: a point outside its element or without weight', &
+                             error_code%input)
+            return
+        end if
         do e = 1, size(self%slave%spans)
             if (mod(count(elem == e), self%n_gauss) /= 0 .or. count(elem == e) == 0) then
                 call fatal_error(error, 'history point_element: not a segmentation of this slave edge '// &
