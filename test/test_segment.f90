@@ -18,7 +18,8 @@ module test_segment
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
     use voiga_test_fixtures, only: paper_layout, rectangle, scene_t, body_settings
-    use test_contact, only: two_body_model, penetrating_state, contact_fd, bc, build_model, ironing_quadratic
+    use test_contact, only: two_body_model, penetrating_state, contact_fd, bc, build_model, ironing_quadratic, &
+                            block_on_plane
     implicit none
     private
 
@@ -141,14 +142,15 @@ contains
     end subroutine test_history
 
     !> A rigid line has no breakpoints: the segment pair integrates on the mortar
-    !> pair's points and gives its residual (the block pressed and slid on a plane).
+    !> pair's points and gives its solution (a block pressed 0.01 onto a plane and
+    !> pushed 0.05 sideways, mu = 0.3: sticking, then slipping).
     subroutine test_rigid_line_is_mortar(error)
         type(error_t), allocatable, intent(out) :: error
         type(model_t) :: ms, mm
         real(dp), allocatable :: us(:), um(:)
-        call block_on_plane('segment', ms, us, error)
+        call block_on_plane(0.05_dp, 0.3_dp, ms, us, error, method='segment')
         if (allocated(error)) return
-        call block_on_plane('mortar', mm, um, error)
+        call block_on_plane(0.05_dp, 0.3_dp, mm, um, error, method='mortar')
         if (allocated(error)) return
         call check(error, size(ms%pairs(1)%pair%xi) == size(mm%pairs(1)%pair%xi), 'as many points')
         if (allocated(error)) return
@@ -156,27 +158,6 @@ contains
         if (allocated(error)) return
         call check(error, maxval(abs(us - um)), 0.0_dp, 'the same solution', abs=1.0e-14_dp)
     end subroutine test_rigid_line_is_mortar
-
-    !> A 1 x 1 block (NN2.2) pressed 0.01 onto the rigid plane y = 0 and pushed 0.05
-    !> sideways, mu = 0.3.
-    subroutine block_on_plane(method, model, u, error)
-        character(len=*), intent(in) :: method
-        type(model_t), intent(out) :: model
-        real(dp), allocatable, intent(out) :: u(:)
-        type(error_t), allocatable, intent(out) :: error
-        type(scene_t) :: c
-        type(solver_stats_t) :: stats
-        c%bodies = [body_settings('block', 'linear', 1.0_dp, paper_layout('NN2.2', [4, 2], 'bottom'))]
-        c%solver%n_steps = [2, 2]
-        c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, 0.05_dp, -0.01_dp], [2, 2]))]
-        allocate (c%contact(1))
-        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
-                                       rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1000.0_dp, &
-                                       penalty_tangent=1000.0_dp, friction=0.3_dp, method=method)
-        call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
-        if (allocated(error)) return
-        call solve_steps(model, c%solver, u, stats, error)
-    end subroutine block_on_plane
 
     !> The die of `two_body_model` (slave, method 'segment') in the penetrating
     !> state, segmented there: evaluated and committed.

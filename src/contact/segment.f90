@@ -27,6 +27,7 @@ module voiga_contact_segment
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_element_quadrature, only: gauss_legendre
+    use voiga_discretization_patch, only: sorted
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, surface_basis
     use voiga_contact_master, only: master_point_t
     use voiga_contact_master_nurbs, only: nurbs_master_t
@@ -372,24 +373,6 @@ contains
             xi = next
         end do
     end function crossing
-
-    !> `v` in ascending order (insertion sort: a few cuts per element).
-    pure function sorted(v) result(s)
-        real(dp), intent(in) :: v(:)
-        real(dp) :: s(size(v)), x
-        integer :: i, j
-        s = v
-        do i = 2, size(s)
-            x = s(i)
-            j = i - 1
-            do while (j >= 1)
-                if (s(j) <= x) exit
-                s(j + 1) = s(j)
-                j = j - 1
-            end do
-            s(j + 1) = x
-        end do
-    end function sorted
 
     !> Make `xi`, `w`, `elem` the pair's points: their spans, slave functions,
     !> multiplier values (the slave functions), element ranges, output records, and
