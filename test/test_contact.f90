@@ -28,7 +28,7 @@ module test_contact
     private
 
     public :: collect_contact, two_body_model, penetrating_state, contact_fd, bc, build_model, run_fd, &
-              small_ironing
+              small_ironing, ironing_quadratic, block_on_plane
 
     real(dp), parameter :: pi = acos(-1.0_dp)
 

@@ -9,6 +9,7 @@ module voiga_contact_factory
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
     use voiga_contact_alm, only: alm_pair_t, default_alm_tolerance
+    use voiga_contact_segment, only: segment_pair_t
     implicit none
     private
 
@@ -18,8 +19,10 @@ module voiga_contact_factory
     real(dp), parameter :: penalty_factor = 10.0_dp
 
     !> The valid values of `&contact method`: Gauss-point-to-surface (the paper's),
-    !> mortar-type penalty, augmented Lagrangian on the mortar-type constraints.
-    character(len=*), parameter :: contact_method_names(3) = [character(len=6) :: 'gpts', 'mortar', 'alm']
+    !> mortar-type penalty, augmented Lagrangian on the mortar-type constraints,
+    !> segment-based mortar (the mortar-type penalty integrated exactly per segment).
+    character(len=*), parameter :: contact_method_names(4) = [character(len=7) :: 'gpts', 'mortar', 'alm', &
+                                                               'segment']
 
     !> One contact pair (`&contact`; docs/formats.md).
     type :: contact_settings_t
@@ -40,7 +43,8 @@ module voiga_contact_factory
         !> The friction coefficient of each load phase [n_phases], when the case gives
         !> one per phase (unallocated: `friction` in every phase).
         real(dp), allocatable :: friction_phases(:)
-        !> Gauss points per slave contact element (0: layer degree + 1).
+        !> Gauss points per slave contact element (0: layer degree + 1); with
+        !> `segment`, per segment (0: `default_segment_points`).
         integer :: n_gauss = 0
         !> One of `contact_method_names`.
         character(len=16) :: method = 'gpts'
@@ -63,6 +67,8 @@ contains
             allocate (mortar_pair_t :: pair)
         case ('alm')
             pair = alm_pair_t(tolerance=settings%tolerance)
+        case ('segment')
+            allocate (segment_pair_t :: pair)
         case default
             call fatal_error(error, "unknown contact method '"//trim(settings%method)//"'", error_code%input)
         end select

@@ -29,6 +29,9 @@ module voiga_contact_mortar
     private
 
     public :: mortar_pair_t, mortar_snapshot_t, mortar_point
+    !> The evaluation, for extensions that add to it (a call through the parent
+    !> component would bind the passes' own calls to the parent's procedures).
+    public :: mortar_evaluate
 
     !> A mortar pair's control points at one evaluation [slave edge control points]
     !> (for the step control, `step_limit`).
@@ -288,9 +291,8 @@ contains
         real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
         integer, allocatable :: blk(:), pos(:), mdofs(:)
         real(dp) :: c
-        integer :: k, i, a, e, j, ng
+        integer :: k, i, a, e, j, rng(2)
 
-        ng = self%n_gauss
         mdofs = self%master%all_dofs()
         do a = 1, size(self%node_first)
             if (wk%st_a(a) == state_inactive) cycle
@@ -300,7 +302,8 @@ contains
             q = 0.0_dp
             mm = 0.0_dp
             do e = self%node_first(a), self%node_last(a)
-                do k = (e - 1)*ng + 1, e*ng
+                rng = self%point_range(e)
+                do k = rng(1), rng(2)
                     if (.not. allocated(wk%vec(k)%dofs)) cycle
                     i = findloc(self%point_nodes(:, k), a, dim=1)
                     c = wk%w0(k)*self%point_values(i, k)

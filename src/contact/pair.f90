@@ -181,6 +181,11 @@ module voiga_contact_pair
         procedure :: fit_pattern => pair_fit_pattern
         procedure :: element_dofs => pair_element_dofs
         procedure :: wanted_ranges => pair_wanted_ranges
+        !> The slave points of slave element e (first and last index) and the slave
+        !> element of point k: `n_gauss` per element in element order unless a method
+        !> places its points otherwise (`voiga_contact_segment`).
+        procedure :: point_range => pair_point_range
+        procedure :: point_element => pair_point_element
     end type contact_pair_t
 
     !> An element of an array of pairs of any methods.
@@ -509,7 +514,7 @@ contains
         type(master_point_t), intent(in) :: mp
         logical, intent(out) :: inside
         integer :: e
-        e = (k - 1)/self%n_gauss + 1
+        e = self%point_element(k)
         inside = mp%first >= self%mlo(e) .and. mp%last <= self%mhi(e)
         if (inside) return
         if (self%mlo(e) > self%mhi(e)) then
@@ -544,12 +549,14 @@ contains
         integer, intent(in) :: n_master, block
         integer, intent(out) :: lo(:), hi(:)
         real(dp) :: h
-        integer :: e, k, ng, w
-        ng = self%n_gauss
+        integer :: e, k, ng, w, rng(2)
         lo = 1
         hi = 0
         do e = 1, size(lo)
-            associate (pts => self%out((e - 1)*ng + 1:e*ng))
+            rng = self%point_range(e)
+            ng = rng(2) - rng(1) + 1
+            if (ng <= 0) cycle
+            associate (pts => self%out(rng(1):rng(2)))
                 h = norm2(maxval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2) - &
                           minval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2))
                 do k = 1, ng
@@ -569,5 +576,19 @@ contains
             hi(e) = min(n_master, ((hi(e) + block - 1)/block)*block)
         end do
     end subroutine pair_wanted_ranges
+
+    !> Points n_gauss (e - 1) + 1 .. n_gauss e: the Gauss points `setup` places.
+    pure function pair_point_range(self, e) result(range)
+        class(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: e
+        integer :: range(2)
+        range = [(e - 1)*self%n_gauss + 1, e*self%n_gauss]
+    end function pair_point_range
+
+    pure integer function pair_point_element(self, k) result(e)
+        class(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: k
+        e = (k - 1)/self%n_gauss + 1
+    end function pair_point_element
 
 end module voiga_contact_pair

@@ -105,7 +105,7 @@ contains
         integer :: k
         allocate (ratio(size(pair%out)), source=0.0_dp)
         do k = 1, size(ratio)
-            if (use(k)) ratio(k) = -pair%out(k)%gap/h((k - 1)/pair%n_gauss + 1)
+            if (use(k)) ratio(k) = -pair%out(k)%gap/h(pair%point_element(k))
         end do
     end function depth_ratios
 
