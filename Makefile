@@ -81,7 +81,7 @@ test-python: build
 clean:
 	rm -rf build
 
-## stress: the full hard-case suite of issue 6 (docs/robustness.md), one case at a time;
+## stress: the full hard-case suite of issue 6 (docs/hard-cases.md), one case at a time;
 ## prints the table (case, outcome, steps, cuts, Newton iterations, wall s) and writes it
 ## to build/stress/table.md; fails if a case does not end as expected.
 ## STRESS_ARGS e.g. --only 'deep-m1-*' 'penalty-*', or --list
@@ -89,12 +89,13 @@ stress: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/hard_cases.py --out build/stress \
 	  --markdown build/stress/table.md $(STRESS_ARGS)
 
-## attack: the attack suite of issue 19 (docs/robustness.md, "Attack suite"): every
-## namelist, geometry, output-path and result-file input of test/python/attack_inputs.py
-## (about 1160) judged by its oracles; prints the counts per family and writes them to
-## build/attack/table.md; fails on any crash, hang, silent wrong result or changed input.
+## attack: the attack suite of issues 19 and 36 (docs/attack.md): every namelist,
+## geometry, output-path and result-file input of test/python/attack_inputs.py and every
+## link, special-file, swap and huge-size attack of attack_files.py (about 1450) judged
+## by its oracles; prints the counts per family and writes them to build/attack/table.md;
+## fails on any crash, hang, silent wrong result, traceback or changed input.
 ## make test runs the reduced set (test/python/test_attack.py). ATTACK_ARGS e.g.
-## --family output post, --list
+## --family output post swap, --list
 attack: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) test/python/attack.py --out build/attack \
 	  --markdown build/attack/table.md $(ATTACK_ARGS)

@@ -1,9 +1,15 @@
 !> The terminal side of a run: the result file's progress hooks (`results_t`)
 !> plus one line per converged step, cut and retry (none with --quiet), and with
 !> --verbose one per Newton iteration and linear solve; warnings go to stderr
-!> (also with --quiet).
+!> (also with --quiet). On a terminal (not a pipe or a file; not with --quiet or
+!> --verbose) a live line shows where a long step is: step, substep, cuts, the
+!> Newton iteration and the elapsed time, rewritten in place (carriage return) at
+!> every attempt and at most four times a second in between, and wiped before any
+!> other line.
 module voiga_app_console
+    use, intrinsic :: iso_fortran_env, only: output_unit
     use voiga_kinds, only: dp
+    use voiga_text, only: str, fixed_str, real_str
     use voiga_error, only: error_t
     use voiga_model, only: model_t
     use voiga_io_results, only: results_t
@@ -17,8 +23,18 @@ module voiga_app_console
     !> Writes the result file and prints.
     type, extends(results_t) :: console_t
         logical :: quiet = .false., verbose = .false.
+        !> Show the live line (a terminal, neither --quiet nor --verbose); is it shown now?
+        logical :: live = .false., shown = .false.
+        !> The run's wall-time origin and when the live line was last written.
+        real(dp) :: t0 = 0.0_dp, last = 0.0_dp
+        !> Where the run is: step, steps, substep, cuts of the step and of the run, iteration.
+        integer :: step = 0, n_steps = 0, sub = 0, cuts = 0, run_cuts = 0, it = 0
+        real(dp) :: time = 0.0_dp, fraction = 1.0_dp
     contains
         procedure :: set_up => console_set_up
+        procedure :: substep => console_substep
+        procedure :: show_live
+        procedure :: clear_live
         procedure :: iteration => console_iteration
         procedure :: factorized => console_factorized
         procedure :: linear_solved => console_linear_solved
@@ -32,6 +48,9 @@ module voiga_app_console
         procedure :: warning => console_warning
     end type console_t
 
+    !> Seconds between two updates of the live line within an attempt.
+    real(dp), parameter :: live_interval = 0.25_dp
+
 contains
 
     subroutine console_set_up(self, level_dofs, error)
@@ -40,16 +59,64 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call self%results_t%set_up(level_dofs, error)
         if (allocated(error)) return
+        call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,*(1x,i0))') 'multigrid: ', size(level_dofs), &
             ' levels, DOFs', level_dofs
     end subroutine console_set_up
+
+    !> An attempt begins: the live line says where.
+    subroutine console_substep(self, step, n_steps, substep, cuts, run_cuts, time, fraction)
+        class(console_t), intent(inout) :: self
+        integer, intent(in) :: step, n_steps, substep, cuts, run_cuts
+        real(dp), intent(in) :: time, fraction
+        self%step = step
+        self%n_steps = n_steps
+        self%sub = substep
+        self%cuts = cuts
+        self%run_cuts = run_cuts
+        self%time = time
+        self%fraction = fraction
+        self%it = 0
+        call self%show_live(.true.)
+    end subroutine console_substep
+
+    !> Write the live line (`always`, or when it is older than `live_interval`).
+    subroutine show_live(self, always)
+        class(console_t), intent(inout) :: self
+        logical, intent(in) :: always
+        real(dp) :: now
+        if (.not. self%live) return
+        now = wall_seconds()
+        if (.not. always .and. now - self%last < live_interval) return
+        self%last = now
+        write (*, '(a)', advance='no') achar(13)//'  step '//str(self%step)//'/'//str(self%n_steps)// &
+            '  substep '//str(self%sub)//'  cuts '//str(self%cuts)//' (run '//str(self%run_cuts)// &
+            ')  t='//fixed_str(self%time, 4)//'  increment '//trim(adjustl(real_str(self%fraction, 'es8.1')))// &
+            '  iteration '//str(self%it)//'  elapsed '// &
+            fixed_str(now - self%t0, 1)//' s'//achar(27)//'[K'
+        flush (output_unit)
+        self%shown = .true.
+    end subroutine show_live
+
+    !> Wipe the live line, so that the next line starts on an empty one.
+    subroutine clear_live(self)
+        class(console_t), intent(inout) :: self
+        if (.not. self%shown) return
+        write (*, '(a)', advance='no') achar(13)//achar(27)//'[K'
+        flush (output_unit)
+        self%shown = .false.
+    end subroutine clear_live
 
     !> Residual, energy norm, step length, round-off floor and contact states.
     subroutine console_iteration(self, report)
         class(console_t), intent(inout) :: self
         type(iteration_report_t), intent(in) :: report
         integer :: ip
-        if (.not. self%verbose) return
+        if (.not. self%verbose) then
+            self%it = report%iteration
+            call self%show_live(.false.)
+            return
+        end if
         write (*, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f6.4,a)', advance='no') '  step ', report%step, &
             ' it ', report%iteration, '  |r|=', report%residual, '  |du.r|=', report%energy, '  step length ', &
             report%step_length, '  floor '
@@ -70,7 +137,7 @@ contains
         class(console_t), intent(inout) :: self
         integer, intent(in) :: sign
         real(dp), intent(in) :: log10_det
-        if (self%verbose) write (*, '(a,i0,a,f0.2)') '    det K: sign ', sign, ', log10 |det K| ', log10_det
+        if (self%verbose) write (*, '(a,i0,a)') '    det K: sign ', sign, ', log10 |det K| '//fixed_str(log10_det, 2)
     end subroutine console_factorized
 
     subroutine console_linear_solved(self, iterations, residual, asked)
@@ -86,6 +153,7 @@ contains
         integer, intent(in) :: step
         real(dp), intent(in) :: time
         character(len=*), intent(in) :: reason
+        call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a)') 'retry step ', step, '  t=', time, &
             ' from the last converged state (the predicted start failed: '//reason//')'
     end subroutine console_retried
@@ -95,6 +163,7 @@ contains
         integer, intent(in) :: step, pair
         real(dp), intent(in) :: time
         character(len=*), intent(in) :: what, reason
+        call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,i0,a)') 'soften step ', step, '  t=', time, &
             ' pair ', pair, ' (alm): '//what//', the same increment again (it failed: '//reason//')'
     end subroutine console_softened
@@ -103,6 +172,7 @@ contains
         class(console_t), intent(inout) :: self
         type(cut_record_t), intent(in) :: cut
         character(len=*), intent(in) :: reason
+        call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,es9.2,a)') 'cut  step ', cut%step, '  t=', cut%time, &
             '  new increment ', cut%new_fraction, ' of the step: '//reason
     end subroutine console_cut
@@ -119,6 +189,7 @@ contains
     subroutine console_fixed_point_done(self, report)
         class(console_t), intent(inout) :: self
         type(fixed_point_report_t), intent(in) :: report
+        call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,f10.6,a,i0,a,i0,a,6(es9.2,a),i0)') 'tresca step ', &
             report%step, '  t=', report%time, ': the Tresca fixed point converged in ', report%iteration, &
             ' iterations (', report%newton_iterations, ' Newton iterations); Coulomb residual ', report%residual, &
@@ -145,6 +216,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: tic, seconds
         tic = wall_seconds()
+        call self%clear_live()
         call self%results_t%step_done(report, u, model, error)
         if (allocated(error) .or. self%quiet) return
         associate (rec => report%record)
@@ -165,6 +237,7 @@ contains
         class(console_t), intent(inout) :: self
         character(len=*), intent(in) :: text
         call self%results_t%warning(text)
+        call self%clear_live()
         write (0, '(a)') 'voiga: warning: '//text
     end subroutine console_warning
 

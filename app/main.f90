@@ -8,27 +8,27 @@ program voiga_main
     use voiga_io_case, only: case_t, read_case, check_edges
     use voiga_io_dump, only: write_dump
     use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
-    use voiga_io_outputs, only: check_outputs, resolve_restart
-    use voiga_io_os, only: canonical_path
+    use voiga_io_outputs, only: check_outputs, resolve_restart, restart_file
     use voiga_io_provenance, only: check_restart
     use voiga_io_results, only: restart_case, read_restart
     use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
-                                memory_available
+                                memory_available, stdout_is_terminal
     use voiga_linalg_blas, only: warm_up_blas, default_library_threads, choose_blas_kernels
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
-    use voiga_model_checks, only: setup_warnings, warning_t
+    use voiga_model_checks, only: setup_warnings, warning_t, check_overlaps
     use voiga_solver_records, only: solver_stats_t, wall_seconds
     use voiga_solver_stepping, only: solve_steps, resume_t
     use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_solver_heap, only: keep_freed_memory
     use voiga_app_console, only: console_t
     use voiga_kinds, only: dp
+    use voiga_text, only: fixed_str
     use, intrinsic :: iso_fortran_env, only: int64
     implicit none
 
     character(len=:), allocatable :: case_path, dump_path, restart_path, note
-    logical :: check, quiet, verbose, overwrite, force_restart, memory_check
+    logical :: check, quiet, verbose, overwrite, force_restart, memory_check, allow_overlap
     type(case_t) :: case
     type(discretization_t), allocatable :: discs(:)
     type(error_t), allocatable :: error, finish_error
@@ -79,19 +79,20 @@ program voiga_main
     call read_rigid_curves(case, error)
     if (allocated(error)) call fail(error)
 
+    ! the DOF lines are what --check is for; a --quiet run does without them
     total = 0
     do i = 1, size(discs)
-        write (*, '(a,4(a,i0))') 'dofs '//trim(case%bodies(i)%name), ' interface=', &
+        if (check .or. .not. quiet) write (*, '(a,4(a,i0))') 'dofs '//trim(case%bodies(i)%name), ' interface=', &
             discs(i)%interface_dofs, ' bulk=', discs(i)%bulk_dofs, ' total=', discs(i)%total_dofs, &
             ' elements=', discs(i)%nel
         total = total + discs(i)%total_dofs
     end do
-    write (*, '(a,i0)') 'dofs all total=', total
+    if (check .or. .not. quiet) write (*, '(a,i0)') 'dofs all total=', total
     call check_edges(case, discs, error)
     if (allocated(error)) call fail(error)
 
     if (len(dump_path) > 0) then
-        call write_dump(dump_path, case, discs, error)
+        call write_dump(dump_path, case, discs, overwrite .or. case%overwrite, error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a)') 'wrote '//dump_path
     end if
@@ -99,20 +100,26 @@ program voiga_main
     call new_model(model, case%bodies, discs, case%solver%n_gauss, case%dirichlet, case%pressure, &
                    case%contact, error)
     if (allocated(error)) call fail(error)
-    if (check) then
+    ! a set-up that cannot make sense is refused before anything is written (a
+    ! restart continues a run that was accepted)
+    if (.not. allocated(restart_path)) call check_overlaps(model, case%contact%allow_overlap .or. allow_overlap, error)
+    if (check .or. allocated(error)) then
         ! what a run would warn about at its start (a run reports them itself)
         warnings = setup_warnings(model)
         do i = 1, size(warnings)
             write (0, '(a)') 'voiga: warning: '//trim(warnings(i)%text)
         end do
+        if (allocated(error)) call fail(error)
         stop
     end if
     results%quiet = quiet
     results%verbose = verbose
+    results%live = stdout_is_terminal() .and. .not. (quiet .or. verbose)
+    results%t0 = t0
     if (allocated(restart_path)) then
         call restart_in_place()
     else
-        call results%open(case, model, error)
+        call results%open(case, model, overwrite .or. case%overwrite, error)
         ! a write that failed (a full disk): no exit handler may flush the rest
         if (allocated(error) .and. results%h5%is_open()) call stop_writing(error)
         if (allocated(error)) call fail(error)
@@ -120,6 +127,7 @@ program voiga_main
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
     call catch_signals()
     call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
+    call results%clear_live()
     if (stats%signal /= 0) then
         call finish('interrupted')
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
@@ -129,14 +137,19 @@ program voiga_main
     end if
     if (allocated(error)) then
         call finish('failed: '//error%message)
-        write (0, '(a)') 'voiga: results of the converged steps '//where_kept()
+        if (results%n_written == 0 .and. .not. results%h5%kept_earlier) then
+            write (0, '(a)') 'voiga: no step converged; '//case%output//' keeps the status and the warnings '// &
+                '(python -m post summary '//case%output//')'
+        else
+            write (0, '(a)') 'voiga: results of the converged steps '//where_kept()
+        end if
         write (0, '(a)') 'voiga: error: '//error%message
         call exit_code(exit_status(error))
     end if
     call finish('converged')
-    write (*, '(a,i0,a,i0,a,i0,a,i0,a,f0.3,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
-        ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, ', &
-        wall_seconds() - t0, ' s; wrote '//case%output
+    write (*, '(a,i0,a,i0,a,i0,a,i0,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
+        ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, '// &
+        fixed_str(wall_seconds() - t0, 3)//' s; wrote '//case%output
     if (stats%tresca_retries > 0) write (*, '(a,i0,a,i0,a,i0,a)') 'Tresca fixed point: ', &
         stats%tresca_retries, ' substeps retried, ', stats%tresca_accepted, ' accepted, ', &
         stats%fixed_point_iterations, ' fixed-point iterations'
@@ -177,6 +190,7 @@ contains
         overwrite = .false.
         force_restart = .false.
         memory_check = .true.
+        allow_overlap = .false.
         dump_path = ''
         n = command_argument_count()
         k = 0
@@ -202,6 +216,8 @@ contains
                 force_restart = .true.
             case ('--no-memory-check')
                 memory_check = .false.
+            case ('--allow-overlap')
+                allow_overlap = .true.
             case ('--restart')
                 if (k == n) call fail_usage('--restart needs a result file')
                 k = k + 1
@@ -222,14 +238,16 @@ contains
         if (force_restart .and. .not. allocated(restart_path)) call fail_usage('--force-restart needs --restart')
     end subroutine parse_arguments
 
-    !> Take the writer's lock of the result file `restart_path` when it exists (by
-    !> its canonical name, as the run writing it took it); a missing file is reported
-    !> by its reader.
+    !> Take the writer's lock of the result file `restart_path` (by its canonical
+    !> name, as the run writing it took it) before anything reads it: it may be
+    !> mid-step. It must be a regular file (a FIFO or a device is refused before it
+    !> is opened); its lock file is created without following links and replaces
+    !> only a lock file a killed run left, so nothing is written before the case
+    !> is known and compared with it (`resolve_restart`).
     subroutine claim_restart_file()
         character(len=:), allocatable :: resolved
-        type(error_t), allocatable :: missing
-        call canonical_path(restart_path, resolved, missing)
-        if (allocated(missing)) return
+        call restart_file(restart_path, resolved, error)
+        if (allocated(error)) call fail(error)
         call results%h5%claim(resolved, error)
         if (allocated(error)) call fail(error)
     end subroutine claim_restart_file
@@ -262,26 +280,27 @@ contains
         call stop_writing(finish_error)
     end subroutine finish
 
-    !> Where the steps of this run are: 'are in <file>', or, when it wrote none and
-    !> an earlier result was there, that this one is kept.
+    !> Where the steps of this run are: 'are in <file>', or why they are not
+    !> (none written and the earlier result kept; the file moved or removed under
+    !> the run).
     function where_kept() result(text)
         character(len=:), allocatable :: text
-        if (results%h5%kept_earlier) then
-            text = '(none) are not written: the earlier '//case%output//' is kept as it was'
-        else
-            text = 'are in '//case%output
-        end if
+        text = results%h5%where_steps()
     end function where_kept
 
     !> A write to the result file failed: say so and what is on disk, and leave
     !> without exit handlers (HDF5's would write the half-written step).
     subroutine stop_writing(err)
         type(error_t), intent(in) :: err
+        character(len=:), allocatable :: text
         write (0, '(a)') 'voiga: error: '//err%message
         call results%h5%abandon()
-        if (results%h5%in_place) then
+        text = results%h5%where_steps()
+        if (results%h5%in_place .and. index(text, 'are in ') == 1) then
             write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before are readable in '// &
                 case%output//" (its status may still say 'running')"
+        else if (results%h5%in_place .or. results%h5%lost .or. results%h5%stuck) then
+            write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before '//text
         else if (results%h5%kept_earlier) then
             write (0, '(a)') 'voiga: '//case%output//' is kept as it was'
         end if
@@ -297,16 +316,18 @@ contains
     end function get_arg
 
     subroutine usage()
-        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--overwrite] [--quiet] [--verbose]', &
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--overwrite] [--allow-overlap] [--quiet] '// &
+            '[--verbose]', &
             '       voiga [CASE.nml] --restart RESULT.h5 [--force-restart] [--quiet] [--verbose]', &
             '  (no option)       solve the case and write the result file it names', &
             '  --check           validate the case, build the discretization, print DOF counts', &
-            '  --overwrite       replace an existing result file (else refused)', &
+            '  --overwrite       replace an existing result or dump file (else refused)', &
             '  --restart R.h5    continue the interrupted or failed run whose result file is R.h5', &
             '  --force-restart   continue it although its case or geometry file changed', &
             '  --dump FILE       write the refined discretization of every body to FILE (HDF5)', &
             '  --no-memory-check run although the memory estimate exceeds the memory available', &
-            '  --quiet           no line per step', &
+            '  --allow-overlap   run although most slave points of a pair start inside its master', &
+            '  --quiet           no line per step (nor the DOF lines of a run)', &
             '  --verbose         a line per Newton iteration (residual, energy, contact states)', &
             '  --version         print the version', &
             'exit codes: 0 converged, 1 other failure (e.g. a full disk), 2 bad input, 3 numerical', &

@@ -3,7 +3,7 @@
 Subcommands:
   run            solve a case with voiga, print what it found, write figures and ParaView files
   summary        what a result file says, in a few lines
-  plot-deformed  draw every body deformed, coloured by |u| (PNG)
+  plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG)
   plot-contact   p_N and p_T along the contact (PNG)
   history        reactions and contact forces against the load time (CSV and PNG)
   vtk            ParaView time series (.pvd + .vtu)
@@ -106,7 +106,7 @@ def _cmd_vtk(args: argparse.Namespace) -> int:
 
 def _cmd_plot_deformed(args: argparse.Namespace) -> int:
     from .naming import output_path
-    from .plot import plot_deformed
+    from .plot import figure_name, plot_deformed
 
     result = _result(args)
     if not result.steps and args.step != 0:
@@ -116,10 +116,11 @@ def _cmd_plot_deformed(args: argparse.Namespace) -> int:
         return 1
     try:
         s = result.select_step(args.step)
-        output = args.output or output_path(result.path, "deformed", 0 if s is None else s.step,
-                                            args.out)
+        output = args.output or output_path(result.path, figure_name(args.field),
+                                            0 if s is None else s.step, args.out)
         path = plot_deformed(result, step=args.step, output=output, scale=args.scale,
-                             length_unit=args.unit, reference=args.reference)
+                             length_unit=args.unit, reference=args.reference, field=args.field,
+                             colour_scale=args.colour_scale)
     except IndexError as err:
         print(f"python -m post: {err}", file=sys.stderr)
         return 1
@@ -135,7 +136,16 @@ def _cmd_plot_contact(args: argparse.Namespace) -> int:
         print(f"python -m post: {args.result} has no converged step with contact output",
               file=sys.stderr)
         return 1
-    index = args.step if args.step < 0 else [s.step for s in result.steps].index(args.step)
+    if args.step == 0:
+        print(f"python -m post plot-contact: step 0 is the reference configuration, which has no "
+              f"contact output; give a step >= 1 or -1 for the last", file=sys.stderr)
+        return 1
+    try:
+        chosen = result.select_step(args.step)
+    except IndexError as err:
+        print(f"python -m post plot-contact: {err}", file=sys.stderr)
+        return 1
+    index = result.steps.index(chosen)
     print(plot_contact(result, step=index, output=args.output, axis=args.axis, out=args.out))
     return 0
 
@@ -244,14 +254,31 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
     figures); 2 for bad input, 1 if a case failed, else 0."""
     from pathlib import Path
 
-    from .engine import connect, run_all
+    from .solver import InputError, voiga_binary
     from .study import StudyError
-    from .sweep import default_binary, previous_times, summarize, write_summary
+    from .sweep import previous_times, summarize, write_summary
 
-    binary = Path(args.binary) if args.binary else default_binary()
-    if not binary.exists() and not (args.list or args.summary_only):
-        print(f"{prog}: no voiga binary at {binary} (run `make build`)", file=sys.stderr)
+    problem = engine_option_problem(args)
+    if problem:
+        print(f"{prog}: {problem}", file=sys.stderr)
         return 2
+    try:
+        from .engine import connect, run_all
+        if not (args.list or args.summary_only):
+            import dask  # noqa: F401  (imported by the engine when it connects)
+            import distributed  # noqa: F401
+    except ModuleNotFoundError as err:
+        print(f"{prog}: no module {err.name!r}: a study runs its cases on Dask; install the study "
+              "extra: pip install 'voiga[study]' (from a checkout: pip install '.[study]')",
+              file=sys.stderr)
+        return 2
+    try:
+        binary = voiga_binary(args.binary)
+    except InputError as err:
+        if not (args.list or args.summary_only):
+            print(f"{prog}: {err}", file=sys.stderr)
+            return 2
+        binary = Path(args.binary or "voiga")
     try:
         runs = study.runs()
     except StudyError as err:
@@ -261,6 +288,10 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
         for run in runs:
             print(run.work)
         return 0
+    if study.out.exists() and not study.out.is_dir():
+        print(f"{prog}: {study.out} is not a folder (the study's cases, results and table go there)",
+              file=sys.stderr)
+        return 2
     failures: dict[str, tuple[int, str]] = {}
     if not args.summary_only:
         try:
@@ -286,6 +317,29 @@ def _run_study(study: Study, args: argparse.Namespace, prog: str) -> int:
             print(f"{len(made)} figures in {study.out / 'figures'}")
     print(f"{len(runs)} cases, {len(failures)} failed; summary in {csv_path} and {md_path}")
     return 1 if failures else 0
+
+
+def max_jobs() -> int:
+    """Most workers of a local cluster: 8 per core (each runs one voiga)."""
+    import os
+
+    return 8 * (os.cpu_count() or 1)
+
+
+def engine_option_problem(args: argparse.Namespace) -> str | None:
+    """Why the options ``study`` and ``sweep`` share cannot be used (None when they
+    can): a number of workers out of range, a time limit that is not a positive
+    finite number of seconds."""
+    from .study import timeout_problem
+
+    if not 0 <= args.jobs <= max_jobs():
+        return (f"--jobs must be 0 (one worker per core) or 1 to {max_jobs()} "
+                f"(8 per core), not {args.jobs}")
+    if args.timeout:      # (0: the study file's)
+        problem = timeout_problem(args.timeout)
+        if problem:
+            return f"--timeout {problem}"
+    return None
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
@@ -324,8 +378,9 @@ def _cmd_figures(args: argparse.Namespace) -> int:
 
     from .figures import make_all
 
-    if args.jobs is not None and args.jobs < 1:
-        print(f"python -m post figures: --jobs must be at least 1, not {args.jobs}", file=sys.stderr)
+    if args.jobs is not None and not 1 <= args.jobs <= max_jobs():
+        print(f"python -m post figures: --jobs must be at least 1 and at most {max_jobs()} (8 per core), "
+              f"not {args.jobs}", file=sys.stderr)
         return 2
     for path in make_all(Path(args.results), Path(args.out), args.jobs):
         print(path)
@@ -351,7 +406,8 @@ def _engine_options(s: argparse.ArgumentParser, timeout_default: float) -> None:
     s.add_argument("--summary-only", action="store_true", help="only (re)write the summary")
     s.add_argument("--list", action="store_true", help="only list the cases (their case files)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--binary", default=None, help="voiga binary (default: $VOIGA_BIN or build/install)")
+    s.add_argument("--binary", default=None,
+                   help="voiga program (default: $VOIGA_BIN, voiga on the PATH, or build/install)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -392,7 +448,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "least 48 per body and direction)")
     s.set_defaults(func=_cmd_vtk)
 
-    s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|")
+    s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|, "
+                                             "a displacement component or a stress or strain")
     s.add_argument("result", help="result file (.h5) written by voiga")
     s.add_argument("--step", type=int, default=-1,
                    help="step number (>= 1), -k for the k-th last, 0 = reference (default: -1)")
@@ -406,6 +463,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--unit", default=None,
                    help="length unit for the labels (default: the result file's units)")
     s.add_argument("--reference", action="store_true", help="also draw the undeformed outlines")
+    s.add_argument("--field", default="u", metavar="NAME",
+                   help="the colouring: u (|u|, default), ux, uy, von_mises, stress_xx, stress_yy, "
+                        "stress_zz, stress_xy, strain_xx, ... (stress and strain: steps with &output "
+                        "fields); files <result>-<NAME>-<step>.png (u: -deformed-)")
+    s.add_argument("--colour-scale", choices=("body", "shared"), default=None,
+                   help="a colour scale per body or one shared by all bodies (default: per body "
+                        "for u, ux, uy; shared for a stress or strain)")
     s.set_defaults(func=_cmd_plot_deformed)
 
     s = sub.add_parser("plot-contact", help="p_N and p_T along the contact")

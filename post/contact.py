@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pre.files import save_figure
 from pre.nurbs import Curve, curve_to_splipy
 
 from .naming import output_path
@@ -121,6 +122,6 @@ def plot_contact(result: Result, step: int = -1, output: str | Path | None = Non
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.legend()
     path = Path(output) if output else output_path(result.path, "contact", st.step, out)
-    fig.savefig(path, dpi=150)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)
     return path

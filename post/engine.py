@@ -26,6 +26,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from pre.files import check_output, copy_file, new_file, write_bytes, write_text
+
 from .sweep import Run, longest_first, up_to_date
 
 CONNECT_TIMEOUT = 30.0
@@ -101,9 +103,8 @@ def run_task(task: Task) -> Outcome:
             else:
                 dest = Path(task.dest)
                 dest.parent.mkdir(parents=True, exist_ok=True)
-                part = dest.with_name(dest.name + ".part")
-                shutil.move(result, part)     # keeps voiga's modification time
-                os.replace(part, dest)
+                with new_file(dest) as part:
+                    shutil.move(result, part)     # keeps voiga's modification time
     except Exception as err:  # noqa: BLE001 -- one case's trouble must not stop the study
         code, message = -2, f"{type(err).__name__}: {err}"
     return Outcome(task.label, code, message, time.perf_counter() - start, data)
@@ -112,18 +113,18 @@ def run_task(task: Task) -> Outcome:
 def write_if_changed(path: Path, text: str) -> None:
     """Write ``text`` unless the file holds it already (its time stays that of the
     last change, which the skip rule compares with the result's)."""
-    if not path.is_file() or path.read_text() != text:
+    if not check_output(path).is_file() or path.read_text() != text:
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
+        write_text(path, text)
 
 
 def prepare(run: Run) -> None:
     """The case and its geometry in the study's folder (``<out>/<scene>/``), as a
     record of what ran and to rerun it by hand."""
     write_if_changed(run.work, run.case_text())
-    target = run.work.parent / run.geometry.name
+    target = check_output(run.work.parent / run.geometry.name)
     if not target.exists() or target.stat().st_mtime < run.geometry.stat().st_mtime:
-        shutil.copy2(run.geometry, target)
+        copy_file(run.geometry, target)
 
 
 def task_for(run: Run, binary: Path, timeout: float, shared: bool) -> Task:
@@ -145,7 +146,9 @@ def connect(scheduler: str | None = None, jobs: int = 0) -> Iterator[object]:
     if scheduler:
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as err:  # ValueError: a malformed address
+        # ValueError: a malformed address; TypeError: a protocol without its configuration
+        # (tls:// without certificates)
+        except (OSError, TimeoutError, ValueError, TypeError) as err:
             raise OSError(f"no Dask scheduler answers at {scheduler} ({err})") from None
         try:
             yield client
@@ -175,7 +178,7 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
         if not force and up_to_date(run, binary):
             outcome[run.label] = Outcome(run.label, 0, "up to date")
         else:
-            run.result.unlink(missing_ok=True)     # a failed rerun leaves no stale result
+            check_output(run.result).unlink(missing_ok=True)     # a failed rerun leaves no stale result
             todo.append(run)
     todo = longest_first(todo, times)
     by_key, futures = {}, []
@@ -194,9 +197,7 @@ def run_all(runs: list[Run], binary: Path, client: object, timeout: float, force
                 out = Outcome(run.label, -3, f"lost on the cluster: {type(err).__name__}: {err}")
             fut.release()
             if out.data is not None:
-                part = run.result.with_name(run.result.name + ".part")
-                part.write_bytes(out.data)
-                os.replace(part, run.result)
+                write_bytes(run.result, out.data)
                 out.data = None
             outcome[run.label] = out
             failed += out.code != 0

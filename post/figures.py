@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pre.files import save_figure, write_text
+
 from .reader import read_result
 from .sweep import SUMMARY_COLUMNS
 
@@ -66,7 +68,7 @@ def ironing_forces(results: Path, out: Path, scene: str = "ironing", mesh: str =
     ax[0].set_title(f"{scene}, mesh {mesh}: reaction on the die's driven edge")
     ax[0].legend(ncol=4, fontsize=8)
     path = out / f"{scene}-forces-{mesh}.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -100,7 +102,7 @@ def hertz_pressure(results: Path, out: Path, mesh: str = "m3") -> Path | None:
     ax.set_title(f"hertz, mesh {mesh}: contact pressure")
     ax.legend(fontsize=8)
     path = out / f"hertz-pressure-{mesh}.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -131,7 +133,7 @@ def error_plots(rows: list[dict[str, str]], out: Path, scene: str, error: str,
         ax.set_title(f"{scene}: {label} against {name}")
         ax.legend(fontsize=8)
         path = out / f"{scene}-{error}-vs-{name}.png"
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
         plt.close(fig)
         paths.append(path)
     return paths
@@ -237,7 +239,7 @@ def make_all(results: Path, out: Path, jobs: int | None = None) -> list[Path]:
                          ("ironing", "osc_py"), ("ironing", "osc_px"),
                          ("ironing-deep", "osc_py"), ("ironing-deep", "osc_px")):
         text += [f"\n## {scene}: {error}\n\n", accuracy_cost(rows, scene, error)]
-    (out / "accuracy-cost.md").write_text("".join(text))
+    write_text(out / "accuracy-cost.md", "".join(text))
     return [path for part in parts for path in part if path is not None]
 
 
@@ -308,7 +310,7 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
             if others:
                 ax.legend(fontsize=7)
             path = out / f"{_safe(m)}-vs-{_safe(x)}.png"
-            fig.savefig(path, dpi=110)
+            save_figure(fig, path, dpi=110)
             plt.close(fig)
             paths.append(path)
         fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
@@ -323,7 +325,7 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
         ax.set_ylabel(m)
         ax.set_title(f"{m} against the run's wall time")
         path = out / f"{_safe(m)}-vs-time.png"
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
         plt.close(fig)
         paths.append(path)
     return paths

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pre.files import save_figure
 from pre.nurbs import patch_to_splipy
 
 from .contact import edge_stretch
@@ -535,7 +536,7 @@ def plot_hertz(comparisons: list[HertzComparison], output: str | Path,
     bottom.set_ylabel("(p - p_ref) / p0 [%]")
     top.legend(fontsize=8)
     path = Path(output)
-    fig.savefig(path, dpi=150)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)
     return path
 

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pre.files import new_file, save_figure
+
 from .naming import output_path
 from .reader import Result
 
@@ -48,7 +50,7 @@ def write_history_csv(result: Result, output: str | Path | None = None,
     path = Path(output) if output else output_path(result.path, "history", out=out, ext="csv")
     names, rows = history_table(result)
     integer = {"step", "iterations", "cuts"}
-    with open(path, "w", newline="") as f:
+    with new_file(path) as tmp, open(tmp, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(names)
         for row in rows:
@@ -100,6 +102,6 @@ def plot_history(result: Result, output: str | Path | None = None,
             a.legend(fontsize=8)
         a.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("load time (phase k ends at time k)")
-    fig.savefig(path, dpi=150)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)
     return path

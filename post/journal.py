@@ -13,6 +13,7 @@ from __future__ import annotations
 import errno
 import fcntl
 import os
+import stat
 import struct
 import zlib
 from pathlib import Path
@@ -37,13 +38,17 @@ def _records(data: bytes) -> list[tuple[int, bytes]] | None:
 def recover(path: str | Path) -> bool:
     """Apply the complete journal a killed writer left at the end of ``path``; True if
     there was one. Nothing when there is none, when the file cannot be opened for
-    writing, while another process holds its ``flock`` (a writer at work), or when
-    the writes fail (a full disk: the journal stays, for a later call)."""
+    writing or is not a regular file, while another process holds its ``flock`` (a
+    writer at work), or when the writes fail (a full disk: the journal stays, for a
+    later call)."""
     try:
-        fd = os.open(path, os.O_RDWR)
+        # (O_NONBLOCK: a FIFO at the name must not make the open wait)
+        fd = os.open(path, os.O_RDWR | os.O_NONBLOCK | os.O_NOCTTY)
     except OSError:
         return False
     try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return False    # a FIFO, a device: nothing of ours, never written
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as err:

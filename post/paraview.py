@@ -48,6 +48,7 @@ import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
 
+from pre.files import new_file, write_text
 from pre.nurbs import curve_to_splipy
 
 from .field import combine, displacement, evaluate
@@ -338,13 +339,14 @@ def fields_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
 
 def _write(grid: vtk.vtkUnstructuredGrid, path: Path) -> None:
     writer = vtk.vtkXMLUnstructuredGridWriter()
-    writer.SetFileName(str(path))
     writer.SetInputData(grid)
     writer.SetDataModeToAppended()
     writer.EncodeAppendedDataOff()
     writer.SetCompressorTypeToZLib()
-    if writer.Write() != 1:
-        raise OSError(f"VTK could not write {path}")
+    with new_file(path) as tmp:
+        writer.SetFileName(str(tmp))
+        if writer.Write() != 1:
+            raise OSError(f"VTK could not write {path}")
 
 
 def write_vtk(result: Result, out: str | Path | None = None, samples: int = SAMPLES,
@@ -373,5 +375,5 @@ def write_vtk(result: Result, out: str | Path | None = None, samples: int = SAMP
             ET.SubElement(coll, "DataSet", timestep=repr(float(time)), part=str(index),
                           name=what, file=f"{folder.name}/{path.name}")
     ET.indent(root)
-    pvd.write_text(ET.tostring(root, encoding="unicode") + "\n")
+    write_text(pvd, ET.tostring(root, encoding="unicode") + "\n")
     return pvd

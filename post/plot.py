@@ -2,12 +2,15 @@
 
 Every body is drawn in its current configuration ``X + scale * u`` (exact
 VO map of :mod:`post.field`, sampled on a parametric grid that contains every
-element boundary), coloured by the displacement magnitude ``|u|`` with
-Gouraud shading, with the deformed element boundaries as thin lines and one
-colorbar shared by all bodies. The scale is chosen automatically when the
-displacements are small (:func:`auto_scale`; the title says the factor), rigid
-masters (lines and curves) are drawn where they are, and when bodies are in
-contact a second panel shows the contact zone at true scale.
+element boundary), coloured by a quantity (:mod:`post.quantity`: the displacement
+magnitude ``|u|`` by default, a component, or a sampled stress or strain field such
+as the von Mises stress) with Gouraud shading, with the deformed element boundaries
+as thin lines and a colour scale per body (or one shared by all). The scale is
+chosen automatically when the displacements are small (:func:`auto_scale`; the
+title says the factor); rigid masters (lines and curves) are drawn moved by their
+prescribed motion times the same factor, so that they sit on the bodies they
+touch; when bodies are in contact a second panel shows the contact zone at true
+scale.
 """
 
 from __future__ import annotations
@@ -23,10 +26,12 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 
+from pre.files import save_figure  # noqa: E402
 from pre.nurbs import curve_to_splipy  # noqa: E402
 
 from .field import displacement, evaluate_grid  # noqa: E402
 from .naming import output_path  # noqa: E402
+from .quantity import DISPLACEMENT, check_name, displacement_quantity, label, sampled_quantity, signed  # noqa: E402
 from .reader import Body, ContactOutput, Result, Step, body_displacement, read_result  # noqa: E402
 
 CMAP = "turbo"
@@ -67,6 +72,39 @@ def sampled_field(body: Body, u_body: np.ndarray,
     return evaluate_grid(body, None, xi, eta), displacement(body, u_body, xx, ee)
 
 
+def quantity_grid(body: Body, step: Step | None, u_pts: np.ndarray, name: str,
+                  minimum: int = MIN_SAMPLES) -> np.ndarray:
+    """The quantity ``name`` (:mod:`post.quantity`) on the sampling grid of
+    :func:`sampled_field` (``u_pts``: the displacement there)."""
+    if name in ("u", "ux", "uy"):
+        return displacement_quantity(name, u_pts)
+    if step is None:
+        raise ValueError(f"--field {name}: the reference configuration (step 0) has no stress")
+    bx, be = breakpoints(body)
+    xx, ee = np.meshgrid(sample_parameters(bx, minimum), sample_parameters(be, minimum))
+    return sampled_quantity(step, body, name, xx, ee)
+
+
+def colour_norms(values: dict[str, np.ndarray], name: str, per_body: bool) -> dict[str, Normalize]:
+    """The colour scale of each body: its own range (``per_body``) or the range of
+    all; from 0 for a magnitude, symmetric about 0 for a quantity of both signs
+    whose range holds 0 (so that 0 has one colour)."""
+    def norm(vals: list[np.ndarray]) -> Normalize:
+        lo = min(float(np.nanmin(v)) for v in vals)
+        hi = max(float(np.nanmax(v)) for v in vals)
+        if not signed(name):
+            lo = 0.0
+        elif lo < 0.0 < hi:
+            lo, hi = -max(-lo, hi), max(-lo, hi)
+        if hi <= lo:
+            hi = lo + (abs(lo) if lo else 1.0)
+        return Normalize(vmin=lo, vmax=hi)
+    if per_body:
+        return {b: norm([v]) for b, v in values.items()}
+    shared = norm(list(values.values()))
+    return {b: shared for b in values}
+
+
 def deformed_grid(body: Body, u_body: np.ndarray, scale: float = 1.0,
                   minimum: int = MIN_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
     """``(points (n_eta, n_xi, 2), |u| (n_eta, n_xi))`` on the sampling grid:
@@ -85,6 +123,12 @@ def element_edges(body: Body, u_body: np.ndarray, scale: float = 1.0,
     lines = [evaluate_grid(body, u, [x], t)[:, 0] for x in bx]
     lines += [evaluate_grid(body, u, t, [e])[0] for e in be]
     return lines
+
+
+def figure_name(field: str) -> str:
+    """The ``<what>`` of a plot-deformed file name: ``deformed`` for ``|u|``, else the
+    quantity (``von_mises``: ``<result>-von_mises-<step>.png``)."""
+    return "deformed" if field == "u" else field
 
 
 def auto_scale(size: float, u_max: float, visible: float = VISIBLE, target: float = TARGET) -> float:
@@ -173,15 +217,16 @@ def _title(result: Result, step: int, time: float | None, scale: float) -> str:
     return text
 
 
-def _draw_bodies(ax: plt.Axes, grids: dict, norm: Normalize, scale: float, reference: bool,
-                 minimum: int, names: bool = True):
-    """Every body on ``ax``: the coloured sampling grid, element edges, outline."""
-    mesh = None
-    for name, (body, u, ref_pts, u_pts) in grids.items():
+def _draw_bodies(ax: plt.Axes, grids: dict, norms: dict[str, Normalize], scale: float, reference: bool,
+                 minimum: int, names: bool = True) -> dict:
+    """Every body on ``ax``: the coloured sampling grid, element edges, outline;
+    returns each body's coloured mesh."""
+    meshes = {}
+    for name, (body, u, ref_pts, u_pts, values) in grids.items():
         pts = ref_pts + scale * u_pts
-        mag = np.linalg.norm(u_pts, axis=-1)
-        mesh = ax.pcolormesh(pts[..., 0], pts[..., 1], mag, shading="gouraud", cmap=CMAP,
-                             norm=norm, rasterized=True)
+        mesh = ax.pcolormesh(pts[..., 0], pts[..., 1], values, shading="gouraud", cmap=CMAP,
+                             norm=norms[name], rasterized=True)
+        meshes[name] = mesh
         mesh.sticky_edges.x[:] = []  # let the margins show the outline
         mesh.sticky_edges.y[:] = []
         ax.add_collection(LineCollection(element_edges(body, u, scale), colors="k",
@@ -197,7 +242,7 @@ def _draw_bodies(ax: plt.Axes, grids: dict, norm: Normalize, scale: float, refer
             centre = pts[pts.shape[0] // 2, pts.shape[1] // 2]
             ax.annotate(name, centre, ha="center", va="center", fontsize=9,
                         bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.5", alpha=0.8))
-    return mesh
+    return meshes
 
 
 def _zoom_window(pairs: list[ContactOutput], size: float) -> tuple[np.ndarray, np.ndarray]:
@@ -211,32 +256,60 @@ def _zoom_window(pairs: list[ContactOutput], size: float) -> tuple[np.ndarray, n
 def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Path | None = None,
                   scale: float | str = "auto", length_unit: str | None = None,
                   reference: bool = False, minimum: int = MIN_SAMPLES,
-                  zoom: bool = True) -> Path:
+                  zoom: bool = True, field: str = "u", colour_scale: str | None = None) -> Path:
     """Draw every body of ``result`` deformed at ``step`` (selection as in
-    :meth:`post.reader.Result.select_step`) and write a PNG.
+    :meth:`post.reader.Result.select_step`) and write a PNG (:func:`deformed_figure`).
+    ``output`` defaults to ``<result>-<deformed or the field>-<step>.png`` next to
+    the result file. Returns the path written."""
+    if not isinstance(result, Result):
+        result = read_result(result)
+    fig, _ = deformed_figure(result, step, scale, length_unit, reference, minimum, zoom, field, colour_scale)
+    s = result.select_step(step)
+    output = Path(output) if output is not None else \
+        output_path(result.path, figure_name(field), 0 if s is None else s.step)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    save_figure(fig, output, dpi=150)
+    plt.close(fig)
+    return output
+
+
+def deformed_figure(result: Result, step: int = -1, scale: float | str = "auto",
+                    length_unit: str | None = None, reference: bool = False, minimum: int = MIN_SAMPLES,
+                    zoom: bool = True, field: str = "u",
+                    colour_scale: str | None = None) -> tuple[plt.Figure, dict]:
+    """The figure of every body of ``result`` deformed at ``step`` (selection as in
+    :meth:`post.reader.Result.select_step`) and each body's coloured mesh on the
+    main panel.
 
     ``scale``: displacement magnification, or ``'auto'`` (:func:`auto_scale`).
     ``length_unit``: axis unit (default: the file's, :attr:`Result.units`).
-    ``output`` defaults to ``<result>-deformed-<step>.png`` next to the result
-    file. ``reference=True`` adds the undeformed outlines (dashed). ``zoom``: when
+    ``reference=True`` adds the undeformed outlines (dashed). ``zoom``: when
     bodies are in contact, a second panel shows the contact zone at true scale.
-    Rigid masters (lines, curves) are drawn in both panels. Returns the path written.
+    ``field``: the colouring (:data:`post.quantity.QUANTITIES`; a stress or strain
+    needs a step with sampled fields). ``colour_scale``: ``'body'`` (each body its
+    own range and colour bar: a body that translates far does not flatten the
+    others) or ``'shared'``; default ``'body'`` for a displacement, ``'shared'``
+    for a stress or strain (continuous across bodies in contact). Rigid masters (lines, curves) are drawn in both panels,
+    in the first moved by their prescribed motion times ``scale``.
     """
-    if not isinstance(result, Result):
-        result = read_result(result)
     if not result.bodies:
         raise ValueError(f"{result.path}: no bodies")
+    check_name(field)
+    if colour_scale is None:
+        colour_scale = "body" if field in DISPLACEMENT else "shared"
+    if colour_scale not in ("body", "shared"):
+        raise ValueError(f"colour scale {colour_scale!r}: 'body' or 'shared'")
     s = result.select_step(step)
     number = 0 if s is None else s.step
-    output = Path(output) if output is not None else output_path(result.path, "deformed", number)
     unit = length_unit or result.units.length
 
     grids = {}
     for name, body in result.bodies.items():
         u = body_displacement(result, name, number if s is not None else 0)
-        grids[name] = (body, u, *sampled_field(body, u, minimum))
+        ref_pts, u_pts = sampled_field(body, u, minimum)
+        grids[name] = (body, u, ref_pts, u_pts, quantity_grid(body, s, u_pts, field, minimum))
+    norms = colour_norms({n: g[4] for n, g in grids.items()}, field, colour_scale == "body")
     vmax = max(float(np.linalg.norm(g[3], axis=-1).max()) for g in grids.values())
-    norm = Normalize(vmin=0.0, vmax=vmax if vmax > 0 else 1.0)
     allpts = np.concatenate([(g[2] + g[3]).reshape(-1, 2) for g in grids.values()])
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     size = float(np.max(hi - lo))
@@ -254,31 +327,16 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
     else:
         fig, ax = plt.subplots(figsize=(width, height), layout="constrained")
         axz = None
-    mesh = _draw_bodies(ax, grids, norm, scale, reference, minimum)
+    meshes = _draw_bodies(ax, grids, norms, scale, reference, minimum)
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.03)
-    lines = rigid_lines(s)
-    if lines:
-        xl, yl = ax.get_xlim(), ax.get_ylim()
-        for p, n, label in lines:
-            note = label if scale == 1.0 else f"{label} (true position; bodies x {scale:g})"
-            draw_rigid_line(ax, p, n, 0.04 * size, 3.0 * size, note, "-" if scale == 1.0 else "--")
-        ax.set_xlim(min(xl[0], *(p[0] - 0.05 * size for p, _, _ in lines)),
-                    max(xl[1], *(p[0] + 0.05 * size for p, _, _ in lines)))
-        ax.set_ylim(min(yl[0], *(p[1] - 0.06 * size for p, _, _ in lines)), yl[1])
-    curves = rigid_curves(s)
-    for pts, n, label in curves:
-        note = label if scale == 1.0 else f"{label} (true position; bodies x {scale:g})"
-        draw_rigid_curve(ax, pts, n, 0.04 * size, note, "-" if scale == 1.0 else "--")
-    if lines or curves:
-        ax.autoscale_view()
-        ax.legend(loc="upper right", fontsize=8)
+    lines, curves = _draw_rigid_masters(ax, s, scale, size)
     ax.set_xlabel(f"x [{unit}]")
     ax.set_ylabel(f"y [{unit}]")
     ax.set_title(_title(result, number, None if s is None else s.time, scale), fontsize=10)
     if axz is not None:
-        _draw_bodies(axz, grids, norm, 1.0, False, minimum, names=False)
+        _draw_bodies(axz, grids, norms, 1.0, False, minimum, names=False)
         centre, half = _zoom_window(pairs, size)
         for p, n, _ in lines:
             draw_rigid_line(axz, p, n, 0.15 * half[1], 3.0 * size)
@@ -293,9 +351,42 @@ def plot_deformed(result: Result | str | Path, step: int = -1, output: str | Pat
         axz.set_xlabel(f"x [{unit}]")
         axz.set_title("contact zone, true scale", fontsize=10)
         axz.legend(loc="upper right", fontsize=8)
-    cbar = fig.colorbar(mesh, ax=[ax] if axz is None else [ax, axz], shrink=0.9, pad=0.02)
-    cbar.set_label(f"displacement magnitude |u| [{unit}]")
-    output.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(output, dpi=150)
-    plt.close(fig)
-    return output
+    axes = [ax] if axz is None else [ax, axz]
+    text = label(field, result.units)
+    if colour_scale == "shared" or len(meshes) == 1:
+        cbar = fig.colorbar(next(iter(meshes.values())), ax=axes, shrink=0.9, pad=0.02)
+        cbar.set_label(text)
+    else:
+        for name, mesh in meshes.items():
+            cbar = fig.colorbar(mesh, ax=axes, shrink=0.9, pad=0.01, fraction=0.04)
+            cbar.set_label(f"{name}: {text}", fontsize=8)
+    return fig, meshes
+
+
+def _draw_rigid_masters(ax: plt.Axes, s: Step | None, scale: float, size: float) -> tuple[list, list]:
+    """The rigid masters of step ``s`` on the main panel, moved by their prescribed
+    motion times ``scale`` (where the bodies drawn at that scale meet them); returns
+    the lines and curves at their true positions (for the true-scale panel)."""
+    lines, curves = rigid_lines(s), rigid_curves(s)
+    contact = [] if s is None else s.contact
+    zero = np.zeros(2)
+
+    def offset(c: ContactOutput) -> np.ndarray:
+        return zero if c.rigid_offset is None else np.asarray(c.rigid_offset, dtype=float)
+    line_offsets = [offset(c) for c in contact if c.rigid_point is not None and c.rigid_normal is not None]
+    curve_offsets = [offset(c) for c in contact if c.rigid_curve is not None]
+    note = "" if scale == 1.0 else f" (its motion x {scale:g}, as the bodies)"
+    moved_lines = [(p + (scale - 1.0) * d, n, lab) for (p, n, lab), d in zip(lines, line_offsets)]
+    if moved_lines:
+        xl, yl = ax.get_xlim(), ax.get_ylim()
+        for p, n, lab in moved_lines:
+            draw_rigid_line(ax, p, n, 0.04 * size, 3.0 * size, lab + note)
+        ax.set_xlim(min(xl[0], *(p[0] - 0.05 * size for p, _, _ in moved_lines)),
+                    max(xl[1], *(p[0] + 0.05 * size for p, _, _ in moved_lines)))
+        ax.set_ylim(min(yl[0], *(p[1] - 0.06 * size for p, _, _ in moved_lines)), yl[1])
+    for (pts, n, lab), d in zip(curves, curve_offsets):
+        draw_rigid_curve(ax, pts + (scale - 1.0) * d, n, 0.04 * size, lab + note)
+    if lines or curves:
+        ax.autoscale_view()
+        ax.legend(loc="upper right", fontsize=8)
+    return lines, curves

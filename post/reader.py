@@ -67,6 +67,38 @@ class BadResultError(ValueError):
     """A file that is not a readable voiga result; the message names it and the cause."""
 
 
+def finite(values: np.ndarray, dataset: str) -> np.ndarray:
+    """``values`` when every one is finite; BadResultError naming the dataset
+    otherwise (voiga writes none: a file that holds a NaN displacement is damaged,
+    and every figure or table made from it would be wrong)."""
+    if not np.all(np.isfinite(values)):
+        bad = int(np.size(values) - np.count_nonzero(np.isfinite(values)))
+        raise BadResultError(f"{dataset} holds {bad} non-finite value(s) (NaN or Inf): "
+                             "not a result voiga wrote")
+    return values
+
+
+def _named(path: Path, err: BadResultError) -> BadResultError:
+    """``err`` with the file's name in front, unless it names it already."""
+    return err if str(err).startswith(str(path)) else BadResultError(f"{path}: {err}")
+
+
+COUNTERS: tuple[str, ...] = ("n_steps_done", "n_steps_planned", "n_dofs", "n_cuts")
+"""Root attributes that count something: never negative."""
+
+
+def check_counters(path: Path, attrs: dict[str, Any]) -> None:
+    """The root's counters are possible: integers >= 0, at most as many steps done
+    as planned; BadResultError naming the attribute otherwise."""
+    for key in COUNTERS:
+        if key in attrs and not (isinstance(attrs[key], int) and attrs[key] >= 0):
+            raise BadResultError(f"{path}: root attribute {key} = {attrs[key]!r}: not a count")
+    done, planned = attrs.get("n_steps_done"), attrs.get("n_steps_planned")
+    if done is not None and planned is not None and done > planned:
+        raise BadResultError(f"{path}: root attribute n_steps_done = {done} exceeds "
+                             f"n_steps_planned = {planned}")
+
+
 STAGES: tuple[str, ...] = ("assembly", "contact", "factorization", "solve", "output")
 """Stages whose wall-clock seconds each step records (attrs ``seconds_<stage>``)."""
 
@@ -239,7 +271,10 @@ class Step:
                 raise AttributeError(f"step {self.step}: no {key} read and no file to read it from")
             path, name, n_dofs = self._source
             with _open(path) as f:
-                self._data.update(_read_step_details(f["steps"][name], name))
+                try:
+                    self._data.update(_read_step_details(f["steps"][name], name))
+                except BadResultError as err:
+                    raise _named(path, err) from None
             if len(self._data["displacement"]) != n_dofs:
                 raise ValueError(f"{path}: step {self.step} displacement has "
                                  f"{len(self._data['displacement'])} entries, n_dofs = {n_dofs}")
@@ -393,8 +428,8 @@ class Result:
         for s in self.steps:
             if s.step == step:
                 return s
-        raise IndexError(f"{self.path}: no converged step {step} "
-                         f"(have {[s.step for s in self.steps]}, status {self.status!r})")
+        raise IndexError(f"{self.path}: no converged step {step} ({_steps_text(self.steps)}, "
+                         f"status {self.status!r}; -1 is the last)")
 
     def dirichlet_index(self, body: str, edge: str) -> int:
         """0-based index of the Dirichlet condition on ``body``'s ``edge``."""
@@ -402,6 +437,17 @@ class Result:
             if d.body == body and d.edge == edge:
                 return k
         raise KeyError(f"no Dirichlet condition on {body}/{edge}")
+
+
+def _steps_text(steps: list[Step]) -> str:
+    """Which steps a result has, in a few words: 'steps 1 to 25', 'steps 2, 5, 9'."""
+    numbers = [s.step for s in steps]
+    if not numbers:
+        return "no converged step"
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"steps {numbers[0]} to {numbers[-1]}" if len(numbers) > 1 else f"step {numbers[0]}"
+    shown = ", ".join(map(str, numbers[:8]))
+    return f"steps {shown}" + (f", ... {numbers[-1]}" if len(numbers) > 8 else "")
 
 
 @contextmanager
@@ -453,7 +499,7 @@ _open = open_result
 
 def _read_body(name: str, g: h5py.Group) -> Body:
     attrs = _attrs(g)
-    cp = np.asarray(g["control_points"][()], dtype=float)
+    cp = finite(np.asarray(g["control_points"][()], dtype=float), f"/bodies/{name}/control_points")
     if cp.ndim != 2 or cp.shape[1] != 2:
         raise ValueError(f"/bodies/{name}/control_points: shape {cp.shape}, expected (ncp, 2)")
     ncp = len(cp)
@@ -476,7 +522,8 @@ def _read_body(name: str, g: h5py.Group) -> Body:
                 youngs_modulus=float(attrs.get("youngs_modulus", np.nan)),
                 poisson_ratio=float(attrs.get("poisson_ratio", np.nan)),
                 dof_offset=int(attrs.get("dof_offset", 0)),
-                control_points=cp, weights=np.asarray(g["weights"][()], dtype=float).reshape(-1),
+                control_points=cp,
+                weights=finite(np.asarray(g["weights"][()], dtype=float).reshape(-1), f"/bodies/{name}/weights"),
                 element_ptr=ptr, element_conn=conn, element_ranges=ranges, element_vo=vo,
                 edges=edges, bulk=read_patch(g["bulk"]),
                 layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs)
@@ -532,7 +579,8 @@ def _read_step(name: str, gid: h5py.h5g.GroupID, n_dirichlet: int, path: Path, n
         return None
     a = _scalar_attrs(gid, _STEP_SCALARS)
     reactions = _read_array(gid, "reactions")
-    reactions = np.zeros((0, 2)) if reactions is None else reactions.reshape(-1, 2)
+    reactions = np.zeros((0, 2)) if reactions is None else finite(reactions.reshape(-1, 2),
+                                                                    f"/steps/{name}/reactions")
     if len(reactions) != n_dirichlet:
         raise ValueError(f"/steps/{name}/reactions: {len(reactions)} rows for "
                          f"{n_dirichlet} Dirichlet conditions")
@@ -558,7 +606,7 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
 
     return {"time": float(a.get("time", np.nan)), "substeps": int(a.get("substeps", 1)),
             "residual_norms": vec("residual_norms"), "energy_norms": vec("energy_norms"),
-            "displacement": vec("displacement"),
+            "displacement": finite(vec("displacement"), f"/steps/{name}/displacement"),
             "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
             if gid.links.exists(b"contact") else [],
             "fields": {body: {k: _field_array(v) for k, v in fg.items()}
@@ -582,7 +630,11 @@ def _read_contact(g: h5py.Group) -> ContactOutput:
         return np.asarray(g[key][()], dtype=float).reshape(-1)
 
     def pts(key: str) -> np.ndarray:
-        return np.asarray(g[key][()], dtype=float).reshape(-1, 2)
+        return finite(np.asarray(g[key][()], dtype=float).reshape(-1, 2), f"{g.name}/{key}")
+
+    # (the gap is NaN where a point has no projection onto its master: not checked)
+    for key in ("force", "p_n", "p_t"):
+        finite(vec(key), f"{g.name}/{key}")
 
     return ContactOutput(slave=str(a.get("slave", "")), master=str(a.get("master", "")),
                          force=vec("force"), xi_slave=vec("xi_slave"), x_ref=pts("x_ref"),
@@ -610,7 +662,9 @@ def read_result(path: str | Path, lazy: bool = False) -> Result:
     for attempt in range(READ_ATTEMPTS):
         try:
             return _read_result(path, lazy)
-        except (BadResultError, FileNotFoundError):
+        except BadResultError as err:
+            raise _named(path, err) from None
+        except FileNotFoundError:
             raise
         except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, AttributeError) as err:
             # a writer that had to stop waiting for a slow read changes the file
@@ -627,6 +681,7 @@ def _read_result(path: Path, lazy: bool) -> Result:
         attrs = _attrs(f)
         if "status" not in attrs:
             raise BadResultError(f"{path}: not a voiga result (no root attribute 'status')")
+        check_counters(path, attrs)
         bodies = [_read_body(name, g) for name, g in f["bodies"].items()] if "bodies" in f else []
         bodies.sort(key=lambda b: b.dof_offset)
         n_dofs = int(attrs.get("n_dofs", 0)) or sum(2 * b.ncp for b in bodies)

@@ -12,6 +12,7 @@ own folder an existing result is replaced only with ``overwrite``.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from .naming import output_path
@@ -29,8 +30,13 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
     written: list[Path] = []
     if not result.steps:
         return written
-    written.append(plot_deformed(result, output=output_path(result.path, "deformed",
-                                                            result.steps[-1].step, out)))
+    last = result.steps[-1]
+    written.append(plot_deformed(result, output=output_path(result.path, "deformed", last.step, out)))
+    if last.fields:  # the case asked for stresses (&output): the von Mises stress too
+        field = "von_mises" if all("von_mises" in f for f in last.fields.values()) else "stress_yy"
+        if field == "von_mises" or all("stress" in f for f in last.fields.values()):
+            written.append(plot_deformed(result, output=output_path(result.path, field, last.step, out),
+                                         field=field))
     written += [write_history_csv(result, out=out), plot_history(result, out=out)]
     if result.steps[-1].contact:
         written.append(plot_contact(result, out=out))
@@ -46,18 +52,39 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
     return written
 
 
+def _identity(path: Path) -> tuple[int, int, int] | None:
+    """(inode, size, modification time in ns) of a file, None when there is none: a
+    run that wrote the file changes it (voiga replaces or extends it)."""
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
 def run_case(case: str | Path, out: str | Path | None = None, binary: str | Path | None = None,
              quiet: bool = False, figures: bool = True, vtk: bool = True, overwrite: bool = False) -> int:
     """Solve ``case`` (staged into ``out`` when given), print the summary and write
-    the figures; returns voiga's exit code (the figures are made of whatever
-    converged, also after a failed run)."""
+    the figures; returns voiga's exit code. The figures are made of whatever
+    converged, also after a failed run (exit 3); when voiga refused the case or
+    stopped otherwise (any other code), or wrote no result, nothing is printed or
+    written but that."""
     case = Path(case)
     program = voiga_binary(binary)
     run = stage_case(case, Path(out)) if out is not None else case
-    code = run_voiga(program, run, quiet, overwrite=overwrite or out is not None)
     path = result_path(run)
-    if not path.is_file():
-        print(f"voiga exited with {code} and wrote no result file {path}")
+    before = _identity(path)
+    code = run_voiga(program, run, quiet, overwrite=overwrite or out is not None)
+    if code not in (0, 3):
+        # refused (2: bad input, an existing result, a wrong set-up), interrupted, no
+        # memory, ...: voiga said why; a result file there is not this run's
+        print(f"voiga exited with {code} (its message is above); no summary, no figures written",
+              file=sys.stderr)
+        return code
+    if not path.is_file() or _identity(path) == before:
+        print(f"voiga exited with {code} and wrote no result (no step converged"
+              + (f"; the earlier {path} is unchanged" if path.is_file() else "")
+              + "); no summary, no figures written", file=sys.stderr)
         return code or 1
     result = read_result(path)
     print()

@@ -15,28 +15,54 @@ from pathlib import Path
 
 import f90nml
 
+from pre.files import new_file
+
 CHECKOUT_BINARY = Path(__file__).resolve().parents[1] / "build" / "install" / "bin" / "voiga"
 """Where ``make build`` installs the program, when this package runs from a checkout."""
+
+BUILD_HINT = ("build it with `make build` in the voiga repository (it installs "
+              "build/install/bin/voiga), then put that folder on the PATH (export "
+              "PATH=\"$PWD/build/install/bin:$PATH\") or set VOIGA_BIN")
+"""How to get a voiga program, for the messages of a missing one."""
 
 
 class InputError(Exception):
     """Bad input named by the message (the command line exits with 2)."""
 
 
+def _runnable(path: Path) -> bool:
+    return path.is_file() and os.access(path, os.X_OK)
+
+
+def in_checkout() -> bool:
+    """Whether this package runs from a source checkout (its fpm.toml beside it), not
+    from an installed copy (site-packages has no build folder)."""
+    return (CHECKOUT_BINARY.parents[2] / "fpm.toml").is_file()
+
+
 def voiga_binary(explicit: str | Path | None = None) -> Path:
-    """The voiga program to run (see the module docstring); InputError when none."""
+    """The voiga program to run (see the module docstring); InputError naming where
+    it looked and how to build one when there is none."""
     if explicit:
         path = Path(explicit)
-    elif os.environ.get("VOIGA_BIN"):
+        if not _runnable(path):
+            raise InputError(f"no voiga program at {path} (--binary): not an executable file")
+        return path
+    if os.environ.get("VOIGA_BIN"):
         path = Path(os.environ["VOIGA_BIN"])
-    elif shutil.which("voiga"):
-        path = Path(shutil.which("voiga"))  # type: ignore[arg-type]
-    else:
-        path = CHECKOUT_BINARY
-    if not (path.is_file() and os.access(path, os.X_OK)):
-        raise InputError(f"no voiga program at {path} (run `make build`, put voiga on the PATH "
-                         "or set VOIGA_BIN)")
-    return path
+        if not _runnable(path):
+            raise InputError(f"no voiga program at {path} (VOIGA_BIN): not an executable file "
+                             "(unset VOIGA_BIN to use voiga on the PATH)")
+        return path
+    found = shutil.which("voiga")
+    if found:
+        return Path(found)
+    if in_checkout() and _runnable(CHECKOUT_BINARY):
+        return CHECKOUT_BINARY
+    where = f"no voiga on the PATH ({os.environ.get('PATH', '')})"
+    if in_checkout():
+        where += f" and no {CHECKOUT_BINARY}"
+    raise InputError(f"no voiga program: {where}; {BUILD_HINT}")
 
 
 def read_case_group(case: Path) -> dict:
@@ -68,8 +94,9 @@ def stage_case(case: Path, folder: Path) -> Path:
     if copy.resolve() == case.resolve():
         return case
     relative = os.path.relpath(geometry_path, folder.resolve())
-    f90nml.patch(str(case), {"case": {"geometry": relative}}, str(copy) + ".tmp")
-    os.replace(str(copy) + ".tmp", copy)
+    with new_file(copy) as tmp:
+        tmp.unlink()      # f90nml writes the patched copy itself
+        f90nml.patch(str(case), {"case": {"geometry": relative}}, str(tmp))
     return copy
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -24,26 +25,10 @@ from typing import Any
 
 import f90nml
 
+from pre.namelists import NAMELISTS
+
 from .measures import parse_file_measure
 from .sweep import REPO, SUMMARY_COLUMNS, Run, find_cases
-
-NAMELISTS: dict[str, frozenset[str]] = {
-    "case": frozenset({"title", "scene", "mesh", "layout", "geometry", "output", "n_bodies", "overwrite"}),
-    "body": frozenset({"name", "material", "youngs_modulus", "poisson_ratio", "basis", "degree_xi",
-                       "degree_eta", "nel_xi", "nel_eta", "knots_xi", "knots_eta", "contact_edge",
-                       "layer_degree", "layer_elevations"}),
-    "solver": frozenset({"n_steps", "max_iterations", "tol_residual", "tol_energy", "n_gauss",
-                         "min_step_fraction", "max_cuts", "grow_iterations", "predictor",
-                         "linear_solver", "damping"}),
-    "dirichlet": frozenset({"body", "edge", "fix_x", "fix_y", "ux", "uy"}),
-    "pressure": frozenset({"body", "edge", "p"}),
-    "contact": frozenset({"slave", "master", "rigid_point", "rigid_normal", "penalty_normal",
-                          "penalty_tangent", "friction", "n_gauss", "method", "tolerance", "rigid_curve",
-                          "rigid_ux", "rigid_uy"}),
-    "output": frozenset({"fields", "samples", "every", "steps"}),
-}
-"""Namelist group -> its variables, as the readers in ``src/io/case/`` declare them (a
-test compares the two)."""
 
 SELECTOR_KEYS = ("name", "slave", "body")
 """The variable a ``group[name]`` selector matches, first present wins (``&body``:
@@ -328,6 +313,34 @@ class Study:
         return runs
 
 
+MAX_TIMEOUT = 1e6
+"""Longest time limit per case (seconds, about 11.6 days)."""
+
+
+def timeout_problem(value: Any) -> str | None:
+    """Why ``value`` is not a time limit in seconds (None when it is one: a finite
+    number in (0, MAX_TIMEOUT])."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"must be a number of seconds, not {value!r}"
+    if not (math.isfinite(value) and 0 < value <= MAX_TIMEOUT):
+        return f"must be more than 0 and at most {MAX_TIMEOUT:g} seconds, not {value!r}"
+    return None
+
+
+def check_value(value: Any, where: str) -> None:
+    """A value a study may give a namelist variable: a string, a boolean, an
+    integer, a finite number, or a (non-nested) list of them; StudyError otherwise."""
+    items = value if isinstance(value, list) else [value]
+    for item in items:
+        if isinstance(item, (str, bool, int)):
+            continue
+        if isinstance(item, float) and math.isfinite(item):
+            continue
+        what = ("a list inside a list" if isinstance(item, list) else f"{item!r}")
+        raise StudyError(f"{where}: {what} is not a namelist value (strings, numbers, true/false, "
+                         "or a list of them)")
+
+
 def _list(value: Any, key: str, where: str) -> list[str] | None:
     if value is None:
         return None
@@ -383,11 +396,15 @@ def load_study(path: Path, out: Path | None = None) -> Study:
     study.scenes = _list(data.get("scenes"), "scenes", where)
     study.meshes = _list(data.get("meshes"), "meshes", where)
     study.layouts = _list(data.get("layouts"), "layouts", where)
+    for key in ("generate", "figures"):
+        if key in data and not isinstance(data[key], bool):
+            raise StudyError(f"{where}: {key} must be true or false, not {data[key]!r}")
     study.generate = bool(data.get("generate", False))
     study.figures = bool(data.get("figures", True))
     if "timeout" in data:
-        if not isinstance(data["timeout"], (int, float)) or data["timeout"] <= 0:
-            raise StudyError(f"{where}: timeout must be a positive number of seconds")
+        problem = timeout_problem(data["timeout"])
+        if problem:
+            raise StudyError(f"{where}: timeout {problem}")
         study.timeout = float(data["timeout"])
     grid = data.get("grid", {})
     if not isinstance(grid, dict):
@@ -396,14 +413,17 @@ def load_study(path: Path, out: Path | None = None) -> Study:
         parse_variable(key, f"{where}: [grid]")
         if not isinstance(values, list) or not values:
             raise StudyError(f"{where}: [grid] {key} must be a non-empty list of values")
+        for value in values:
+            check_value(value, f"{where}: [grid] {key}")
         study.grid[key] = values
     points = data.get("list", [])
     if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
         raise StudyError(f"{where}: list must be an array of tables ([[list]])")
     for k, point in enumerate(points, start=1):
         flat = _flatten(point)
-        for key in flat:
+        for key, value in flat.items():
             parse_variable(key, f"{where}: [[list]] entry {k}")
+            check_value(value, f"{where}: [[list]] entry {k}: {key}")
         study.points.append(flat)
     measures = data.get("measures", {})
     if isinstance(measures, list):

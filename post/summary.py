@@ -65,10 +65,14 @@ def _vec(v: np.ndarray) -> str:
 
 
 def summary_lines(result: Result) -> list[str]:
-    """Human-readable lines describing ``result`` (any status)."""
+    """Human-readable lines describing ``result`` (any status; the recorded warnings
+    also when no step converged)."""
     u = result.units
     steps = result.steps
     iters = sum(s.iterations if s.iterations_total is None else s.iterations_total for s in steps)
+    # voiga records the iterations of all attempts (failed ones too) when the run ends;
+    # a restarted run counts its own only, the written steps count theirs
+    iters = max(iters, int(result.attrs.get("newton_iterations", 0)))
     lines = [f"{result.title or result.path.name}: {result.status or 'no status'}, "
              f"{len(steps)} of {result.n_steps_planned} steps, {iters} Newton iterations, "
              f"{int(result.attrs.get('n_cuts', 0))} cuts, {result.n_dofs} DOFs, "
@@ -77,7 +81,7 @@ def summary_lines(result: Result) -> list[str]:
         lines.append(f"units: the file says {result.attrs.get('units', '')!r}: "
                      "labels use 'length' and 'force'")
     if not steps:
-        return lines
+        return lines + warnings_for(result)
     last = steps[-1]
     lines.append(f"last converged step {last.step}, load time {last.time:g}:")
     for d, r in zip(result.dirichlet, last.reactions):

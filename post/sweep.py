@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pre.files import new_file, write_text
+
 REPO = Path(__file__).resolve().parents[1]
 STAGES = ("assembly", "contact", "factorization", "solve", "output")
 
@@ -270,7 +272,7 @@ def write_summary(rows: list[dict[str, object]], out: Path) -> tuple[Path, Path]
         keys += [k for k in row if k not in keys]
     out.mkdir(parents=True, exist_ok=True)
     csv_path, md_path = out / "summary.csv", out / "summary.md"
-    with csv_path.open("w", newline="") as fh:
+    with new_file(csv_path) as tmp, tmp.open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys)
         w.writeheader()
         w.writerows(rows)
@@ -282,7 +284,7 @@ def write_summary(rows: list[dict[str, object]], out: Path) -> tuple[Path, Path]
 
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
     lines += ["| " + " | ".join(fmt(row.get(k)) for k in keys) + " |" for row in rows]
-    md_path.write_text("\n".join(lines) + "\n")
+    write_text(md_path, "\n".join(lines) + "\n")
     write_parquet(rows, keys, out / "summary.parquet")
     return csv_path, md_path
 
@@ -305,10 +307,7 @@ def write_parquet(rows: list[dict[str, object]], keys: list[str], path: Path) ->
             columns[key] = pa.array([None if v is None else float(v) for v in values], type=pa.float64())
         else:
             columns[key] = pa.array([None if v is None else str(v) for v in values], type=pa.string())
-    pq.write_table(pa.table(columns), path)
+    with new_file(path) as tmp:
+        pq.write_table(pa.table(columns), tmp)
     return path
 
-
-def default_binary() -> Path:
-    """VOIGA_BIN, else build/install/bin/voiga."""
-    return Path(os.environ.get("VOIGA_BIN", REPO / "build" / "install" / "bin" / "voiga"))

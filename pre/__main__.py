@@ -16,16 +16,37 @@ import argparse
 import sys
 from pathlib import Path
 
+
 def _cmd_geometry(args: argparse.Namespace) -> int:
     from .spec import SpecError, write_from_spec
 
     try:
-        geometry, case, written = write_from_spec(args.spec, args.out, args.force)
+        done = write_from_spec(args.spec, args.out, args.force)
     except (SpecError, FileNotFoundError, OSError) as err:
         print(f"python -m pre geometry: {err}", file=sys.stderr)
         return 2
-    print(f"wrote {geometry}")
-    print(f"wrote {case}" if written else f"kept {case} (exists; --force to overwrite)")
+    except (ValueError, TypeError, KeyError, IndexError, ArithmeticError, RuntimeError) as err:
+        # what the checks of spec_check.py and the builders did not name (a spline
+        # library's own refusal): still one line, still bad input
+        print(f"python -m pre geometry: {args.spec}: {type(err).__name__}: {err}", file=sys.stderr)
+        return 2
+    if done.stale:
+        print(f"python -m pre geometry: {done.case} and {done.geometry.name} differ from what "
+              f"{args.spec} gives now:", file=sys.stderr)
+        for line in done.changes:
+            print(f"  {line}", file=sys.stderr)
+        print("nothing written; --force writes both from the spec (the case file's own values "
+              "listed above are then replaced)", file=sys.stderr)
+        return 2
+    if not done.written:
+        print(f"kept {done.geometry} and {done.case} (up to date with {args.spec})")
+        return 0
+    print(f"wrote {done.geometry}")
+    print(f"wrote {done.case}")
+    if done.changes:
+        print("replaced (case file or geometry -> spec):")
+        for line in done.changes:
+            print(f"  {line}")
     return 0
 
 
@@ -118,7 +139,9 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("geometry", help="geometry spec (TOML) -> geometry file and case file")
     s.add_argument("spec", help="spec file (.toml; docs/pre.md)")
     s.add_argument("--out", default=None, help="output folder (default: the spec's folder)")
-    s.add_argument("--force", action="store_true", help="overwrite an existing case file")
+    s.add_argument("--force", action="store_true",
+                   help="write the geometry and case files although they exist and differ from the spec "
+                        "(what is replaced is listed)")
     s.set_defaults(func=_cmd_geometry)
 
     s = sub.add_parser("cases", help="write geometry files and case namelists")

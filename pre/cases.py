@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import io
 import math
-import os
 from pathlib import Path
 from typing import Any
 
 import f90nml
 import numpy as np
 
+from .files import write_text
 from .h5io import write_geometry
 from .layouts import parse_layout
 from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, arc_parameter_exact, hertz_eta_knots,
@@ -308,15 +308,12 @@ def write_cases(out: str | Path) -> list[Path]:
         folder = out / scene
         folder.mkdir(parents=True, exist_ok=True)
         geo = folder / GEOMETRY_FILE
-        tmp = geo.with_name(f".{geo.name}.tmp")
-        write_geometry(tmp, scene, scene_bodies(scene))
-        os.replace(tmp, geo)  # atomic; a reader holding the old file keeps it
+        # written beside it and renamed (pre.files): a reader holding the old file keeps it
+        write_geometry(geo, scene, scene_bodies(scene))
         written.append(geo)
     for rel, groups in all_cases().items():
         path = out / rel
-        tmp = path.with_name(f".{path.name}.tmp")
-        tmp.write_text(to_namelist_text(groups))
-        os.replace(tmp, path)
+        write_text(path, to_namelist_text(groups))
         written.append(path)
     return written
 

@@ -86,18 +86,82 @@ def annular_sector(centre: Point, r_in: float, r_out: float, angles: Sequence[fl
                    edges: dict[str, str] | None = None) -> Patch:
     """The region between two concentric arcs from ``angles[0]`` to ``angles[1]``
     (degrees, counter-clockwise when the second is larger; at most 360 apart);
-    ``edges`` names its sides ``start``, ``end``, ``inner``, ``outer``."""
+    ``edges`` names its sides ``start``, ``end``, ``inner``, ``outer``. ``r_in = 0``:
+    the solid sector (at most 180 degrees, :func:`solid_sector`)."""
     a0, a1 = float(angles[0]), float(angles[1])
-    if not 0 < r_in < r_out:
-        raise ValueError(f"annular sector: need 0 < r_in < r_out, got {r_in}, {r_out}")
-    if not 0 < abs(a1 - a0) <= 360:
-        raise ValueError(f"annular sector: angles {a0}, {a1} must differ by at most 360 degrees")
+    if not 0 <= r_in < r_out:
+        raise ValueError(f"annular sector: need 0 <= r_in < r_out, got {r_in}, {r_out}")
+    if a0 == a1 or not abs(a1 - a0) <= 360:
+        raise ValueError(f"annular sector: angles {a0:g}, {a1:g}: a sector spans more than 0 and at most "
+                         f"360 degrees ({abs(a1 - a0):g} given)")
+    if r_in == 0:
+        return solid_sector(centre, r_out, angles, edges)
     names = _named(SECTOR_SIDES, edges)
     if a0 % 90 == 0 and a1 % 90 == 0 and a1 > a0:  # the scenes' exact construction
         return _quarter_sector(centre, r_in, r_out, list(range(int(a0), int(a1) + 1, 90)), names)
     surface = surface_factory.edge_curves(_arc(centre, r_in, a0, a1), _arc(centre, r_out, a0, a1))
     surface.reparam()
     return patch_from_splipy(surface, names)
+
+
+SOLID_CORE = 0.5
+"""A solid sector's ``inner`` side runs along the two radii to this fraction of the
+radius from the centre (its ``start`` and ``end`` sides are the rest of the radii)."""
+
+
+def solid_sector(centre: Point, radius: float, angles: Sequence[float],
+                 edges: dict[str, str] | None = None) -> Patch:
+    """The solid circular sector (a half-disc for 180 degrees) from ``angles[0]`` to
+    ``angles[1]`` (at most 180 apart), as one patch without a degenerate point: the
+    arc is one side (``outer``: a contact edge), the radii are the other three,
+    ``start`` and ``end`` from the arc to ``SOLID_CORE`` of the radius and ``inner``
+    through the centre between them (a corner of the body inside that side, a C0
+    line of the patch). A patch whose inner edge is collapsed to the centre would
+    let its coincident control points move apart (a hole opens under load)."""
+    a0, a1 = float(angles[0]), float(angles[1])
+    sweep = a1 - a0
+    if radius <= 0 or not 0 < abs(sweep) <= 180:
+        raise ValueError(f"solid sector: need a radius > 0 and angles at most 180 degrees apart, got "
+                         f"{radius}, {list(angles)} (a larger one: two bodies)")
+    if sweep < 0:  # counter-clockwise from the smaller angle, the sides named alike
+        a0, a1 = a1, a0
+        names = dict(edges or {})
+        names = {"start": names.get("end", "end"), "end": names.get("start", "start"),
+                 **{k: v for k, v in names.items() if k not in ("start", "end")}}
+    else:
+        names = dict(edges or {})
+    labels = _named(SECTOR_SIDES, names)
+    c = np.asarray(centre, dtype=float)
+    u0 = np.array([math.cos(math.radians(a0)), math.sin(math.radians(a0))])
+    u1 = np.array([math.cos(math.radians(a1)), math.sin(math.radians(a1))])
+    core = SOLID_CORE * radius
+    sides = [_arc(c, radius, a0, a1),
+             _segment(c + radius * u1, c + core * u1, None),
+             _chain([_segment(c + core * u1, c, None), _segment(c, c + core * u0, None)]),
+             _segment(c + core * u0, c + radius * u0, None)]
+    order = ["outer", "end", "inner", "start"]
+    surface = surface_factory.edge_curves(*sides)
+    surface.reparam()
+    patch = patch_from_splipy(surface)
+    patch.edges = _match_edges(patch, sides, [labels[SECTOR_SIDES[label]] for label in order])
+    return patch
+
+
+def ellipse_sector(centre: Point, semi_axes: Sequence[float], angles: Sequence[float],
+                   inner: float = 0.0, edges: dict[str, str] | None = None) -> Patch:
+    """The region between the ellipse of ``semi_axes = [a, b]`` (along x and y) about
+    ``centre`` and the same ellipse scaled by ``inner`` (0: solid, at most 180 degrees),
+    from the parametric angle ``angles[0]`` to ``angles[1]`` (the point at angle t is
+    ``centre + (a cos t, b sin t)``): the annular or solid sector of the unit circle,
+    stretched (an affine map keeps a NURBS exact). Sides as :func:`annular_sector`."""
+    a, b = (float(v) for v in semi_axes)
+    if not (a > 0 and b > 0):
+        raise ValueError(f"ellipse: semi_axes must be positive, got {list(semi_axes)}")
+    if not 0 <= inner < 1:
+        raise ValueError(f"ellipse: inner must lie in [0, 1), got {inner}")
+    patch = annular_sector((0.0, 0.0), float(inner), 1.0, angles, edges)
+    patch.control_points = patch.control_points * np.array([a, b]) + np.asarray(centre, dtype=float)
+    return patch
 
 
 def _segment(p: np.ndarray, q: np.ndarray, radius: float | None) -> splipy.Curve:
@@ -150,9 +214,6 @@ def polygon(points: Sequence[Point], corners: Sequence[int] | None = None,
     n = len(pts)
     if pts.ndim != 2 or pts.shape[1] != 2 or n < 4:
         raise ValueError("polygon: need at least 4 points [x, y]")
-    area = 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1]))
-    if area <= 0:
-        raise ValueError("polygon: give the points counter-clockwise")
     corners = list(range(4)) if corners is None and n == 4 else list(corners or [])
     if len(corners) != 4 or sorted(corners) != corners or len(set(corners)) != 4 \
             or min(corners) < 0 or max(corners) >= n:
@@ -160,6 +221,8 @@ def polygon(points: Sequence[Point], corners: Sequence[int] | None = None,
     arcs = {int(k): float(r) for k, r in (arcs or {}).items()}
     if any(not 0 <= k < n for k in arcs):
         raise ValueError(f"polygon: arc segments must be in 0..{n - 1}")
+    if enclosed_area(pts, arcs) <= 0:
+        raise ValueError("polygon: give the points counter-clockwise")
     names = list(edges) if edges is not None else [f"side{i}" for i in range(4)]
     if len(names) != 4:
         raise ValueError("polygon: give 4 edge names")
@@ -173,6 +236,23 @@ def polygon(points: Sequence[Point], corners: Sequence[int] | None = None,
     patch = patch_from_splipy(surface)
     patch.edges = _match_edges(patch, sides, names)
     return patch
+
+
+def enclosed_area(points: np.ndarray, arcs: dict[int, float]) -> float:
+    """Signed area (counter-clockwise > 0) of the closed polygon ``points`` whose segment
+    ``k`` is a circular arc of signed radius ``arcs[k]`` (> 0 bulges to the right of the
+    travel: outward on a counter-clockwise boundary): the straight polygon's area plus
+    each arc's circular segment, so that a half-disc (two points and one arc) has one."""
+    pts = np.asarray(points, dtype=float)
+    area = 0.5 * float(np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1]))
+    for k, radius in arcs.items():
+        chord = float(np.linalg.norm(pts[(k + 1) % len(pts)] - pts[k]))
+        r = abs(radius)
+        if r < chord / 2:
+            continue  # _segment refuses it, naming the radius
+        theta = 2.0 * math.asin(min(1.0, chord / (2.0 * r)))
+        area += math.copysign(0.5 * r * r * (theta - math.sin(theta)), radius)
+    return area
 
 
 def _edge_points(patch: Patch, key: str, t: np.ndarray) -> np.ndarray:
@@ -287,14 +367,27 @@ def obstacle_arc(centre: Point, radius: float, angles: Sequence[float], side: st
     round punch) or what surrounds the circle (``"outside"``: a round seat or groove).
     The contact zone should not include the ends of the arc."""
     a0, a1 = float(angles[0]), float(angles[1])
-    if radius <= 0 or not 0 < abs(a1 - a0) <= 360:
-        raise ValueError(f"obstacle arc: need radius > 0 and angles at most 360 degrees apart, "
-                         f"got {radius}, {list(angles)}")
+    if not radius > 0 or a0 == a1 or not abs(a1 - a0) <= 360:
+        raise ValueError(f"obstacle arc: need radius > 0 and angles that differ by more than 0 and at "
+                         f"most 360 degrees, got {radius}, {list(angles)}")
     if side not in ("inside", "outside"):
         raise ValueError(f"obstacle arc: side must be 'inside' or 'outside', got {side!r}")
     lo, hi = min(a0, a1), max(a0, a1)
     # counter-clockwise with the disc on the left
     return obstacle(_arc(centre, radius, lo, hi), "left" if side == "inside" else "right")
+
+
+def obstacle_ellipse(centre: Point, semi_axes: Sequence[float], angles: Sequence[float],
+                     side: str = "inside") -> Curve:
+    """An elliptical arc (``semi_axes = [a, b]``, parametric ``angles`` in degrees as
+    :func:`ellipse_sector`) bounding a rigid obstacle: the ellipse's inside (the
+    default) or its outside, as :func:`obstacle_arc`."""
+    a, b = (float(v) for v in semi_axes)
+    if not (a > 0 and b > 0):
+        raise ValueError(f"obstacle ellipse: semi_axes must be positive, got {list(semi_axes)}")
+    curve = obstacle_arc((0.0, 0.0), 1.0, angles, side)
+    curve.control_points = curve.control_points * np.array([a, b]) + np.asarray(centre, dtype=float)
+    return curve
 
 
 def obstacle_polyline(points: Sequence[Point], side: str, arcs: dict[int, float] | None = None) -> Curve:

@@ -14,6 +14,7 @@ from typing import Any
 import h5py
 import numpy as np
 
+from .files import new_file
 from .nurbs import EDGE_KEYS, Curve, Patch
 
 UNITS = "mm, N"
@@ -88,7 +89,7 @@ def write_geometry(path: str | Path, scene: str, bodies: dict[str, Patch], units
                    generator: str = GENERATOR, curves: dict[str, Curve] | None = None) -> None:
     """Write the coarse geometry file of a scene: its bodies and (``/curves``, only
     when there are any) the curves of its rigid obstacles."""
-    with h5py.File(path, "w") as f:
+    with new_file(path) as tmp, h5py.File(tmp, "w") as f:
         f.attrs["scene"] = _str(scene)
         f.attrs["units"] = _str(units)
         f.attrs["generator"] = _str(generator)

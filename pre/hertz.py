@@ -41,6 +41,7 @@ from typing import Any
 from scipy.optimize import brentq
 
 from .cases import GEOMETRY_FILE, HERTZ_DISPLACEMENT, hertz_case, to_namelist_text
+from .files import check_output, write_text
 from .h5io import write_geometry
 from .layouts import parse_layout
 from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_R_IN, HERTZ_R_OUT,
@@ -230,7 +231,8 @@ def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     case = folder / f"{case_stem(mesh, layout, options.get('edge_refine', 1), options.get('surface_size'))}.nml"
-    geometry = folder / GEOMETRY_FILE
+    geometry = check_output(folder / GEOMETRY_FILE)
+    check_output(case)
     tmp = folder / f".{GEOMETRY_FILE}.{os.getpid()}.tmp"
     try:
         write_geometry(tmp, "hertz", cylinder_geometry(cyl.radius),
@@ -247,7 +249,5 @@ def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
             os.replace(tmp, geometry)
     finally:
         tmp.unlink(missing_ok=True)
-    tmp_case = case.with_name(f".{case.name}.tmp")
-    tmp_case.write_text(text)
-    os.replace(tmp_case, case)
+    write_text(case, text)
     return geometry, case, not same

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import splipy  # noqa: E402
 
+from .files import save_figure  # noqa: E402
 from .nurbs import Curve, Patch, eta1_curve, evaluate_patch, unique_knots  # noqa: E402
 from .refine import BodyDiscretization, discretize_case  # noqa: E402
 
@@ -94,7 +95,7 @@ def plot_layout(case_path: str | Path, body_name: str, out: str | Path) -> Path:
     fig = plt.figure(figsize=(8, 7.5), layout="constrained")
     draw_body(fig, disc.bodies[body_name], f"{disc.attrs.get('title', '')}: {body_name}")
     out = Path(out)
-    fig.savefig(out, dpi=130, metadata={"Software": None})
+    save_figure(fig, out, dpi=130, metadata={"Software": None})
     plt.close(fig)
     return out
 
@@ -116,7 +117,7 @@ def plot_bases(cases: list[tuple[str, BodyDiscretization]], out: str | Path) -> 
                      f"interface {body.interface_dofs} DOF", fontsize=9)
         ax.tick_params(labelsize=8)
     np.atleast_1d(axes)[-1].set_xlabel("xi (along the contact edge)")
-    fig.savefig(out, dpi=130, metadata={"Software": None})
+    save_figure(fig, out, dpi=130, metadata={"Software": None})
     plt.close(fig)
     return Path(out)
 

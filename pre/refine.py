@@ -28,6 +28,7 @@ import h5py
 import numpy as np
 
 from .cases import case_bodies, read_case
+from .files import new_file
 from .h5io import _str, read_curve, read_geometry, read_patch, write_curve, write_patch, attrs_dict
 from .nurbs import (KNOT_TOL, Curve, Patch, curve_from_splipy, curve_to_splipy, eta1_curve,
                     interior_breakpoints, patch_from_splipy, patch_to_splipy, unique_knots)
@@ -251,7 +252,7 @@ def discretize_case(case_path: str | Path) -> Discretization:
 
 def write_dump(path: str | Path, disc: Discretization) -> None:
     """Write the discretization dump schema of docs/formats.md."""
-    with h5py.File(path, "w") as f:
+    with new_file(path) as tmp, h5py.File(tmp, "w") as f:
         for key in ("title", "scene", "mesh", "layout"):
             f.attrs[key] = _str(disc.attrs.get(key, "") or " ")
         bodies = f.create_group("bodies")

@@ -2,29 +2,39 @@
 (``python -m pre geometry SPEC.toml``; reference in ``docs/pre.md``).
 
 A spec lists bodies (``[[body]]``, one patch each: ``shape = "rectangle"``,
-``"annular_sector"``, ``"arc"``, ``"polygon"`` or ``"g2"``), rigid obstacles
-(``[[curve]]``: ``shape = "arc"``, ``"polyline"`` or ``"g2"``), the refinement and
-material defaults (``[defaults]``), and optionally the groups of the case file
-(``[case]``, ``[solver]``, ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]``),
-which are written to the case as they are. From ``name.toml`` it writes
-``name-geometry.h5`` and the case ``name.nml`` next to it (or into ``--out``).
-A case written without load groups is a template: its comments show the groups
-to add (``docs/formats.md``).
+``"annular_sector"`` (``r_in = 0``: a solid sector), ``"arc"``, ``"ellipse"``,
+``"polygon"`` or ``"g2"``), rigid obstacles (``[[curve]]``: ``shape = "arc"``,
+``"ellipse"``, ``"polyline"`` or ``"g2"``), the refinement and material defaults
+(``[defaults]``), and the other groups of the case file (``[case]``, ``[solver]``,
+``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]``, ``[output]``), written to the
+case as they are after their variables are checked against those voiga reads
+(:data:`pre.namelists.NAMELISTS`): the spec holds the whole case. From ``name.toml``
+it writes ``name-geometry.h5`` and the case ``name.nml`` next to it (or into
+``--out``). When they exist and differ from what the spec gives now (the spec was
+edited, or the case by hand), nothing is written: the differences are listed, and
+``force`` writes both anew, listing what it replaced. A case written without load
+groups is a template: its comments show the groups to add (``docs/formats.md``).
 """
 
 from __future__ import annotations
 
 import math
+import os
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from .cases import to_namelist_text
-from .geometry import (annular_sector, body, check_curve, check_patch, edge_length, obstacle,
-                       obstacle_arc, obstacle_polyline, polygon, read_g2, rectangle, write_bodies)
+from .changes import geometry_changes, namelist_changes
+from .files import check_output, write_text
+from .geometry import (annular_sector, body, check_curve, check_patch, edge_length, ellipse_sector, obstacle,
+                       obstacle_arc, obstacle_ellipse, obstacle_polyline, polygon, read_g2, rectangle,
+                       write_bodies)
 from .layouts import parse_layout
+from .namelists import NAMELISTS
 from .nurbs import Curve, Patch
+from .spec_check import MAX_ELEMENTS, SpecCheckError, check_spec, check_table
 
 DEFAULTS: dict[str, Any] = {
     "layout": "NN2.2",
@@ -38,8 +48,15 @@ DEFAULTS: dict[str, Any] = {
 the longer parametric direction of a body unless ``element_size`` is given (then
 ``ceil(edge length / element_size)`` in each direction) or the body sets ``nel``."""
 
-CASE_GROUPS = ("solver", "dirichlet", "pressure", "contact")
-"""Spec tables copied into the case file, in this order."""
+CASE_GROUPS = ("solver", "dirichlet", "pressure", "contact", "output")
+"""Spec tables copied into the case file, in this order (``[case]`` goes into
+``&case``)."""
+
+SINGLE_GROUPS = ("case", "solver", "output")
+"""Groups a case has at most once: a table (``[solver]``), not an array of tables."""
+
+CASE_BY_PRE = ("geometry", "n_bodies")
+"""``&case`` variables pre writes itself (the geometry file it writes, the bodies)."""
 
 BODY_KEYS = {"name", "shape", "edges", "contact_edge", "nel", "layout", "elements",
              "element_size", "material", "youngs_modulus", "poisson_ratio"}
@@ -47,6 +64,7 @@ SHAPE_KEYS = {
     "rectangle": {"x", "y"},
     "annular_sector": {"centre", "r_in", "r_out", "angles"},
     "arc": {"centre", "radius", "thickness", "angles"},
+    "ellipse": {"centre", "semi_axes", "angles", "inner"},
     "polygon": {"points", "corners", "arcs"},
     "g2": {"file", "index"},
 }
@@ -55,6 +73,7 @@ SHAPE_KEYS = {
 CURVE_KEYS = {"name", "shape", "side"}
 CURVE_SHAPE_KEYS = {
     "arc": {"centre", "radius", "angles"},
+    "ellipse": {"centre", "semi_axes", "angles"},
     "polyline": {"points", "arcs"},
     "g2": {"file", "index"},
 }
@@ -96,10 +115,42 @@ def read_spec(path: str | Path) -> Spec:
         raise SpecError(f"{path}: not valid TOML ({err})") from None
     unknown = set(data) - {"units", "scene", "defaults", "body", "curve", "case", *CASE_GROUPS}
     if unknown:
-        raise SpecError(f"{path}: unknown table(s) {sorted(unknown)}")
+        raise SpecError(f"{path}: unknown table(s) {sorted(unknown)} (known: units, scene, [defaults], "
+                        f"[[body]], [[curve]], [case], {', '.join(_table_name(g) for g in CASE_GROUPS)})")
     if not data.get("body"):
         raise SpecError(f"{path}: no [[body]]")
+    try:
+        check_spec(data)
+    except SpecCheckError as err:
+        raise SpecError(f"{path}: {err}") from None
+    for group in ("case", *CASE_GROUPS):
+        if group in data:
+            check_case_tables(path, group, data[group])
     return Spec(path, data)
+
+
+def _table_name(group: str) -> str:
+    return f"[{group}]" if group in SINGLE_GROUPS else f"[[{group}]]"
+
+
+def check_case_tables(path: Path, group: str, value: Any) -> None:
+    """A case group of the spec: one table for ``[case]``, ``[solver]``, ``[output]``
+    (any number for the others), each key a variable voiga reads in that group."""
+    tables = [value] if isinstance(value, dict) else value
+    if group in SINGLE_GROUPS and not isinstance(value, dict):
+        raise SpecError(f"{path}: [{group}] is one table (the case has one &{group}), not [[{group}]]")
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise SpecError(f"{path}: {_table_name(group)} must be a table")
+    for k, table in enumerate(tables, start=1):
+        where = f"[{group}]" if isinstance(value, dict) else f"[[{group}]] ({k})"
+        unknown = sorted(set(table) - NAMELISTS[group])
+        if unknown:
+            raise SpecError(f"{path}: {where}: {unknown} not variable(s) of &{group} (known: "
+                            f"{', '.join(sorted(NAMELISTS[group]))}; docs/formats.md)")
+        own = sorted(set(table) & set(CASE_BY_PRE)) if group == "case" else []
+        if own:
+            raise SpecError(f"{path}: [case]: {own} written by pre itself (the geometry file it writes, "
+                            "the [[body]] tables)")
 
 
 def _need(b: dict[str, Any], key: str, what: str = "body") -> Any:
@@ -112,11 +163,17 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
     """The patch of one ``[[body]]`` table (``folder``: where relative files are)."""
     name = _need(b, "name")
     shape = _need(b, "shape")
+    if not isinstance(name, str) or not isinstance(shape, str):
+        raise SpecError(f"body {name!r}: name and shape must be strings")
     if shape not in SHAPE_KEYS:
         raise SpecError(f"body {name!r}: unknown shape {shape!r} (known: {sorted(SHAPE_KEYS)})")
     unknown = set(b) - BODY_KEYS - SHAPE_KEYS[shape]
     if unknown:
         raise SpecError(f"body {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
+    try:
+        check_table(b, "body")
+    except SpecCheckError as err:
+        raise SpecError(str(err)) from None
     edges = b.get("edges")
     try:
         if shape == "rectangle":
@@ -127,6 +184,9 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
         if shape == "arc":
             r, t = float(_need(b, "radius")), float(_need(b, "thickness"))
             return annular_sector(_need(b, "centre"), r - t / 2, r + t / 2, _need(b, "angles"), edges)
+        if shape == "ellipse":
+            return ellipse_sector(_need(b, "centre"), _need(b, "semi_axes"), _need(b, "angles"),
+                                  float(b.get("inner", 0.0)), edges)
         if shape == "polygon":
             arcs = {int(a["segment"]): float(a["radius"]) for a in b.get("arcs", [])}
             return polygon(_need(b, "points"), b.get("corners"), arcs, edges)
@@ -143,20 +203,29 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
 
 def build_curve(c: dict[str, Any], folder: Path) -> Curve:
     """The obstacle curve of one ``[[curve]]`` table (``folder``: where relative files
-    are): an ``arc`` (``side`` "inside", the default: the disc is the obstacle, or
-    "outside"), a ``polyline`` or the ``index``-th curve of a ``.g2`` file (``side``
-    "left" or "right" of the direction of travel: required)."""
+    are): an ``arc`` or ``ellipse`` (``side`` "inside", the default: the disc is the
+    obstacle, or "outside"), a ``polyline`` or the ``index``-th curve of a ``.g2``
+    file (``side`` "left" or "right" of the direction of travel: required)."""
     name = _need(c, "name", "curve")
     shape = _need(c, "shape", "curve")
+    if not isinstance(name, str) or not isinstance(shape, str):
+        raise SpecError(f"curve {name!r}: name and shape must be strings")
     if shape not in CURVE_SHAPE_KEYS:
         raise SpecError(f"curve {name!r}: unknown shape {shape!r} (known: {sorted(CURVE_SHAPE_KEYS)})")
     unknown = set(c) - CURVE_KEYS - CURVE_SHAPE_KEYS[shape]
     if unknown:
         raise SpecError(f"curve {name!r}: unknown key(s) {sorted(unknown)} for shape {shape!r}")
     try:
+        check_table(c, "curve")
+    except SpecCheckError as err:
+        raise SpecError(str(err)) from None
+    try:
         if shape == "arc":
             return obstacle_arc(_need(c, "centre", "curve"), float(_need(c, "radius", "curve")),
                                 _need(c, "angles", "curve"), str(c.get("side", "inside")))
+        if shape == "ellipse":
+            return obstacle_ellipse(_need(c, "centre", "curve"), _need(c, "semi_axes", "curve"),
+                                    _need(c, "angles", "curve"), str(c.get("side", "inside")))
         side = str(_need(c, "side", "curve"))
         if shape == "polyline":
             arcs = {int(a["segment"]): float(a["radius"]) for a in c.get("arcs", [])}
@@ -209,7 +278,11 @@ def body_group(b: dict[str, Any], patch: Patch, defaults: dict[str, Any]) -> dic
             h = float(opt["element_size"])
             if h <= 0:
                 raise SpecError(f"body {name!r}: element_size must be positive")
-            nel = [max(1, math.ceil(L / h - 1e-9)) for L in lengths]
+            nel = [max(1, math.ceil(L / h - 1e-9)) if L / h < MAX_ELEMENTS else MAX_ELEMENTS + 1
+                   for L in lengths]
+            if max(nel) > MAX_ELEMENTS:
+                raise SpecError(f"body {name!r}: element_size {h:g} gives more than {MAX_ELEMENTS} elements "
+                                f"along an edge (edges {lengths[0]:g} and {lengths[1]:g} long)")
         else:
             n = int(opt["elements"])
             h = max(lengths) / n
@@ -243,8 +316,9 @@ TEMPLATE_HELP = """
 
 
 def case_groups(spec: Spec, patches: dict[str, Patch], geometry: str, stem: str) -> dict[str, Any]:
-    """The case file's groups: ``&case``, one ``&body`` per body, then the spec's
-    ``[solver]``, ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]`` as given."""
+    """The case file's groups: ``&case`` (pre's values, then the spec's ``[case]``), one
+    ``&body`` per body, then the spec's ``[solver]``, ``[[dirichlet]]``,
+    ``[[pressure]]``, ``[[contact]]``, ``[output]`` as given."""
     case = {"title": spec.data.get("scene", stem), "scene": spec.data.get("scene", stem),
             "geometry": geometry, "output": f"{stem}.h5", "n_bodies": len(patches)}
     case.update(spec.data.get("case", {}))
@@ -258,16 +332,25 @@ def case_groups(spec: Spec, patches: dict[str, Patch], geometry: str, stem: str)
     return groups
 
 
-def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
-                    force: bool = False) -> tuple[Path, Path, bool]:
-    """Build every body of the spec, write ``<stem>-geometry.h5`` and the case
-    ``<stem>.nml`` (into ``out``, default the spec's folder). An existing case file
-    is kept unless ``force`` (it may have been edited). Returns ``(geometry, case,
-    case written)``."""
-    spec = read_spec(spec_path)
-    folder = Path(out) if out is not None else spec.path.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    stem = spec.path.stem
+@dataclass
+class SpecOutcome:
+    """What ``write_from_spec`` did: the two files, whether it wrote them, and what
+    differed between the files there before and the spec (empty: new files, or the
+    same values)."""
+
+    geometry: Path
+    case: Path
+    written: bool
+    changes: list[str] = field(default_factory=list)
+
+    @property
+    def stale(self) -> bool:
+        """The files differ from the spec and were kept (no ``force``)."""
+        return bool(self.changes) and not self.written
+
+
+def build_all(spec: Spec) -> tuple[dict[str, Patch], dict[str, Curve]]:
+    """Every body's patch and every obstacle curve of the spec, checked."""
     patches: dict[str, Patch] = {}
     curves: dict[str, Curve] = {}
     for tables, build, check, into in ((spec.bodies, build_patch, check_patch, patches),
@@ -281,17 +364,51 @@ def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
             except ValueError as err:
                 raise SpecError(str(err)) from None
             into[t["name"]] = obj
-    groups = case_groups(spec, patches, f"{stem}-geometry.h5", stem)
-    geometry = write_bodies(folder / f"{stem}-geometry.h5", patches,
-                            scene=str(spec.data.get("scene", stem)),
-                            units=str(spec.data.get("units", "mm, N")), curves=curves)
-    case = folder / f"{stem}.nml"
-    if case.exists() and not force:
-        return geometry, case, False
-    text = to_namelist_text(groups)
-    if not any(g in spec.data for g in CASE_GROUPS):
+    return patches, curves
+
+
+def case_text(spec: Spec, patches: dict[str, Patch], stem: str) -> str:
+    """The case file of the spec (a template with comments when it has no load groups)."""
+    text = to_namelist_text(case_groups(spec, patches, f"{stem}-geometry.h5", stem))
+    if not any(g in spec.data for g in CASE_GROUPS if g != "output"):
         first = spec.bodies[0]["name"]
         edge = sorted(patches[first].edges.values())[0]
         text += TEMPLATE_HELP.format(body=first, edge=edge)
-    case.write_text(text)
-    return geometry, case, True
+    return text
+
+
+def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
+                    force: bool = False) -> SpecOutcome:
+    """Build every body of the spec and write ``<stem>-geometry.h5`` and the case
+    ``<stem>.nml`` (into ``out``, default the spec's folder). When the case file
+    exists, nothing is written without ``force``: its values and the geometry are
+    the spec's (the file keeps its comments; a missing geometry file is written), or
+    they differ (the spec or the case was edited) and the outcome lists how. With
+    ``force`` both are written anew, the outcome listing what was replaced."""
+    spec = read_spec(spec_path)
+    folder = Path(out) if out is not None else spec.path.parent
+    stem = spec.path.stem
+    patches, curves = build_all(spec)
+    text = case_text(spec, patches, stem)
+    folder.mkdir(parents=True, exist_ok=True)
+    geometry, case = folder / f"{stem}-geometry.h5", folder / f"{stem}.nml"
+    # nothing is written through a link or over a special file (pre/files.py)
+    check_output(geometry)
+    check_output(case)
+    fresh = folder / f".{stem}-geometry.h5.new"
+    try:
+        write_bodies(fresh, patches, scene=str(spec.data.get("scene", stem)),
+                     units=str(spec.data.get("units", "mm, N")), curves=curves)
+        changes: list[str] = []
+        if case.exists():
+            changes = [f"{case.name}: {c}" for c in namelist_changes(case.read_text(), text)]
+            changes += geometry_changes(geometry, fresh)
+            if not force:
+                if not changes and not geometry.exists():
+                    os.replace(fresh, check_output(geometry))
+                return SpecOutcome(geometry, case, False, changes)
+        os.replace(fresh, check_output(geometry))
+        write_text(case, text)
+        return SpecOutcome(geometry, case, True, changes)
+    finally:
+        fresh.unlink(missing_ok=True)

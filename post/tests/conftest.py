@@ -81,6 +81,28 @@ TWO_BODIES = """&case
 /
 """
 
+# The stretch with its sampled fields (3 x 3 per element, every step).
+STRETCH_FIELDS = STRETCH.replace("output = 'stretch.h5'", "output = 'fields.h5'") + """&output
+  samples = 3
+/
+"""
+
+# A rigid line pressed 0.01 into the slab's top in two steps (a rigid motion to magnify).
+PRESS_LINE = """&case
+  title = 'line press', geometry = 'geometry.h5', output = 'line.h5', n_bodies = 1
+/
+""" + SLAB.format(material="linear") + """&solver
+  n_steps = 2
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_x = .true., fix_y = .true.
+/
+&contact
+  slave = 'slab', master = 'rigid', rigid_point = 0.0, 0.0, rigid_normal = 0.0, -1.0,
+  rigid_uy = -0.01, penalty_normal = 100.0
+/
+"""
+
 # A neo-Hookean slab pushed to less than nothing in phase 2: step 1 converges,
 # step 2 inverts the elements, the run fails with exit code 3.
 CRUSH = """&case
@@ -154,6 +176,18 @@ def run_case(voiga: Path, folder: Path, text: str, output: str, expect: int = 0)
 def stretch_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Result of the one-body slab stretch (VO layer, 2 steps, converged)."""
     return run_case(voiga, tmp_path_factory.mktemp("stretch"), STRETCH, "stretch.h5")
+
+
+@pytest.fixture(scope="session")
+def fields_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The slab stretch with stress, strain and von Mises at 3 x 3 points per element."""
+    return run_case(voiga, tmp_path_factory.mktemp("fields"), STRETCH_FIELDS, "fields.h5")
+
+
+@pytest.fixture(scope="session")
+def line_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A rigid line moved 0.01 down into the slab (2 steps)."""
+    return run_case(voiga, tmp_path_factory.mktemp("line"), PRESS_LINE, "line.h5")
 
 
 @pytest.fixture(scope="session")

@@ -64,6 +64,24 @@ def test_figures_next_to_the_result(hertz_h5: Path, tmp_path: Path,
     assert "converged, 5 of 5 steps" in out and "hertz vs analytic: P = " in out
 
 
+def test_plot_contact_unknown_step(hertz_h5: Path, tmp_path: Path,
+                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """A step the result does not have: one line naming the steps it has (issue 38,
+    item 7: it was `99 is not in list`); step 0 has no contact output; -k counts back."""
+    path = tmp_path / "h.h5"
+    path.write_bytes(hertz_h5.read_bytes())
+    assert main(["plot-contact", str(path), "--step", "99"]) == 1
+    err = capsys.readouterr().err
+    assert f"plot-contact: {path}: no converged step 99 (steps 1 to 5, status 'converged'; -1 is the last)" \
+        in err, err
+    assert main(["plot-contact", str(path), "--step", "0"]) == 1
+    assert "step 0 is the reference configuration" in capsys.readouterr().err
+    assert main(["plot-contact", str(path), "--step", "-9"]) == 1
+    assert "step index -9 but only 5 converged step(s)" in capsys.readouterr().err
+    assert main(["plot-contact", str(path), "--step", "3", "--out", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.strip() == str(tmp_path / "h-contact-000003.png")
+
+
 def test_auto_scale() -> None:
     assert auto_scale(1.0, 0.5) == 1.0 and auto_scale(1.0, 0.0) == 1.0
     assert auto_scale(1.0, 0.01) == 10.0  # 0.1 of the size

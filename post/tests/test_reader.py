@@ -270,3 +270,44 @@ def test_lazy_read_checks_the_displacement_when_used(two_h5: Path, tmp_path: Pat
     assert len(res.steps[0].displacement) == res.n_dofs
     with pytest.raises(ValueError, match="displacement has"):
         res.steps[1].displacement
+
+
+def _damaged(source: Path, folder: Path, edit) -> Path:
+    path = folder / "bad.h5"
+    shutil.copy(source, path)
+    with h5py.File(path, "r+") as f:
+        edit(f)
+    return path
+
+
+def _poison(f: h5py.File, key: str) -> None:
+    data = f[key][()].astype(float)
+    data.reshape(-1)[0] = np.nan
+    f[key][...] = data
+
+
+@pytest.mark.parametrize("key", ["steps/000002/displacement", "steps/000002/reactions",
+                                 "bodies/slab/control_points", "bodies/slab/weights"])
+@pytest.mark.parametrize("command", ["summary", "vtk", "plot-deformed", "history"])
+def test_non_finite_result_data_refused(two_h5: Path, tmp_path: Path, key: str, command: str) -> None:
+    """Issue 36: a result whose displacements are NaN was accepted with exit 0 (vtk
+    wrote NaN, plot-deformed failed with 'max() arg is an empty sequence'). voiga
+    writes no such value: exit 2, one line naming the dataset, nothing written."""
+    path = _damaged(two_h5, tmp_path, lambda f: _poison(f, key))
+    res = subprocess.run([sys.executable, "-m", "post", command, str(path), *([] if command == "summary" else
+                          ["--out", str(tmp_path / "out")])], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2, res.stderr
+    assert res.stderr.count("\n") == 1 and f"/{key}" in res.stderr and "non-finite" in res.stderr, res.stderr
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize("attr,value,words", [("n_steps_done", -5, "n_steps_done = -5: not a count"),
+                                              ("n_steps_planned", -1, "n_steps_planned = -1"),
+                                              ("n_dofs", -3, "n_dofs = -3"),
+                                              ("n_steps_done", 99, "exceeds n_steps_planned")])
+def test_impossible_counters_refused(two_h5: Path, tmp_path: Path, attr: str, value: int, words: str) -> None:
+    """Issue 36: n_steps_done = -5 was read with a note, as a run with no step."""
+    path = _damaged(two_h5, tmp_path, lambda f: f.attrs.__setitem__(attr, np.int32(value)))
+    res = subprocess.run([sys.executable, "-m", "post", "summary", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 2 and words in res.stderr and res.stderr.count("\n") == 1, res.stderr

@@ -95,6 +95,15 @@ def test_long_case_names_are_hashed() -> None:
     ('base = "{hertz}"\nmeasures = { cuts = "n_cuts" }\n', "is a column of the table already"),
     ('cases = "../.."\nscenes = ["nosuch"]\n', "no committed case"),
     ('base = "{hertz}"\n[grid\n', "not a TOML file"),
+    # issue 36: values that ended in a traceback or an error per case
+    ('base = "{hertz}"\ntimeout = 1e308\n', "timeout must be more than 0 and at most"),
+    ('base = "{hertz}"\ntimeout = nan\n', "timeout must be more than 0 and at most"),
+    ('base = "{hertz}"\ntimeout = true\n', "timeout must be a number of seconds"),
+    ('base = "{hertz}"\n[grid]\ncontact.friction = [{a = 1}]\n', "is not a namelist value"),
+    ('base = "{hertz}"\n[grid]\ncontact.friction = [nan]\n', "is not a namelist value"),
+    ('base = "{hertz}"\n[grid]\ncontact.rigid_point = [[[0.0]]]\n', "a list inside a list"),
+    ('base = "{hertz}"\n[[list]]\ncontact.friction = [{a = 1}]\n', "is not a namelist value"),
+    ('base = "{hertz}"\nfigures = "yes"\n', "figures must be true or false"),
 ])
 def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                           text: str, cause: str) -> None:
@@ -107,10 +116,30 @@ def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.Capture
 def test_malformed_scheduler_address(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     fake = tmp_path / "voiga"
     fake.write_text("")
+    fake.chmod(0o755)  # (never run: the scheduler is refused first)
     assert main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(tmp_path / "out"),
                  "--binary", str(fake), "--scheduler", "foo"]) == 2
     err = capsys.readouterr().err
     assert "no Dask scheduler answers at foo" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("option", [["--jobs", "-1"], ["--jobs", "100000"], ["--timeout", "1e308"],
+                                    ["--timeout", "nan"], ["--timeout", "-1"],
+                                    ["--scheduler", "tls://127.0.0.1:1"]])
+def test_bad_engine_options_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path,
+                                    option: list[str]) -> None:
+    """Issue 36: --jobs -1 hung (a local cluster of -1 workers), --jobs 100000 ran,
+    --timeout 1e308 failed every case with OverflowError, a tls:// scheduler without
+    certificates ended in a TypeError traceback. Now each is one line and exit 2."""
+    fake = tmp_path / "voiga"
+    fake.write_text("")
+    code = main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(tmp_path / "out"),
+                 "--binary", str(fake), "--no-progress", *option])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    lines = [line for line in err.strip().splitlines() if line.startswith("python -m post study")]
+    assert len(lines) == 1 and (option[0] in lines[0] or option[1] in lines[0]), err
+    assert "Traceback" not in err
 
 
 def test_missing_study_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

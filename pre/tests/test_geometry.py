@@ -165,6 +165,9 @@ def test_spec_writes_geometry_and_case(tmp_path: Path, capsys: pytest.CaptureFix
     assert all(f"dofs {b} " in run.stdout for b in bodies)
 
 
+RECT = "[[body]]\nname = 'a'\nshape = 'rectangle'\nx = [0, 1]\ny = [0, 1]\n"
+
+
 @pytest.mark.parametrize("text,message", [
     ("[[body]]\nname = 'a'\nshape = 'circle'\n", "unknown shape"),
     ("[[body]]\nname = 'a'\nshape = 'rectangle'\nx = [0, 1]\n", "missing 'y'"),
@@ -175,6 +178,29 @@ def test_spec_writes_geometry_and_case(tmp_path: Path, capsys: pytest.CaptureFix
     ("[[body]\n", "not valid TOML"),
     ("[defaults]\nlayout = 'Q7'\n[[body]]\nname = 'a'\nshape = 'rectangle'\nx = [0, 1]\ny = [0, 1]\n",
      "unknown layout"),
+    # issue 36: values that ended in a traceback, ran, or were named wrongly
+    (RECT + "element_size = nan\n", "element_size: nan is not a finite number"),
+    (RECT + "element_size = 'x'\n", "element_size must be a number"),
+    (RECT + "element_size = 1e-300\n", "more than 100000 elements"),
+    (RECT + "nel = 12\n", "nel must be two integers"),
+    (RECT + "nel = [1.5, 3]\n", "nel[0] must be an integer"),
+    (RECT + "nel = [1000000000, 3]\n", "nel[0] must be 1 to 100000"),
+    (RECT + "youngs_modulus = 'soft'\n", "youngs_modulus must be a number"),
+    (RECT + "youngs_modulus = nan\n", "youngs_modulus: nan is not a finite number"),
+    (RECT + "poisson_ratio = 0.5\n", "poisson_ratio must be < 0.5"),
+    (RECT + "material = 5\n", "material must be a non-empty string"),
+    ("[defaults]\nelements = 0\n" + RECT, "elements must be 1 to 100000"),
+    (RECT.replace("x = [0, 1]", "x = [0, inf]"), "x[1]: inf is not a finite number"),
+    (RECT.replace("x = [0, 1]", "x = [0, 1, 2]"), "x must have 2 numbers"),
+    ("[[body]]\nname = 3\nshape = 'rectangle'\nx = [0, 1]\ny = [0, 1]\n", "name and shape must be strings"),
+    ("[[body]]\nname = 'a'\nshape = 'annular_sector'\ncentre = [0, 0]\nr_in = 1\nr_out = 2\n"
+     "angles = [180, 180]\n", "a sector spans more than 0 and at most 360 degrees (0 given)"),
+    ("[[body]]\nname = 'a'\nshape = 'annular_sector'\ncentre = [0, 0]\nr_in = 1\nr_out = 2\n"
+     "angles = [180]\n", "angles must have 2 numbers"),
+    ("[[body]]\nname = 'a'\nshape = 'polygon'\npoints = [[0, 0], [1, 0], [1, nan], [0, 1]]\n",
+     "nan is not a finite number"),
+    ("units = 5\n" + RECT, "units must be a non-empty string"),
+    (RECT + "[solver]\nn_steps = [{a = 1}]\n", "is not a namelist value"),
 ])
 def test_bad_specs_exit_2(tmp_path: Path, text: str, message: str,
                           capsys: pytest.CaptureFixture[str]) -> None:

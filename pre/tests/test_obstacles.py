@@ -110,7 +110,7 @@ side = "left"
     ("[[curve]]\nname = 'c'\nshape = 'arc'\ncentre = [0, 0]\nradius = 1\nangles = [0, 90]\nx = 1\n",
      "unknown key"),
     ("[[curve]]\nname = 'c'\nshape = 'arc'\ncentre = [0, 0]\nradius = -1\nangles = [0, 90]\n",
-     "radius > 0"),
+     "radius must be > 0"),
     ("[[curve]]\nname = 'c'\nshape = 'polyline'\npoints = [[0, 0], [0, 0]]\nside = 'left'\n",
      "coincide"),
 ])

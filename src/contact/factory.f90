@@ -50,6 +50,9 @@ module voiga_contact_factory
         character(len=16) :: method = 'gpts'
         !> Augmented Lagrangian: constraint tolerance relative to the slave element size.
         real(dp) :: tolerance = default_alm_tolerance
+        !> Run although most slave points start inside the master (an intended
+        !> interference fit); else such a set-up is refused (`voiga_model_checks`).
+        logical :: allow_overlap = .false.
     end type contact_settings_t
 
 contains

@@ -29,6 +29,8 @@ module voiga_contact_master_curve
         real(dp), allocatable :: zero(:)
         !> The current translation from the reference position.
         real(dp) :: offset(2) = 0.0_dp
+        !> The curve's name in the geometry file (`&contact rigid_curve`), for messages.
+        character(len=32) :: name = ''
     contains
         procedure :: project => curve_project
         procedure :: all_dofs => curve_all_dofs

@@ -6,7 +6,9 @@
 !> variable.
 module voiga_io_case
     use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str
     use voiga_io_namelist, only: nml_group_t, scan_groups
+    use voiga_io_os, only: path_kind, kind_name, kind_missing, kind_regular
     use voiga_io_case_case, only: case_settings_t, read_case_group, resolve_path
     use voiga_io_case_body, only: read_body
     use voiga_io_case_solver, only: read_solver
@@ -24,6 +26,10 @@ module voiga_io_case
     private
 
     public :: case_t, read_case, resolve_path, known_groups, check_edges
+
+    !> Most groups of one name a case file may have (a case has a few; many
+    !> thousands would only cost time and memory).
+    integer, parameter :: max_groups = 1000
 
     !> The namelist groups a case file may contain.
     character(len=*), parameter :: known_groups(7) = [character(len=9) :: 'case', 'body', 'solver', &
@@ -50,12 +56,16 @@ contains
         type(case_t), intent(out) :: self
         type(error_t), allocatable, intent(out) :: error
         type(nml_group_t), allocatable :: groups(:)
-        integer :: i
-        logical :: exists
+        integer :: i, kind
 
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
+        kind = path_kind(path, .true.)
+        if (kind == kind_missing) then
             call fatal_error(error, "case file '"//path//"' does not exist", error_code%input)
+            return
+        else if (kind /= kind_regular) then
+            ! (reading a FIFO would wait for a writer)
+            call fatal_error(error, "case file '"//path//"' is "//kind_name(kind)//', not a namelist file', &
+                             error_code%input)
             return
         end if
         self%path = path
@@ -141,17 +151,25 @@ contains
     end function where_named
 
     !> Every group in the file is known, `&case` appears once, `&solver` and
-    !> `&output` at most once.
+    !> `&output` at most once, no group more than `max_groups` times.
     subroutine check_groups(path, groups, error)
         character(len=*), intent(in) :: path
         type(nml_group_t), intent(in) :: groups(:)
         type(error_t), allocatable, intent(out) :: error
-        integer :: i
+        integer :: i, n
         do i = 1, size(groups)
             if (.not. any(known_groups == groups(i)%name)) then
                 call fatal_error(error, path//': unknown namelist group &'//trim(groups(i)%name)// &
                                  ' (known: &case, &body, &solver, &dirichlet, &pressure, &contact, &output)', &
                                  error_code%input)
+                return
+            end if
+        end do
+        do i = 1, size(known_groups)
+            n = count(groups%name == known_groups(i))
+            if (n > max_groups) then
+                call fatal_error(error, path//': at most '//str(max_groups)//' &'//trim(known_groups(i))// &
+                                 ' groups ('//str(n)//' given)', error_code%input)
                 return
             end if
         end do

@@ -7,7 +7,7 @@ module voiga_io_dump
     use voiga_discretization_patch, only: discretization_t
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_io_case, only: case_t
-    use voiga_io_os, only: rename_file, remove_file, companion
+    use voiga_io_result_file, only: result_file_t
     use voiga_version, only: voiga_version_string
     implicit none
     private
@@ -17,19 +17,24 @@ module voiga_io_dump
 contains
 
     !> The dump file `path` (`voiga --dump`): the case's metadata and the refined
-    !> bulk patch and VO layer of every body (`discs`, one per body). Written as
-    !> `path`.part and renamed to `path` when complete (a failed write leaves
-    !> whatever was at `path` before).
-    subroutine write_dump(path, case, discs, error)
+    !> bulk patch and VO layer of every body (`discs`, one per body). Written as a
+    !> result file is (`result_file_t`): under its lock, as `path`.part, a new file,
+    !> renamed to `path` when complete; an earlier file at `path` is replaced only
+    !> when `replace` (`--overwrite`), and a failed write leaves it as it was.
+    subroutine write_dump(path, case, discs, replace, error)
         character(len=*), intent(in) :: path
         type(case_t), intent(in) :: case
         type(discretization_t), intent(in) :: discs(:)
+        logical, intent(in) :: replace
         type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: h5
-        type(error_t), allocatable :: close_error
+        type(result_file_t) :: h5
+        type(error_t), allocatable :: ignored
         integer :: i
-        call h5%open(companion(path, '.part'), 'w', error)
-        if (allocated(error)) return
+        call h5%create(path, replace, error, 'dump file')
+        if (allocated(error)) then
+            call h5%abandon()
+            return
+        end if
         steps: block
             call h5%write_attr('/', 'title', case%title, error)
             if (allocated(error)) exit steps
@@ -46,15 +51,18 @@ contains
                 if (allocated(error)) exit steps
             end do
         end block steps
-        call h5%close(close_error)
-        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
-        if (.not. allocated(error)) call rename_file(companion(path, '.part'), path, error)
-        if (allocated(error)) call remove_file(companion(path, '.part'))
+        if (allocated(error)) then
+            ! nothing of a failed dump is kept
+            call h5%close(ignored)
+            call h5%abandon()
+            return
+        end if
+        call h5%settle(.true., error)
     end subroutine write_dump
 
     !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`.
     subroutine write_discretization(h5, group, disc, error)
-        type(h5file_t), intent(inout) :: h5
+        class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: group
         type(discretization_t), intent(in) :: disc
         type(error_t), allocatable, intent(out) :: error

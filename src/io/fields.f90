@@ -9,25 +9,40 @@ module voiga_io_fields
     implicit none
     private
 
-    public :: write_fields
+    public :: write_fields, sample_bodies
 
 contains
 
-    !> The sampled fields `settings` asks for, of every body of `model` at `u`, under
-    !> `g`/fields/<body> (docs/hdf5.md).
-    subroutine write_fields(h5, g, settings, model, u, error)
+    !> The sampled fields of every body of `model` at `u` (`samples` [n_bodies]):
+    !> computed before the step is written, so that a field that cannot be computed
+    !> fails the step as a numerical error and leaves the file as it was.
+    subroutine sample_bodies(settings, model, u, samples, error)
+        type(output_settings_t), intent(in) :: settings
+        type(model_t), intent(in) :: model
+        real(dp), intent(in) :: u(:)
+        type(field_samples_t), allocatable, intent(out) :: samples(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: ib
+        allocate (samples(size(model%bodies)))
+        do ib = 1, size(model%bodies)
+            call sample_fields(model%bodies(ib), u, settings%samples, samples(ib), error)
+            if (allocated(error)) return
+        end do
+    end subroutine sample_bodies
+
+    !> The sampled fields `settings` asks for (`samples`, from `sample_bodies`), of
+    !> every body of `model`, under `g`/fields/<body> (docs/hdf5.md).
+    subroutine write_fields(h5, g, settings, model, samples, error)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(output_settings_t), intent(in) :: settings
         type(model_t), intent(in) :: model
-        real(dp), intent(in) :: u(:)
+        type(field_samples_t), intent(in) :: samples(:)
         type(error_t), allocatable, intent(out) :: error
-        type(field_samples_t) :: f
         character(len=:), allocatable :: b
         integer :: ib
         do ib = 1, size(model%bodies)
-            call sample_fields(model%bodies(ib), u, settings%samples, f, error)
-            if (allocated(error)) return
+            associate (f => samples(ib))
             b = g//'/fields/'//trim(model%bodies(ib)%name)
             call h5%create_group(b, error)
             if (allocated(error)) return
@@ -51,6 +66,7 @@ contains
             if (allocated(error)) return
             if (settings%fields(3)) call h5%write(b//'/'//trim(field_names(3)), f%von_mises, error)
             if (allocated(error)) return
+            end associate
         end do
     end subroutine write_fields
 

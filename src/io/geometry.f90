@@ -3,6 +3,7 @@
 !> value validated.
 module voiga_io_geometry
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
@@ -18,6 +19,14 @@ module voiga_io_geometry
     !> Sample points per knot span and direction for the sign of det J (a fold
     !> narrower than about 1/32 of a span of the exact geometry could hide between them).
     integer, parameter :: samples = 32
+
+    !> The largest geometry read (docs/formats.md): at most `max_side` control
+    !> points of a patch along each direction (and of a curve), `max_points` in all;
+    !> knot vectors of n + p + 1 values. Each dataset's size is checked against them
+    !> before anything is allocated or read: a small file that claims a huge
+    !> (never written) dataset is refused at once.
+    integer, parameter :: max_side = 100000, max_points = 1000000, max_degree = 20
+    integer(int64), parameter :: max_knots = max_side + max_degree + 1
 
 contains
 
@@ -36,14 +45,19 @@ contains
         call read_degree(h5, 'body', name, g, 2, degree, where, error)
         if (allocated(error)) return
         surf%degree = degree
-        call h5%read(g//'/knots_xi', surf%knots_xi, error)
+        call h5%read(g//'/knots_xi', surf%knots_xi, error, max_knots)
         if (allocated(error)) return
-        call h5%read(g//'/knots_eta', surf%knots_eta, error)
+        call h5%read(g//'/knots_eta', surf%knots_eta, error, max_knots)
         if (allocated(error)) return
-        call h5%read(g//'/control_points', cp, error)
+        call h5%read(g//'/control_points', cp, error, 2_int64*max_points)
         if (allocated(error)) return
-        call h5%read(g//'/weights', w, error)
+        call h5%read(g//'/weights', w, error, int(max_points, int64))
         if (allocated(error)) return
+        if (size(cp, 2) > max_side .or. size(cp, 3) > max_side) then
+            call fatal_error(error, where//'control_points: '//str(size(cp, 3))//' x '//str(size(cp, 2))// &
+                             ' points; at most '//str(max_side)//' along each direction', error_code%input)
+            return
+        end if
         if (size(cp, 1) /= 2) then
             call fatal_error(error, where//'control_points must have shape (n_eta, n_xi, 2)', &
                              error_code%input)
@@ -132,11 +146,11 @@ contains
         call read_degree(h5, 'curve', name, g, 1, degree, where, error)
         if (allocated(error)) return
         curve%degree = degree(1)
-        call h5%read(g//'/knots', curve%knots, error)
+        call h5%read(g//'/knots', curve%knots, error, max_knots)
         if (allocated(error)) return
-        call h5%read(g//'/control_points', cp, error)
+        call h5%read(g//'/control_points', cp, error, 2_int64*max_side)
         if (allocated(error)) return
-        call h5%read(g//'/weights', curve%w, error)
+        call h5%read(g//'/weights', curve%w, error, int(max_side, int64))
         if (allocated(error)) return
         if (size(cp, 1) /= 2 .or. size(curve%w) /= size(cp, 2)) then
             call fatal_error(error, where//'control_points must have shape (n, 2) and weights (n,)', &
@@ -168,12 +182,12 @@ contains
                              " is missing)", error_code%input)
             return
         end if
-        call h5%read(g//'/degree', degree, error)
+        call h5%read(g//'/degree', degree, error, 16_int64)
         if (allocated(error)) return
         if (size(degree) /= n) then
             call fatal_error(error, where//'degree must have '//trim(merge('2 entries', '1 entry  ', n == 2)), &
                              error_code%input)
-        else if (any(degree < 1) .or. any(degree > 20)) then
+        else if (any(degree < 1) .or. any(degree > max_degree)) then
             call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
         end if
     end subroutine read_degree

@@ -30,7 +30,7 @@ module voiga_io_hdf5
     use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_int, path_char => c_char, path_end => c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use hdf5, only: hid_t, hsize_t, h5open_f, h5fopen_f, h5fcreate_f, h5fclose_f, h5fflush_f, &
-                    H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
+                    H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, H5F_ACC_TRUNC_F, H5F_ACC_EXCL_F, H5F_SCOPE_GLOBAL_F, &
                     h5dopen_f, h5dcreate_f, h5dwrite_f, h5dread_f, h5dget_space_f, h5dget_type_f, &
                     h5screate_simple_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
                     h5gcreate_f, h5lexists_f, h5ldelete_f, h5tget_class_f, H5T_INTEGER_F, &
@@ -40,6 +40,7 @@ module voiga_io_hdf5
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5_status, only: note, release, class_name, not_open, fits_integer
+    use voiga_io_os, only: file_info_t, file_status, kind_name, kind_missing, kind_regular
     implicit none
     private
 
@@ -63,9 +64,12 @@ module voiga_io_hdf5
         !> Write a real (64-bit) or integer array of any rank, or a scalar.
         generic :: write => write_real, write_int
         procedure, private :: write_real, write_int
-        !> Read into an allocatable real array of rank 0 to 3 or integer array of rank 0 or 1.
+        !> Read into an allocatable real array of rank 0 to 3 or integer array of rank
+        !> 0 or 1, optionally of at most `limit` values (checked before anything is read).
         generic :: read => read_real, read_int
         procedure, private :: read_real, read_int
+        !> The descriptor of the open file (-1 when none): its identity.
+        procedure :: descriptor => file_descriptor
         generic :: write_attr => attr_write_str, attr_write_int, attr_write_real
         procedure, private :: attr_write_str, attr_write_int, attr_write_real
         procedure :: read_attr_str => attr_read_str
@@ -135,6 +139,43 @@ module voiga_io_hdf5
     end interface
 
     interface
+        !> Read a real dataset of the array's rank (rank 0: a scalar or one-element
+        !> dataset), converting integers and other floats; a dataset of more than
+        !> `limit` values (default: 2^31 - 1) is refused before anything is read.
+        module subroutine read_real(self, path, array, error, limit)
+            class(h5file_t), intent(in) :: self
+            character(len=*), intent(in) :: path
+            real(dp), allocatable, target, intent(out) :: array(..)
+            type(error_t), allocatable, intent(out) :: error
+            integer(int64), intent(in), optional :: limit
+        end subroutine read_real
+
+        !> Read an integer dataset (any integer width) of the array's rank; its values
+        !> must fit a default integer. `limit` as for `read_real`.
+        module subroutine read_int(self, path, array, error, limit)
+            class(h5file_t), intent(in) :: self
+            character(len=*), intent(in) :: path
+            integer, allocatable, intent(out) :: array(..)
+            type(error_t), allocatable, intent(out) :: error
+            integer(int64), intent(in), optional :: limit
+        end subroutine read_int
+
+        !> Shape of dataset `path` in Fortran order (empty if missing, unreadable or
+        !> kept outside the file; a dimension beyond 2^31 - 1 as 2^31 - 1).
+        module function dataset_shape(self, path) result(dims)
+            class(h5file_t), intent(in) :: self
+            character(len=*), intent(in) :: path
+            integer, allocatable :: dims(:)
+        end function dataset_shape
+    end interface
+
+    interface
+        !> The descriptor of an open HDF5 file (journal_vfd.c; -1 when none).
+        function c_h5_fd(file) bind(c, name='voiga_h5_fd') result(fd)
+            import :: c_int, hid_t
+            integer(hid_t), value :: file
+            integer(c_int) :: fd
+        end function c_h5_fd
         !> The journaled file driver on a file access list (journal_vfd.c); 0: done.
         function c_journal_fapl(fapl) bind(c, name='voiga_journal_fapl') result(st)
             import :: c_int, hid_t
@@ -152,7 +193,9 @@ module voiga_io_hdf5
 
 contains
 
-    !> Open `path`: mode 'r' read-only, 'rw' read-write, 'w' create (truncate).
+    !> Open `path`: mode 'r' read-only, 'rw' read-write (an existing regular file:
+    !> a FIFO or a device is refused before HDF5 opens it), 'w' create (truncate), 'x'
+    !> create a new file (refused when anything is at the name; never through a link).
     !> A file this object had open is closed first. HDF5's own file locking is off:
     !> a result file is guarded by the writer's lock file and its `flock` while a
     !> step is written (`voiga_io_results`, docs/hdf5.md), whatever
@@ -163,7 +206,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer :: st
         integer(hid_t) :: fapl
-        logical :: present
+        type(file_info_t) :: info
 
         call self%close(error)
         if (allocated(error)) return
@@ -181,9 +224,13 @@ contains
         end if
         select case (mode)
         case ('r', 'rw')
-            inquire (file=path, exist=present)
-            if (.not. present) then
+            info = file_status(path, .true.)
+            if (info%kind == kind_missing) then
                 call fatal_error(error, "file '"//path//"' does not exist", error_code%input)
+            else if (info%kind /= kind_regular) then
+                ! (HDF5 would wait for the other end of a FIFO, or read a device)
+                call fatal_error(error, "'"//path//"' is "//kind_name(info%kind)//', not an HDF5 file', &
+                                 error_code%input)
             else
                 call h5fopen_f(path, merge(H5F_ACC_RDONLY_F, H5F_ACC_RDWR_F, mode == 'r'), self%id, st, &
                                access_prp=fapl)
@@ -193,8 +240,9 @@ contains
                                      error_code%input)
                 end if
             end if
-        case ('w')
-            call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, st, access_prp=fapl)
+        case ('w', 'x')
+            call h5fcreate_f(path, merge(H5F_ACC_EXCL_F, H5F_ACC_TRUNC_F, mode == 'x'), self%id, st, &
+                             access_prp=fapl)
             if (st /= 0) then
                 self%id = -1
                 call fatal_error(error, "cannot create HDF5 file '"//path//"'", error_code%input)
@@ -239,6 +287,13 @@ contains
         if (self%id >= 0) call h5fclose_f(self%id, st)
         self%id = -1
     end subroutine file_finalize
+
+    !> The descriptor of the open file (the driver's; -1 when the file is not open).
+    integer(c_int) function file_descriptor(self)
+        class(h5file_t), intent(in) :: self
+        file_descriptor = -1
+        if (self%id >= 0) file_descriptor = c_h5_fd(self%id)
+    end function file_descriptor
 
     !> Is the file open?
     logical function file_is_open(self)
@@ -402,205 +457,6 @@ contains
         if (allocated(failed)) call fatal_error(error, self%path//": writing dataset '"//path// &
                                                 "' failed in "//failed)
     end subroutine write_dataset
-
-    !> Read a real dataset of the array's rank (rank 0: a scalar or one-element dataset),
-    !> converting integers and other floats.
-    subroutine read_real(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        real(dp), allocatable, target, intent(out) :: array(..)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hsize_t), allocatable :: dims(:)
-
-        call dataset_layout(self, path, rank(array), .true., dims, error)
-        if (allocated(error)) return
-        select rank (array)
-        rank (0)
-            allocate (array)
-        rank (1)
-            allocate (array(dims(1)))
-        rank (2)
-            allocate (array(dims(1), dims(2)))
-        rank (3)
-            allocate (array(dims(1), dims(2), dims(3)))
-        rank default
-            call unsupported_rank(self, path, rank(array), error)
-            return
-        end select
-        call read_dataset(self, path, H5T_NATIVE_DOUBLE, product(dims), c_loc(array), error)
-    end subroutine read_real
-
-    !> Read an integer dataset (any integer width) of the array's rank; its values
-    !> must fit a default integer.
-    subroutine read_int(self, path, array, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, allocatable, intent(out) :: array(..)
-        type(error_t), allocatable, intent(out) :: error
-        integer(hsize_t), allocatable :: dims(:)
-        integer(int64), allocatable, target :: wide(:)
-
-        call dataset_layout(self, path, rank(array), .false., dims, error)
-        if (allocated(error)) return
-        allocate (wide(product(dims)))
-        call read_dataset(self, path, h5kind_to_type(int64, H5_INTEGER_KIND), product(dims), &
-                          c_loc(wide), error)
-        if (allocated(error)) return
-        if (.not. fits_integer(wide)) then
-            call fatal_error(error, self%path//": dataset '"//path// &
-                             "' holds integers too large for a default integer", error_code%input)
-            return
-        end if
-        select rank (array)
-        rank (0)
-            allocate (array)
-            array = int(wide(1))
-        rank (1)
-            allocate (array(dims(1)))
-            array = int(wide)
-        rank default
-            call unsupported_rank(self, path, rank(array), error)
-        end select
-    end subroutine read_int
-
-    !> The error for an array rank `read` has no branch for.
-    subroutine unsupported_rank(self, path, array_rank, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: array_rank
-        type(error_t), allocatable, intent(out) :: error
-        character(len=12) :: buf
-        write (buf, '(i0)') array_rank
-        call fatal_error(error, self%path//": reading dataset '"//path// &
-                         "' into an array of rank "//trim(buf)//" is not supported")
-    end subroutine unsupported_rank
-
-    !> Shape (Fortran order) of dataset `path`, checked to be readable as an array of
-    !> rank `array_rank` (rank 0 takes a scalar or one-element dataset) holding
-    !> reals (`as_real`: integer or float datasets) or integers (integer datasets).
-    subroutine dataset_layout(self, path, array_rank, as_real, dims, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: array_rank
-        logical, intent(in) :: as_real
-        integer(hsize_t), allocatable, intent(out) :: dims(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer :: type_class
-        character(len=32) :: buf
-        character(len=:), allocatable :: expected
-
-        call dataset_info(self, path, dims, type_class, error)
-        if (allocated(error)) return
-        expected = merge('numbers ', 'integers', as_real)
-        if (.not. (type_class == H5T_INTEGER_F .or. &
-                   (as_real .and. type_class == H5T_FLOAT_F))) then
-            call fatal_error(error, self%path//": dataset '"//path//"' holds "// &
-                             class_name(type_class)//", not "//trim(expected), error_code%input)
-            return
-        end if
-        if (array_rank == 0 .and. product(dims) == 1 .and. size(dims) <= 1) then
-            dims = [integer(hsize_t) ::]
-        else if (size(dims) /= array_rank) then
-            write (buf, '(i0,a,i0)') size(dims), ', expected ', array_rank
-            call fatal_error(error, self%path//": dataset '"//path//"' has rank "//trim(buf), &
-                             error_code%input)
-        end if
-    end subroutine dataset_layout
-
-    !> Shape (Fortran order) and HDF5 type class of dataset `path`.
-    subroutine dataset_info(self, path, dims, type_class, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer(hsize_t), allocatable, intent(out) :: dims(:)
-        integer, intent(out) :: type_class
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did, sid, tid
-        integer(hsize_t), allocatable :: maxdims(:)
-        integer :: st, ndims
-        character(len=:), allocatable :: failed
-
-        type_class = -1
-        allocate (dims(0))
-        if (not_open(self%id, path, error)) return
-        if (.not. self%exists(path)) then
-            call fatal_error(error, self%path//": dataset '"//path//"' is missing", &
-                             error_code%input)
-            return
-        end if
-        sid = -1
-        tid = -1
-        call h5dopen_f(self%id, path, did, st)
-        if (st /= 0) then
-            call fatal_error(error, self%path//": '"//path//"' is not a dataset", error_code%input)
-            return
-        end if
-        steps: block
-            call h5dget_type_f(did, tid, st)
-            call note(st, 'H5Dget_type', failed)
-            if (allocated(failed)) exit steps
-            call h5tget_class_f(tid, type_class, st)
-            call note(st, 'H5Tget_class', failed)
-            call h5dget_space_f(did, sid, st)
-            call note(st, 'H5Dget_space', failed)
-            if (allocated(failed)) exit steps
-            call h5sget_simple_extent_ndims_f(sid, ndims, st)
-            call note(st, 'H5Sget_simple_extent_ndims', failed)
-            if (allocated(failed)) exit steps
-            deallocate (dims)
-            allocate (dims(ndims), maxdims(ndims))
-            call h5sget_simple_extent_dims_f(sid, dims, maxdims, st)
-            ! (returns the rank on success)
-            call note(merge(0, -1, st == ndims), 'H5Sget_simple_extent_dims', failed)
-        end block steps
-        call release(tid, failed)
-        call release(sid, failed)
-        call release(did, failed)
-        if (allocated(failed)) call fatal_error(error, self%path//": inspecting dataset '"//path// &
-                                                "' failed in "//failed, error_code%input)
-    end subroutine dataset_info
-
-    !> Read all `n` values of dataset `path` as HDF5 type `mem_type` into `buf`.
-    subroutine read_dataset(self, path, mem_type, n, buf, error)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer(hid_t), intent(in) :: mem_type
-        integer(hsize_t), intent(in) :: n
-        type(c_ptr), intent(in) :: buf
-        type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: did
-        integer :: st
-        character(len=:), allocatable :: failed
-        type(c_ptr) :: p
-
-        if (n == 0) return
-        p = buf
-        did = -1
-        call h5dopen_f(self%id, path, did, st)
-        call note(st, 'H5Dopen', failed)
-        if (.not. allocated(failed)) then
-            call h5dread_f(did, mem_type, p, st)
-            call note(st, 'H5Dread', failed)
-        end if
-        call release(did, failed)
-        if (allocated(failed)) call fatal_error(error, self%path//": reading dataset '"//path// &
-                                                "' failed in "//failed, error_code%input)
-    end subroutine read_dataset
-
-    !> Shape of dataset `path` in Fortran order (empty if missing or unreadable).
-    function dataset_shape(self, path) result(dims)
-        class(h5file_t), intent(in) :: self
-        character(len=*), intent(in) :: path
-        integer, allocatable :: dims(:)
-        integer(hsize_t), allocatable :: d(:)
-        integer :: type_class
-        type(error_t), allocatable :: error
-        call dataset_info(self, path, d, type_class, error)
-        if (allocated(error)) then
-            allocate (dims(0))
-        else
-            dims = int(d)
-        end if
-    end function dataset_shape
 
     !> Parent group of a path ('/a/b/c' -> '/a/b'); '' for top-level names.
     pure function parent_of(path) result(parent)

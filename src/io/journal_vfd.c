@@ -127,6 +127,21 @@ static uint64_t get64(const unsigned char *p)
     return v;
 }
 
+/* The existing regular file `path` opened with `oflags`, never through a symbolic
+ * link, and never waiting on a FIFO (O_NONBLOCK while it is opened): anything but a
+ * regular file is refused (-1). */
+static int open_regular(const char *path, int oflags)
+{
+    struct stat st;
+    int fd = open(path, oflags | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) return -1;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
 /* Steps 2 and 3 from a journal in memory (records of `length` bytes). */
 static int apply_records(int fd, const unsigned char *rec, uint64_t length, uint64_t final_size,
                          int kill)
@@ -198,7 +213,7 @@ int voiga_journal_recover(const char *path)
     struct stat st;
     int fd, status = 0;
 
-    fd = open(path, O_RDWR | O_CLOEXEC);
+    fd = open_regular(path, O_RDWR);
     if (fd < 0) return -1;
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
         close(fd);
@@ -242,10 +257,11 @@ static H5FD_t *j_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxa
     if (flags & H5F_ACC_TRUNC) oflags |= O_TRUNC;
     if (flags & H5F_ACC_CREAT) oflags |= O_CREAT;
     if (flags & H5F_ACC_EXCL) oflags |= O_EXCL;
-    if ((flags & H5F_ACC_RDWR) && !(flags & H5F_ACC_TRUNC) && voiga_journal_recover(name) < 0) return NULL;
-    fd = open(name, oflags, 0666);
+    if ((flags & H5F_ACC_RDWR) && !(flags & (H5F_ACC_TRUNC | H5F_ACC_CREAT)) && voiga_journal_recover(name) < 0)
+        return NULL;
+    fd = (oflags & O_CREAT) ? open(name, oflags | O_NOFOLLOW, 0666) : open_regular(name, oflags);
     if (fd < 0) return NULL;
-    if (fstat(fd, &st) != 0) {
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         close(fd);
         return NULL;
     }
@@ -409,4 +425,13 @@ int voiga_journal_fapl(hid_t fapl)
         if (H5Pset_mdc_config(fapl, &c) < 0) return -1;
     }
     return H5Pset_driver(fapl, driver_id, NULL) < 0 ? -1 : 0;
+}
+
+/* The descriptor of the open HDF5 file `file` (its driver's; -1 when there is
+ * none): what a writer checks its file's name against (os.f90's names_file). */
+int voiga_h5_fd(hid_t file)
+{
+    void *handle = NULL;
+    if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || handle == NULL) return -1;
+    return *(int *)handle;
 }

@@ -46,11 +46,12 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: text
         integer, allocatable :: starts(:)
-        integer :: pos, n, line, first, last, first_line
+        integer :: pos, n, line, first, last, first_line, found
         character :: quote
         character(len=32) :: name
 
         allocate (groups(0))
+        found = 0
         call read_bytes(path, text, error)
         if (allocated(error)) return
         call line_starts(text, starts)
@@ -119,34 +120,44 @@ contains
                                  ") is not closed: a group ends with '/'", error_code%input)
                 return
             end if
-            call append(groups, name, first_line, records(text, starts, first, last))
+            call append(groups, found, name, first_line, records(text, starts, first, last))
             pos = last + 1
         end do
+        call resize(groups, found, found)
     end subroutine scan_groups
 
-    !> Add a group at the end of `groups` (by hand: gfortran 12 corrupts the heap
+    !> Add a group after the `n` of `groups` (its size doubled when full, so that
+    !> many groups cost linear time; moved by hand: gfortran 12 corrupts the heap
     !> building an array constructor of this type, whose component is a
     !> deferred-length character array).
-    pure subroutine append(groups, name, line, text)
+    pure subroutine append(groups, n, name, line, text)
         type(nml_group_t), allocatable, intent(inout) :: groups(:)
+        integer, intent(inout) :: n
         character(len=*), intent(in) :: name
         integer, intent(in) :: line
         character(len=*), intent(in) :: text(:)
+        if (n == size(groups)) call resize(groups, n, max(16, 2*n))
+        n = n + 1
+        groups(n)%name = name
+        groups(n)%line = line
+        allocate (character(len=len(text)) :: groups(n)%text(size(text)))
+        groups(n)%text = text
+    end subroutine append
+
+    !> `groups` with room for `capacity` groups, its first `n` kept.
+    pure subroutine resize(groups, n, capacity)
+        type(nml_group_t), allocatable, intent(inout) :: groups(:)
+        integer, intent(in) :: n, capacity
         type(nml_group_t), allocatable :: grown(:)
-        integer :: i, n
-        n = size(groups)
-        allocate (grown(n + 1))
+        integer :: i
+        allocate (grown(capacity))
         do i = 1, n
             grown(i)%name = groups(i)%name
             grown(i)%line = groups(i)%line
             call move_alloc(groups(i)%text, grown(i)%text)
         end do
-        grown(n + 1)%name = name
-        grown(n + 1)%line = line
-        allocate (character(len=len(text)) :: grown(n + 1)%text(size(text)))
-        grown(n + 1)%text = text
         call move_alloc(grown, groups)
-    end subroutine append
+    end subroutine resize
 
     !> The whole file as one string (lines separated by LF, as stored).
     subroutine read_bytes(path, text, error)
@@ -184,10 +195,23 @@ contains
         end do
     end subroutine line_starts
 
-    !> Line number of position `pos`.
+    !> Line number of position `pos` (`starts` ascending: bisection, so that a file
+    !> of many groups is scanned in linear time).
     pure integer function line_of(starts, pos)
         integer, intent(in) :: starts(:), pos
-        line_of = count(starts <= pos)
+        integer :: lo, hi, mid
+        ! invariant: starts(lo) <= pos < starts(hi + 1)
+        lo = 1
+        hi = size(starts)
+        do while (lo < hi)
+            mid = (lo + hi + 1)/2
+            if (starts(mid) <= pos) then
+                lo = mid
+            else
+                hi = mid - 1
+            end if
+        end do
+        line_of = lo
     end function line_of
 
     !> Position of the last character of the line that holds `pos` (before its LF).

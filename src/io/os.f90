@@ -1,38 +1,46 @@
 !> The operating-system calls of the file layer (Linux, glibc): canonical paths,
-!> rename and remove, advisory locks (`flock`) and space reserved for a write
-!> (`fallocate`). The process's own limits are `voiga_io_process`'s.
+!> what a path names and its identity (device and inode, so that two names of one
+!> file are told from two files), files created without following links and
+!> without replacing anything, regular files opened without blocking on a FIFO,
+!> renames that replace only when asked, descriptors' `flock`, and space reserved
+!> for a write (`fallocate`). The locks built on them are `voiga_io_lock`'s, the
+!> process's own limits `voiga_io_process`'s.
 !>
-!> The raw libc interfaces are private. The constants are Linux's (asm-generic,
-!> x86-64 and arm64): `open` flags O_RDONLY 0, O_WRONLY 1, O_RDWR 2, O_CREAT 64,
-!> O_CLOEXEC 524288, O_DIRECTORY 65536; `flock` LOCK_SH 1, LOCK_EX 2, LOCK_NB 4,
-!> LOCK_UN 8; `fallocate` FALLOC_FL_KEEP_SIZE 1; errno EINTR 4, ENOENT 2,
-!> EWOULDBLOCK 11, EOPNOTSUPP 95.
+!> The raw interfaces are private; the calls that need the system's constants are
+!> in os_calls.c (which includes the system headers: no flag value is written
+!> here) and return -errno on failure.
 module voiga_io_os
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_long, &
                                            c_size_t, c_associated, c_f_pointer, c_int64_t
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_sha256, only: sha256_text
+    use voiga_kinds, only: dp
+    use voiga_text, only: fixed_str
     implicit none
     private
 
     public :: canonical_path, rename_file, remove_file, path_exists, is_directory, companion
-    public :: lock_t, acquire_lock, release_lock, hold_exclusive, hold_shared, let_go
-    public :: reserve_space, release_space, c_str
+    public :: file_info_t, file_status, fd_status, path_kind, fd_size, same_file, names_file, kind_name, what_is
+    public :: create_new, open_regular, close_fd, lock_fd, write_text, read_text
+    public :: reserve_space, release_space, c_str, strerror
+    public :: kind_unknown, kind_missing, kind_regular, kind_folder, kind_link, kind_fifo, kind_char, &
+              kind_block, kind_socket
 
-    integer(c_int), parameter :: o_rdonly = 0, o_wronly = 1, o_rdwr = 2, o_creat = 64, &
-                                 o_cloexec = 524288
-    integer(c_int), parameter :: lock_sh = 1, lock_ex = 2, lock_nb = 4, lock_un = 8
-    integer(c_int), parameter :: falloc_fl_keep_size = 1
-    integer(c_int), parameter :: eintr = 4, enoent = 2, ewouldblock = 11, eopnotsupp = 95
+    !> What a path names (os_calls.c's KIND_*); `kind_unknown` when its status
+    !> could not be taken.
+    integer, parameter :: kind_unknown = -1, kind_missing = 0, kind_regular = 1, kind_folder = 2, &
+                          kind_link = 3, kind_fifo = 4, kind_char = 5, kind_block = 6, kind_socket = 7
 
-    !> A lock held on a file (`flock` on an open descriptor; released when the
-    !> descriptor is closed, also by the kernel when the process dies).
-    type :: lock_t
-        integer(c_int) :: fd = -1
-        !> The lock file, when the lock owns one (removed on release).
-        character(len=:), allocatable :: path
-    end type lock_t
+    !> What a path or a descriptor names: its kind and, when it exists, the
+    !> identity of the file (device and inode: one file whatever name it has), its
+    !> number of names (hard links) and its size in bytes.
+    type :: file_info_t
+        integer :: kind = kind_missing
+        integer(int64) :: device = -1, inode = -1, links = 0, size = 0
+        !> The errno when `kind` is `kind_unknown`.
+        integer :: errno = 0
+    end type file_info_t
 
     interface
         function c_realpath(path, resolved) bind(c, name='realpath') result(p)
@@ -50,7 +58,7 @@ module voiga_io_os
             type(c_ptr), value :: s
             integer(c_size_t) :: n
         end function c_strlen
-        function c_strerror(errnum) bind(c, name='strerror') result(p)
+        function c_strerror(errnum) bind(c, name='voiga_strerror') result(p)
             import :: c_int, c_ptr
             integer(c_int), value :: errnum
             type(c_ptr) :: p
@@ -59,57 +67,14 @@ module voiga_io_os
             import :: c_ptr
             type(c_ptr) :: p
         end function c_errno_location
-        function c_rename(from, to) bind(c, name='rename') result(st)
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: from(*), to(*)
-            integer(c_int) :: st
-        end function c_rename
-        function c_unlink(path) bind(c, name='unlink') result(st)
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int) :: st
-        end function c_unlink
-        function c_open(path, flags, mode) bind(c, name='open') result(fd)
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int), value :: flags, mode
-            integer(c_int) :: fd
-        end function c_open
-        function c_close(fd) bind(c, name='close') result(st)
+        function c_enoent() bind(c, name='voiga_enoent') result(e)
             import :: c_int
-            integer(c_int), value :: fd
-            integer(c_int) :: st
-        end function c_close
-        function c_flock(fd, op) bind(c, name='flock') result(st)
+            integer(c_int) :: e
+        end function c_enoent
+        function c_eexist() bind(c, name='voiga_eexist') result(e)
             import :: c_int
-            integer(c_int), value :: fd, op
-            integer(c_int) :: st
-        end function c_flock
-        function c_lseek(fd, offset, whence) bind(c, name='lseek') result(pos)
-            import :: c_int, c_int64_t
-            integer(c_int), value :: fd, whence
-            integer(c_int64_t), value :: offset
-            integer(c_int64_t) :: pos
-        end function c_lseek
-        function c_fallocate(fd, mode, offset, length) bind(c, name='fallocate') result(st)
-            import :: c_int, c_int64_t
-            integer(c_int), value :: fd, mode
-            integer(c_int64_t), value :: offset, length
-            integer(c_int) :: st
-        end function c_fallocate
-        function c_ftruncate(fd, length) bind(c, name='ftruncate') result(st)
-            import :: c_int, c_int64_t
-            integer(c_int), value :: fd
-            integer(c_int64_t), value :: length
-            integer(c_int) :: st
-        end function c_ftruncate
-        function c_write(fd, buf, n) bind(c, name='write') result(written)
-            import :: c_int, c_char, c_size_t, c_long
-            integer(c_int), value :: fd
-            character(kind=c_char), intent(in) :: buf(*)
-            integer(c_size_t), value :: n
-            integer(c_long) :: written
-        end function c_write
+            integer(c_int) :: e
+        end function c_eexist
         function c_readlink(path, buf, n) bind(c, name='readlink') result(length)
             import :: c_char, c_size_t, c_long
             character(kind=c_char), intent(in) :: path(*)
@@ -117,15 +82,76 @@ module voiga_io_os
             integer(c_size_t), value :: n
             integer(c_long) :: length
         end function c_readlink
-        function c_getpid() bind(c, name='getpid') result(pid)
+        function c_file_status(path, follow, out) bind(c, name='voiga_file_status') result(kind)
+            import :: c_char, c_int, c_int64_t
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: follow
+            integer(c_int64_t), intent(out) :: out(4)
+            integer(c_int) :: kind
+        end function c_file_status
+        function c_fd_status(fd, out) bind(c, name='voiga_fd_status') result(kind)
+            import :: c_int, c_int64_t
+            integer(c_int), value :: fd
+            integer(c_int64_t), intent(out) :: out(4)
+            integer(c_int) :: kind
+        end function c_fd_status
+        function c_create_new(path, mode) bind(c, name='voiga_create_new') result(fd)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+            integer(c_int) :: fd
+        end function c_create_new
+        function c_open_regular(path, writable, follow, kind) bind(c, name='voiga_open_regular') result(fd)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: writable, follow
+            integer(c_int), intent(out) :: kind
+            integer(c_int) :: fd
+        end function c_open_regular
+        function c_lock(fd, how, wait) bind(c, name='voiga_lock') result(st)
             import :: c_int
-            integer(c_int) :: pid
-        end function c_getpid
-        function c_usleep(usec) bind(c, name='usleep') result(st)
-            import :: c_int
-            integer(c_int), value :: usec
+            integer(c_int), value :: fd, how, wait
             integer(c_int) :: st
-        end function c_usleep
+        end function c_lock
+        function c_close(fd) bind(c, name='voiga_close') result(st)
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: st
+        end function c_close
+        function c_write_text(fd, text, n) bind(c, name='voiga_write_text') result(st)
+            import :: c_int, c_char
+            integer(c_int), value :: fd, n
+            character(kind=c_char), intent(in) :: text(*)
+            integer(c_int) :: st
+        end function c_write_text
+        function c_read_text(fd, text, n) bind(c, name='voiga_read_text') result(st)
+            import :: c_int, c_char
+            integer(c_int), value :: fd, n
+            character(kind=c_char), intent(out) :: text(*)
+            integer(c_int) :: st
+        end function c_read_text
+        function c_unlink(path) bind(c, name='voiga_unlink') result(st)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: st
+        end function c_unlink
+        function c_rename(from, to, replace) bind(c, name='voiga_rename') result(st)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: from(*), to(*)
+            integer(c_int), value :: replace
+            integer(c_int) :: st
+        end function c_rename
+        function c_reserve(fd, bytes) bind(c, name='voiga_reserve') result(st)
+            import :: c_int, c_int64_t
+            integer(c_int), value :: fd
+            integer(c_int64_t), value :: bytes
+            integer(c_int) :: st
+        end function c_reserve
+        function c_release(fd) bind(c, name='voiga_release') result(st)
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: st
+        end function c_release
     end interface
 
 contains
@@ -239,7 +265,7 @@ contains
         end if
         call real_path(path, resolved, ok, e)
         if (ok) return
-        if (e /= enoent) then
+        if (e /= c_enoent()) then
             call fatal_error(error, "'"//path//"': "//strerror(e), error_code%input)
             return
         end if
@@ -289,209 +315,236 @@ contains
         end if
     end function companion
 
+    !> What `path` names: the file a symbolic link points to when `follow`, else
+    !> the link itself.
+    function file_status(path, follow) result(info)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: follow
+        type(file_info_t) :: info
+        integer(c_int64_t) :: out(4)
+        call described(c_file_status(c_str(path), merge(1_c_int, 0_c_int, follow), out), out, info)
+    end function file_status
+
+    !> The kind of what `path` names (`file_status`'s).
+    integer function path_kind(path, follow)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: follow
+        type(file_info_t) :: info
+        info = file_status(path, follow)
+        path_kind = info%kind
+    end function path_kind
+
+    !> The size in bytes of the file open as `fd` (0 when unknown).
+    integer(int64) function fd_size(fd)
+        integer(c_int), intent(in) :: fd
+        type(file_info_t) :: info
+        info = fd_status(fd)
+        fd_size = info%size
+    end function fd_size
+
+    !> What the open descriptor `fd` is.
+    function fd_status(fd) result(info)
+        integer(c_int), intent(in) :: fd
+        type(file_info_t) :: info
+        integer(c_int64_t) :: out(4)
+        call described(c_fd_status(fd, out), out, info)
+    end function fd_status
+
+    pure subroutine described(kind, out, info)
+        integer(c_int), intent(in) :: kind
+        integer(c_int64_t), intent(in) :: out(4)
+        type(file_info_t), intent(out) :: info
+        if (kind < 0) then
+            info%kind = kind_unknown
+            info%errno = -kind
+        else
+            info%kind = kind
+            if (kind /= kind_missing) then
+                info%device = out(1)
+                info%inode = out(2)
+                info%links = out(3)
+                info%size = out(4)
+            end if
+        end if
+    end subroutine described
+
+    !> Are `a` and `b` the same existing file (device and inode), whatever their names?
+    pure logical function same_file(a, b)
+        type(file_info_t), intent(in) :: a, b
+        same_file = a%kind > kind_missing .and. b%kind > kind_missing .and. a%device == b%device .and. &
+                    a%inode == b%inode
+    end function same_file
+
+    !> Does the name `path` (not followed if a link) still name the file `info`
+    !> describes? (No when it was removed, or moved and something else put there.)
+    logical function names_file(path, info)
+        character(len=*), intent(in) :: path
+        type(file_info_t), intent(in) :: info
+        names_file = same_file(file_status(path, .false.), info)
+    end function names_file
+
+    !> What a kind of file is called in messages ('a FIFO (named pipe)').
+    pure function kind_name(kind) result(name)
+        integer, intent(in) :: kind
+        character(len=:), allocatable :: name
+        select case (kind)
+        case (kind_missing)
+            name = 'missing'
+        case (kind_regular)
+            name = 'a regular file'
+        case (kind_folder)
+            name = 'a folder'
+        case (kind_link)
+            name = 'a symbolic link'
+        case (kind_fifo)
+            name = 'a FIFO (named pipe)'
+        case (kind_char)
+            name = 'a character device'
+        case (kind_block)
+            name = 'a block device'
+        case (kind_socket)
+            name = 'a socket'
+        case default
+            name = 'of unknown kind'
+        end select
+    end function kind_name
+
+    !> What `info` is called in a message refusing to touch it: its kind, or 'a
+    !> second name of another file' for a regular file with more than one name.
+    pure function what_is(info) result(name)
+        type(file_info_t), intent(in) :: info
+        character(len=:), allocatable :: name
+        if (info%kind == kind_regular .and. info%links > 1) then
+            name = 'a second name of another file'
+        else
+            name = kind_name(info%kind)
+        end if
+    end function what_is
+
     !> Does `path` exist (after following links)?
     logical function path_exists(path)
         character(len=*), intent(in) :: path
-        character(len=:), allocatable :: resolved
-        integer :: e
-        call real_path(path, resolved, path_exists, e)
+        path_exists = path_kind(path, .true.) > kind_missing
     end function path_exists
 
-    !> Is `path` an existing folder?
+    !> Is `path` an existing folder (after following links)?
     logical function is_directory(path)
         character(len=*), intent(in) :: path
-        integer(c_int) :: fd
-        ! O_DIRECTORY (65536) opens only a folder
-        fd = c_open(c_str(path), ior(o_rdonly, ior(o_cloexec, 65536_c_int)), 0_c_int)
-        is_directory = fd >= 0
-        if (fd >= 0) fd = c_close(fd)
+        is_directory = path_kind(path, .true.) == kind_folder
     end function is_directory
 
-    !> Rename `from` to `to` (same file system: atomic; `to` is replaced).
-    subroutine rename_file(from, to, error)
+    !> Create `path` as a new file, open for reading and writing (`fd`), never
+    !> through a symbolic link and never over anything there; `fd` < 0 and `e`
+    !> the errno when it cannot be (`exists`: because something is there).
+    subroutine create_new(path, fd, e, exists)
+        character(len=*), intent(in) :: path
+        integer(c_int), intent(out) :: fd
+        integer, intent(out) :: e
+        logical, intent(out) :: exists
+        fd = c_create_new(c_str(path), int(o'644', c_int))
+        e = int(max(-fd, 0_c_int))
+        exists = e == c_eexist()
+    end subroutine create_new
+
+    !> Open the existing regular file `path` (for writing too when `writable`; a
+    !> link at its last component is not followed unless `follow`): `fd`, or `fd` < 0
+    !> with `e` the errno and `kind` what is there (a FIFO or a device is never
+    !> opened in a way that waits).
+    subroutine open_regular(path, writable, follow, fd, kind, e)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: writable, follow
+        integer(c_int), intent(out) :: fd
+        integer, intent(out) :: kind, e
+        integer(c_int) :: k
+        fd = c_open_regular(c_str(path), merge(1_c_int, 0_c_int, writable), merge(1_c_int, 0_c_int, follow), k)
+        kind = int(k)
+        e = int(max(-fd, 0_c_int))
+    end subroutine open_regular
+
+    !> Close a descriptor (nothing when < 0) and set it to -1.
+    subroutine close_fd(fd)
+        integer(c_int), intent(inout) :: fd
+        integer(c_int) :: st
+        if (fd >= 0) st = c_close(fd)
+        fd = -1
+    end subroutine close_fd
+
+    !> `flock` on `fd`: `how` 'release', 'shared' or 'exclusive', waiting for it
+    !> when `wait`. 0 taken, 1 another process holds it, else -errno.
+    integer function lock_fd(fd, how, wait)
+        integer(c_int), intent(in) :: fd
+        character(len=*), intent(in) :: how
+        logical, intent(in) :: wait
+        integer(c_int) :: op
+        op = merge(0_c_int, merge(1_c_int, 2_c_int, how == 'shared'), how == 'release')
+        lock_fd = int(c_lock(fd, op, merge(1_c_int, 0_c_int, wait)))
+    end function lock_fd
+
+    !> Make `text` the whole content of the file open as `fd`; the errno, or 0.
+    integer function write_text(fd, text)
+        integer(c_int), intent(in) :: fd
+        character(len=*), intent(in) :: text
+        write_text = -int(c_write_text(fd, text, int(len(text), c_int)))
+    end function write_text
+
+    !> At most the first `n` bytes of the file open as `fd` ('' when unreadable).
+    function read_text(fd, n) result(text)
+        integer(c_int), intent(in) :: fd
+        integer, intent(in) :: n
+        character(len=:), allocatable :: text
+        character(kind=c_char) :: buf(max(n, 1))
+        integer(c_int) :: got
+        integer :: i
+        got = c_read_text(fd, buf, int(n, c_int))
+        allocate (character(len=max(int(got), 0)) :: text)
+        do i = 1, len(text)
+            text(i:i) = buf(i)
+        end do
+    end function read_text
+
+    !> Rename `from` to `to` (same file system: atomic). An existing `to` is
+    !> replaced only when `replace`; otherwise the rename fails naming it.
+    subroutine rename_file(from, to, replace, error)
         character(len=*), intent(in) :: from, to
+        logical, intent(in) :: replace
         type(error_t), allocatable, intent(out) :: error
-        if (c_rename(c_str(from), c_str(to)) /= 0) &
-            call fatal_error(error, "cannot rename '"//from//"' to '"//to//"': "//strerror(errno()))
+        integer(c_int) :: st
+        st = c_rename(c_str(from), c_str(to), merge(1_c_int, 0_c_int, replace))
+        if (st /= 0) call fatal_error(error, "cannot rename '"//from//"' to '"//to//"': "//strerror(-int(st)))
     end subroutine rename_file
 
-    !> Remove the file `path` (nothing if it does not exist).
+    !> Remove the name `path` (a link itself, never its target; nothing if it does
+    !> not exist).
     subroutine remove_file(path)
         character(len=*), intent(in) :: path
         integer(c_int) :: st
         st = c_unlink(c_str(path))
     end subroutine remove_file
 
-    !> Take the lock file `path` (created if missing) for this process, without
-    !> waiting: a lock another process holds is an error naming its process id.
-    !> The lock file holds our process id; `release_lock` removes it.
-    subroutine acquire_lock(lock, path, what, error)
-        type(lock_t), intent(inout) :: lock
-        character(len=*), intent(in) :: path
-        !> What the lock guards, for messages ("result file 'out.h5'").
-        character(len=*), intent(in) :: what
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: holder, link
-        character(len=24) :: buf
-        integer(c_int) :: fd, st
-        integer :: attempt
-        logical :: ok
-
-        do attempt = 1, 3
-            fd = c_open(c_str(path), ior(o_rdwr, ior(o_creat, o_cloexec)), int(o'644', c_int))
-            if (fd < 0) then
-                call fatal_error(error, "cannot create the lock file '"//path//"' for "//what//': '// &
-                                 strerror(errno()), error_code%input)
-                return
-            end if
-            if (c_flock(fd, ior(lock_ex, lock_nb)) /= 0) then
-                holder = first_line(path)
-                st = c_close(fd)
-                if (len(holder) > 0) holder = ' (process '//holder//')'
-                call fatal_error(error, what//' is being written by another voiga run'//holder// &
-                                 '; lock file '//path, error_code%input)
-                return
-            end if
-            ! a lock file removed by its last holder between our open and our flock
-            ! is no lock: open it again
-            write (buf, '(i0)') fd
-            call link_target('/proc/self/fd/'//trim(buf), link, ok)
-            if (.not. ok) exit
-            if (index(link, ' (deleted)') == 0) exit
-            st = c_close(fd)
-            fd = -1
-        end do
-        if (fd < 0) then
-            call fatal_error(error, "cannot take the lock file '"//path//"' for "//what, error_code%input)
-            return
-        end if
-        write (buf, '(i0)') c_getpid()
-        st = c_ftruncate(fd, 0_c_int64_t)
-        if (c_write(fd, c_str(trim(buf)//new_line('a')), int(len_trim(buf) + 1, c_size_t)) < 0) continue
-        lock%fd = fd
-        lock%path = path
-    end subroutine acquire_lock
-
-    !> The first line of a small text file ('' if unreadable).
-    function first_line(path) result(line)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable :: line
-        character(len=64) :: buf
-        integer :: u, ios
-        line = ''
-        open (newunit=u, file=path, status='old', action='read', iostat=ios)
-        if (ios /= 0) return
-        read (u, '(a)', iostat=ios) buf
-        close (u)
-        if (ios == 0) line = trim(adjustl(buf))
-    end function first_line
-
-    !> Let go of a lock; a lock file the lock owns is removed first (while held).
-    subroutine release_lock(lock)
-        type(lock_t), intent(inout) :: lock
-        integer(c_int) :: st
-        if (lock%fd < 0) return
-        if (allocated(lock%path)) call remove_file(lock%path)
-        st = c_close(lock%fd)
-        lock%fd = -1
-    end subroutine release_lock
-
-    !> Hold an exclusive `flock` on the existing file `path` (readers that take a
-    !> shared one wait), waiting at most `seconds`; `held` tells whether it was
-    !> taken (not when a reader kept its lock that long, or the file system has no
-    !> locks). Released by `let_go`.
-    subroutine hold_exclusive(lock, path, seconds, held)
-        type(lock_t), intent(inout) :: lock
-        character(len=*), intent(in) :: path
-        real, intent(in) :: seconds
-        logical, intent(out) :: held
-        call hold(lock, path, lock_ex, seconds, held)
-    end subroutine hold_exclusive
-
-    !> Hold a shared `flock` on `path` (waits while a writer holds an exclusive one,
-    !> at most `seconds`).
-    subroutine hold_shared(lock, path, seconds, held)
-        type(lock_t), intent(inout) :: lock
-        character(len=*), intent(in) :: path
-        real, intent(in) :: seconds
-        logical, intent(out) :: held
-        call hold(lock, path, lock_sh, seconds, held)
-    end subroutine hold_shared
-
-    subroutine hold(lock, path, op, seconds, held)
-        type(lock_t), intent(inout) :: lock
-        character(len=*), intent(in) :: path
-        integer(c_int), intent(in) :: op
-        real, intent(in) :: seconds
-        logical, intent(out) :: held
-        integer :: waited_ms
-        integer(c_int) :: st
-        held = .false.
-        call let_go(lock)
-        lock%fd = c_open(c_str(path), ior(o_rdonly, o_cloexec), 0_c_int)
-        if (lock%fd < 0) return
-        waited_ms = 0
-        do
-            if (c_flock(lock%fd, ior(op, lock_nb)) == 0) then
-                held = .true.
-                return
-            end if
-            if (errno() /= ewouldblock .and. errno() /= eintr) exit
-            if (waited_ms >= int(1000*seconds)) exit
-            st = c_usleep(10000_c_int)
-            waited_ms = waited_ms + 10
-        end do
-        st = c_close(lock%fd)
-        lock%fd = -1
-    end subroutine hold
-
-    !> Release a lock taken by `hold_exclusive` or `hold_shared`.
-    subroutine let_go(lock)
-        type(lock_t), intent(inout) :: lock
-        integer(c_int) :: st
-        if (lock%fd < 0) return
-        st = c_close(lock%fd)
-        lock%fd = -1
-    end subroutine let_go
-
-    !> Reserve `bytes` of disk beyond the end of the existing file `path`, so that
-    !> writes of up to that size cannot fail for want of space (`fallocate`, the
-    !> file's size unchanged). A full disk or an exceeded quota is an error naming
-    !> it; a file system that cannot reserve space is not (nothing is reserved).
-    subroutine reserve_space(path, bytes, error)
+    !> Reserve `bytes` of disk beyond the end of the file open as `fd` (`path` names
+    !> it in messages), so that writes of up to that size cannot fail for want of
+    !> space (`fallocate`, the file's size unchanged). A full disk or an exceeded
+    !> quota is an error naming it; a file system that cannot reserve space is not
+    !> (nothing is reserved).
+    subroutine reserve_space(fd, path, bytes, error)
+        integer(c_int), intent(in) :: fd
         character(len=*), intent(in) :: path
         integer(int64), intent(in) :: bytes
         type(error_t), allocatable, intent(out) :: error
-        integer(c_int) :: fd, st
-        integer(c_int64_t) :: size
-        integer :: e
-        character(len=32) :: buf
-        fd = c_open(c_str(path), ior(o_wronly, o_cloexec), 0_c_int)
-        if (fd < 0) then
-            call fatal_error(error, "cannot open '"//path//"' to reserve space: "//strerror(errno()))
-            return
+        integer(c_int) :: st
+        st = c_reserve(fd, int(bytes, c_int64_t))
+        if (st /= 0) then
+            call fatal_error(error, path//': no room for the next '//fixed_str(real(bytes, dp)/2.0_dp**20, 1)// &
+                             ' MB: '//strerror(-int(st)))
         end if
-        size = c_lseek(fd, 0_c_int64_t, 2_c_int)
-        st = c_fallocate(fd, falloc_fl_keep_size, max(size, 0_c_int64_t), int(bytes, c_int64_t))
-        e = errno()
-        if (st /= 0 .and. e /= eopnotsupp) then
-            write (buf, '(f0.1)') real(bytes, 8)/2.0d0**20
-            call fatal_error(error, path//': no room for the next '//trim(buf)//' MB: '//strerror(e))
-        end if
-        st = c_close(fd)
     end subroutine reserve_space
 
-    !> Give back the space `reserve_space` reserved beyond the end of `path` and
-    !> the writes did not use (truncating the file to its own size does it).
-    subroutine release_space(path)
-        character(len=*), intent(in) :: path
-        integer(c_int) :: fd, st
-        integer(c_int64_t) :: size
-        fd = c_open(c_str(path), ior(o_wronly, o_cloexec), 0_c_int)
-        if (fd < 0) return
-        size = c_lseek(fd, 0_c_int64_t, 2_c_int)
-        if (size >= 0) st = c_ftruncate(fd, size)
-        st = c_close(fd)
+    !> Give back the space `reserve_space` reserved beyond the end of the file open
+    !> as `fd` and the writes did not use.
+    subroutine release_space(fd)
+        integer(c_int), intent(in) :: fd
+        integer(c_int) :: st
+        st = c_release(fd)
     end subroutine release_space
 
 end module voiga_io_os

@@ -14,7 +14,7 @@ module voiga_io_process
     private
 
     public :: memory_available, address_space_limited, write_failure_cause, leave
-    public :: reexec_with_environment, ignore_file_size_signal
+    public :: reexec_with_environment, ignore_file_size_signal, stdout_is_terminal
 
     integer(c_int), parameter :: rlimit_as = 9, rlimit_fsize = 1
     !> SIGXFSZ (a write beyond `ulimit -f`), and `signal`'s SIG_IGN.
@@ -51,6 +51,11 @@ module voiga_io_process
             type(c_funptr), value :: handler
             type(c_funptr) :: previous
         end function c_signal
+        function c_isatty(fd) bind(c, name='isatty') result(yes)
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: yes
+        end function c_isatty
         function c_execv(path, argv) bind(c, name='execv') result(st)
             import :: c_char, c_ptr, c_int
             character(kind=c_char), intent(in) :: path(*)
@@ -168,5 +173,11 @@ contains
         flush (error_unit)
         st = c_execv(c_str('/proc/self/exe'), argv)
     end subroutine reexec_with_environment
+
+    !> Whether the standard output is a terminal (`isatty(1)`): only there does a run
+    !> show a live progress line (a pipe or a file gets whole lines only).
+    logical function stdout_is_terminal() result(yes)
+        yes = c_isatty(1_c_int) == 1_c_int
+    end function stdout_is_terminal
 
 end module voiga_io_process

@@ -5,7 +5,7 @@
 !> that size is allocated.
 !>
 !> The estimate is fitted to the peak resident memory of runs on this code
-!> (docs/robustness.md, "Resources", has the table and the command): a base of
+!> (docs/files.md, "Resources", has the table and the command): a base of
 !> 20 MiB (libraries, the program) plus, per entry of the element stiffness
 !> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
 !> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows

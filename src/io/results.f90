@@ -10,6 +10,7 @@ module voiga_io_results
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_version, only: voiga_version_string
+    use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     use voiga_io_dump, only: write_discretization, write_curve, write_elements
@@ -18,8 +19,8 @@ module voiga_io_results
     use voiga_io_result_file, only: result_file_t
     use voiga_io_provenance, only: write_provenance
     use voiga_model, only: model_t
-    use voiga_model_fields, only: output_settings_t
-    use voiga_io_fields, only: write_fields
+    use voiga_model_fields, only: output_settings_t, field_samples_t
+    use voiga_io_fields, only: write_fields, sample_bodies
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_nurbs_curve, only: nurbs_curve_t
@@ -44,6 +45,8 @@ module voiga_io_results
         !> The sampled fields the case asks for (`&output`) and the run's last step.
         type(output_settings_t) :: fields
         integer :: last_step = 0
+        !> A step's fields could not be sampled (warned once; the steps are written).
+        logical :: fields_failed = .false.
     contains
         procedure :: open => results_open
         procedure :: reopen => results_reopen
@@ -56,13 +59,37 @@ module voiga_io_results
         procedure :: warning => results_warning
     end type results_t
 
+    interface
+        !> The case file recorded in the result file `path`.
+        module subroutine restart_case(path, case_file, error)
+            character(len=*), intent(in) :: path
+            character(len=:), allocatable, intent(out) :: case_file
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine restart_case
+
+        !> The state after the last written step of the result file `path` (as
+        !> `write_step` wrote it): displacement, the solver's substep fraction, force
+        !> scale and det K sign, and the committed history of each contact pair of
+        !> `model`, which is set on the pairs. The file is only read; it must hold
+        !> no more values than the model has (checked before anything is read).
+        module subroutine read_restart(path, model, state, error)
+            character(len=*), intent(in) :: path
+            type(model_t), intent(inout) :: model
+            type(resume_t), intent(out) :: state
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine read_restart
+    end interface
+
 contains
 
-    !> Create the file (status 'running') with metadata and the discretization of each body.
-    subroutine results_open(self, case, model, error)
+    !> Create the file (status 'running') with metadata and the discretization of
+    !> each body; it replaces an earlier file at its name (once it has a step) only
+    !> when `replace` (`--overwrite`).
+    subroutine results_open(self, case, model, replace, error)
         class(results_t), intent(inout) :: self
         type(case_t), intent(in) :: case
         type(model_t), intent(in) :: model
+        logical, intent(in) :: replace
         type(error_t), allocatable, intent(out) :: error
         integer :: i, k
         character(len=:), allocatable :: g
@@ -70,7 +97,7 @@ contains
 
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
-        call self%h5%create(case%output, error)
+        call self%h5%create(case%output, replace, error)
         if (allocated(error)) return
         call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
         if (allocated(error)) return
@@ -198,12 +225,27 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> The model of `u` (its bodies' sampled fields, when `&output` asks for them).
         type(model_t), intent(in), optional :: model
+        type(field_samples_t), allocatable :: samples(:)
+        type(error_t), allocatable :: sampling
         if (self%h5%broken) return
+        if (present(model)) then
+            ! an output sample that cannot be evaluated does not undo a converged step:
+            ! the step is written without its fields, and the run says so once
+            if (self%fields%wants(rec%step, self%last_step)) &
+                call sample_bodies(self%fields, model, u, samples, sampling)
+            if (allocated(sampling)) then
+                deallocate (samples)
+                if (.not. self%fields_failed) call self%warning('step '//str(rec%step)// &
+                    ': its sampled fields are not written (nor those of a later step where this happens): '// &
+                    sampling%message)
+                self%fields_failed = .true.
+            end if
+        end if
         ! at least 1 MiB, and for the first step its displacement, contact output
         ! and metadata, generously
         call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
         if (allocated(error)) return
-        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
+        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
         if (.not. allocated(error)) call write_counters(self, wall, n_cuts, error)
         call self%h5%end_write(error)
         if (allocated(error)) return
@@ -211,7 +253,7 @@ contains
     end subroutine results_write_step
 
     !> Write one converged step and the current displacement; flush.
-    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model)
+    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -223,9 +265,10 @@ contains
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
         type(error_t), allocatable, intent(out) :: error
-        !> The model of `u`: its bodies' sampled fields are written when `&output`
-        !> asks for them at this step.
+        !> The model of `u` and its bodies' sampled fields (allocated when `&output`
+        !> asks for them at this step).
         type(model_t), intent(in), optional :: model
+        type(field_samples_t), allocatable, intent(in), optional :: samples(:)
         character(len=:), allocatable :: g
         character(len=8) :: buf
         integer :: k
@@ -278,8 +321,8 @@ contains
             call write_contact(self%h5, g, k, pairs(k)%pair, error)
             if (allocated(error)) return
         end do
-        if (present(model)) then
-            if (self%fields%wants(rec%step, self%last_step)) call write_fields(self%h5, g, self%fields, model, u, error)
+        if (present(model) .and. present(samples)) then
+            if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples, error)
             if (allocated(error)) return
         end if
         ! this step's own output time (the record was made before it was written)
@@ -432,8 +475,9 @@ contains
     !> run's counters of `stats` (every cut as /cuts when there is one, the Tresca
     !> fixed point's, the multiplier updates), and close. The file is closed whatever fails (the first error is returned)
     !> and given its name (`result_file_t%settle`); a broken file is not touched
-    !> (`abandon`), nor one with no room left for the status (it stays 'running',
-    !> every step written readable).
+    !> (`abandon`), nor one with no room left for the status, nor one moved, replaced
+    !> or removed under the run (`lost`; they stay 'running', every step written
+    !> readable).
     subroutine results_finish(self, status, wall, stats, error)
         class(results_t), intent(inout) :: self
         character(len=*), intent(in) :: status
@@ -442,6 +486,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         if (self%h5%broken) then
             call self%h5%abandon()
+            return
+        end if
+        if (self%h5%lost) then
+            ! the run's error says so: the file is closed as its last flush left it
+            call self%h5%settle(self%n_written > 0, error)
             return
         end if
         if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)
@@ -460,6 +509,8 @@ contains
             call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'stick_predictions', stats%stick_predictions, error)
+            if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'newton_iterations', stats%iterations, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'status', status, error)
             if (allocated(error)) exit records
@@ -526,134 +577,5 @@ contains
         call self%h5%write('/multigrid_level_dofs', level_dofs, error)
         call self%h5%end_write(error)
     end subroutine results_write_multigrid
-
-    !> The case file recorded in the result file `path`.
-    subroutine restart_case(path, case_file, error)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable, intent(out) :: case_file
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: f
-        character(len=:), allocatable :: absolute
-        call f%open(path, 'r', error)
-        if (allocated(error)) return
-        call f%read_attr_str('/', 'case_file', case_file, error)
-        ! run from another folder: the absolute path recorded beside it
-        if (.not. allocated(error) .and. .not. path_exists(case_file) .and. f%has_attr('/', 'case_path')) then
-            call f%read_attr_str('/', 'case_path', absolute, error)
-            if (.not. allocated(error)) case_file = absolute
-        end if
-        call close_read(f, error)
-        if (allocated(error)) error%message = '--restart: '//error%message
-    end subroutine restart_case
-
-    !> The state after the last written step of the result file `path` (as
-    !> `write_step` wrote it): displacement, the solver's substep fraction, force
-    !> scale and det K sign, and the committed history of each contact pair of
-    !> `model`, which is set on the pairs. The file is only read.
-    subroutine read_restart(path, model, state, error)
-        character(len=*), intent(in) :: path
-        type(model_t), intent(inout) :: model
-        type(resume_t), intent(out) :: state
-        type(error_t), allocatable, intent(out) :: error
-        type(h5file_t) :: h5
-        call h5%open(path, 'r', error)
-        if (allocated(error)) return
-        call read_state(h5, model, state, error)
-        call close_read(h5, error)
-    end subroutine read_restart
-
-    !> Close a file that was only read; `error` keeps the first error.
-    subroutine close_read(h5, error)
-        type(h5file_t), intent(inout) :: h5
-        type(error_t), allocatable, intent(inout) :: error
-        type(error_t), allocatable :: close_error
-        call h5%close(close_error)
-        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
-    end subroutine close_read
-
-    subroutine read_state(h5, model, state, error)
-        type(h5file_t), intent(inout) :: h5
-        type(model_t), intent(inout) :: model
-        type(resume_t), intent(out) :: state
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: g
-        character(len=16) :: buf
-        integer :: done, ip
-
-        call h5%read_attr_int('/', 'n_steps_done', done, error)
-        if (allocated(error)) return
-        state%step = done
-        allocate (state%u(model%ndof))
-        state%u = 0.0_dp
-        if (done == 0) return
-        write (buf, '(i6.6)') done
-        g = '/steps/'//trim(buf)
-        call h5%read(g//'/displacement', state%u, error)
-        if (allocated(error)) return
-        ! the step before (the predictor extrapolates the last step's increment)
-        allocate (state%u_before(size(state%u)))
-        state%u_before = 0.0_dp
-        if (done > 1) then
-            write (buf, '(i6.6)') done - 1
-            call h5%read('/steps/'//trim(buf)//'/displacement', state%u_before, error)
-            if (allocated(error)) return
-        end if
-        if (size(state%u) /= model%ndof) then
-            call fatal_error(error, h5%path//': --restart: the result file does not belong to this '// &
-                             'case (different number of DOFs)', error_code%input)
-            return
-        end if
-        if (h5%has_attr(g, 'next_fraction')) call h5%read_attr_real(g, 'next_fraction', state%fraction, error)
-        if (allocated(error)) return
-        if (h5%has_attr(g, 'r0_max')) call h5%read_attr_real(g, 'r0_max', state%r0_max, error)
-        if (allocated(error)) return
-        if (h5%has_attr(g, 'tangent_det_sign')) &
-            call h5%read_attr_int(g, 'tangent_det_sign', state%det_sign, error)
-        if (allocated(error)) return
-        do ip = 1, size(model%pairs)
-            write (buf, '(i0)') ip
-            call read_history(h5, g//'/contact/'//trim(buf)//'/history', model%pairs(ip)%pair, error)
-            if (allocated(error)) return
-            call read_penalties(h5, g//'/contact/'//trim(buf), model%pairs(ip)%pair, error)
-            if (allocated(error)) return
-        end do
-    end subroutine read_state
-
-    !> The penalties a pair with multipliers used at the step of group `c` (it may
-    !> have softened them, `alm_soften`): a restart goes on with them, as the run
-    !> did. Other pairs keep the case's (a user may restart with another penalty);
-    !> so do files without the attributes.
-    subroutine read_penalties(h5, c, pair, error)
-        type(h5file_t), intent(inout) :: h5
-        character(len=*), intent(in) :: c
-        class(contact_pair_t), intent(inout) :: pair
-        type(error_t), allocatable, intent(out) :: error
-        if (.not. pair%has_multipliers()) return
-        if (h5%has_attr(c, 'penalty_normal')) call h5%read_attr_real(c, 'penalty_normal', pair%law%eps_n, error)
-        if (allocated(error)) return
-        if (h5%has_attr(c, 'penalty_tangent')) call h5%read_attr_real(c, 'penalty_tangent', pair%law%eps_t, error)
-    end subroutine read_penalties
-
-    !> Read the committed history `pair` keeps (its `history` names the arrays) from
-    !> group `c` and set it on the pair.
-    subroutine read_history(h5, c, pair, error)
-        type(h5file_t), intent(inout) :: h5
-        character(len=*), intent(in) :: c
-        class(contact_pair_t), intent(inout) :: pair
-        type(error_t), allocatable, intent(out) :: error
-        type(history_item_t), allocatable :: history(:)
-        integer :: i
-        history = pair%history()
-        if (size(history) == 0) return
-        do i = 1, size(history)
-            if (allocated(history(i)%values)) then
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error)
-            else
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error)
-            end if
-            if (allocated(error)) return
-        end do
-        call pair%set_history(history, error)
-    end subroutine read_history
 
 end module voiga_io_results

@@ -6,20 +6,29 @@
 !> `deep_fraction` of the slave element; at the end, a pair that never came into
 !> contact. Only messages are made here; the solver reports them through
 !> `progress_t%warning`, `--check` prints the set-up ones.
+!>
+!> One set-up cannot make sense and is refused before a run starts
+!> (`check_overlaps`): a pair most of whose slave points start inside the master.
+!> That is a rigid normal, a rigid curve or a contact edge the wrong way round far
+!> more often than an intended interference fit, and the penalty would push the
+!> bodies through each other for many load cuts before failing.
 module voiga_model_checks
     use voiga_kinds, only: dp
-    use voiga_text, only: str, real_str
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_text, only: str, real_str, short_str
     use voiga_model, only: model_t
     use voiga_contact_pair, only: contact_pair_t
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
     use voiga_contact_master, only: master_point_t
     use voiga_contact_master_nurbs, only: nurbs_master_t, outward_sign
+    use voiga_contact_master_rigid, only: rigid_line_t
+    use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_contact_law, only: state_inactive
     use voiga_element_quadrature, only: gauss_legendre
     implicit none
     private
 
-    public :: warning_t, contact_watch_t, new_contact_watch, setup_warnings, deep_fraction
+    public :: warning_t, contact_watch_t, new_contact_watch, setup_warnings, deep_fraction, check_overlaps
 
     !> A penetration deeper than this fraction of its slave element is reported.
     real(dp), parameter :: deep_fraction = 0.1_dp
@@ -31,9 +40,11 @@ module voiga_model_checks
     !> are longer by this factor on average.
     real(dp), parameter :: coarser_factor = 1.25_dp
 
-    !> One warning (fixed length: arrays of them grow by constructor).
+    !> One warning (fixed length: arrays of them grow by constructor); `topic`: its
+    !> pair and cause in a few words, by which a failure points back to it.
     type :: warning_t
         character(len=512) :: text = ''
+        character(len=160) :: topic = ''
     end type warning_t
 
     !> The reference lengths of a pair's slave elements [nel].
@@ -132,24 +143,155 @@ contains
         end do
     end function setup_warnings
 
+    !> The slave points of `pair` that start inside the master deeper than
+    !> `overlap_fraction` of their slave element (`inside`), of those that have a
+    !> projection on it (`found`); `depth`: each point's depth in slave elements;
+    !> `share`: the part of the slave edge's length those inside stand for, of the
+    !> length of those found (each point stands for its element's length over
+    !> the points per element: on a graded edge, many points may cover little length).
+    subroutine overlap_counts(pair, depth, inside, found, share)
+        class(contact_pair_t), intent(in) :: pair
+        real(dp), allocatable, intent(out) :: depth(:)
+        integer, intent(out) :: inside, found
+        real(dp), intent(out) :: share
+        real(dp), allocatable :: h(:), length(:)
+        integer :: k
+        h = element_lengths(pair%slave)
+        depth = depth_ratios(pair, h, pair%out%gap < 1.0e300_dp)
+        inside = count(depth > overlap_fraction)
+        found = count(pair%out%gap < 1.0e300_dp)
+        length = [(h((k - 1)/pair%n_gauss + 1), k=1, size(depth))]
+        share = 0.0_dp
+        if (found > 0) share = sum(length, mask=depth > overlap_fraction)/ &
+                               sum(length, mask=pair%out%gap < 1.0e300_dp)
+    end subroutine overlap_counts
+
     !> Slave points inside the master at the start.
     subroutine overlap_warning(pair, list)
         class(contact_pair_t), intent(in) :: pair
         type(warning_t), allocatable, intent(inout) :: list(:)
         real(dp), allocatable :: depth(:)
-        integer :: k, n
-        depth = depth_ratios(pair, element_lengths(pair%slave), pair%out%gap < 1.0e300_dp)
-        n = count(depth > overlap_fraction)
+        real(dp) :: share
+        integer :: k, n, found
+        call overlap_counts(pair, depth, n, found, share)
         if (n == 0) return
         k = maxloc(depth, dim=1)
         list = [list, warning_t(pair_label(pair)//'the bodies overlap at the start: '//str(n)//' of '// &
                                 str(size(depth))//' slave points lie inside the master, the deepest by '// &
                                 trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
                                 point_str(pair%out(k)%x0)//' ('//trim(adjustl(real_str(depth(k), 'f6.2')))// &
-                                ' slave elements). If the bodies do not overlap, a contact edge is on the '// &
-                                "wrong side of its body (the master's outward normal points into the slave): "// &
-                                'check contact_edge of both bodies')]
+                                ' slave elements). If the bodies do not overlap, '//wrong_way(pair), &
+                                topic=pair_label(pair)//'the bodies overlap at the start')]
     end subroutine overlap_warning
+
+    !> What is the wrong way round when a master seems to hold the slave inside it.
+    function wrong_way(pair) result(text)
+        class(contact_pair_t), intent(in) :: pair
+        character(len=:), allocatable :: text
+        select type (m => pair%master)
+        type is (rigid_line_t)
+            text = 'rigid_normal = '//vector_str(m%n)//' points into the slave (the obstacle lies on the '// &
+                   'side rigid_normal points away from): check rigid_normal and rigid_point'
+        class is (rigid_curve_t)
+            text = "the rigid curve '"//trim(m%name)//"' is the wrong way round (the obstacle lies on the "// &
+                   "left of the curve's direction, docs/formats.md): check its side ([[curve]] side in a "// &
+                   'spec) and its position'
+        class default
+            text = "a contact edge is on the wrong side of its body (the master's outward normal points "// &
+                   'into the slave): check contact_edge of both bodies'
+        end select
+    end function wrong_way
+
+    !> Refuse (exit 2) a pair most of whose slave edge (by length, of the part that
+    !> faces the master) starts inside it, unless `allow(ip)`: the message names the
+    !> variable to change.
+    subroutine check_overlaps(model, allow, error)
+        type(model_t), intent(in) :: model
+        !> Per pair: an overlap is intended (`&contact allow_overlap`, `--allow-overlap`).
+        logical, intent(in) :: allow(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: depth(:)
+        real(dp) :: share
+        integer :: ip, k, n, found
+        do ip = 1, size(model%pairs)
+            if (allow(ip)) cycle
+            associate (pair => model%pairs(ip)%pair)
+                call overlap_counts(pair, depth, n, found, share)
+                if (share <= 0.5_dp) cycle
+                k = maxloc(depth, dim=1)
+                call fatal_error(error, pair_label(pair)//'most of the slave edge starts inside the master ('// &
+                                 str(n)//' of the '//str(found)//' slave points that face it, '// &
+                                 str(nint(100.0_dp*share))//' % of their length; the deepest by '// &
+                                 trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
+                                 point_str(pair%out(k)%x0)//'): '//overlap_remedy(model, pair, found)// &
+                                 '. If the bodies are meant to start overlapping, run with --allow-overlap '// &
+                                 '(or allow_overlap = .true. in this &contact)', error_code%input)
+                return
+            end associate
+        end do
+    end subroutine check_overlaps
+
+    !> What to change when most of the `found` slave points of `pair` start inside
+    !> its master. A rigid master turned round would hold them outside, unless it
+    !> cuts through the slave (some points would still be inside it).
+    function overlap_remedy(model, pair, found) result(text)
+        type(model_t), intent(in) :: model
+        class(contact_pair_t), intent(in) :: pair
+        integer, intent(in) :: found
+        character(len=:), allocatable :: text
+        real(dp), allocatable :: h(:)
+        integer :: k, behind
+        h = element_lengths(pair%slave)
+        ! the points that would be inside the master turned round (the gap's sign flipped)
+        behind = 0
+        do k = 1, size(pair%out)
+            if (pair%out(k)%gap < 1.0e300_dp) then
+                if (pair%out(k)%gap/h((k - 1)/pair%n_gauss + 1) > overlap_fraction) behind = behind + 1
+            end if
+        end do
+        select type (m => pair%master)
+        type is (rigid_line_t)
+            if (behind > 0) then
+                text = 'the line through rigid_point = '//vector_str(m%p_ref)//' cuts through the slave body ('// &
+                       str(behind)//' of the '//str(found)//' points lie on the side rigid_normal = '// &
+                       vector_str(m%n)//' points to): move rigid_point (the obstacle lies on the side '// &
+                       'rigid_normal points away from)'
+            else
+                text = 'rigid_normal = '//vector_str(m%n)//' points into the slave (the obstacle lies on the '// &
+                       'side rigid_normal points away from): give rigid_normal = '//vector_str(-m%n, .false.)
+            end if
+        class is (rigid_curve_t)
+            if (behind > 0) then
+                text = "the rigid curve '"//trim(m%name)//"' cuts through the slave body: move it (or the slave)"
+            else
+                text = "the rigid curve '"//trim(m%name)//"' is the wrong way round (the obstacle lies on the "// &
+                       "left of the curve's direction, docs/formats.md): turn it round (in a spec, the "// &
+                       "[[curve]]'s other side: 'inside' or 'outside' of an arc, 'left' or 'right' of a "// &
+                       'polyline or .g2 curve)'
+            end if
+        class default
+            text = "a contact edge is on the wrong side of its body (the master's outward normal then "// &
+                   "points into the slave): check contact_edge of the slave '"//trim(pair%slave_name)// &
+                   "' (now '"//trim(model%bodies(pair%slave_body)%disc%edges(4)%name)//"') and of the "// &
+                   "master '"//trim(pair%master_name)//"' (now '"// &
+                   trim(model%bodies(pair%master_body)%disc%edges(4)%name)//"'), or move the bodies apart"
+        end select
+    end function overlap_remedy
+
+    !> A vector as a case file takes it: "(a, b)", or "a, b" without `brackets`
+    !> (`short_str`: '0.0, -1.0').
+    pure function vector_str(x, brackets) result(text)
+        real(dp), intent(in) :: x(2)
+        logical, intent(in), optional :: brackets
+        character(len=:), allocatable :: text
+        text = short_str(x(1))//', '//short_str(x(2))
+        if (present(brackets)) then
+            if (.not. brackets) return
+        end if
+        text = '('//text//')'
+    end function vector_str
+
+
 
     !> The slave point closest to the master (outside it) must face it: its outward
     !> normal against the master's. Else the slave's contact edge is on the wrong side.
@@ -177,8 +319,24 @@ contains
         list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '//point_str(sp%x)// &
                                 ", faces away from it: the slave's contact_edge = '"// &
                                 trim(model%bodies(pair%slave_body)%disc%edges(4)%name)// &
-                                "' is on the side of its body away from the master; choose the edge that faces it")]
+                                "' is on the side of its body away from the master; choose the edge that faces it"// &
+                                rigid_alternative(pair), topic=pair_label(pair)//'the slave faces away from the master')]
     end subroutine facing_warning
+
+    !> For a rigid master: that its own side may be the wrong one instead.
+    function rigid_alternative(pair) result(text)
+        class(contact_pair_t), intent(in) :: pair
+        character(len=:), allocatable :: text
+        select type (m => pair%master)
+        type is (rigid_line_t)
+            text = ', or rigid_normal = '//vector_str(m%n)//' points the wrong way (it points out of the '// &
+                   'obstacle, towards the slave)'
+        class is (rigid_curve_t)
+            text = ", or the rigid curve '"//trim(m%name)//"' is the wrong way round (its side)"
+        class default
+            text = ''
+        end select
+    end function rigid_alternative
 
     !> A deformable master softer or finer than its slave: GPTS enforces the contact
     !> at the slave's points, so the usual choice is the softer, finer body as slave.
@@ -210,7 +368,7 @@ contains
         list = [list, warning_t(pair_label(pair)//"the slave is "//why//' than its master: the master '// &
                                 "may then penetrate between the slave's points; the usual choice is the "// &
                                 'softer, finer body as slave (swap slave and master), or more slave points '// &
-                                '(n_gauss)')]
+                                '(n_gauss)', topic=pair_label(pair)//'the slave is '//why//' than its master')]
     end subroutine slave_choice_warning
 
     !> After converged step `step`: remember which pairs touch, and report (once per
@@ -236,7 +394,8 @@ contains
                                         point_str(pair%out(k)%x)//' is '// &
                                         trim(adjustl(real_str(ratio(k), 'f6.2')))//' of its slave element '// &
                                         '(more than '//trim(adjustl(real_str(deep_fraction, 'f6.2')))// &
-                                        '): the penalty is too soft for this load; raise penalty_normal')]
+                                        '): the penalty is too soft for this load; raise penalty_normal', &
+                                        topic=pair_label(pair)//'step '//str(step)//': a deep penetration')]
             end associate
         end do
     end subroutine watch_after_step
@@ -253,7 +412,8 @@ contains
             if (self%ever_active(ip)) cycle
             list = [list, warning_t(pair_label(model%pairs(ip)%pair)//'no point came into contact in '// &
                                     str(n_steps)//' steps: check the loads, the contact edges and the gap '// &
-                                    'between the bodies')]
+                                    'between the bodies', topic=pair_label(model%pairs(ip)%pair)// &
+                                    'no point came into contact')]
         end do
     end subroutine watch_at_end
 

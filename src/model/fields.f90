@@ -10,7 +10,7 @@
 module voiga_model_fields
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_text, only: str
+    use voiga_text, only: str, real_str
     use voiga_material, only: von_mises
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_solid, only: reference_gradients
@@ -19,6 +19,10 @@ module voiga_model_fields
     private
 
     public :: output_settings_t, field_samples_t, sample_fields, field_names
+
+    !> A sample point whose |det dX/dxi| is at most `degenerate` times the element
+    !> centre's is degenerate; it is sampled `nudge` of the way to the centre instead.
+    real(dp), parameter :: degenerate = 1.0e-8_dp, nudge = 1.0e-6_dp
 
     !> The fields `&output fields` may name.
     character(len=*), parameter :: field_names(3) = [character(len=9) :: 'stress', 'strain', 'von_mises']
@@ -64,7 +68,11 @@ contains
     end function output_wants
 
     !> The fields of `body` with the global displacement `u` at `samples` x `samples`
-    !> points per element. Fails (numeric) where the deformation is inverted.
+    !> points per element. Fails (numeric) where the deformation is inverted. Where
+    !> the reference map is degenerate (det dX/dxi = 0: the centre of a solid disc
+    !> sector, whose inner edge is one point, or a corner of 180 degrees), the
+    !> gradient is undefined: the point is sampled `nudge` of the way towards the
+    !> element's centre instead (the field's limit there), and recorded where it is.
     subroutine sample_fields(body, u, samples, out, error)
         type(body_t), intent(in) :: body
         real(dp), intent(in) :: u(:)
@@ -72,7 +80,7 @@ contains
         type(field_samples_t), intent(out) :: out
         type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: r(:), dr(:, :), dndx(:, :), ue(:, :)
-        real(dp) :: t(samples), det, grad_u(2, 2), xi, eta
+        real(dp) :: t(samples), det, det_centre, grad_u(2, 2), xi, eta, xc, ec
         integer :: e, i, j, q, n, a
         logical :: ok
 
@@ -89,18 +97,29 @@ contains
                 do a = 1, size(el%conn)
                     ue(:, a) = u(body%dof0 + 2*el%conn(a) - 1:body%dof0 + 2*el%conn(a))
                 end do
+                xc = 0.5_dp*(el%xi(1) + el%xi(2))
+                ec = 0.5_dp*(el%eta(1) + el%eta(2))
+                call element_basis(body%disc, e, xc, ec, r, dr)
+                det_centre = reference_det(body%disc%x(:, el%conn), dr)
                 do j = 1, samples
                     eta = el%eta(1) + t(j)*(el%eta(2) - el%eta(1))
                     do i = 1, samples
                         xi = el%xi(1) + t(i)*(el%xi(2) - el%xi(1))
                         q = q + 1
                         call element_basis(body%disc, e, xi, eta, r, dr)
+                        if (abs(reference_det(body%disc%x(:, el%conn), dr)) <= degenerate*abs(det_centre)) &
+                            call element_basis(body%disc, e, xi + nudge*(xc - xi), eta + nudge*(ec - eta), r, dr)
                         call reference_gradients(body%disc%x(:, el%conn), dr, dndx, det)
                         grad_u = matmul(ue, transpose(dndx))
                         call body%mat%fields(grad_u, out%stress(:, q), out%strain(:, q), ok)
                         if (.not. ok) then
                             call fatal_error(error, "fields: body '"//trim(body%name)//"' element "//str(e)// &
-                                             ': the deformation is inverted (J <= 0)', error_code%numeric)
+                                             ': the deformation is inverted (J <= 0) at the sample (xi, eta) = ('// &
+                                             trim(adjustl(real_str(xi, 'f8.5')))//', '// &
+                                             trim(adjustl(real_str(eta, 'f8.5')))//'), between the quadrature '// &
+                                             'points, which are not (a corner of 180 degrees in the patch, a '// &
+                                             'coarse mesh): a finer mesh there, or &output samples = 1 (the '// &
+                                             'element centres)', error_code%numeric)
                             return
                         end if
                         out%von_mises(q) = von_mises(out%stress(:, q))
@@ -113,5 +132,13 @@ contains
             end associate
         end do
     end subroutine sample_fields
+
+    !> det dX/dxi of the reference map at a point (`x0` [2, nen], `dr` [2, nen]).
+    pure real(dp) function reference_det(x0, dr) result(det)
+        real(dp), intent(in) :: x0(:, :), dr(:, :)
+        real(dp) :: jac(2, 2)
+        jac = matmul(x0, transpose(dr))
+        det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
+    end function reference_det
 
 end module voiga_model_fields

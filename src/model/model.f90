@@ -172,6 +172,7 @@ contains
                     return
                 end if
                 call new_rigid_curve(curve, inp%curve)
+                curve%name = inp%rigid_curve
                 allocate (pair%master, source=curve)
             else if (trim(inp%master) == 'rigid') then
                 call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)

@@ -2,7 +2,8 @@
 !> prints or writes a file itself. `progress_t` does nothing; the result file
 !> (`voiga_io_results`) and the terminal (`app/`) extend it with what they show.
 !> The hooks a run calls, in order: `set_up` once (a hierarchical linear solver's
-!> levels), then per Newton iteration `iteration`, `factorized`, `linear_solved`;
+!> levels), then per attempt at a substep `substep`, per Newton iteration
+!> `iteration`, `factorized`, `linear_solved`;
 !> per failed attempt `retried` or `cut`; per Tresca fixed point `fixed_point`
 !> and `fixed_point_done`; per converged step `step_done`; `warning` whenever the
 !> run finds something the user should know (`voiga_model_checks`).
@@ -53,6 +54,7 @@ module voiga_solver_progress
     type :: progress_t
     contains
         procedure :: set_up => progress_set_up
+        procedure :: substep => progress_substep
         procedure :: iteration => progress_iteration
         procedure :: factorized => progress_factorized
         procedure :: linear_solved => progress_linear_solved
@@ -75,6 +77,15 @@ contains
         integer, intent(in) :: level_dofs(:)
         type(error_t), allocatable, intent(out) :: error
     end subroutine progress_set_up
+
+    !> An attempt at substep `substep` of nominal step `step` (of `n_steps`) begins,
+    !> towards load time `time` with increment `fraction` of the nominal step;
+    !> `cuts`: the cuts of this step so far, `run_cuts` those of the run.
+    subroutine progress_substep(self, step, n_steps, substep, cuts, run_cuts, time, fraction)
+        class(progress_t), intent(inout) :: self
+        integer, intent(in) :: step, n_steps, substep, cuts, run_cuts
+        real(dp), intent(in) :: time, fraction
+    end subroutine progress_substep
 
     subroutine progress_iteration(self, report)
         class(progress_t), intent(inout) :: self

@@ -21,7 +21,7 @@ module voiga_solver_settings
         real(dp) :: tol_energy = 1.0e-20_dp
         !> Gauss points per direction in the bodies (0: degree + 1 in each direction).
         integer :: n_gauss = 0
-        !> Adaptive load stepping (docs/robustness.md): a failed load increment is
+        !> Adaptive load stepping (docs/stepping.md): a failed load increment is
         !> halved down to min_step_fraction of the nominal step ...
         real(dp) :: min_step_fraction = 1.0e-4_dp
         !> ... at most max_cuts times per nominal step (0: no cutting, a failed step fails the run) ...
@@ -29,8 +29,13 @@ module voiga_solver_settings
         !> ... and doubled (never beyond the nominal step) after a substep that
         !> converged in at most grow_iterations Newton iterations.
         integer :: grow_iterations = 5
+        !> A nominal step is given up as hopeless when its failed attempts since the
+        !> last converged substep have taken this many Newton iterations (all
+        !> attempts, Tresca retries included; 0: no such budget): the run then ends
+        !> suggesting more load steps instead of cutting on (docs/stepping.md).
+        integer :: max_stalled_iterations = 1000
         !> Start each substep from the last step's increment, extrapolated (within a
-        !> load phase; docs/robustness.md).
+        !> load phase; docs/stepping.md).
         logical :: predictor = .true.
         !> Start a frictional substep that has no increment to extrapolate (the first
         !> of a load phase, a retry) from a stick predictor: one linear step with every

@@ -1,4 +1,4 @@
-!> Quasi-static load stepping with adaptive load increments (docs/robustness.md).
+!> Quasi-static load stepping with adaptive load increments (docs/stepping.md).
 !>
 !> Per (sub)step the prescribed displacements are set to their values at the load
 !> time and a Newton attempt (`voiga_solver_newton`) solves the step. A substep
@@ -13,6 +13,10 @@
 !> attempt from the last converged state failed with contact states switching is
 !> retried once by the Tresca fixed point (`voiga_solver_outer`) before it is cut.
 !> A step that fails at its limit gets the diagnoses of `voiga_solver_diagnostics`.
+!> A step whose failed attempts since its last converged substep have taken
+!> `max_stalled_iterations` Newton iterations is given up as hopeless, with the
+!> suggestion of more load steps. A failed run names the warnings reported before
+!> (`voiga_model_checks`): they often explain the failure.
 module voiga_solver_stepping
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
@@ -63,6 +67,10 @@ module voiga_solver_stepping
         real(dp) :: start = 0.0_dp
         !> What the warnings after each step and at the end remember.
         type(contact_watch_t) :: watch
+        !> Every warning reported so far (a failure points back to them).
+        type(warning_t), allocatable :: warned(:)
+        !> The run's Newton iterations when the last substep converged (or the step began).
+        integer :: stall_start = 0
     end type stepper_t
 
 contains
@@ -109,7 +117,8 @@ contains
         first = 1
         if (present(resume)) call resume_from(sp, resume, u, stats, first)
         call new_contact_watch(sp%watch, model)
-        call report_warnings(out, setup_warnings(model))
+        allocate (sp%warned(0))
+        call report_warnings(sp, out, setup_warnings(model))
         t = 0.0_dp
         do step = first, sp%settings%total_steps()
             call solve_step(sp, model, step, u, stats, out, t, error)
@@ -123,9 +132,12 @@ contains
         end do
         if (.not. allocated(error)) then
             call sp%watch%at_end(model, sp%settings%total_steps() - first + 1, warnings)
-            call report_warnings(out, warnings)
+            call report_warnings(sp, out, warnings)
         end if
-        if (allocated(error) .and. stats%signal == 0) call prefix_step(error, step, t)
+        if (allocated(error) .and. stats%signal == 0) then
+            call prefix_step(error, step, t)
+            if (error%code == error_code%numeric) call point_back(error, sp%warned)
+        end if
         call sp%newton%linear%factorizations(stats%symbolic_factorizations, stats%numeric_factorizations)
     end subroutine solve_steps
 
@@ -147,15 +159,33 @@ contains
         first = resume%step + 1
     end subroutine resume_from
 
-    !> Every warning of `list` to `progress`.
-    subroutine report_warnings(progress, list)
+    !> Every warning of `list` to `progress`; the stepper keeps them.
+    subroutine report_warnings(sp, progress, list)
+        type(stepper_t), intent(inout) :: sp
         class(progress_t), intent(inout) :: progress
         type(warning_t), intent(in) :: list(:)
         integer :: i
         do i = 1, size(list)
             call progress%warning(trim(list(i)%text))
         end do
+        sp%warned = [sp%warned, list]
     end subroutine report_warnings
+
+    !> A numerical failure after warnings: name them (their topics), since a wrong
+    !> set-up or a soft penalty often explains the failure.
+    pure subroutine point_back(error, warned)
+        type(error_t), intent(inout) :: error
+        type(warning_t), intent(in) :: warned(:)
+        integer :: i
+        if (size(warned) == 0) return
+        error%message = error%message//'. It may follow from the warning'
+        if (size(warned) > 1) error%message = error%message//'s'
+        error%message = error%message//' reported before (stderr, and in the result file: post summary): '
+        do i = 1, size(warned)
+            if (i > 1) error%message = error%message//'; '
+            error%message = error%message//trim(warned(i)%topic)
+        end do
+    end subroutine point_back
 
     !> "step N (load time t): " before the reason of a failed run.
     pure subroutine prefix_step(error, step, t)
@@ -189,6 +219,7 @@ contains
         rec%time = t_end
         rec%substeps = 0
         first_cut = size(stats%cut_records) + 1
+        sp%stall_start = stats%iterations
         sp%fold_iterations = 0
         sp%fold_total = 0
         sp%s = 0.0_dp
@@ -196,6 +227,7 @@ contains
             ds = min(sp%frac, 1.0_dp - sp%s)
             t = t_end
             if (sp%s + ds < 1.0_dp) t = t_begin + (sp%s + ds)*(t_end - t_begin)
+            call progress%substep(step, sp%settings%total_steps(), rec%substeps + 1, rec%cuts, stats%cuts, t, ds)
             call attempt_substep(sp, model, step, t, ds, u, stats, rec, progress, attempt, predicted, error)
             if (.not. allocated(error)) then
                 call accept_substep(sp, model, ds, u, attempt, stats, rec)
@@ -301,6 +333,7 @@ contains
         integer :: ip
         if (attempt%iterations > 0) sp%conv_det_sign = attempt%det_sign
         sp%u_conv = u
+        sp%stall_start = stats%iterations
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%commit()
         end do
@@ -352,6 +385,13 @@ contains
             deallocate (error)
             return
         end if
+        if (sp%settings%max_stalled_iterations > 0 .and. &
+            stats%iterations - sp%stall_start >= sp%settings%max_stalled_iterations) then
+            call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, rec, stats, error, &
+                                 stalled=stats%iterations - sp%stall_start)
+            stop_run = .true.
+            return
+        end if
         if (rec%cuts >= sp%settings%max_cuts .or. &
             0.5_dp*ds < sp%settings%min_step_fraction*(1.0_dp - 1.0e-12_dp)) then
             call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, rec, stats, error)
@@ -387,24 +427,47 @@ contains
         end do
     end function softened
 
-    !> The step cannot be cut further: the limits it reached, and the diagnoses at
-    !> the last converged state (load time `t_conv`).
-    subroutine explain_failure(sp, model, t_conv, ds, rec, stats, error)
+    !> The step cannot be cut further, or (`stalled`: the Newton iterations of its
+    !> failed attempts since the last converged substep) is given up as hopeless:
+    !> the limits it reached, and the diagnoses at the last converged state (load
+    !> time `t_conv`).
+    subroutine explain_failure(sp, model, t_conv, ds, rec, stats, error, stalled)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: t_conv, ds
         type(step_record_t), intent(in) :: rec
         type(solver_stats_t), intent(inout) :: stats
         type(error_t), intent(inout) :: error
-        if (rec%cuts > 0 .or. sp%settings%max_cuts > 0) &
+        integer, intent(in), optional :: stalled
+        if (present(stalled)) then
+            error%message = error%message//'; gave the step up: its attempts since the last converged substep '// &
+                            'took '//str(stalled)//' Newton iterations without converging (the budget, &solver '// &
+                            'max_stalled_iterations = '//str(sp%settings%max_stalled_iterations)//'; '// &
+                            str(rec%cuts)//' cuts, increment '//real_str(ds, 'es9.2')//' of the nominal step). '// &
+                            'The load of a step is likely too large to follow: give more load steps (&solver '// &
+                            'n_steps'//steps_now(sp%settings%n_steps)//') or smaller motions per step'
+        else if (rec%cuts > 0 .or. sp%settings%max_cuts > 0) then
             error%message = error%message//' (after '//str(rec%cuts)//' cuts; increment '// &
                             real_str(ds, 'es9.2')//' of the nominal step, minimum '// &
                             real_str(sp%settings%min_step_fraction, 'es9.2')//', max_cuts '// &
                             str(sp%settings%max_cuts)//')'
+        end if
         if (sp%fold_iterations > 0 .and. (sp%fold_iterations < sp%fold_total .or. sp%conv_det_sign > 0)) &
             error%message = error%message//fold_diagnosis(model, sp%fold_iterations, sp%fold_total)
         call append_pair_diagnoses(model, sp%u_conv, t_conv, stats%assembly, error%message)
     end subroutine explain_failure
+
+    !> " now a, b" (the load steps of each phase).
+    pure function steps_now(n_steps) result(text)
+        integer, intent(in) :: n_steps(:)
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ', now'
+        do k = 1, size(n_steps)
+            if (k > 1) text = text//','
+            text = text//' '//str(n_steps(k))
+        end do
+    end function steps_now
 
     !> The nominal step converged: its reactions, its report (the result file writes
     !> it), its record.
@@ -441,7 +504,7 @@ contains
                                next_fraction=sp%frac, r0_max=stats%r0_max)
         call progress%step_done(report, u, model, error)
         call sp%watch%after_step(model, step, warnings)
-        call report_warnings(progress, warnings)
+        call report_warnings(sp, progress, warnings)
         rec%seconds(5) = wall_seconds() - tic
         stats%records = [stats%records, rec]
     end subroutine finish_step

@@ -1,4 +1,4 @@
-"""The attack suite of issue 19 (docs/robustness.md, "Attack suite"): namelist texts,
+"""The attack suite of issues 19 and 36 (docs/attack.md): namelist texts,
 geometry files, output paths and damaged result files (`attack_inputs.py`), each run
 through voiga (or `python -m post`) and judged by oracles that do not trust the
 program:
@@ -30,7 +30,10 @@ import concurrent.futures
 import hashlib
 import math
 import os
+import re
 import shutil
+import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -38,6 +41,7 @@ import time
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import f90nml
 import h5py
@@ -67,7 +71,18 @@ class Outcome:
 
 
 def digest(path: Path) -> str | None:
-    return hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else None
+    """What `path` is, to tell whether it changed: the SHA-256 of a regular file, the
+    target of a symbolic link, the kind and device numbers of a special file (never
+    opened), None when nothing is there."""
+    try:
+        st = os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if stat.S_ISLNK(st.st_mode):
+        return "link to " + os.readlink(path)
+    if stat.S_ISREG(st.st_mode):
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    return f"mode {stat.S_IFMT(st.st_mode):o} device {st.st_rdev}"
 
 
 def base_result(voiga: Path, work: Path) -> Path:
@@ -104,8 +119,11 @@ def _run_attack(attack: Attack, work: Path, voiga: Path, base: Path) -> Outcome:
         env = dict(os.environ)
     start = time.perf_counter()
     try:
-        proc = subprocess.run(command + args, cwd=work, capture_output=True, text=True, timeout=TIMEOUT,
-                              env=env, errors="replace")
+        if attack.during is None:
+            proc = subprocess.run(command + args, cwd=work, capture_output=True, text=True, timeout=TIMEOUT,
+                                  env=env, errors="replace")
+        else:
+            proc = run_interfered(command + args, work, env, attack.during)
     except subprocess.TimeoutExpired:
         outcome.kind = "hang"
         outcome.problems.append(f"no end within {TIMEOUT:g} s")
@@ -116,6 +134,12 @@ def _run_attack(attack: Attack, work: Path, voiga: Path, base: Path) -> Outcome:
     for name, value in before.items():
         if value is not None and digest(work / name) != value:
             outcome.problems.append(f"destroyed: {name} changed")
+    for name in attack.absent:
+        if digest(work / name) is not None:
+            outcome.problems.append(f"destroyed: {name} was created (through a link)")
+    for name, other in attack.same_as:
+        if digest(work / name) != digest(work / other):
+            outcome.problems.append(f"destroyed: {name} is not the file {other} put there")
     if attack.family == "post" or outcome.kind in ("crash",):
         return outcome
     result = result_file(work)
@@ -127,6 +151,34 @@ def _run_attack(attack: Attack, work: Path, voiga: Path, base: Path) -> Outcome:
         if problem:
             outcome.problems.append(f"silent wrong: geometry accepted but {problem}")
     return outcome
+
+
+def run_interfered(command: list[str], work: Path, env: dict[str, str],
+                   during: Callable[[Path], None]) -> subprocess.CompletedProcess:
+    """Run `command` until it has written a step, stop it (SIGSTOP), let
+    `during` change its files, let it go on (SIGCONT): whatever `during` does happens
+    between two of its flushes."""
+    env = dict(env, GFORTRAN_UNBUFFERED_PRECONNECTED="y")
+    proc = subprocess.Popen(command, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env, errors="replace")
+    try:
+        assert proc.stdout is not None
+        seen = []
+        for line in proc.stdout:
+            seen.append(line)
+            if re.match(r"step \d+/", line):     # its first step written (a restart's: the next)
+                proc.send_signal(signal.SIGSTOP)
+                try:
+                    during(work)
+                finally:
+                    proc.send_signal(signal.SIGCONT)
+                break
+        out, err = proc.communicate(timeout=TIMEOUT)
+    except BaseException:
+        proc.kill()
+        proc.communicate()
+        raise
+    return subprocess.CompletedProcess(command, proc.returncode, "".join(seen) + out, err)
 
 
 def judge_exit(outcome: Outcome, proc: subprocess.CompletedProcess) -> None:

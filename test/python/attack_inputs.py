@@ -1,4 +1,4 @@
-"""The inputs of the attack suite (`attack.py`, docs/robustness.md "Attack suite"):
+"""The inputs of the attack suite (`attack.py`, docs/attack.md):
 namelist texts, geometry files, output paths and result files a user could give,
 deterministically generated, each with what it may do.
 
@@ -56,6 +56,12 @@ class Attack:
     protect: tuple[str, ...] = ()
     #: one of the issue's examples (always in the reduced set)
     example: bool = False
+    #: files of the work folder that must not exist afterwards (nothing created through a link)
+    absent: tuple[str, ...] = ()
+    #: (name, other): the file at `name` afterwards must be `other`'s (kept as it was put there)
+    same_as: tuple[tuple[str, str], ...] = ()
+    #: what is done to the files while the run is stopped after its first step
+    during: Callable[[Path], None] | None = None
 
 
 def stage(work: Path, text: str = BASE, name: str = "case.nml") -> Path:
@@ -455,16 +461,17 @@ def output_attacks() -> list[Attack]:
                 (work / "g-link.h5").symlink_to("geometry.h5")
             (work / link).symlink_to(target)
         refused_output(f"output/symlink-{link.replace('/', '-')}", link, ("is the",), prep)
-    # a hard link is another name of the same bytes: the result replaces the name, not the bytes
+    # a hard link is another name of the same file: compared by identity, it is the geometry
     def hard(work: Path) -> None:
         os.link(work / "geometry.h5", work / "hard.h5")
-    refused_output("output/hardlink-no-overwrite", "hard.h5", ("exists",), hard)
+    refused_output("output/hardlink-no-overwrite", "hard.h5", ("is the geometry file",), hard)
 
     def hard_overwrite(work: Path) -> list[str]:
         case = stage(work, output_case("hard.h5"))
         hard(work)
         return [case.name, "--quiet", "--overwrite"]
-    out.append(Attack("output", "output/hardlink-overwrite", hard_overwrite, RUNS, same=True))
+    # (compared by identity, issue 36: another name of the geometry is the geometry)
+    out.append(Attack("output", "output/hardlink-overwrite", hard_overwrite, REFUSED, ("is the geometry file",)))
     long_geometry = "./" + "/" * 243 + "geometry.h5"
     refused_output("output/long-to-geometry", long_geometry, ("is the geometry file",), example=True)
     for name, output, words in (("dot", ".", ("is a folder",)), ("dotdot", "..", ("is a folder",)),
@@ -579,15 +586,30 @@ def post_attacks(result: Path) -> list[Attack]:
     files["running-partial"] = edit(lambda f: (f.attrs.__setitem__("status", np.bytes_("running")),
                                                f.attrs.__setitem__("n_steps_done", np.int32(2))))
     files["counter-beyond"] = edit(lambda f: f.attrs.__setitem__("n_steps_done", np.int32(99)))
+    # issue 36: values no run writes, which post read as if they were results
+    refused = {"nan-displacement": edit(lambda f: _poison(f, "steps/000002/displacement", np.nan)),
+               "inf-reaction": edit(lambda f: _poison(f, "steps/000004/reactions", np.inf)),
+               "nan-control-point": edit(lambda f: _poison(f, "bodies/slab/control_points", np.nan)),
+               "negative-counter": edit(lambda f: f.attrs.__setitem__("n_steps_done", np.int32(-5))),
+               "negative-planned": edit(lambda f: f.attrs.__setitem__("n_steps_planned", np.int32(-1)))}
+    files.update(refused)
     out = []
     for name, make in files.items():
-        for command in ("summary", "plot-contact", "history", "hertz", "plot-deformed"):
+        for command in ("summary", "plot-contact", "history", "hertz", "plot-deformed", "vtk"):
             def setup(work: Path, make=make, command=command) -> list[str]:
                 make(work / "bad.h5")
                 return [command, "bad.h5"] + ([] if command == "summary" else ["--out", str(work)])
-            out.append(Attack("post", f"post/{command}/{name}", setup, frozenset({0, 1, 2}),
-                              example=name in ("empty", "truncated-0.5") and command == "summary"))
+            out.append(Attack("post", f"post/{command}/{name}", setup,
+                              REFUSED if name in refused else frozenset({0, 1, 2}),
+                              example=(name in ("empty", "truncated-0.5") and command == "summary")
+                              or (name == "nan-displacement" and command == "vtk")))
     return out
+
+
+def _poison(f: h5py.File, key: str, value: float) -> None:
+    data = f[key][()].astype(float)
+    data.reshape(-1)[0] = value
+    f[key][...] = data
 
 
 def _shorten(f: h5py.File, key: str) -> None:
@@ -598,8 +620,10 @@ def _shorten(f: h5py.File, key: str) -> None:
 
 def all_attacks(result: Path | None = None) -> list[Attack]:
     """Every attack (the post family needs a finished result to damage)."""
+    from attack_files import file_attacks
+
     attacks = form_attacks() + structure_attacks() + value_attacks() + random_attacks() + geometry_attacks() \
-        + output_attacks()
+        + output_attacks() + file_attacks()
     if result is not None:
         attacks += post_attacks(result)
     return attacks

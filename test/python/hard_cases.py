@@ -1,4 +1,4 @@
-"""The hard-case suite of issue 6 (docs/robustness.md, "Hard cases").
+"""The hard-case suite of issue 6 (docs/hard-cases.md).
 
 Every hard case is derived from a committed case (`cases/<scene>/<mesh>-<layout>.nml`)
 by a few changes of its namelist (f90nml) and, for bodies that start apart, of its

@@ -293,3 +293,39 @@ def test_hertz_m4_half_space_values(hertz_m4: Path) -> None:
     """The issue's acceptance line as written: on m4 NN2.2, 0.30 p0 at 0.78 a within 2 %."""
     tau, depth, _, _, _, _ = axis_max_shear(hertz_m4)
     assert abs(tau / TAU_MAX - 1.0) < 0.02 and abs(depth / ZETA - 1.0) < 0.02, (tau, depth)
+
+
+@pytest.mark.parametrize("shape", ["solid sector", "polygon half-disc"])
+def test_fields_at_a_degenerate_point_of_the_map(run, tmp_path: Path, shape: str) -> None:
+    """A solid half-disc (its centre a corner of 180 degrees, det dX/dxi = 0 there) and a
+    polygon half-disc (two such corners) moved as a whole: every sample, those at the
+    degenerate points included (taken 1e-6 inside their element), has zero stress. At
+    det = 0 the gradient divided by zero and the step failed as an inverted element."""
+    from pre.geometry import annular_sector, polygon
+
+    body = annular_sector((0.0, 1.0), 0.0, 1.0, [180, 360]) if shape == "solid sector" else \
+        polygon([(-1.0, 1.0), (1.0, 1.0), (0.3, 1.0), (-0.3, 1.0)], arcs={0: 1.0},
+                edges=["outer", "end", "inner", "start"])
+    write_bodies(tmp_path / "geometry.h5", {"disc": body}, scene="disc")
+    case = {"case": {"title": "disc", "geometry": "geometry.h5", "output": "disc.h5", "n_bodies": 1},
+            "body": [{"name": "disc", "material": "linear", "youngs_modulus": 1.0, "poisson_ratio": 0.3,
+                      "degree_xi": 2, "degree_eta": 2, "nel_xi": 6, "nel_eta": 4, "contact_edge": "outer",
+                      "layer_degree": 2, "layer_elevations": 1}],
+            "solver": {"n_steps": 1},
+            "dirichlet": [{"body": "disc", "edge": e, "fix_x": True, "fix_y": True, "ux": 0.1, "uy": -0.2}
+                          for e in ("start", "inner", "end")],
+            "output": {"samples": 3}}
+    path = tmp_path / "disc.nml"
+    path.write_text(to_namelist_text(case))
+    res = run(path, "--quiet")
+    assert res.returncode == 0 and "warning" not in res.stderr, res.stderr
+    step = read_result(tmp_path / "disc.h5").steps[-1]
+    fields = step.fields["disc"]
+    assert len(fields["von_mises"]) == 6 * 4 * 9
+    # round-off of u (|u| 0.2, 2e-16 relative) is amplified by the inverse Jacobian, about
+    # 1/nudge = 1e6 at a sample taken 1e-6 from a degenerate point: 1e-8 there, 1e-12 elsewhere
+    stress = np.abs(fields["stress"]).max(axis=1)
+    assert stress.max() < 1e-8, stress.max()
+    assert np.sort(stress)[-9] < 1e-12, np.sort(stress)[-12:]
+    np.testing.assert_allclose(step.displacement.reshape(-1, 2), [[0.1, -0.2]] * (step.displacement.size // 2),
+                               atol=1e-12)

@@ -1,4 +1,4 @@
-"""Hard cases of issue 6 (docs/robustness.md): the reduced subset of the suite in
+"""Hard cases of issue 6 (docs/hard-cases.md): the reduced subset of the suite in
 `hard_cases.py` (the full suite is `make stress`), and the round-off floor of the
 convergence test, which must accept a stiff-penalty state only when it is converged."""
 from __future__ import annotations

@@ -1,7 +1,6 @@
 """Issue 19, classes 1, 2, 4, 5, 6 and 8: every example of the issue is refused with
 exit code 2 and a message naming the real cause, or handled as described, and the
-inputs and earlier results are intact afterwards (docs/robustness.md, "Inputs,
-outputs and resources")."""
+inputs and earlier results are intact afterwards (docs/files.md, "Outputs of a run")."""
 from __future__ import annotations
 
 import hashlib

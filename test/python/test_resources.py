@@ -1,7 +1,7 @@
 """Issue 19, class 3: a full disk, a file-size limit and a memory limit end the run
 with a message naming the cause and leave a readable result file; a mesh that
-cannot fit is refused before anything is allocated (docs/robustness.md,
-"Inputs, outputs and resources"). No test depends on timing: the limits are set
+cannot fit is refused before anything is allocated (docs/files.md,
+"Resources"). No test depends on timing: the limits are set
 so that the run meets them whatever the machine's speed."""
 from __future__ import annotations
 

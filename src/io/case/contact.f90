@@ -33,9 +33,10 @@ contains
         real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, tolerance
         real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases), friction(max_phases)
         integer :: n_gauss, ios
+        logical :: allow_overlap
         character(len=512) :: msg
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy
+            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy, allow_overlap
 
         slave = ''
         master = ''
@@ -50,6 +51,7 @@ contains
         rigid_curve = ''
         rigid_ux = unset()
         rigid_uy = unset()
+        allow_overlap = .false.
         read (text, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call group_error(path, 'contact', text, ios, msg, try_contact, error)
@@ -64,7 +66,7 @@ contains
         entry = contact_settings_t(slave=slave, master=master, rigid_point=rigid_point, rigid_normal=rigid_normal, &
                                    rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
                                    penalty_tangent=penalty_tangent, n_gauss=n_gauss, &
-                                   method=method, tolerance=tolerance)
+                                   method=method, tolerance=tolerance, allow_overlap=allow_overlap)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
         call take_friction(friction, nph, path//trim(msg)//' ', entry, error)
         if (allocated(error)) return

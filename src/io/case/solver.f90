@@ -30,6 +30,7 @@ contains
         type(solver_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         integer :: n_steps(max_phases), max_iterations, n_gauss, ios, nph, max_cuts, grow_iterations
+        integer :: max_stalled_iterations
         integer :: first_read(max_phases)
         logical :: given(max_phases)
         real(dp) :: tol_residual, tol_energy, min_step_fraction
@@ -38,7 +39,8 @@ contains
         character(len=17) :: linear_solver, damping
         character(len=512) :: msg
         namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
-            min_step_fraction, max_cuts, grow_iterations, predictor, stick_predictor, linear_solver, damping
+            min_step_fraction, max_cuts, grow_iterations, predictor, stick_predictor, linear_solver, damping, &
+            max_stalled_iterations
 
         max_iterations = entry%max_iterations
         tol_residual = entry%tol_residual
@@ -47,6 +49,7 @@ contains
         min_step_fraction = entry%min_step_fraction
         max_cuts = entry%max_cuts
         grow_iterations = entry%grow_iterations
+        max_stalled_iterations = entry%max_stalled_iterations
         predictor = entry%predictor
         stick_predictor = entry%stick_predictor
         linear_solver = entry%linear_solver
@@ -81,6 +84,7 @@ contains
         entry%min_step_fraction = min_step_fraction
         entry%max_cuts = max_cuts
         entry%grow_iterations = grow_iterations
+        entry%max_stalled_iterations = max_stalled_iterations
         entry%predictor = predictor
         entry%stick_predictor = stick_predictor
         entry%max_iterations = max_iterations
@@ -127,6 +131,9 @@ contains
             call fatal_error(error, where//'max_cuts must be between 0 and 10000', error_code%input)
         else if (s%grow_iterations < 0) then
             call fatal_error(error, where//'grow_iterations must be >= 0', error_code%input)
+        else if (s%max_stalled_iterations < 0) then
+            call fatal_error(error, where//'max_stalled_iterations must be >= 0 (0: no budget)', &
+                             error_code%input)
         else if (.not. any(linear_solver_names == s%linear_solver)) then
             call fatal_error(error, where//"linear_solver = '"//trim(s%linear_solver)// &
                              "': must be "//either(linear_solver_names), error_code%input)
