@@ -60,6 +60,7 @@ def _cmd_cases(args: argparse.Namespace) -> int:
 
 def _cmd_cattaneo(args: argparse.Namespace) -> int:
     from .cattaneo import CattaneoCaseError, CattaneoScene, write_cattaneo
+    from .files import OutputError
 
     scene = CattaneoScene(radius=args.radius, youngs_modulus=args.youngs_modulus,
                           poisson_ratio=args.poisson_ratio, indentation=args.indentation,
@@ -69,7 +70,7 @@ def _cmd_cattaneo(args: argparse.Namespace) -> int:
                           shear_steps=args.steps[1], penalty_normal=args.penalty_normal)
     try:
         case = write_cattaneo(scene, args.out, force=args.force)
-    except (CattaneoCaseError, OSError) as err:
+    except (CattaneoCaseError, OutputError, OSError) as err:
         print(f"python -m pre cattaneo: {err}", file=sys.stderr)
         return 2
     print(f"wrote {case} and {case.with_name(case.stem + '-geometry.h5')}")

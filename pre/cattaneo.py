@@ -33,7 +33,6 @@ The automatic penalty unless ``penalty_normal`` is given.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from .cases import GEOMETRY_FILE, to_namelist_text
+from .files import check_output, write_text
 from .h5io import write_geometry
 from .hertz import MAX_INDENTATION, expected_half_width
 from .layouts import parse_layout
@@ -286,6 +286,8 @@ def write_cattaneo(scene: CattaneoScene, out: str | Path, force: bool = False,
     stem = stem or case_stem(scene)
     folder = Path(out)
     case, geometry = folder / f"{stem}.nml", folder / f"{stem}-geometry.h5"
+    for p in (case, geometry):
+        check_output(p)
     clash = [str(p) for p in (case, geometry) if p.exists()]
     if clash and not force:
         raise CattaneoCaseError(" and ".join(clash) + (" exist" if len(clash) > 1 else " exists")
@@ -293,13 +295,7 @@ def write_cattaneo(scene: CattaneoScene, out: str | Path, force: bool = False,
     groups, bodies = cattaneo_case(scene, f"{stem}.h5")
     groups["case"]["geometry"] = geometry.name
     folder.mkdir(parents=True, exist_ok=True)
-    tmp = folder / f".{geometry.name}.{os.getpid()}.tmp"
-    try:
-        write_geometry(tmp, "cattaneo", bodies, generator="voiga pre (python -m pre cattaneo)")
-        os.replace(tmp, geometry)
-    finally:
-        tmp.unlink(missing_ok=True)
-    tmp_case = folder / f".{case.name}.tmp"
-    tmp_case.write_text(to_namelist_text(groups))
-    os.replace(tmp_case, case)
+    # each written beside its name and renamed in, never through a link (pre/files.py)
+    write_geometry(geometry, "cattaneo", bodies, generator="voiga pre (python -m pre cattaneo)")
+    write_text(case, to_namelist_text(groups))
     return case

@@ -76,7 +76,7 @@ def test_tresca_retry_accepts_coulomb_solutions(voiga_bin: Path, tmp_path: Path)
     """The die of ironing m1-NN2.2 pressed 0.1 and slid (0.04 or 0.1 in two steps) with
     stiff penalties (3e5 and 1e6 x E both, mu = 0.3), GPTS: substeps whose Newton
     attempts fold (stick/slip cycles, det K changing sign) are retried with the Tresca
-    fixed point (docs/stepping.md, "Tresca fixed point"). Every run converges, at least
+    fixed point (docs/robustness.md, "Tresca fixed point"). Every run converges, at least
     one substep is retried, and every state the fixed point accepted had a Coulomb
     residual that passed Newton's own test: tol_residual (1e-10) of the substep's first
     residual, or a round-off floor (1e4 eps of the force scale, or 10 eps || |K| |x| ||
