@@ -7,7 +7,7 @@ module voiga_io_case_contact
     use voiga_io_case_values, only: check_length, unset, is_unset, max_value, max_phases, body_index, quoted, &
         phase_values
     use voiga_model_body, only: body_settings_t
-    use voiga_contact_factory, only: contact_settings_t, contact_method_names
+    use voiga_contact_factory, only: contact_settings_t, contact_method_names, default_method
     use voiga_contact_alm, only: default_alm_tolerance
     implicit none
     private
@@ -46,7 +46,7 @@ contains
         penalty_tangent = unset()
         friction = unset()
         n_gauss = 0
-        method = 'gpts'
+        method = ''
         tolerance = default_alm_tolerance
         rigid_curve = ''
         rigid_ux = unset()
@@ -72,6 +72,8 @@ contains
         if (allocated(error)) return
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
+        ! none named: the default for the kind of master
+        if (len_trim(entry%method) == 0) entry%method = default_method(trim(entry%master) == 'rigid')
         call check_law(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
