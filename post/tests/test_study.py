@@ -133,6 +133,7 @@ def test_bad_engine_options_refused(capsys: pytest.CaptureFixture[str], tmp_path
     certificates ended in a TypeError traceback. Now each is one line and exit 2."""
     fake = tmp_path / "voiga"
     fake.write_text("")
+    fake.chmod(0o755)  # (never run: a valid binary, so that only the option is at fault)
     code = main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--out", str(tmp_path / "out"),
                  "--binary", str(fake), "--no-progress", *option])
     err = capsys.readouterr().err
