@@ -52,6 +52,9 @@ module voiga_contact_pair
         character(len=16) :: name = ''
         real(dp), allocatable :: values(:)
         integer, allocatable :: flags(:)
+        !> The most values a restart may read for it (-1: as many as it holds now;
+        !> a pair whose number of points changes between steps gives its bound).
+        integer :: most = -1
     end type history_item_t
 
     !> A vector on a few global DOFs.

@@ -423,14 +423,42 @@ contains
         class(segment_pair_t), intent(in) :: self
         type(history_item_t), allocatable :: items(:)
         type(history_item_t) :: xi, w, elem
+        integer :: i
         xi%name = 'point_xi'
         xi%values = self%xi
         w%name = 'point_w'
         w%values = self%w
         elem%name = 'point_element'
         elem%flags = self%elem
+        xi%most = most_points(self)
+        w%most = xi%most
+        elem%most = xi%most
         items = [xi, w, elem, self%mortar_pair_t%history()]
+        ! the mortar pair's arrays per point (xi_last, ...) have as many
+        do i = 4, size(items)
+            if (allocated(items(i)%values)) then
+                if (size(items(i)%values) == size(self%xi)) items(i)%most = xi%most
+            else if (allocated(items(i)%flags)) then
+                if (size(items(i)%flags) == size(self%xi)) items(i)%most = xi%most
+            end if
+        end do
     end function segment_history
+
+    !> The most points a segmentation can have: per slave element, `n_gauss` on each
+    !> of its segments, at most 2q + 2 cuts (one per bracket of `element_cuts`) for
+    !> each of the master's normal lines (at most two per breakpoint).
+    pure integer function most_points(self) result(n)
+        class(segment_pair_t), intent(in) :: self
+        integer :: n_lines
+        n_lines = 0
+        select type (m => self%master)
+        type is (rigid_curve_t)
+            n_lines = 2*size(m%surf%breaks)
+        class is (nurbs_master_t)
+            n_lines = 2*size(m%surf%breaks)
+        end select
+        n = size(self%slave%spans)*self%n_gauss*(1 + (2*self%slave%degree + 2)*n_lines)
+    end function most_points
 
     !> Continue on the points of `items` (checked to be a segmentation of this slave
     !> edge with `n_gauss` points per segment), then the mortar pair's history.
