@@ -9,6 +9,8 @@ Subcommands:
   vtk            ParaView time series (.pvd + .vtu)
   hertz          a cylinder on a rigid flat against analytic Hertz in the reference
                  configuration (and the figure; several results: one overlay)
+  cattaneo       a cylinder pressed and sheared against Cattaneo-Mindlin's stick zone;
+                 --halfplane: the incremental half-plane reference for a rigid flat
   study          a parameter study from a study file (docs/studies.md): derived cases
                  run on Dask, one table (CSV, markdown, Parquet) and figures
   sweep          the committed cases as a study without changes (the same engine)
@@ -184,6 +186,54 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
             output = Path(args.output or Path(args.out or first.path.parent) / "hertz-profiles.png")
             output.parent.mkdir(parents=True, exist_ok=True)
             print(plot_hertz([h for _, h in done], output, units=first.units))
+    return code
+
+
+def _cmd_cattaneo(args: argparse.Namespace) -> int:
+    import json
+
+    from .cattaneo import CattaneoError, cattaneo_comparison
+
+    if args.halfplane:
+        from .stickslip import halfplane_stick_slip
+
+        if not (-1.0 < args.poisson_ratio < 0.5 and args.friction > 0 and 0 < args.ratio < 1):
+            print("python -m post cattaneo: --halfplane needs -1 < --poisson-ratio < 0.5, "
+                  "--friction > 0 and 0 < --ratio < 1", file=sys.stderr)
+            return 2
+        h = halfplane_stick_slip(args.poisson_ratio, args.friction, args.ratio)
+        print(f"half-plane pressed by a rigid flat with friction, then sheared (nu = {h.poisson_ratio:g}, "
+              f"mu = {h.friction:g}, beta = {h.beta:.4f}):")
+        print(f"  after the press: stick traction up to {h.press_stick_traction:.4f} mu p0")
+        print(f"  at Q/(mu P) = {h.ratio:.3f}: stick zone c/a = {h.stick_half_width:.4f} "
+              f"(Cattaneo-Mindlin {h.cattaneo_half_width:.4f}); traction {100 * h.l2_from_cattaneo:.2f} % "
+              f"(L2) from Cattaneo-Mindlin's")
+        return 0
+    if not args.result:
+        print("python -m post cattaneo: give a result file, or --halfplane", file=sys.stderr)
+        return 2
+    code, rows = 0, []
+    for path in args.result:
+        try:
+            result = _read(path, "cattaneo")
+            if not result.steps:
+                print(f"python -m post cattaneo: {path} has no converged step (status "
+                      f"{result.status!r})", file=sys.stderr)
+                code = max(code, 1)
+                continue
+            cmp = cattaneo_comparison(result, step=args.step)
+        except (CattaneoError, OSError, KeyError, ValueError) as err:
+            print(f"python -m post cattaneo: {path}: {err}", file=sys.stderr)
+            code = 2
+            continue
+        if args.json:
+            rows.append({k: getattr(cmp, k) for k in ("source", "step", "time", "friction", "force",
+                                                      "tangential", "ratio", "a", "p0", "c_analytic",
+                                                      "c_simulated", "l2", "stick_traction")})
+        else:
+            print("\n".join(cmp.report()))
+    if rows:
+        print(json.dumps(rows, indent=1))
     return code
 
 
@@ -492,6 +542,20 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--partial", action="store_true",
                    help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz)
+
+    s = sub.add_parser("cattaneo", help="a cylinder pressed and sheared against Cattaneo-Mindlin's "
+                                        "stick zone (reference configuration, nominal traction)")
+    s.add_argument("result", nargs="*", help="result file(s) (.h5)")
+    s.add_argument("--step", type=int, default=-1,
+                   help="step number (>= 1) or -k for the k-th last (default: -1)")
+    s.add_argument("--json", action="store_true", help="the measures as JSON")
+    s.add_argument("--halfplane", action="store_true",
+                   help="instead: the incremental half-plane solution for a rigid flat pressed "
+                        "with friction then sheared, against Cattaneo-Mindlin (post/stickslip.py)")
+    s.add_argument("--poisson-ratio", type=float, default=0.49, help="--halfplane: nu (default 0.49)")
+    s.add_argument("--friction", type=float, default=0.3, help="--halfplane: mu (default 0.3)")
+    s.add_argument("--ratio", type=float, default=0.5, help="--halfplane: Q/(mu P) (default 0.5)")
+    s.set_defaults(func=_cmd_cattaneo)
     return p
 
 

@@ -4,6 +4,7 @@ Subcommands:
   geometry     a geometry spec (TOML) -> geometry file and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
+  cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       refine a case with splipy and write the discretization dump
   plot-layout  draw a body's control nets and contact basis functions
   figures      write the figures of docs/figures/
@@ -54,6 +55,26 @@ def _cmd_cases(args: argparse.Namespace) -> int:
 
     written = write_cases(args.out)
     print(f"wrote {len(written)} files under {args.out}")
+    return 0
+
+
+def _cmd_cattaneo(args: argparse.Namespace) -> int:
+    from .cattaneo import CattaneoCaseError, CattaneoScene, write_cattaneo
+    from .files import OutputError
+
+    scene = CattaneoScene(radius=args.radius, youngs_modulus=args.youngs_modulus,
+                          poisson_ratio=args.poisson_ratio, indentation=args.indentation,
+                          friction=args.friction, press_friction=args.press_friction,
+                          elements_per_a=args.elements_per_a, master=args.master, method=args.method,
+                          layout=args.layout, shear=args.shear, press_steps=args.steps[0],
+                          shear_steps=args.steps[1], penalty_normal=args.penalty_normal)
+    try:
+        case = write_cattaneo(scene, args.out, force=args.force)
+    except (CattaneoCaseError, OutputError, OSError) as err:
+        print(f"python -m pre cattaneo: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {case} and {case.with_name(case.stem + '-geometry.h5')}")
+    print(f"expected half-width a = {scene.half_width:.6g}, arc elements h = {scene.h:.4g} over |x| <= 1.5 a")
     return 0
 
 
@@ -156,6 +177,32 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", required=True, help="folder for geometry.h5 and <mesh>-<layout>.nml")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz)
+
+    s = sub.add_parser("cattaneo", help="a Cattaneo-Mindlin case: a half cylinder pressed onto a "
+                                        "rigid flat, its mirror image or a block, then sheared")
+    s.add_argument("--master", default="rigid", choices=("rigid", "mirror", "block"),
+                   help="rigid: the rigid line y = -R (default); mirror: the cylinder's mirror image "
+                        "(elastically similar, symmetric); block: a block of the same material")
+    s.add_argument("--radius", type=float, default=1.0, help="cylinder radius R (default 1)")
+    s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
+    s.add_argument("--poisson-ratio", type=float, default=0.49, help="nu (default 0.49)")
+    s.add_argument("--indentation", type=float, default=0.01, help="press depth d (default 0.01)")
+    s.add_argument("--friction", type=float, default=0.3, help="mu of the shear (default 0.3)")
+    s.add_argument("--press-friction", type=float, default=None,
+                   help="mu of the press (default: --friction; 0: a frictionless press)")
+    s.add_argument("--elements-per-a", type=float, default=20.0,
+                   help="arc elements per expected half-width a over |x| <= 1.5 a (default 20)")
+    s.add_argument("--layout", default="NN2.2", help="layout of both bodies (default NN2.2)")
+    s.add_argument("--method", default=None, help="&contact method (default: voiga's)")
+    s.add_argument("--penalty-normal", type=float, default=None, help="default: automatic")
+    s.add_argument("--shear", type=float, default=3.5e-3,
+                   help="tangential displacement of the master in the shear phase (default 3.5e-3: "
+                        "Q/(mu P) about 0.55 for the defaults)")
+    s.add_argument("--steps", type=int, nargs=2, default=[20, 20], metavar=("PRESS", "SHEAR"),
+                   help="load steps of the press and of the shear (default 20 20)")
+    s.add_argument("--out", required=True, help="folder for <master>-<layout>-a<n>.nml and its geometry")
+    s.add_argument("--force", action="store_true", help="overwrite existing files")
+    s.set_defaults(func=_cmd_cattaneo)
 
     s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
     s.add_argument("case", help="case namelist (.nml)")

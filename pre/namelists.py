@@ -11,7 +11,7 @@ NAMELISTS: dict[str, frozenset[str]] = {
                        "layer_degree", "layer_elevations"}),
     "solver": frozenset({"n_steps", "max_iterations", "tol_residual", "tol_energy", "n_gauss",
                          "min_step_fraction", "max_cuts", "grow_iterations", "predictor",
-                         "linear_solver", "damping", "max_stalled_iterations"}),
+                         "linear_solver", "damping", "max_stalled_iterations", "stick_predictor"}),
     "dirichlet": frozenset({"body", "edge", "fix_x", "fix_y", "ux", "uy"}),
     "pressure": frozenset({"body", "edge", "p"}),
     "contact": frozenset({"slave", "master", "rigid_point", "rigid_normal", "penalty_normal",

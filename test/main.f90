@@ -21,6 +21,7 @@ program voiga_tests
     use test_bulk_update, only: collect_bulk_update
     use test_supernodal, only: collect_supernodal
     use test_newton, only: collect_newton
+    use test_segment, only: collect_segment
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -44,7 +45,8 @@ program voiga_tests
              new_testsuite('files', collect_files), &
              new_testsuite('bulk_update', collect_bulk_update), &
              new_testsuite('supernodal', collect_supernodal), &
-             new_testsuite('newton', collect_newton) &
+             new_testsuite('newton', collect_newton), &
+             new_testsuite('segment', collect_segment) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

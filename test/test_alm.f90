@@ -62,6 +62,7 @@ contains
                 if (mu > 0.0_dp) then
                     pair%active_last = .true.
                     pair%xi_last = pair%out%xi_m - shift
+                    pair%node_active = .true.
                     pair%tau = 0.0_dp
                 end if
             end select

@@ -243,7 +243,7 @@ contains
         do a = 1, size(self%lambda)
             if (self%state(a) == state_inactive .or. self%h(a) <= 0.0_dp .or. self%d(a) <= 0.0_dp) cycle
             residual = max(residual, abs(self%g(a)/self%d(a))/self%h(a))
-            if (allocated(self%tau) .and. self%state(a) == state_stick) &
+            if (allocated(self%tau) .and. self%law%mu > 0.0_dp .and. self%state(a) == state_stick) &
                 residual = max(residual, abs(self%ds(a)/self%d(a))/self%h(a))
         end do
         satisfied = residual <= self%tolerance
@@ -260,7 +260,9 @@ contains
         integer :: j, a, n
         active = pack([(a, a=1, size(self%state))], self%state /= state_inactive)
         allocate (stick(0))
-        if (allocated(self%tau)) stick = pack([(a, a=1, size(self%state))], self%state == state_stick)
+        ! (a phase without friction has no tangential constraints)
+        if (allocated(self%tau) .and. self%law%mu > 0.0_dp) &
+            stick = pack([(a, a=1, size(self%state))], self%state == state_stick)
         n = size(active) + size(stick)
         allocate (set%c(n), set%rows(n), set%cols(n))
         do j = 1, size(active)
@@ -297,7 +299,7 @@ contains
         end do
         if (.not. allocated(self%tau)) return
         do a = 1, size(self%state)
-            if (self%state(a) == state_stick) then
+            if (self%law%mu > 0.0_dp .and. self%state(a) == state_stick) then
                 j = j + 1
                 self%tau(a) = self%tau(a) + delta(j)
             else

@@ -88,9 +88,9 @@ contains
         type(master_point_t) :: mp
         real(dp), allocatable :: rl(:), kl(:, :)
         integer, allocatable :: dofs(:)
-        real(dp) :: g, pn, pt, anchor, new_anchor
+        real(dp) :: g, pn, pt, anchor, new_anchor, gap0
         integer :: k, state, nd, j
-        logical :: found, converged, inside
+        logical :: found, converged, inside, touch
 
         self%force = 0.0_dp
         allocate (dofs(0))
@@ -101,6 +101,7 @@ contains
                 self%trial_xi(k) = mp%xi
                 self%trial_active(k) = .false.
                 self%trial_anchor(k) = mp%xi
+                self%trial_gap(k) = self%out(k)%gap
             end if
             if (.not. found) cycle
             if (self%out(k)%gap >= self%gap_tol) cycle
@@ -111,8 +112,14 @@ contains
             ! a point that was not in contact at the last converged state sticks where
             ! it projected then
             anchor = mp%xi
+            touch = .false.
+            gap0 = huge(1.0_dp)
             if (allocated(self%anchor)) then
+                ! a point open at the last converged state touched in this step: its slip
+                ! counts from where its gap, interpolated linearly from there, vanished
                 anchor = merge(self%anchor(k), self%xi_last(k), self%active_last(k))
+                touch = .not. self%active_last(k)
+                gap0 = self%gap_last(k)
                 self%n_friction = self%n_friction + 1
             end if
             nd = size(sp%dofs) + size(mp%dofs)
@@ -121,10 +128,11 @@ contains
             end if
             if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
             if (allocated(self%slip_bound)) then
-                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor, &
-                                self%slip_bound(k))
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, pt, &
+                                new_anchor, self%slip_bound(k))
             else
-                call gpts_point(self%law, self%w(k), sp, mp, anchor, rl, kl, state, g, pn, pt, new_anchor)
+                call gpts_point(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, pt, &
+                                new_anchor)
             end if
             self%n_evaluations = self%n_evaluations + 1
             if (size(dofs) /= nd) then
@@ -151,6 +159,8 @@ contains
             self%out(k)%pt0 = pt*self%out(k)%stretch
             if (allocated(self%anchor)) then
                 self%trial_active(k) = .true.
+                ! frictionless (a phase without friction): the point slides freely
+                if (self%law%mu <= 0.0_dp) new_anchor = mp%xi
                 self%trial_anchor(k) = new_anchor
             end if
         end do
@@ -331,13 +341,20 @@ contains
     !> master coordinate); `new_anchor` the one to commit if the step converges.
     !> With `bound` (and mu > 0) the slip limit |t_T| <= bound is prescribed (Tresca
     !> friction) instead of mu pn; without it the Coulomb code below runs unchanged.
-    pure subroutine gpts_point(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, bound)
+    pure subroutine gpts_point(law, w, sp, mp, anchor, touch, gap0, r, k, state, g, pn, pt, new_anchor, bound)
         type(contact_law_t), intent(in) :: law
         !> Quadrature weight times d(xi_s)/d(reference parameter): da = |a_s| w.
         real(dp), intent(in) :: w
         type(surface_point_t), intent(in) :: sp
         type(master_point_t), intent(in) :: mp
         real(dp), intent(in) :: anchor
+        !> Whether the point was open at the last converged state, and its gap there
+        !> (huge: no projection). Such a point touched in this step where its gap,
+        !> interpolated linearly from that state, vanished; `anchor` is then its
+        !> projection at that state, and only the fraction -g / (gap0 - g) of its slip
+        !> since, the part after the touch, counts (none without a projection then).
+        logical, intent(in) :: touch
+        real(dp), intent(in) :: gap0
         real(dp), intent(out) :: r(:), k(:, :)
         integer, intent(out) :: state
         !> Normal gap, contact pressure (>= 0) and tangential traction t . t_hat.
@@ -347,36 +364,39 @@ contains
         real(dp), intent(in), optional :: bound
         ! the operators of a point with up to `max_nd` local DOFs in fixed (stack)
         ! buffers: gfortran puts automatic arrays on the heap, eleven per point
-        real(dp) :: ops(2, max_nd, 5), vecs(max_nd, 6)
+        real(dp) :: ops(2, max_nd, 5), vecs(max_nd, 7)
         real(dp), allocatable :: big_ops(:, :, :), big_vecs(:, :)
         integer :: nd
         nd = size(r)
         if (nd <= max_nd) then
-            call point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, ops(:, 1:nd, 1), &
+            call point_law(law, w, sp, mp, anchor, touch, gap0, r, k, state, g, pn, pt, new_anchor, ops(:, 1:nd, 1), &
                            ops(:, 1:nd, 2), ops(:, 1:nd, 3), ops(:, 1:nd, 4), ops(:, 1:nd, 5), vecs(1:nd, 1), &
-                           vecs(1:nd, 2), vecs(1:nd, 3), vecs(1:nd, 4), vecs(1:nd, 5), vecs(1:nd, 6), bound)
+                           vecs(1:nd, 2), vecs(1:nd, 3), vecs(1:nd, 4), vecs(1:nd, 5), vecs(1:nd, 6), &
+                           vecs(1:nd, 7), bound)
         else
-            allocate (big_ops(2, nd, 5), big_vecs(nd, 6))
-            call point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, big_ops(:, :, 1), &
+            allocate (big_ops(2, nd, 5), big_vecs(nd, 7))
+            call point_law(law, w, sp, mp, anchor, touch, gap0, r, k, state, g, pn, pt, new_anchor, big_ops(:, :, 1), &
                            big_ops(:, :, 2), big_ops(:, :, 3), big_ops(:, :, 4), big_ops(:, :, 5), big_vecs(:, 1), &
-                           big_vecs(:, 2), big_vecs(:, 3), big_vecs(:, 4), big_vecs(:, 5), big_vecs(:, 6), bound)
+                           big_vecs(:, 2), big_vecs(:, 3), big_vecs(:, 4), big_vecs(:, 5), big_vecs(:, 6), &
+                           big_vecs(:, 7), bound)
         end if
     end subroutine gpts_point
 
     !> `gpts_point` on its work arrays [2, nd] and [nd].
-    pure subroutine point_law(law, w, sp, mp, anchor, r, k, state, g, pn, pt, new_anchor, gm, dm, ds, amat, tmat, &
-                              c, ng, na, gt, dmt, dst, bound)
+    pure subroutine point_law(law, w, sp, mp, anchor, touch, gap0, r, k, state, g, pn, pt, new_anchor, gm, dm, ds, &
+                              amat, tmat, c, ng, na, gt, dmt, dst, dslip, bound)
         type(contact_law_t), intent(in) :: law
         real(dp), intent(in) :: w
         type(surface_point_t), intent(in) :: sp
         type(master_point_t), intent(in) :: mp
-        real(dp), intent(in) :: anchor
+        real(dp), intent(in) :: anchor, gap0
+        logical, intent(in) :: touch
         real(dp), intent(out) :: r(:), k(:, :)
         integer, intent(out) :: state
         real(dp), intent(out) :: g, pn, pt
         real(dp), intent(out) :: new_anchor
         real(dp), intent(out) :: gm(:, :), dm(:, :), ds(:, :), amat(:, :), tmat(:, :)
-        real(dp), intent(out) :: c(:), ng(:), na(:), gt(:), dmt(:), dst(:)
+        real(dp), intent(out) :: c(:), ng(:), na(:), gt(:), dmt(:), dst(:), dslip(:)
         real(dp), intent(in), optional :: bound
         real(dp) :: n(2), that(2), ts(2), t(2), la, las, den, da, slip, ttr, s
         integer :: a, b
@@ -410,14 +430,14 @@ contains
         state = state_stick
         pt = 0.0_dp
         new_anchor = anchor
+        if (law%mu > 0.0_dp) call touch_slip(mp%xi, anchor, touch, gap0, g, c, ng, slip, dslip, new_anchor)
         if (law%mu > 0.0_dp .and. present(bound)) then
             ! Tresca: the same predictor and return map with the slip limit fixed
-            slip = mp%xi - anchor
             ttr = law%eps_t*abs(slip)*la
             if (ttr <= bound) then
                 t = t - law%eps_t*slip*mp%a
-                tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*c + slip*amat(1, :))
-                tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*c + slip*amat(2, :))
+                tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*dslip + slip*amat(1, :))
+                tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*dslip + slip*amat(2, :))
                 pt = -law%eps_t*slip*la
             else
                 ! t_T = -bound s t_hat; only t_hat moves (dt_hat = n na)
@@ -431,12 +451,11 @@ contains
             end if
         else if (law%mu > 0.0_dp) then
             ! elastic predictor on the convected coordinate
-            slip = mp%xi - anchor
             ttr = law%eps_t*abs(slip)*la
-            if (ttr <= law%mu*pn) then
+            if (ttr <= law%mu*pn .or. .not. law%return_map) then
                 t = t - law%eps_t*slip*mp%a
-                tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*c + slip*amat(1, :))
-                tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*c + slip*amat(2, :))
+                tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*dslip + slip*amat(1, :))
+                tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*dslip + slip*amat(2, :))
                 pt = -law%eps_t*slip*la
             else
                 ! return map: |t_T| = mu pn, the anchor follows the slave point
@@ -463,4 +482,33 @@ contains
             end do
         end do
     end subroutine point_law
+
+    !> The slip (master parameter) since the stick anchor and its derivative by the
+    !> local DOFs, `c` being that of xi: xi - anchor and c; for a point that touched in
+    !> this step (`touch`, open at the last converged state with gap `gap0`) only the
+    !> part after the touch, f (xi - anchor) with f = -g / (gap0 - g) the share of the
+    !> step after the gap, interpolated linearly, vanished (dg = `ng`), and the anchor
+    !> to commit when it sticks is there, xi - slip; none without a projection then.
+    !> Without it a point that closes in a step sticks where it projected at the
+    !> step's start, and the motion of the open surface before it touched (a body's
+    !> surface sliding along a rigid one under a growing load) becomes stick traction.
+    pure subroutine touch_slip(xi, anchor, touch, gap0, g, c, ng, slip, dslip, new_anchor)
+        real(dp), intent(in) :: xi, anchor, gap0, g, c(:), ng(:)
+        logical, intent(in) :: touch
+        real(dp), intent(out) :: slip, dslip(:)
+        real(dp), intent(inout) :: new_anchor
+        real(dp) :: f
+        slip = xi - anchor
+        dslip = c
+        if (.not. touch) return
+        if (gap0 < huge(1.0_dp) .and. gap0 > g) then
+            f = -g/(gap0 - g)
+            dslip = f*c - slip*gap0/(gap0 - g)**2*ng
+            slip = f*slip
+        else
+            slip = 0.0_dp
+            dslip = 0.0_dp
+        end if
+        new_anchor = xi - slip
+    end subroutine touch_slip
 end module voiga_contact_gpts

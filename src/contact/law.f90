@@ -16,6 +16,10 @@ module voiga_contact_law
     !> Penalty and friction parameters of a pair.
     type :: contact_law_t
         real(dp) :: eps_n = 0.0_dp, eps_t = 0.0_dp, mu = 0.0_dp
+        !> False only for the stick predictor of a substep (`voiga_solver_newton`,
+        !> `stick_predictor`): the elastic predictor is kept whatever its size, so every
+        !> active point sticks.
+        logical :: return_map = .true.
     end type contact_law_t
 
 contains
@@ -42,7 +46,7 @@ contains
         state = state_stick
         if (law%mu > 0.0_dp) then
             ttr = t_old - law%eps_t*ds_a/d_a
-            if (abs(ttr) <= law%mu*p) then
+            if (abs(ttr) <= law%mu*p .or. .not. law%return_map) then
                 t = ttr
             else
                 state = state_slip

@@ -22,13 +22,16 @@ module voiga_contact_mortar
     use voiga_contact_surface, only: surface_point_t, surface_point
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
-    use voiga_contact_kinematics, only: point_operators
+    use voiga_contact_mortar_kernels, only: mortar_point, node_touch_factors
     use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
                                   pair_reset_trial, pair_history, pair_set_history
     implicit none
     private
 
     public :: mortar_pair_t, mortar_snapshot_t, mortar_point
+    !> The evaluation, for extensions that add to it (a call through the parent
+    !> component would bind the passes' own calls to the parent's procedures).
+    public :: mortar_evaluate
 
     !> A mortar pair's control points at one evaluation [slave edge control points]
     !> (for the step control, `step_limit`).
@@ -57,6 +60,13 @@ module voiga_contact_mortar
         !> Friction history (mu > 0) [nodes]: committed and trial tangential traction
         !> t_A (along the master tangent).
         real(dp), allocatable :: traction(:), trial_traction(:)
+        !> Friction history (mu > 0) [nodes]: the mean gap g_A / D_A (huge where
+        !> nothing projected) and whether the node was in contact, at the last converged
+        !> state; committed and trial. A node that was open there touched in this step
+        !> where its mean gap, interpolated linearly from there, vanished: only its slip
+        !> after that counts (`touch_factors`).
+        real(dp), allocatable :: node_gap(:), trial_node_gap(:)
+        logical, allocatable :: node_active(:), trial_node_active(:)
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
         type(mortar_snapshot_t) :: last, accepted
@@ -71,6 +81,7 @@ module voiga_contact_mortar
         procedure :: history => mortar_history
         procedure :: set_history => mortar_set_history
         procedure :: accept_iterate => mortar_accept_iterate
+        procedure :: contact_last => mortar_contact_last
         procedure :: step_limit => mortar_step_limit
         !> The law at every control point from its weighted gap and slip.
         procedure :: control_laws => mortar_control_laws
@@ -99,6 +110,10 @@ module voiga_contact_mortar
         !> projection in its support, states.
         real(dp), allocatable :: d_a(:), g_a(:), ds_a(:), p_a(:), t_a(:), t_tr(:), d_seen(:)
         integer, allocatable :: st_a(:)
+        !> Per node [nodes] (friction): the share f_A of its slip that counts (1, or
+        !> for a node open at the last converged state the part after it touched), the
+        !> weighted slip before that scaling, and d f_A / d(g_A / D_A).
+        real(dp), allocatable :: f_a(:), ds_raw(:), df_a(:)
     end type mortar_work_t
 
 contains
@@ -131,7 +146,13 @@ contains
         ! open where no point of its support has a projection: its weighted gap is
         ! then empty, not zero
         where (wk%d_seen <= 0.0_dp) wk%g_a = huge(1.0_dp)
+        if (allocated(self%node_gap)) then
+            call touch_factors(self, wk)
+            self%trial_node_gap = huge(1.0_dp)
+            where (wk%g_a < huge(1.0_dp) .and. wk%d_a > 0.0_dp) self%trial_node_gap = wk%g_a/wk%d_a
+        end if
         call self%control_laws(wk%g_a, wk%d_a, wk%ds_a, wk%p_a, wk%t_a, wk%st_a, wk%t_tr)
+        if (allocated(self%node_active)) self%trial_node_active = wk%st_a /= state_inactive
         call mortar_points(self, r, wk, miss, add)
         self%last = mortar_snapshot_t(wk%g_a, wk%d_a, wk%t_tr, wk%st_a)
         if (.not. present(add) .or. miss) return
@@ -193,6 +214,17 @@ contains
             end associate
         end do
     end subroutine mortar_project
+
+    !> The share of each node's weighted slip that counts (`node_touch_factors`), and
+    !> the weighted slips scaled by it.
+    pure subroutine touch_factors(self, wk)
+        class(mortar_pair_t), intent(in) :: self
+        type(mortar_work_t), intent(inout) :: wk
+        allocate (wk%f_a(size(wk%g_a)), wk%df_a(size(wk%g_a)))
+        call node_touch_factors(self%node_active, self%node_gap, wk%g_a, wk%d_a, wk%f_a, wk%df_a)
+        wk%ds_raw = wk%ds_a
+        wk%ds_a = wk%f_a*wk%ds_raw
+    end subroutine touch_factors
 
     !> Pass 3: every point's interpolated traction: residual, resultant, output and
     !> (with `add`) geometric tangent; `miss`: a point fell outside the pattern.
@@ -259,9 +291,8 @@ contains
         real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
         integer, allocatable :: blk(:), pos(:), mdofs(:)
         real(dp) :: c
-        integer :: k, i, a, e, j, ng
+        integer :: k, i, a, e, j, rng(2)
 
-        ng = self%n_gauss
         mdofs = self%master%all_dofs()
         do a = 1, size(self%node_first)
             if (wk%st_a(a) == state_inactive) cycle
@@ -271,7 +302,8 @@ contains
             q = 0.0_dp
             mm = 0.0_dp
             do e = self%node_first(a), self%node_last(a)
-                do k = (e - 1)*ng + 1, e*ng
+                rng = self%point_range(e)
+                do k = rng(1), rng(2)
                     if (.not. allocated(wk%vec(k)%dofs)) cycle
                     i = findloc(self%point_nodes(:, k), a, dim=1)
                     c = wk%w0(k)*self%point_values(i, k)
@@ -283,6 +315,8 @@ contains
                     end if
                 end do
             end do
+            ! the counted slip f_A ds_A: d = f_A d ds_A + ds_A f_A' d(g_A / D_A)
+            if (allocated(wk%f_a)) mm = wk%f_a(a)*mm + wk%ds_raw(a)*wk%df_a(a)/wk%d_a(a)*v
             allocate (kc(size(blk), size(blk)))
             do j = 1, size(blk)
                 kc(:, j) = self%law%eps_n/wk%d_a(a)*v*v(j)
@@ -376,6 +410,12 @@ contains
         allocate (self%traction(size(self%node_first)), self%trial_traction(size(self%node_first)))
         self%traction = 0.0_dp
         self%trial_traction = 0.0_dp
+        allocate (self%node_gap(size(self%node_first)), self%trial_node_gap(size(self%node_first)))
+        allocate (self%node_active(size(self%node_first)), self%trial_node_active(size(self%node_first)))
+        self%node_gap = huge(1.0_dp)
+        self%trial_node_gap = huge(1.0_dp)
+        self%node_active = .false.
+        self%trial_node_active = .false.
     end subroutine mortar_setup_history
 
     !> The multiplier basis at the slave points and the supports of its nodes: the
@@ -426,13 +466,21 @@ contains
 
     pure subroutine mortar_commit(self)
         class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) self%traction = self%trial_traction
+        if (allocated(self%traction)) then
+            self%traction = self%trial_traction
+            self%node_gap = self%trial_node_gap
+            self%node_active = self%trial_node_active
+        end if
         call pair_commit(self)
     end subroutine mortar_commit
 
     pure subroutine mortar_reset_trial(self)
         class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) self%trial_traction = self%traction
+        if (allocated(self%traction)) then
+            self%trial_traction = self%traction
+            self%trial_node_gap = self%node_gap
+            self%trial_node_active = self%node_active
+        end if
         call pair_reset_trial(self)
     end subroutine mortar_reset_trial
 
@@ -440,12 +488,16 @@ contains
     pure function mortar_history(self) result(items)
         class(mortar_pair_t), intent(in) :: self
         type(history_item_t), allocatable :: items(:)
-        type(history_item_t) :: traction
+        type(history_item_t) :: traction, gap, active
         items = pair_history(self)
         if (.not. allocated(self%traction)) return
         traction%name = 'traction'
         traction%values = self%traction
-        items = [traction, items]
+        gap%name = 'node_gap'
+        gap%values = self%node_gap
+        active%name = 'node_active'
+        active%flags = merge(1, 0, self%node_active)
+        items = [traction, gap, active, items]
     end function mortar_history
 
     pure subroutine mortar_set_history(self, items, error)
@@ -456,15 +508,33 @@ contains
         call pair_set_history(self, items, error)
         if (allocated(error) .or. .not. allocated(self%traction)) return
         do i = 1, size(items)
-            if (trim(items(i)%name) /= 'traction') cycle
-            if (size(items(i)%values) /= size(self%traction)) then
-                call fatal_error(error, 'history traction: wrong length', error_code%input)
-                return
-            end if
-            self%traction = items(i)%values
-            self%trial_traction = self%traction
+            select case (trim(items(i)%name))
+            case ('traction', 'node_gap')
+                if (size(items(i)%values) /= size(self%traction)) then
+                    call fatal_error(error, 'history '//trim(items(i)%name)//': wrong length', error_code%input)
+                    return
+                end if
+                if (trim(items(i)%name) == 'traction') self%traction = items(i)%values
+                if (trim(items(i)%name) == 'node_gap') self%node_gap = items(i)%values
+            case ('node_active')
+                if (size(items(i)%flags) /= size(self%traction)) then
+                    call fatal_error(error, 'history node_active: wrong length', error_code%input)
+                    return
+                end if
+                self%node_active = items(i)%flags /= 0
+            end select
         end do
+        self%trial_traction = self%traction
+        self%trial_node_gap = self%node_gap
+        self%trial_node_active = self%node_active
     end subroutine mortar_set_history
+
+    !> A control point was in contact at the last converged state (friction only).
+    pure logical function mortar_contact_last(self)
+        class(mortar_pair_t), intent(in) :: self
+        mortar_contact_last = .false.
+        if (allocated(self%node_active)) mortar_contact_last = any(self%node_active)
+    end function mortar_contact_last
 
     !> The last evaluation is an accepted Newton iterate: the reference of `step_limit`.
     pure subroutine mortar_accept_iterate(self)
@@ -503,53 +573,4 @@ contains
         end associate
     end function mortar_step_limit
 
-    !> Residual `r` and geometric tangent `k` of one slave point whose interpolated
-    !> pressure `pbar` and tangential traction `tbar` are held fixed; and the point's
-    !> derivative vectors (local DOFs), from which `voiga_contact_pair` forms the
-    !> coupling through the control-point tractions: `gn` = d g / du = G^T n,
-    !> `gt` = G^T t_hat, `m` = d ds / du with ds = dxi |a_m| the point's slip since
-    !> the last converged state (`dxi` = xi_m - xi_m,last; zero vector without
-    !> `slip`, a point that had no projection then).
-    pure subroutine mortar_point(w0, sp, mp, pbar, tbar, dxi, slip, friction, r, k, gn, gt, m)
-        !> Reference length weight: Gauss weight x |dX/dxi|.
-        real(dp), intent(in) :: w0
-        type(surface_point_t), intent(in) :: sp
-        type(master_point_t), intent(in) :: mp
-        real(dp), intent(in) :: pbar, tbar, dxi
-        logical, intent(in) :: slip
-        !> False: frictionless, `gt` and `m` are zero (no friction code runs).
-        logical, intent(in) :: friction
-        real(dp), intent(out) :: r(:), k(:, :), gn(:), gt(:), m(:)
-        real(dp) :: gm(2, size(r)), dm(2, size(r)), ds(2, size(r)), amat(2, size(r))
-        real(dp) :: c(size(r)), na(size(r)), dmt(size(r)), n(2), that(2), t(2), dt(2), la, g, den
-        integer :: a
-
-        call point_operators(sp, mp, gm, dm, ds)
-        n = mp%n
-        la = norm2(mp%a)
-        that = mp%a/la
-        g = dot_product(sp%x - mp%x, n)
-        ! linearization of the projection: dxi = c . du; master tangent A = Dm + a2 (x) c
-        den = dot_product(mp%a, mp%a) - g*dot_product(n, mp%a2)
-        c = (matmul(mp%a, gm) + g*matmul(n, dm))/den
-        amat(1, :) = dm(1, :) + mp%a2(1)*c
-        amat(2, :) = dm(2, :) + mp%a2(2)*c
-        na = matmul(n, amat)/la     ! dn = -t_hat na, dt_hat = n na
-        gn = matmul(n, gm)
-        gt = 0.0_dp
-        m = 0.0_dp
-        if (friction) then
-            gt = matmul(that, gm)
-            if (slip) m = la*c + dxi*matmul(that, amat)
-        end if
-        t = pbar*n + tbar*that
-        ! d t at fixed pbar, tbar: pbar dn + tbar dt_hat = (tbar n - pbar t_hat) na
-        dt = tbar*n - pbar*that
-        r = -w0*matmul(t, gm)
-        dmt = matmul(t, dm)
-        do a = 1, size(r)
-            ! K = -w0 G^T dt na^T + w0 (Dm^T t) c^T (the master functions move with xi)
-            k(:, a) = -w0*matmul(dt, gm)*na(a) + w0*dmt*c(a)
-        end do
-    end subroutine mortar_point
 end module voiga_contact_mortar

@@ -52,6 +52,9 @@ module voiga_contact_pair
         character(len=16) :: name = ''
         real(dp), allocatable :: values(:)
         integer, allocatable :: flags(:)
+        !> The most values a restart may read for it (-1: as many as it holds now;
+        !> a pair whose number of points changes between steps gives its bound).
+        integer :: most = -1
     end type history_item_t
 
     !> A vector on a few global DOFs.
@@ -104,6 +107,10 @@ module voiga_contact_pair
         !> committed and trial.
         real(dp), allocatable :: xi_last(:), trial_xi(:)
         logical, allocatable :: active_last(:), trial_active(:)
+        !> The normal gap at the last converged state (huge without a projection),
+        !> committed and trial [npts]: where between that state and this one a point
+        !> that was open first touched (friction only).
+        real(dp), allocatable :: gap_last(:), trial_gap(:)
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
         !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
@@ -161,6 +168,11 @@ module voiga_contact_pair
         procedure :: constraint_test => pair_constraint_test
         procedure :: constraints => pair_constraints
         procedure :: update_multipliers => pair_update_multipliers
+        !> The stick predictor (`voiga_solver_newton`): while on, every active point
+        !> sticks (no return map); and whether any point (or control point) was in
+        !> contact at the last converged state (friction only).
+        procedure :: stick_trial => pair_stick_trial
+        procedure :: contact_last => pair_contact_last
         !> A substep failed: a pair whose penalties do not decide its solution may
         !> make them softer for the next attempt (default: not; `text` says what changed).
         procedure :: soften => pair_soften
@@ -172,6 +184,11 @@ module voiga_contact_pair
         procedure :: fit_pattern => pair_fit_pattern
         procedure :: element_dofs => pair_element_dofs
         procedure :: wanted_ranges => pair_wanted_ranges
+        !> The slave points of slave element e (first and last index) and the slave
+        !> element of point k: `n_gauss` per element in element order unless a method
+        !> places its points otherwise (`voiga_contact_segment`).
+        procedure :: point_range => pair_point_range
+        procedure :: point_element => pair_point_element
     end type contact_pair_t
 
     !> An element of an array of pairs of any methods.
@@ -261,6 +278,9 @@ contains
         if (self%law%mu <= 0.0_dp) return
         n = size(self%xi)
         allocate (self%xi_last(n), self%trial_xi(n), self%active_last(n), self%trial_active(n))
+        allocate (self%gap_last(n), self%trial_gap(n))
+        self%gap_last = huge(1.0_dp)
+        self%trial_gap = huge(1.0_dp)
         self%xi_last = 0.0_dp
         self%trial_xi = 0.0_dp
         self%active_last = .false.
@@ -272,6 +292,7 @@ contains
         if (.not. allocated(self%xi_last)) return
         self%active_last = self%trial_active
         self%xi_last = self%trial_xi
+        self%gap_last = self%trial_gap
     end subroutine pair_commit
 
     pure subroutine pair_reset_trial(self)
@@ -279,6 +300,7 @@ contains
         if (.not. allocated(self%xi_last)) return
         self%trial_active = self%active_last
         self%trial_xi = self%xi_last
+        self%trial_gap = self%gap_last
     end subroutine pair_reset_trial
 
     !> The shared friction history: `xi_last`, `active_last` (empty without friction).
@@ -288,11 +310,13 @@ contains
         allocate (items(0))
         if (.not. allocated(self%xi_last)) return
         deallocate (items)
-        allocate (items(2))
+        allocate (items(3))
         items(1)%name = 'xi_last'
         items(1)%values = self%xi_last
         items(2)%name = 'active_last'
         items(2)%flags = merge(1, 0, self%active_last)
+        items(3)%name = 'gap_last'
+        items(3)%values = self%gap_last
     end function pair_history
 
     !> Set the committed (and trial) history from `items` (as `history` names them).
@@ -307,6 +331,9 @@ contains
             case ('xi_last')
                 call take(items(i)%values, self%xi_last, error)
                 if (allocated(error)) return
+            case ('gap_last')
+                call take(items(i)%values, self%gap_last, error)
+                if (allocated(error)) return
             case ('active_last')
                 if (size(items(i)%flags) /= size(self%active_last)) then
                     call fatal_error(error, 'history active_last: wrong length', error_code%input)
@@ -317,6 +344,7 @@ contains
         end do
         self%trial_xi = self%xi_last
         self%trial_active = self%active_last
+        self%trial_gap = self%gap_last
     contains
         pure subroutine take(values, target, error)
             real(dp), intent(in) :: values(:)
@@ -383,6 +411,19 @@ contains
         class(contact_pair_t), intent(inout) :: self
         real(dp), intent(in) :: delta(:)
     end subroutine pair_update_multipliers
+
+    pure subroutine pair_stick_trial(self, on)
+        class(contact_pair_t), intent(inout) :: self
+        logical, intent(in) :: on
+        self%law%return_map = .not. on
+    end subroutine pair_stick_trial
+
+    !> Default (GPTS): a slave point was in contact at the last converged state.
+    pure logical function pair_contact_last(self)
+        class(contact_pair_t), intent(in) :: self
+        pair_contact_last = .false.
+        if (allocated(self%active_last)) pair_contact_last = any(self%active_last)
+    end function pair_contact_last
 
     pure subroutine pair_soften(self, changed, text)
         class(contact_pair_t), intent(inout) :: self
@@ -476,7 +517,7 @@ contains
         type(master_point_t), intent(in) :: mp
         logical, intent(out) :: inside
         integer :: e
-        e = (k - 1)/self%n_gauss + 1
+        e = self%point_element(k)
         inside = mp%first >= self%mlo(e) .and. mp%last <= self%mhi(e)
         if (inside) return
         if (self%mlo(e) > self%mhi(e)) then
@@ -511,12 +552,14 @@ contains
         integer, intent(in) :: n_master, block
         integer, intent(out) :: lo(:), hi(:)
         real(dp) :: h
-        integer :: e, k, ng, w
-        ng = self%n_gauss
+        integer :: e, k, ng, w, rng(2)
         lo = 1
         hi = 0
         do e = 1, size(lo)
-            associate (pts => self%out((e - 1)*ng + 1:e*ng))
+            rng = self%point_range(e)
+            ng = rng(2) - rng(1) + 1
+            if (ng <= 0) cycle
+            associate (pts => self%out(rng(1):rng(2)))
                 h = norm2(maxval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2) - &
                           minval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2))
                 do k = 1, ng
@@ -536,5 +579,19 @@ contains
             hi(e) = min(n_master, ((hi(e) + block - 1)/block)*block)
         end do
     end subroutine pair_wanted_ranges
+
+    !> Points n_gauss (e - 1) + 1 .. n_gauss e: the Gauss points `setup` places.
+    pure function pair_point_range(self, e) result(range)
+        class(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: e
+        integer :: range(2)
+        range = [(e - 1)*self%n_gauss + 1, e*self%n_gauss]
+    end function pair_point_range
+
+    pure integer function pair_point_element(self, k) result(e)
+        class(contact_pair_t), intent(in) :: self
+        integer, intent(in) :: k
+        e = (k - 1)/self%n_gauss + 1
+    end function pair_point_element
 
 end module voiga_contact_pair

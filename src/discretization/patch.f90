@@ -18,6 +18,8 @@ module voiga_discretization_patch
     private
 
     public :: discretization_t, element_t, edge_t, new_discretization, edge_cps, new_knots
+    !> An ascending copy of a short real vector (also the contact segments' cuts).
+    public :: sorted
 
     !> One element (a knot-span rectangle).
     type :: element_t

@@ -15,6 +15,7 @@ module voiga_io_provenance
     use voiga_io_sha256, only: sha256_file
     use voiga_io_os, only: canonical_path
     use voiga_io_case, only: case_t
+    use voiga_model_loads, only: phase_of
     use voiga_linalg_blas, only: library_threads, blas_kernels
     implicit none
     private
@@ -173,9 +174,13 @@ contains
         character(len=:), allocatable, intent(inout) :: text
         character(len=:), allocatable :: g, s
         character(len=8) :: buf
+        type(error_t), allocatable :: error
+        real(dp) :: t, mu
         integer :: k
         if (step < 1) return
         write (buf, '(i6.6)') step
+        t = 0.0_dp
+        call h5%read_attr_real('/steps/'//trim(buf), 'time', t, error)
         do k = 1, size(case%contact)
             g = '/steps/'//trim(buf)//'/contact/'//str(k)
             if (.not. h5%exists(g)) cycle
@@ -184,7 +189,11 @@ contains
             call compare_str(h5, g, 'master', trim(case%contact(k)%master), s//' master', text)
             call compare_str(h5, g, 'method', trim(case%contact(k)%method), s//' method', text)
             call compare_real(h5, g, 'penalty_normal', case%contact(k)%penalty_normal, s//' penalty_normal', text)
-            call compare_real(h5, g, 'friction', case%contact(k)%friction, s//' friction', text)
+            ! (the step's: friction may change with the phase)
+            mu = case%contact(k)%friction
+            if (allocated(case%contact(k)%friction_phases)) &
+                mu = case%contact(k)%friction_phases(phase_of(t, size(case%contact(k)%friction_phases)))
+            call compare_real(h5, g, 'friction', mu, s//' friction', text)
             if (case%contact(k)%friction > 0.0_dp) call compare_real(h5, g, 'penalty_tangent', &
                                                                       case%contact(k)%penalty_tangent, &
                                                                       s//' penalty_tangent', text)

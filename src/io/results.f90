@@ -508,6 +508,8 @@ contains
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates, error)
             if (allocated(error)) exit records
+            call self%h5%write_attr('/', 'stick_predictions', stats%stick_predictions, error)
+            if (allocated(error)) exit records
             call self%h5%write_attr('/', 'newton_iterations', stats%iterations, error)
             if (allocated(error)) exit records
             call self%h5%write_attr('/', 'status', status, error)

@@ -3,7 +3,7 @@
 module voiga_model_assembly
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t, move_obstacles
+    use voiga_model, only: model_t, set_contact_time
     use voiga_model_body, only: body_t
     use voiga_model_loads, only: phase_value
     use voiga_text, only: str
@@ -277,7 +277,7 @@ contains
         real(dp), allocatable :: r_bulk(:), k_bulk(:)
         integer :: pass, ip
         logical :: fit, keep
-        call move_obstacles(model, t)
+        call set_contact_time(model, t)
         fit = .false.
         if (present(refit)) fit = refit .and. present(k)
         ! the bulk part is kept for a rebuild at a substep's first assembly, where the
@@ -357,7 +357,7 @@ contains
         logical, intent(out) :: fits
         integer :: ip
         fits = .false.
-        call move_obstacles(model, t)
+        call set_contact_time(model, t)
         call assemble_bulk(model, u, t, r, stats, error, k, map, forces_only=.true.)
         if (allocated(error)) return
         call assemble_contact(model, u, r, stats, error, fit_only=.true.)

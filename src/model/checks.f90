@@ -116,7 +116,7 @@ contains
         integer :: k
         allocate (ratio(size(pair%out)), source=0.0_dp)
         do k = 1, size(ratio)
-            if (use(k)) ratio(k) = -pair%out(k)%gap/h((k - 1)/pair%n_gauss + 1)
+            if (use(k)) ratio(k) = -pair%out(k)%gap/h(pair%point_element(k))
         end do
     end function depth_ratios
 
@@ -160,7 +160,13 @@ contains
         depth = depth_ratios(pair, h, pair%out%gap < 1.0e300_dp)
         inside = count(depth > overlap_fraction)
         found = count(pair%out%gap < 1.0e300_dp)
-        length = [(h((k - 1)/pair%n_gauss + 1), k=1, size(depth))]
+        ! (each point stands for its element's length over the element's points)
+        allocate (length(size(depth)))
+        do k = 1, size(h)
+            associate (range => pair%point_range(k))
+                length(range(1):range(2)) = h(k)/real(max(range(2) - range(1) + 1, 1), dp)
+            end associate
+        end do
         share = 0.0_dp
         if (found > 0) share = sum(length, mask=depth > overlap_fraction)/ &
                                sum(length, mask=pair%out%gap < 1.0e300_dp)

@@ -8,7 +8,7 @@ module voiga_model_loads
     private
 
     public :: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
-    public :: obstacle_motion_t
+    public :: obstacle_motion_t, phase_friction_t, phase_of
 
     !> A prescribed displacement on a named edge (docs/formats.md, `&dirichlet`).
     type :: dirichlet_settings_t
@@ -55,7 +55,24 @@ module voiga_model_loads
         real(dp), allocatable :: values(:, :)
     end type obstacle_motion_t
 
+    !> A contact pair whose friction coefficient changes with the load phase (one
+    !> value per phase, constant within it: `&contact friction` with one value per phase).
+    type :: phase_friction_t
+        !> The contact pair.
+        integer :: pair = 0
+        !> Its friction coefficient in each phase [n_phases].
+        real(dp), allocatable :: values(:)
+    end type phase_friction_t
+
 contains
+
+    !> The load phase of load time `t` out of `n`: phase k runs over (k - 1, k], phase 1
+    !> from t = 0.
+    pure integer function phase_of(t, n) result(k)
+        real(dp), intent(in) :: t
+        integer, intent(in) :: n
+        k = min(max(ceiling(t), 1), n)
+    end function phase_of
 
     !> Value of a phase-wise linear history at load time `t`: 0 at t = 0, `values(k)` at t = k.
     pure real(dp) function phase_value(values, t) result(v)
@@ -63,7 +80,7 @@ contains
         real(dp), intent(in) :: t
         integer :: k
         real(dp) :: a, s
-        k = min(max(ceiling(t), 1), size(values))
+        k = phase_of(t, size(values))
         s = t - real(k - 1, dp)
         a = 0.0_dp
         if (k > 1) a = values(k - 1)

@@ -7,7 +7,7 @@ module voiga_model
     use voiga_discretization_patch, only: discretization_t, edge_cps
     use voiga_model_body, only: body_t, body_settings_t, new_body
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
-                                 obstacle_motion_t
+                                 obstacle_motion_t, phase_friction_t, phase_of
     use voiga_contact_pair, only: pair_slot_t
     use voiga_contact_factory, only: contact_settings_t, new_contact_pair, automatic_penalty
     use voiga_contact_surface, only: new_contact_surface, element_lengths
@@ -17,7 +17,7 @@ module voiga_model
     implicit none
     private
 
-    public :: model_t, new_model, set_prescribed, reference_coordinates, move_obstacles, contact_reach
+    public :: model_t, new_model, set_prescribed, reference_coordinates, set_contact_time, contact_reach
 
     !> Everything the solver needs to know of the physics.
     type :: model_t
@@ -34,6 +34,8 @@ module voiga_model
         type(pair_slot_t), allocatable :: pairs(:)
         !> The prescribed motions of rigid masters (only those that move).
         type(obstacle_motion_t), allocatable :: motions(:)
+        !> The friction coefficients of pairs whose friction changes with the phase.
+        type(phase_friction_t), allocatable :: frictions(:)
     end type model_t
 
 contains
@@ -85,6 +87,14 @@ contains
             i = i + 1
             self%motions(i)%pair = k
             self%motions(i)%values = contact(k)%rigid_motion
+        end do
+        allocate (self%frictions(count([(allocated(contact(k)%friction_phases), k=1, size(contact))])))
+        i = 0
+        do k = 1, size(contact)
+            if (.not. allocated(contact(k)%friction_phases)) cycle
+            i = i + 1
+            self%frictions(i)%pair = k
+            self%frictions(i)%values = contact(k)%friction_phases
         end do
     end subroutine new_model
 
@@ -179,9 +189,12 @@ contains
             if (pair%law%eps_n <= 0.0_dp) pair%law%eps_n = pair%eps_automatic
             pair%law%eps_t = inp%penalty_tangent
             if (pair%law%eps_t <= 0.0_dp) pair%law%eps_t = pair%law%eps_n
+            ! the largest coefficient decides what friction history the pair keeps; the
+            ! one of the first phase holds from the start (`set_contact_time`)
             pair%law%mu = inp%friction
             pair%n_gauss = inp%n_gauss
             call pair%setup()
+            if (allocated(inp%friction_phases)) pair%law%mu = inp%friction_phases(1)
             allocate (u0(self%ndof), r0(self%ndof))
             u0 = 0.0_dp
             r0 = 0.0_dp
@@ -238,17 +251,25 @@ contains
 
     !> Put every moving rigid master where its prescribed motion has it at load
     !> time `t` (before the contact pairs are evaluated at `t`).
-    pure subroutine move_obstacles(model, t)
+    !> The contact pairs at load time `t`: where the rigid masters that move are
+    !> (`&contact rigid_ux, rigid_uy`), and the friction coefficient of the phase of
+    !> the pairs whose friction changes with it.
+    pure subroutine set_contact_time(model, t)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: t
         integer :: k
+        do k = 1, size(model%frictions)
+            associate (f => model%frictions(k))
+                model%pairs(f%pair)%pair%law%mu = f%values(phase_of(t, size(f%values)))
+            end associate
+        end do
         do k = 1, size(model%motions)
             associate (m => model%motions(k))
                 call model%pairs(m%pair)%pair%master%move([phase_value(m%values(1, :), t), &
                                                            phase_value(m%values(2, :), t)])
             end associate
         end do
-    end subroutine move_obstacles
+    end subroutine set_contact_time
 
     !> Reference coordinates of the control point of every DOF; shape: [ndof]
     !> (2(a-1)+i of body b at dof0 + 2(a-1) + i, as the displacement).

@@ -62,6 +62,9 @@ module voiga_solver_records
         !> Substeps whose predicted start failed and that were retried from the last
         !> converged state.
         integer :: predictor_retries = 0
+        !> Substeps started from the stick predictor (`stick_predictor`; its linear
+        !> step counts as a Newton iteration).
+        integer :: stick_predictions = 0
         !> Substeps retried after an augmented-Lagrangian pair softened its penalties.
         integer :: softenings = 0
         !> Residual evaluations spent on shortening Newton steps (halving, natural

@@ -37,6 +37,10 @@ module voiga_solver_settings
         !> Start each substep from the last step's increment, extrapolated (within a
         !> load phase; docs/stepping.md).
         logical :: predictor = .true.
+        !> Start a frictional substep that has no increment to extrapolate (the first
+        !> of a load phase, a retry) from a stick predictor: one linear step with every
+        !> point in contact at the last converged state sticking (docs/robustness.md).
+        logical :: stick_predictor = .true.
         !> Linear solver of each Newton iteration (`linear_solver_names`): 'direct'
         !> (UMFPACK LU) or 'multigrid' (GMRES preconditioned by geometric multigrid).
         character(len=16) :: linear_solver = 'direct'

@@ -20,12 +20,13 @@
 module voiga_solver_stepping
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_model, only: model_t, set_prescribed
+    use voiga_model, only: model_t, set_prescribed, set_contact_time
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, step_record_t, cut_record_t, append_cut, wall_seconds
     use voiga_solver_progress, only: progress_t, step_report_t
     use voiga_solver_newton, only: newton_t, new_newton, attempt_t
+    use voiga_solver_stick_predictor, only: stick_predictor
     use voiga_solver_outer, only: tresca_fixed_point, frictional, substep_attempt
     use voiga_solver_diagnostics, only: fold_diagnosis, append_pair_diagnoses
     use voiga_model_checks, only: contact_watch_t, new_contact_watch, setup_warnings, warning_t
@@ -257,9 +258,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: tresca_error
         integer :: ip
+        logical :: retry
 
         predicted = .false.
-        if (sp%settings%predictor .and. .not. sp%unpredicted_retry .and. allocated(sp%u_step_before) &
+        retry = sp%unpredicted_retry
+        if (sp%settings%predictor .and. .not. retry .and. allocated(sp%u_step_before) &
             .and. step >= 2) then
             if (sp%settings%phase_of_step(step - 1) == sp%settings%phase_of_step(step)) then
                 u = u + ds*(sp%u_step - sp%u_step_before)
@@ -274,6 +277,12 @@ contains
             return
         end if
         call set_prescribed(model, t, u)
+        if (.not. predicted .and. .not. retry .and. sp%settings%stick_predictor .and. sliding_start(model, t)) then
+            ! (a failure from this start is retried once from the converged state)
+            call stick_predictor(sp%newton, model, t, u, stats, rec, error)
+            if (allocated(error)) return
+            predicted = .true.
+        end if
         call substep_attempt(sp%newton, model, step, t, u, stats, rec, progress, attempt, error)
         if (.not. allocated(error) .or. predicted) return
         sp%fold_iterations = attempt%nonpositive_det
@@ -297,6 +306,20 @@ contains
             error%message = error%message//'; retried with the Tresca fixed point: '//tresca_error%message
         end if
     end subroutine attempt_substep
+
+    !> Whether a substep at load time `t` starts with points that may stick: a pair
+    !> with friction at `t` and a point in contact at the last converged state.
+    logical function sliding_start(model, t)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: t
+        integer :: ip
+        call set_contact_time(model, t)
+        sliding_start = .false.
+        do ip = 1, size(model%pairs)
+            if (model%pairs(ip)%pair%law%mu > 0.0_dp .and. model%pairs(ip)%pair%contact_last()) &
+                sliding_start = .true.
+        end do
+    end function sliding_start
 
     !> The substep converged: it is the new converged state; the increment grows
     !> after an easy substep.

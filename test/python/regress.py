@@ -19,17 +19,18 @@ most); counts must be equal.
     python3 test/python/regress.py --only 'hertz/*' 'penalty-1e2'
 
 The baseline is a gzip'd JSON file, {run name: {"status", "steps": [{...}, ...]}}, its
-floats kept to 13 significant digits. It was remade by the binary of the merge of issue
-21 (5e8215a: the supernodal LU, the new element and contact kernels) with ``--write``.
-Against the baseline before it (e54ff29's binary; ``penalty-hertz-1e9`` from 7ea93d8's,
-the alm hard cases from ea01bff's), 26 to 28 of 137 runs (over the branch's last
-commits) did not agree to 1e-10: ironing-deep runs, stiff-penalty hard cases, nu-0.49
-and ratio-1e3-rings, where a cut or the last Newton iteration changes with the order of
-floating-point sums. The old
-binary itself with OpenBLAS's Haswell kernels (``OPENBLAS_CORETYPE=Haswell``, another
-order of the same sums) differs from its own baseline in the same steps by the same
-amounts (docs/performance.md). Those runs are reproducible on one machine and binary,
-not to 1e-10 across BLAS kernels or CPUs.
+floats kept to 13 significant digits. It was remade (``--write``, 141 runs) by the binary
+of issue 35 (the touchdown of friction points, the stick predictor) on the 2-core AMD EPYC
+development machine. Against a baseline made there just before by the binary of main
+before it (b96b3f6), the 40 frictionless runs (every hertz case, nu-0.49-hertz,
+penalty-1e6-mu0, penalty-hertz-1e9, apart-hertz) agree to 1e-10 and all 101 frictional
+ones differ (step 1 already: where a point's slip starts, and the stick predictor's start;
+mu-1.0-deep and penalty-1e5 now converge). Runs with stiff penalties, ironing-deep,
+nu-0.49 and ratio-1e3-rings, where a cut or the last Newton iteration changes with the
+order of floating-point sums, are reproducible on one machine and binary, not to 1e-10
+across BLAS kernels or CPUs (with OpenBLAS's Haswell kernels,
+``OPENBLAS_CORETYPE=Haswell``, an older binary differed from its own baseline in the same
+steps by the same amounts; docs/performance.md).
 """
 from __future__ import annotations
 

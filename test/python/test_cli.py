@@ -125,7 +125,7 @@ BAD_CASES = [
     ("nel_xi = 6", "knots_xi = 0.5, 1.5", ["&body 'die'", "knots_xi", "(0, 1)"]),
     ("layer_degree = 0", "layer_degree = 1", ["&body 'die'", "layer_degree"]),
     ("layer_elevations = 0", "layer_elevations = 2", ["&body 'die'", "layer_elevations"]),
-    ("friction = 0.3", "friction = 0.3, method = 'mortal'", ["&contact", "method = 'mortal'", "'gpts', 'mortar'"]),
+    ("method = 'gpts'", "method = 'mortal'", ["&contact", "method = 'mortal'", "'gpts', 'mortar'"]),
     # an edge a load names is checked against the body's edges by --check too
     ("edge = 'bottom'", "edge = 'floor'", ["&dirichlet (2)", "no edge named 'floor'", "'slab'", "'bottom'"]),
     # every group is validated by --check (issue 18, item 8)

@@ -73,45 +73,49 @@ TRESCA_LINE = re.compile(r"^tresca step (\d+) .* converged in (\d+) iterations .
 
 
 def test_tresca_retry_accepts_coulomb_solutions(voiga_bin: Path, tmp_path: Path) -> None:
-    """Penalty 3e5 x E with friction (mu = 0.3), GPTS, the press of gpts-locking-1e6 in
-    two steps to three depths: Newton attempts from the last converged state fold
-    (stick/slip cycles, det K changing sign) and substeps are retried with the Tresca
-    fixed point (docs/robustness.md, "Tresca fixed point"). Every run converges; every
-    accepted state's Coulomb residual passed Newton's own test: tol_residual (1e-10) of
-    the substep's first residual, or a round-off floor (1e4 eps of the force scale, or
-    10 eps || |K| |x| || below 1e-6 of the force scale); the file keeps the counters.
+    """The die of ironing m1-NN2.2 pressed 0.1 and slid (0.04 or 0.1 in two steps) with
+    stiff penalties (3e5 and 1e6 x E both, mu = 0.3), GPTS: substeps whose Newton
+    attempts fold (stick/slip cycles, det K changing sign) are retried with the Tresca
+    fixed point (docs/robustness.md, "Tresca fixed point"). Every run converges, at least
+    one substep is retried, and every state the fixed point accepted had a Coulomb
+    residual that passed Newton's own test: tol_residual (1e-10) of the substep's first
+    residual, or a round-off floor (1e4 eps of the force scale, or 10 eps || |K| |x| ||
+    below 1e-6 of the force scale); the file keeps the counters.
 
-    Which substeps fold, and which retries are accepted, depends on the machine's
-    rounding (BLAS kernels, libm): the single run this test made before (1e6 x E, depth
-    0.1) had an accepted retry where it was written and none on an AMD EPYC. So three
-    depths are run and every accepted state of all of them is checked; at 3e5 x E each
-    depth had two accepted retries on that EPYC."""
-    eps = 3e5
-    n_accepted = 0
-    for uy in (-0.08, -0.1, -0.12):
-        case = HardCase(f"tresca{-uy:g}", "ironing", "m1-NN2.2", "",
-                        (contact(penalty_normal=eps, penalty_tangent=eps), solver(n_steps=[2]),
-                         dirichlet("die", "inner", ux=[0.0], uy=[uy])))
-        path = prepare(case, tmp_path / case.name)
-        proc = subprocess.run([str(voiga_bin), path.name], cwd=path.parent, capture_output=True, text=True,
-                              timeout=600)
-        assert proc.returncode == 0, proc.stderr
-        accepted = [TRESCA_LINE.match(line) for line in proc.stdout.splitlines()
-                    if line.startswith("tresca step")]
-        assert all(accepted), proc.stdout[-2000:]
-        # the line prints 3 significant digits (es9.2): 1 % covers its rounding
-        for m in accepted:
-            rn, r0, floor, scale = (float(m.group(i)) for i in range(3, 7))
-            assert (rn <= 1e-10 * r0 * (1 + 1e-2) or rn <= 1e4 * np.finfo(float).eps * scale * (1 + 1e-2)
-                    or (rn <= floor * (1 + 1e-2) and rn <= 1e-6 * scale)), m.group(0)
-        summary = re.search(r"Tresca fixed point: (\d+) substeps retried, (\d+) accepted", proc.stdout)
-        assert summary and int(summary.group(2)) == len(accepted), proc.stdout[-2000:]
-        with h5py.File(path.parent / "result.h5") as f:
-            assert f.attrs["status"] == b"converged"
-            assert f.attrs["n_steps_done"] == 2
-            # the run's counters are in the file too
-            assert f.attrs["tresca_accepted"] == len(accepted)
-            assert f.attrs["tresca_retries"] == int(summary.group(1)) >= len(accepted)
-            assert f.attrs["fixed_point_iterations"] >= len(accepted)
-        n_accepted += len(accepted)
-    assert n_accepted >= 1, "no Tresca retry was accepted: the test checked nothing"
+    Which substeps fold, and whether a retry is accepted or cut, depends on the machine's
+    rounding (BLAS kernels, libm) and on the friction history: since a point that
+    touches in a step counts only its slip after the touch and a sliding step starts
+    from the stick predictor, these scenes fold far less (the old single run, 1e6 x E
+    pressed 0.1 in two steps, now needs no retry). That an accepted state is a Coulomb
+    solution whenever the fixed point is taken is checked deterministically by
+    `fpm test -- tresca_fixed_point` (every substep by the fixed point)."""
+    retries = 0
+    for eps in (3e5, 1e6):
+        for ux in (0.04, 0.1):
+            case = HardCase(f"tresca{eps:g}-{ux:g}", "ironing", "m1-NN2.2", "",
+                            (contact(penalty_normal=eps, penalty_tangent=eps), solver(n_steps=[2, 2]),
+                             dirichlet("die", "inner", ux=[0.0, ux], uy=[-0.1, -0.1])))
+            path = prepare(case, tmp_path / case.name)
+            proc = subprocess.run([str(voiga_bin), path.name], cwd=path.parent, capture_output=True,
+                                  text=True, timeout=600)
+            assert proc.returncode == 0, proc.stderr
+            accepted = [TRESCA_LINE.match(line) for line in proc.stdout.splitlines()
+                        if line.startswith("tresca step")]
+            assert all(accepted), proc.stdout[-2000:]
+            # the line prints 3 significant digits (es9.2): 1 % covers its rounding
+            for m in accepted:
+                rn, r0, floor, scale = (float(m.group(i)) for i in range(3, 7))
+                assert (rn <= 1e-10 * r0 * (1 + 1e-2) or rn <= 1e4 * np.finfo(float).eps * scale * (1 + 1e-2)
+                        or (rn <= floor * (1 + 1e-2) and rn <= 1e-6 * scale)), m.group(0)
+            summary = re.search(r"Tresca fixed point: (\d+) substeps retried, (\d+) accepted", proc.stdout)
+            n_retried = int(summary.group(1)) if summary else 0
+            assert int(summary.group(2) if summary else 0) == len(accepted), proc.stdout[-2000:]
+            with h5py.File(path.parent / "result.h5") as f:
+                assert f.attrs["status"] == b"converged"
+                assert f.attrs["n_steps_done"] == 4
+                # the run's counters are in the file too
+                assert f.attrs["tresca_accepted"] == len(accepted)
+                assert f.attrs["tresca_retries"] == n_retried >= len(accepted)
+                assert f.attrs["fixed_point_iterations"] >= len(accepted)
+            retries += n_retried
+    assert retries >= 1, "no substep was retried with the Tresca fixed point: the test checks nothing"

@@ -73,19 +73,19 @@ def compare(a: Path, b: Path) -> None:
         assert sb[k]["det"] == sa[k]["det"], k
 
 
-@pytest.mark.parametrize("method", ["gpts", "mortar"])
+@pytest.mark.parametrize("method", ["gpts", "mortar", "segment"])
 @pytest.mark.parametrize("keep", [2, 5])
 def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, method: str) -> None:
     """The friction history is the stick anchors per slave point (GPTS) or the
-    tangential tractions per slave control point (mortar)."""
+    tangential tractions per slave control point (mortar, segment)."""
     case = setup(tmp_path, 6, method)
     res = run(case, "--quiet")
     assert res.returncode == 0, res.stderr
     with h5py.File(tmp_path / "run.h5") as f:
         history = f["steps"][max(f["steps"], key=int)]["contact/1/history"]
-        assert ("traction" in history) == (method == "mortar")
+        assert ("traction" in history) == (method in ("mortar", "segment"))
         assert ("anchor" in history) == (method == "gpts")
-        if method == "mortar":        # the slab slides: its control points carry mu p_A
+        if method != "gpts":          # the slab slides: its control points carry mu p_A
             assert np.abs(history["traction"][()]).max() > 0.0
     full = tmp_path / "full.h5"
     shutil.copy(tmp_path / "run.h5", full)
@@ -99,16 +99,25 @@ def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, me
     compare(full, partial)
 
 
-@pytest.mark.parametrize("keep", [2, 5])
-def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> None:
-    """alm at 1e6 x E with 4 Newton iterations per attempt softens its penalties at
-    steps 1 and 4 (docs/theory.md, "Softening"); a restart after step 2 or 5 goes on
-    with the penalties of the last written step and reproduces the uninterrupted run."""
+def softened_case(tmp_path: Path, stick_predictor: bool) -> Path:
+    """alm at 1e6 x E with 4 Newton iterations per attempt (the slab in contact from the
+    start, friction in the press)."""
     case = setup(tmp_path, 6, "alm")
+    solver = "n_steps = 3, 6, max_iterations = 4" + ("" if stick_predictor else ", stick_predictor = .false.")
     case.write_text(case.read_text()
                     .replace("penalty_normal = 100.0, penalty_tangent = 100.0",
                              "penalty_normal = 1e6, penalty_tangent = 1e6")
-                    .replace("n_steps = 3, 6", "n_steps = 3, 6, max_iterations = 4"))
+                    .replace("n_steps = 3, 6", solver))
+    return case
+
+
+@pytest.mark.parametrize("keep", [2, 5])
+def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> None:
+    """The softened case softens its penalties at steps 1 and 4 (docs/theory.md,
+    "Softening"); a restart after step 2 or 5 goes on with the penalties of the last
+    written step and reproduces the uninterrupted run. Without the stick predictor: with
+    it, see the next test."""
+    case = softened_case(tmp_path, stick_predictor=False)
     res = run(case)
     assert res.returncode == 0, res.stderr
     assert res.stdout.count("soften step 1 ") == 3 and res.stdout.count("soften step 4 ") == 2
@@ -124,6 +133,87 @@ def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> Non
     assert res.returncode == 0, res.stderr
     assert ("soften step 4 " in res.stdout) == (keep < 4)
     compare(full, partial)
+
+
+@pytest.mark.xfail(strict=True, reason="open (issue 35): in the softened case with the stick predictor "
+                   "(26 stick predictions, most in step 1), a restart after step 1 or 2 differs from "
+                   "the uninterrupted run at the Newton tolerance (u by 1.8e-9 at step 3); after step 3, "
+                   "4 or 5 it is equal. Not the kept LU analyses (forcing fresh ones after each "
+                   "prediction changed nothing); the state the predictor leaves is not found yet")
+def test_restart_after_stick_predictions(run, tmp_path: Path) -> None:
+    res = run(softened_case(tmp_path, stick_predictor=True), "--quiet")
+    assert res.returncode == 0, res.stderr
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    partial = tmp_path / "partial.h5"
+    shutil.copy(full, partial)
+    truncate(partial, 2)
+    res = run("--restart", partial, "--quiet")
+    assert res.returncode == 0, res.stderr
+    compare(full, partial)
+
+
+IRONING = """&case
+  title = 'restart ironing', geometry = 'geometry.h5', output = 'run.h5', n_bodies = 2
+/
+&body
+  name = 'die', material = 'neo-hookean', youngs_modulus = 10.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 6, nel_eta = 1, contact_edge = 'outer',
+  layer_degree = 2, layer_elevations = 2
+/
+&body
+  name = 'slab', material = 'neo-hookean', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, nel_xi = 8, nel_eta = 2, contact_edge = 'top',
+  layer_degree = 2, layer_elevations = 2
+/
+&solver
+  n_steps = 3, 6
+/
+&dirichlet
+  body = 'die', edge = 'inner', fix_x = .true., fix_y = .true., ux = 0.0, 0.6, uy = -0.3, -0.3
+/
+&dirichlet
+  body = 'slab', edge = 'bottom', fix_x = .true., fix_y = .true.
+/
+&contact
+  slave = 'die', master = 'slab', penalty_normal = 100.0, penalty_tangent = 100.0, friction = 0.3,
+  method = 'segment'
+/
+"""
+
+
+@pytest.mark.parametrize("keep", [2, 5])
+def test_restart_segment_points(run, tmp_path: Path, keep: int) -> None:
+    """The segment method's points are state: made at every converged state where the
+    slab's knots project onto the die, so their number changes as the die slides (55
+    points, then 60); each step writes them (history point_xi, point_w, point_element)
+    and a restart continues on those of the last written step. To round-off, as the
+    mortar pair here: the LU's analysis drops the entries that are zero at its first
+    factorization, so the restarted run (analysed at step keep + 1) can order the
+    factorization otherwise (1e-15 apart; with the structural pattern analysed, both
+    methods reproduce the run to the bit)."""
+    shutil.copy(REPO / "cases" / "ironing" / "geometry.h5", tmp_path / "geometry.h5")
+    case = tmp_path / "case.nml"
+    case.write_text(IRONING)
+    res = run(case, "--quiet")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "run.h5") as f:
+        counts = {k: g["contact/1/xi_slave"].shape[0] for k, g in f["steps"].items()}
+        last = f["steps"][max(f["steps"], key=int)]["contact/1"]
+        np.testing.assert_array_equal(last["history/point_xi"][()], last["xi_slave"][()])
+    assert len(set(counts.values())) > 1, counts
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    partial = tmp_path / "partial.h5"
+    shutil.copy(full, partial)
+    truncate(partial, keep)
+    res = run("--restart", partial, "--quiet")
+    assert res.returncode == 0, res.stderr
+    compare(full, partial)
+    with h5py.File(full) as a, h5py.File(partial) as b:
+        for k in a["steps"]:
+            np.testing.assert_allclose(b[f"steps/{k}/contact/1/xi_slave"][()], a[f"steps/{k}/contact/1/xi_slave"][()],
+                                       rtol=0, atol=1e-12, err_msg=k)
 
 
 def test_restart_after_kill9(voiga_bin: Path, tmp_path: Path) -> None:

@@ -69,7 +69,9 @@ def test_the_tutorial_runs_as_written(voiga_bin: Path, tmp_path: Path) -> None:
         c = step.contact[0]
         assert c.active.any() and np.all(c.state[c.active] == 2)  # every point slips
         ratio = -c.force[0] / c.force[1]  # (the block is pushed down and dragged right)
-        assert 0.19 < ratio <= 0.2 + 1e-9, (step.step, ratio)
+        # measured 0.191-0.206 (segment, the default; gpts 0.197-0.200): mu = 0.2 at every
+        # point, the resultant tilted by the curved surface
+        assert 0.19 < ratio < 0.21, (step.step, ratio)
         # the contact force on the block is the reaction the ring's driven edge carries
         np.testing.assert_allclose(c.force, step.reactions[k_ring], rtol=1e-6, atol=1e-10)
     # the ring moved 2.0 to the right: its contact zone is centred near x = 1.5 + 2.0

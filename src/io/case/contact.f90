@@ -7,7 +7,7 @@ module voiga_io_case_contact
     use voiga_io_case_values, only: check_length, unset, is_unset, max_value, max_phases, body_index, quoted, &
         phase_values
     use voiga_model_body, only: body_settings_t
-    use voiga_contact_factory, only: contact_settings_t, contact_method_names
+    use voiga_contact_factory, only: contact_settings_t, contact_method_names, default_method
     use voiga_contact_alm, only: default_alm_tolerance
     implicit none
     private
@@ -30,8 +30,8 @@ contains
         ! one character more than kept: a longer value is refused, not cut
         character(len=33) :: slave, master, rigid_curve
         character(len=17) :: method
-        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, friction, tolerance
-        real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases)
+        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, tolerance
+        real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases), friction(max_phases)
         integer :: n_gauss, ios
         logical :: allow_overlap
         character(len=512) :: msg
@@ -44,9 +44,9 @@ contains
         rigid_normal = [0.0_dp, 1.0_dp]
         penalty_normal = unset()
         penalty_tangent = unset()
-        friction = 0.0_dp
+        friction = unset()
         n_gauss = 0
-        method = 'gpts'
+        method = ''
         tolerance = default_alm_tolerance
         rigid_curve = ''
         rigid_ux = unset()
@@ -65,11 +65,15 @@ contains
         if (allocated(error)) return
         entry = contact_settings_t(slave=slave, master=master, rigid_point=rigid_point, rigid_normal=rigid_normal, &
                                    rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
-                                   penalty_tangent=penalty_tangent, friction=friction, n_gauss=n_gauss, &
+                                   penalty_tangent=penalty_tangent, n_gauss=n_gauss, &
                                    method=method, tolerance=tolerance, allow_overlap=allow_overlap)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        call take_friction(friction, nph, path//trim(msg)//' ', entry, error)
+        if (allocated(error)) return
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
+        ! none named: the default for the kind of master
+        if (len_trim(entry%method) == 0) entry%method = default_method(trim(entry%master) == 'rigid')
         call check_law(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
@@ -84,6 +88,40 @@ contains
             read (text, nml=contact, iostat=ios, iomsg=msg)
         end subroutine try_contact
     end subroutine read_contact
+
+    !> `friction`: one coefficient for every phase, or one per load phase (constant
+    !> within a phase: a normal preload without friction, then sliding with it); none
+    !> given: 0. Each finite and >= 0. Sets `friction` (the largest) and, when the
+    !> phases differ, `friction_phases`.
+    subroutine take_friction(raw, nph, where, c, error)
+        real(dp), intent(in) :: raw(:)
+        integer, intent(in) :: nph
+        character(len=*), intent(in) :: where
+        type(contact_settings_t), intent(inout) :: c
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: values(:)
+        integer :: n
+        character(len=128) :: msg
+        n = count(.not. is_unset(raw))
+        if (n == 0) return
+        if (any(is_unset(raw(1:n))) .or. (n /= 1 .and. n /= nph)) then
+            write (msg, '(a,i0,a)') 'friction needs one value, or one per load phase (', nph, &
+                ' phases in &solver n_steps)'
+            call fatal_error(error, where//trim(msg), error_code%input)
+            return
+        end if
+        values = raw(1:n)
+        if (.not. all(ieee_is_finite(values))) then
+            call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
+            return
+        end if
+        if (any(values < 0.0_dp)) then
+            call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
+            return
+        end if
+        c%friction = maxval(values)
+        if (any(values /= values(1))) c%friction_phases = values
+    end subroutine take_friction
 
     !> The slave and master are bodies of the case with a contact edge (or the
     !> master is a valid rigid line, or a rigid curve).
@@ -158,8 +196,6 @@ contains
         if (given_not_positive(c%penalty_normal)) then
             call fatal_error(error, where//'penalty_normal must be finite and > 0 (or not given: automatic)', &
                              error_code%input)
-        else if (.not. (c%friction >= 0.0_dp .and. ieee_is_finite(c%friction))) then
-            call fatal_error(error, where//'friction must be finite and >= 0', error_code%input)
         else if (c%friction > 0.0_dp .and. given_not_positive(c%penalty_tangent)) then
             call fatal_error(error, where//'penalty_tangent must be finite and > 0 (or not given)', &
                              error_code%input)

@@ -34,12 +34,12 @@ contains
         integer :: first_read(max_phases)
         logical :: given(max_phases)
         real(dp) :: tol_residual, tol_energy, min_step_fraction
-        logical :: predictor
+        logical :: predictor, stick_predictor
         ! one character more than kept: a longer value is refused, not cut
         character(len=17) :: linear_solver, damping
         character(len=512) :: msg
         namelist /solver/ n_steps, max_iterations, tol_residual, tol_energy, n_gauss, &
-            min_step_fraction, max_cuts, grow_iterations, predictor, linear_solver, damping, &
+            min_step_fraction, max_cuts, grow_iterations, predictor, stick_predictor, linear_solver, damping, &
             max_stalled_iterations
 
         max_iterations = entry%max_iterations
@@ -51,6 +51,7 @@ contains
         grow_iterations = entry%grow_iterations
         max_stalled_iterations = entry%max_stalled_iterations
         predictor = entry%predictor
+        stick_predictor = entry%stick_predictor
         linear_solver = entry%linear_solver
         damping = entry%damping
         ! the entries of n_steps the group sets are those two reads with different
@@ -85,6 +86,7 @@ contains
         entry%grow_iterations = grow_iterations
         entry%max_stalled_iterations = max_stalled_iterations
         entry%predictor = predictor
+        entry%stick_predictor = stick_predictor
         entry%max_iterations = max_iterations
         entry%tol_residual = tol_residual
         entry%tol_energy = tol_energy
