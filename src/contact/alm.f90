@@ -187,6 +187,10 @@ contains
         class(alm_pair_t), intent(inout) :: self
         call self%mortar_pair_t%commit()
         self%lambda_last = self%lambda
+        ! the tangential multipliers go on from the committed tractions, as after a
+        ! retry (`reset_trial`) or a restart (`set_history`): the run does not depend on
+        ! whether it was interrupted (at convergence they agree to the tolerance)
+        if (allocated(self%tau)) self%tau = self%traction
     end subroutine alm_commit
 
     !> A step is retried: back to the multipliers of the last converged state.
