@@ -47,6 +47,9 @@ module voiga_solver_linear
         procedure :: level_dofs => linear_level_dofs
         !> Symbolic analyses and numeric factorizations so far (0 for an iterative solver).
         procedure :: factorizations => linear_factorizations
+        !> At the next `factor`, keep what was analysed before only if it was made for
+        !> exactly that matrix's nonzeros (default: nothing is kept, nothing to do).
+        procedure :: renew_analysis => linear_renew_analysis
     end type linear_solver_t
 
     abstract interface
@@ -139,5 +142,9 @@ contains
         symbolic = 0
         numeric = 0
     end subroutine linear_factorizations
+
+    pure subroutine linear_renew_analysis(self)
+        class(linear_solver_t), intent(inout) :: self
+    end subroutine linear_renew_analysis
 
 end module voiga_solver_linear

@@ -485,6 +485,8 @@ contains
 
         tic = wall_seconds()
         call self%k%fix_dofs(model%fixed)
+        ! a substep's first tangent: its analysis depends on this matrix only (restarts)
+        if (st%it == 0 .and. st%nls == 0) call self%linear%renew_analysis()
         call self%linear%factor(self%k, error)
         if (.not. allocated(error) .and. self%linear%has_determinant()) then
             ! the orientation of the tangent (O(n) from the factors): a sign

@@ -55,6 +55,7 @@ contains
         if (allocated(error)) return
         tic = wall_seconds()
         call self%k%fix_dofs(model%fixed)
+        call self%linear%renew_analysis()
         call self%linear%factor(self%k, error)
         rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
         if (allocated(error)) return

@@ -69,6 +69,10 @@ module voiga_solver_supernodal
         !> The last factorization is UMFPACK's; every one is (the pattern is not taken).
         logical, private :: on_umfpack = .false., umfpack_only = .false.
         logical, private :: factored = .false.
+        !> The next factorization keeps the analysis only for the same nonzeros
+        !> (`renew_analysis`); the nonzeros analysed (lower triangle, CSC, 0-based).
+        logical, private :: renew = .false.
+        integer(c_int), allocatable, private :: an_col(:), an_row(:)
         !> The CSC pattern the maps were made for, and the position of each entry's
         !> transpose in it (1-based) [nnz].
         integer, private :: n = 0
@@ -109,6 +113,7 @@ module voiga_solver_supernodal
         procedure :: determinant => sn_determinant
         procedure :: has_determinant => sn_has_determinant
         procedure :: factorizations => sn_factorizations
+        procedure :: renew_analysis => sn_renew_analysis
     end type supernodal_lu_t
 
     interface
@@ -167,6 +172,10 @@ contains
         new_pattern = .not. same_csc(self, a)
         if (new_pattern) call take_pattern(self, a)
         ok = .not. self%umfpack_only
+        if (ok .and. self%renew .and. self%nsuper > 0) then
+            if (.not. same_nonzeros(self, a)) self%nsuper = 0
+        end if
+        self%renew = .false.
         if (ok .and. self%nsuper == 0) then
             call analyse(self, a, ok)
         else if (ok) then
@@ -191,6 +200,56 @@ contains
         self%n_numeric = self%n_numeric + 1
         self%factored = .true.
     end subroutine sn_factor
+
+    !> Keep the analysis at the next factorization only if it was made for the same
+    !> nonzeros: the analysis kept otherwise depends on the nonzeros of the matrices
+    !> before (a stick predictor's, contact states of earlier steps), while a
+    !> restarted run analyses the matrix it starts with; called at the start of each
+    !> substep, it makes the order of elimination, and so the round-off, depend on
+    !> that substep's matrix only, and a restart reproduces the run bit for bit.
+    pure subroutine sn_renew_analysis(self)
+        class(supernodal_lu_t), intent(inout) :: self
+        self%renew = .true.
+    end subroutine sn_renew_analysis
+
+    !> The nonzeros of `a`'s lower triangle (diagonal always; an off-diagonal pair
+    !> where either of a(i, j), a(j, i) is nonzero), CSC with 0-based rows: what the
+    !> analysis orders.
+    pure subroutine nonzero_pattern(self, a, lcol, lrow)
+        class(supernodal_lu_t), intent(in) :: self
+        type(csc_matrix_t), intent(in) :: a
+        integer(c_int), allocatable, intent(out) :: lcol(:), lrow(:)
+        integer :: i, j, p, q
+        allocate (lcol(a%n + 1), lrow(size(a%rowind)))
+        q = 0
+        do j = 1, a%n
+            lcol(j) = int(q, c_int)
+            do p = a%colptr(j) + 1, a%colptr(j + 1)
+                i = a%rowind(p) + 1
+                if (i < j) cycle
+                if (i /= j .and. a%values(p) == 0.0_dp .and. a%values(self%tpos(p)) == 0.0_dp) cycle
+                q = q + 1
+                lrow(q) = int(i - 1, c_int)
+            end do
+        end do
+        lcol(a%n + 1) = int(q, c_int)
+    end subroutine nonzero_pattern
+
+    !> Whether `a`'s nonzeros are those the analysis was made for.
+    pure logical function same_nonzeros(self, a)
+        class(supernodal_lu_t), intent(in) :: self
+        type(csc_matrix_t), intent(in) :: a
+        integer(c_int), allocatable :: lcol(:), lrow(:)
+        integer :: q
+        same_nonzeros = .false.
+        if (.not. (allocated(self%an_col) .and. allocated(self%an_row))) return
+        call nonzero_pattern(self, a, lcol, lrow)
+        if (size(lcol) /= size(self%an_col)) return
+        if (any(lcol /= self%an_col)) return
+        q = int(lcol(size(lcol)))
+        if (q > size(self%an_row)) return
+        same_nonzeros = all(lrow(:q) == self%an_row(:q))
+    end function same_nonzeros
 
     !> Whether `a` has the CSC pattern the maps were made for.
     pure logical function same_csc(self, a)
@@ -275,22 +334,12 @@ contains
         integer(c_int), allocatable :: lcol(:), lrow(:)
         type(c_ptr) :: handle
         integer(c_int) :: ns, nr, status
-        integer :: i, j, p, q
+        integer :: j
         integer(i8) :: storage
 
-        allocate (lcol(a%n + 1), lrow(size(a%rowind)))
-        q = 0
-        do j = 1, a%n
-            lcol(j) = int(q, c_int)
-            do p = a%colptr(j) + 1, a%colptr(j + 1)
-                i = a%rowind(p) + 1
-                if (i < j) cycle
-                if (i /= j .and. a%values(p) == 0.0_dp .and. a%values(self%tpos(p)) == 0.0_dp) cycle
-                q = q + 1
-                lrow(q) = int(i - 1, c_int)
-            end do
-        end do
-        lcol(a%n + 1) = int(q, c_int)
+        call nonzero_pattern(self, a, lcol, lrow)
+        self%an_col = lcol
+        self%an_row = lrow
         handle = c_null_ptr
         status = voiga_supernodal_analyze(int(a%n, c_int), lcol, lrow, handle, ns, nr)
         ok = status == 0

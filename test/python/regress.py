@@ -25,7 +25,13 @@ development machine. Against a baseline made there just before by the binary of 
 before it (b96b3f6), the 40 frictionless runs (every hertz case, nu-0.49-hertz,
 penalty-1e6-mu0, penalty-hertz-1e9, apart-hertz) agree to 1e-10 and all 101 frictional
 ones differ (step 1 already: where a point's slip starts, and the stick predictor's start;
-mu-1.0-deep and penalty-1e5 now converge). Runs with stiff penalties, ironing-deep,
+mu-1.0-deep and penalty-1e5 now converge). Then rewritten for 17 runs: alm-1e4/1e5/1e6
+(alm's tangential multipliers at a commit: at most 2.9e-9 relative, every count equal),
+and the 14 runs that changed when a substep's first LU factorization began to keep an
+analysis only for the same nonzeros (the stiff-penalty hard cases, penalty-1e6-mu0,
+ironing-deep m1-NN6, m3-NN2.3, m4-NN6, ratio-1e3-rings, slide-off, alm-1e6: a cut or
+the last iterations moved with the order of elimination; all converge; the other 127
+runs equal). Runs with stiff penalties, ironing-deep,
 nu-0.49 and ratio-1e3-rings, where a cut or the last Newton iteration changes with the
 order of floating-point sums, are reproducible on one machine and binary, not to 1e-10
 across BLAS kernels or CPUs (with OpenBLAS's Haswell kernels,
