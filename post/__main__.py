@@ -249,13 +249,15 @@ def _positive(text: str) -> float:
 
 
 def _at_least_one(text: str) -> int:
-    """``--repeats``: a whole number, at least 1."""
+    """``--repeats``: a whole number, at least 1 and at most ``MAX_REPEATS``."""
+    from .cost import MAX_REPEATS
+
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be at least 1")
+    if not 1 <= value <= MAX_REPEATS:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be at least 1 and at most {MAX_REPEATS}")
     return value
 
 

@@ -89,6 +89,10 @@ class RepeatPolicy:
         return len(samples) < self.min_repeats or sum(s.cpu for s in samples) < self.budget_s
 
 
+MAX_REPEATS = 100
+"""The most runs a study may ask of each short case (``repeats``, ``--repeats``): more
+tell nothing new and only take the machine."""
+
 ONCE = RepeatPolicy(short_s=0.0)
 """Every run once."""
 

@@ -47,13 +47,14 @@ def voiga_binary(explicit: str | Path | None = None) -> Path:
         path = Path(explicit)
         if not _runnable(path):
             raise InputError(f"no voiga program at {path} (--binary): not an executable file")
-        return path
+        # absolute: the cases run in their own folders
+        return path.absolute()
     if os.environ.get("VOIGA_BIN"):
         path = Path(os.environ["VOIGA_BIN"])
         if not _runnable(path):
             raise InputError(f"no voiga program at {path} (VOIGA_BIN): not an executable file "
                              "(unset VOIGA_BIN to use voiga on the PATH)")
-        return path
+        return path.absolute()
     found = shutil.which("voiga")
     if found:
         return Path(found)

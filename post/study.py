@@ -27,7 +27,7 @@ import f90nml
 
 from pre.namelists import NAMELISTS
 
-from .cost import ONCE, RepeatPolicy
+from .cost import MAX_REPEATS, ONCE, RepeatPolicy
 from .measures import parse_file_measure
 from .sweep import REPO, SUMMARY_COLUMNS, Run, find_cases
 
@@ -420,8 +420,10 @@ def load_study(path: Path, out: Path | None = None) -> Study:
             raise StudyError(f"{where}: timeout {problem}")
         study.timeout = float(data["timeout"])
     if "repeats" in data:
-        if not isinstance(data["repeats"], int) or isinstance(data["repeats"], bool) or data["repeats"] < 1:
-            raise StudyError(f"{where}: repeats must be a whole number of runs, at least 1")
+        if not isinstance(data["repeats"], int) or isinstance(data["repeats"], bool) or \
+                not 1 <= data["repeats"] <= MAX_REPEATS:
+            raise StudyError(f"{where}: repeats must be a whole number of runs, at least 1 and at most "
+                             f"{MAX_REPEATS}")
         study.repeats = data["repeats"]
     if "repeat_below" in data:
         below = data["repeat_below"]

@@ -98,6 +98,7 @@ def test_long_case_names_are_hashed() -> None:
     ('base = "{hertz}"\n[grid\n', "not a TOML file"),
     ('base = "{hertz}"\nrepeats = 0\n', "repeats must be a whole number of runs, at least 1"),
     ('base = "{hertz}"\nrepeats = 2.5\n', "repeats must be a whole number of runs, at least 1"),
+    ('base = "{hertz}"\nrepeats = 101\n', "at least 1 and at most 100"),
     ('base = "{hertz}"\nrepeat_below = -1\n', "repeat_below must be a positive number"),
     ('base = "{hertz}"\nrepeats = true\n', "repeats must be a whole number of runs, at least 1"),
     ('base = "{hertz}"\nrepeat_below = nan\n', "repeat_below must be a positive number"),
@@ -119,10 +120,11 @@ def test_bad_study_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.Capture
     assert err.count("\n") == 1 and cause in err and "Traceback" not in err, err
 
 
-def test_repeats_must_be_at_least_one(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+@pytest.mark.parametrize("n", ["0", "101"])
+def test_repeats_must_be_from_one_to_a_hundred(capsys: pytest.CaptureFixture[str], n: str) -> None:
     with pytest.raises(SystemExit) as stop:
-        main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--list", "--repeats", "0"])
-    assert stop.value.code == 2 and "'0': must be at least 1" in capsys.readouterr().err
+        main(["study", str(REPO / "cases" / "studies" / "friction.toml"), "--list", "--repeats", n])
+    assert stop.value.code == 2 and f"'{n}': must be at least 1 and at most 100" in capsys.readouterr().err
 
 
 def test_malformed_scheduler_address(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -203,6 +205,19 @@ def test_file_measures(stretch_h5: Path) -> None:
     assert parse_file_measure("absmax(steps/last/contact/1/p_t)") == ("absmax", "steps/last/contact/1/p_t", ())
     with pytest.raises(ValueError):
         parse_file_measure("steps/last/x[a]")
+
+
+def test_relative_binary(voiga: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--binary bin/voiga`` is relative to where post is run, not to each case's own
+    folder, where the cases run (before, every case failed: FileNotFoundError)."""
+    (tmp_path / "bin").mkdir()
+    (tmp_path / "bin" / "voiga").symlink_to(voiga)
+    study = write_study(tmp_path, 'base = "{hertz}"\n[grid]\ncontact.friction = [0.0]\n')
+    monkeypatch.chdir(tmp_path)
+    code = main(["study", str(study), "--out", "out", "--binary", "bin/voiga", "--no-progress", "--no-figures"])
+    assert code == 0
+    rows = list(csv.DictReader((tmp_path / "out" / "summary.csv").open()))
+    assert [r["status"] for r in rows] == ["converged"]
 
 
 def test_friction_study(voiga: Path, tmp_path: Path) -> None:
