@@ -30,6 +30,7 @@ file that is not a readable result is refused in one line (exit code 2).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 from typing import TYPE_CHECKING
@@ -578,6 +579,11 @@ def main(argv: list[str] | None = None) -> int:
     except (InputError, FileNotFoundError) as err:
         print(f"python -m post {args.command}: {err}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # whoever read the output has stopped (`... | head`): nothing to say; what was
+        # written stays; stdout to /dev/null so that the exit's flush does not fail too
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except OSError as err:  # h5py: not an HDF5 file, truncated, ...
         print(f"python -m post {args.command}: {getattr(args, 'result', '')}: {err}",
               file=sys.stderr)

@@ -246,3 +246,23 @@ def test_friction_study(voiga: Path, tmp_path: Path) -> None:
     table = pq.read_table(out / "summary.parquet")
     assert table.column("contact.friction").to_pylist() == [0.0, 0.1, 0.3, 0.5]
     assert table.column("mean_px").to_pylist() == pytest.approx(list(px), rel=1e-15)
+
+
+def test_output_closed_by_its_reader(tmp_path: Path) -> None:
+    """``post study --list | head -1``: the reader has gone before post writes; post
+    stops quietly (exit 141, as a process ended by SIGPIPE; before: a garbled
+    "[Errno 32] Broken pipe" line on stderr)."""
+    import subprocess
+    import sys
+
+    read, write = os.pipe()
+    os.close(read)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    try:
+        proc = subprocess.run([sys.executable, "-m", "post", "study", str(REPO / "cases" / "studies" / "paper.toml"),
+                               "--list"], stdout=write, stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env,
+                              timeout=120)
+    finally:
+        os.close(write)
+    assert proc.returncode == 141, proc.stderr
+    assert proc.stderr == "", proc.stderr
