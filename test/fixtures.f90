@@ -12,9 +12,11 @@ module voiga_test_fixtures
     use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_solver_settings, only: solver_settings_t
+    use voiga_contact_mortar, only: mortar_pair_t
     implicit none
     private
 
+    public :: mortar_history
     public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model, body_settings
 
     !> The settings of a test scene, as a case file would give them.
@@ -174,5 +176,23 @@ contains
         s%w = 1.0_dp
         s%edge_names = [character(len=32) :: 'left', 'right', 'bottom', 'top']
     end function rectangle
+
+    !> A mortar-type pair's committed history for a tangent check: every point in
+    !> contact at the last converged state, projected `shift` before its projection now,
+    !> no committed tractions; with `touch`, every control point open then at mean gap
+    !> `touch` (it touched in this step).
+    subroutine mortar_history(pair, shift, touch)
+        class(mortar_pair_t), intent(inout) :: pair
+        real(dp), intent(in) :: shift
+        real(dp), intent(in), optional :: touch
+        pair%active_last = .true.
+        pair%xi_last = pair%out%xi_m - shift
+        pair%traction = 0.0_dp
+        pair%node_active = .true.
+        if (present(touch)) then
+            pair%node_active = .false.
+            pair%node_gap = touch
+        end if
+    end subroutine mortar_history
 
 end module voiga_test_fixtures

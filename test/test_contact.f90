@@ -23,7 +23,7 @@ module test_contact
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model, &
-                                   body_settings
+                                   body_settings, mortar_history
     implicit none
     private
 
@@ -240,14 +240,7 @@ contains
                         pair%gap_last = touch
                     end if
                 type is (mortar_pair_t)
-                    pair%active_last = .true.
-                    pair%xi_last = pair%out%xi_m - anchor_shift
-                    pair%traction = 0.0_dp
-                    pair%node_active = .true.
-                    if (present(touch)) then
-                        pair%node_active = .false.
-                        pair%node_gap = touch
-                    end if
+                    call mortar_history(pair, anchor_shift, touch)
                 end select
                 deallocate (r)
             end if

@@ -17,7 +17,7 @@ module test_segment
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
-    use voiga_test_fixtures, only: paper_layout, rectangle, scene_t, body_settings
+    use voiga_test_fixtures, only: paper_layout, rectangle, scene_t, body_settings, mortar_history
     use test_contact, only: two_body_model, penetrating_state, contact_fd, bc, build_model, ironing_quadratic, &
                             block_on_plane
     implicit none
@@ -201,14 +201,7 @@ contains
             if (mu > 0.0_dp) then
                 select type (pair => model%pairs(1)%pair)
                 class is (mortar_pair_t)
-                    pair%active_last = .true.
-                    pair%xi_last = pair%out%xi_m - shift
-                    pair%traction = 0.0_dp
-                    pair%node_active = .true.
-                    if (present(touch)) then
-                        pair%node_active = .false.
-                        pair%node_gap = touch
-                    end if
+                    call mortar_history(pair, shift, touch)
                 end select
             end if
             call contact_fd(model%pairs(1)%pair, u, want_state, 'segment '//trim(layouts(il))// &

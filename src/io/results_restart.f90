@@ -122,11 +122,13 @@ contains
             ! reallocates the array)
             if (allocated(history(i)%values)) then
                 most = size(history(i)%values, kind=int64)
-                if (history(i)%most >= 0) most = history(i)%most
-                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error, most)
             else
                 most = size(history(i)%flags, kind=int64)
-                if (history(i)%most >= 0) most = history(i)%most
+            end if
+            if (history(i)%most >= 0) most = history(i)%most
+            if (allocated(history(i)%values)) then
+                call h5%read(c//'/'//trim(history(i)%name), history(i)%values, error, most)
+            else
                 call h5%read(c//'/'//trim(history(i)%name), history(i)%flags, error, most)
             end if
             if (allocated(error)) return

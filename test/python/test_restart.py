@@ -64,6 +64,19 @@ def truncate(path: Path, keep: int) -> None:
         f.attrs["status"] = np.bytes_("interrupted")
 
 
+def restart_after(run, folder: Path, keep: int, *args: str):  # noqa: ANN001, ANN201
+    """The finished run's `run.h5` kept as `full.h5`; a copy cut after `keep` steps
+    (`partial.h5`) continued with --restart (exit 0 asserted). (full, partial, the
+    restart's process)."""
+    full, partial = folder / "full.h5", folder / "partial.h5"
+    shutil.copy(folder / "run.h5", full)
+    shutil.copy(full, partial)
+    truncate(partial, keep)
+    res = run("--restart", partial, *args)
+    assert res.returncode == 0, res.stderr
+    return full, partial, res
+
+
 def compare(a: Path, b: Path) -> None:
     sa, sb = steps(a), steps(b)
     assert sa.keys() == sb.keys()
@@ -87,13 +100,8 @@ def test_restart_reproduces_uninterrupted_run(run, tmp_path: Path, keep: int, me
         assert ("anchor" in history) == (method == "gpts")
         if method != "gpts":          # the slab slides: its control points carry mu p_A
             assert np.abs(history["traction"][()]).max() > 0.0
-    full = tmp_path / "full.h5"
-    shutil.copy(tmp_path / "run.h5", full)
-    partial = tmp_path / "partial.h5"
-    shutil.copy(full, partial)
-    truncate(partial, keep)           # steps 1..keep; keep = 5 is in the sliding phase
-    res = run("--restart", partial, "--quiet")
-    assert res.returncode == 0, res.stderr
+    # steps 1..keep; keep = 5 is in the sliding phase
+    full, partial, _ = restart_after(run, tmp_path, keep, "--quiet")
     with h5py.File(partial) as f:
         assert f.attrs["status"] == b"converged" and f.attrs["n_steps_done"] == 9
     compare(full, partial)
@@ -121,16 +129,10 @@ def test_restart_keeps_softened_penalties(run, tmp_path: Path, keep: int) -> Non
     res = run(case)
     assert res.returncode == 0, res.stderr
     assert res.stdout.count("soften step 1 ") == 3 and res.stdout.count("soften step 4 ") == 2
-    full = tmp_path / "full.h5"
-    shutil.copy(tmp_path / "run.h5", full)
-    with h5py.File(full) as f:
+    with h5py.File(tmp_path / "run.h5") as f:
         used = [f[f"steps/{k}/contact/1"].attrs["penalty_normal"] for k in sorted(f["steps"])]
     assert used[0] == pytest.approx(1e3) and used[-1] < 100.0
-    partial = tmp_path / "partial.h5"
-    shutil.copy(full, partial)
-    truncate(partial, keep)
-    res = run("--restart", partial)
-    assert res.returncode == 0, res.stderr
+    full, partial, res = restart_after(run, tmp_path, keep)
     assert ("soften step 4 " in res.stdout) == (keep < 4)
     compare(full, partial)
 
@@ -147,14 +149,7 @@ def test_restart_after_stick_predictions(run, tmp_path: Path, keep: int) -> None
     the same nonzeros (`renew_analysis`)."""
     res = run(softened_case(tmp_path, stick_predictor=True), "--quiet")
     assert res.returncode == 0, res.stderr
-    full = tmp_path / "full.h5"
-    shutil.copy(tmp_path / "run.h5", full)
-    partial = tmp_path / "partial.h5"
-    shutil.copy(full, partial)
-    truncate(partial, keep)
-    res = run("--restart", partial, "--quiet")
-    assert res.returncode == 0, res.stderr
-    compare(full, partial)
+    compare(*restart_after(run, tmp_path, keep, "--quiet")[:2])
 
 
 IRONING = """&case
@@ -206,13 +201,7 @@ def test_restart_segment_points(run, tmp_path: Path, keep: int) -> None:
         last = f["steps"][max(f["steps"], key=int)]["contact/1"]
         np.testing.assert_array_equal(last["history/point_xi"][()], last["xi_slave"][()])
     assert len(set(counts.values())) > 1, counts
-    full = tmp_path / "full.h5"
-    shutil.copy(tmp_path / "run.h5", full)
-    partial = tmp_path / "partial.h5"
-    shutil.copy(full, partial)
-    truncate(partial, keep)
-    res = run("--restart", partial, "--quiet")
-    assert res.returncode == 0, res.stderr
+    full, partial, _ = restart_after(run, tmp_path, keep, "--quiet")
     compare(full, partial)
     with h5py.File(full) as a, h5py.File(partial) as b:
         for k in a["steps"]:

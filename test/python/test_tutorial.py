@@ -69,8 +69,10 @@ def test_the_tutorial_runs_as_written(voiga_bin: Path, tmp_path: Path) -> None:
         c = step.contact[0]
         assert c.active.any() and np.all(c.state[c.active] == 2)  # every point slips
         ratio = -c.force[0] / c.force[1]  # (the block is pushed down and dragged right)
-        # measured 0.191-0.206 (segment, the default; gpts 0.197-0.200): mu = 0.2 at every
-        # point, the resultant tilted by the curved surface
+        # Coulomb at every slipping point: |p_T| = mu p_N (measured to 3.5e-17)
+        np.testing.assert_allclose(np.abs(c.p_t[c.active]), 0.2 * c.p_n[c.active], rtol=0, atol=1e-12)
+        # the resultant: measured 0.191-0.206 (segment, the default; gpts 0.197-0.200),
+        # tilted from 0.2 by the curved surface (the pressure has a horizontal part)
         assert 0.19 < ratio < 0.21, (step.step, ratio)
         # the contact force on the block is the reaction the ring's driven edge carries
         np.testing.assert_allclose(c.force, step.reactions[k_ring], rtol=1e-6, atol=1e-10)
