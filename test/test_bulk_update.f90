@@ -1,5 +1,5 @@
 !> Linear bodies factorized once (`voiga_solver_bulk_update`, the kept stiffness of
-!> `voiga_model_assembly`): the update solves as a whole LU does, a linear contact
+!> `voiga_model_assembly_bulk`): the update solves as a whole LU does, a linear contact
 !> scene factorizes its bulk once per run and ends where the plain Newton path
 !> (every body integrated, every tangent factorized) ends, to 1e-10, for each
 !> contact method and with friction; a Neo-Hookean scene does not take the path,

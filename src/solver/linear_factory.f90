@@ -21,7 +21,7 @@ contains
     !> The linear solver `name` for the tangents of `model`: 'direct' (UMFPACK LU)
     !> or 'multigrid' (GMRES with the multigrid preconditioner, whose hierarchy of
     !> spaces is built here, once). With 'direct' and `bulk`, the bodies' stiffness
-    !> when every body is linear-elastic (`voiga_model_assembly%bulk_stiffness`), it is
+    !> when every body is linear-elastic (`voiga_model_assembly_bulk%bulk_stiffness`), it is
     !> factorized here, once, and every tangent solved as an update of it
     !> (`voiga_solver_bulk_update`).
     subroutine new_linear_solver(solver, name, model, error, bulk)
