@@ -185,13 +185,13 @@ contains
         class(mortar_pair_t), intent(inout) :: pair
         real(dp), intent(in) :: shift
         real(dp), intent(in), optional :: touch
-        pair%active_last = .true.
-        pair%xi_last = pair%out%xi_m - shift
-        pair%traction = 0.0_dp
-        pair%node_active = .true.
+        pair%hist%field(pair%h_active)%last = 1.0_dp
+        pair%hist%field(pair%h_xi)%last = pair%out%xi_m - shift
+        pair%hist%field(pair%h_traction)%last = 0.0_dp
+        pair%hist%field(pair%h_node_active)%last = 1.0_dp
         if (present(touch)) then
-            pair%node_active = .false.
-            pair%node_gap = touch
+            pair%hist%field(pair%h_node_active)%last = 0.0_dp
+            pair%hist%field(pair%h_node_gap)%last = touch
         end if
     end subroutine mortar_history
 

@@ -22,6 +22,7 @@ program voiga_tests
     use test_supernodal, only: collect_supernodal
     use test_newton, only: collect_newton
     use test_segment, only: collect_segment
+    use test_method, only: collect_method
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -46,7 +47,8 @@ program voiga_tests
              new_testsuite('bulk_update', collect_bulk_update), &
              new_testsuite('supernodal', collect_supernodal), &
              new_testsuite('newton', collect_newton), &
-             new_testsuite('segment', collect_segment) &
+             new_testsuite('segment', collect_segment), &
+             new_testsuite('method', collect_method) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

@@ -58,11 +58,13 @@ contains
             select type (pair => model%pairs(1)%pair)
             type is (alm_pair_t)
                 ! multipliers of the order of the penalty pressures, varying along the edge
-                pair%lambda = [(0.01_dp*(1.0_dp + 0.5_dp*sin(7.0_dp*j)), j=1, size(pair%lambda))]
+                associate (lambda => pair%hist%field(pair%h_lambda)%trial)
+                    lambda = [(0.01_dp*(1.0_dp + 0.5_dp*sin(7.0_dp*j)), j=1, size(lambda))]
+                end associate
                 if (mu > 0.0_dp) then
-                    pair%active_last = .true.
-                    pair%xi_last = pair%out%xi_m - shift
-                    pair%node_active = .true.
+                    pair%hist%field(pair%h_active)%last = 1.0_dp
+                    pair%hist%field(pair%h_xi)%last = pair%out%xi_m - shift
+                    pair%hist%field(pair%h_node_active)%last = 1.0_dp
                     pair%tau = 0.0_dp
                 end if
             end select

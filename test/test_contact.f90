@@ -231,13 +231,13 @@ contains
                 if (allocated(error)) return
                 select type (pair => model%pairs(1)%pair)
                 type is (gpts_pair_t)
-                    pair%active_last = .true.
-                    pair%anchor = pair%out%xi_m - anchor_shift
+                    pair%hist%field(pair%h_active)%last = 1.0_dp
+                    pair%hist%field(pair%h_anchor)%last = pair%out%xi_m - anchor_shift
                     if (present(tresca)) pair%slip_bound = tresca*mu*max(0.0_dp, pair%out%pn)
                     if (present(touch)) then
-                        pair%active_last = .false.
-                        pair%xi_last = pair%out%xi_m - anchor_shift
-                        pair%gap_last = touch
+                        pair%hist%field(pair%h_active)%last = 0.0_dp
+                        pair%hist%field(pair%h_xi)%last = pair%out%xi_m - anchor_shift
+                        pair%hist%field(pair%h_gap)%last = touch
                     end if
                 type is (mortar_pair_t)
                     call mortar_history(pair, anchor_shift, touch)
@@ -725,7 +725,7 @@ contains
                                       (pair%out(k)%xi_m - pair%out(k)%x0(1))) <= 1.0e-15_dp, &
                            'projection of a point below it on the plane')
                 if (allocated(error)) return
-                call check(error, abs(pair%out(k)%xi_m - pair%anchor(k)) <= limit, &
+                call check(error, abs(pair%out(k)%xi_m - pair%hist%field(pair%h_anchor)%last(k)) <= limit, &
                            'stick: no slip beyond the penalty compliance')
                 if (allocated(error)) return
             end do
@@ -753,14 +753,14 @@ contains
         call block_on_plane(0.0_dp, 0.0_dp, model, u, error, method=method)
         if (allocated(error)) return
         associate (pair => model%pairs(1)%pair)
-            call check(error, size(pair%history()) == 0 .and. .not. allocated(pair%xi_last), &
+            call check(error, size(pair%history()) == 0 .and. pair%h_xi == 0, &
                        method//': no friction history stored')
             if (allocated(error)) return
             select type (pair)
             type is (gpts_pair_t)
-                call check(error, .not. allocated(pair%anchor), method//': no anchors')
+                call check(error, pair%h_anchor == 0, method//': no anchors')
             type is (mortar_pair_t)
-                call check(error, .not. allocated(pair%traction), method//': no tractions')
+                call check(error, pair%h_traction == 0, method//': no tractions')
             end select
             if (allocated(error)) return
             call check(error, pair%n_friction == 0, method//': no friction evaluation')

@@ -34,12 +34,12 @@ module voiga_contact_alm
     use voiga_text, only: real_str
     use voiga_contact_law, only: control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_surface, only: element_lengths
-    use voiga_contact_pair, only: history_item_t, sparse_vector_t, constraint_set_t
+    use voiga_contact_pair, only: history_item_t, sparse_vector_t, constraint_set_t, automatic
     use voiga_contact_mortar, only: mortar_pair_t
     implicit none
     private
 
-    public :: alm_pair_t, default_alm_tolerance, softening_factor
+    public :: alm_pair_t, alm_pair, default_alm_tolerance, softening_factor
 
     !> Default constraint tolerance, relative to the slave element size: the mean
     !> weighted gap of an active control point and the mean weighted slip of a
@@ -52,9 +52,9 @@ module voiga_contact_alm
     type, extends(mortar_pair_t) :: alm_pair_t
         !> Constraint tolerance relative to the slave element size.
         real(dp) :: tolerance = default_alm_tolerance
-        !> Normal multipliers (nominal pressure) [slave edge control points]: the
-        !> current ones and those of the last converged state.
-        real(dp), allocatable :: lambda(:), lambda_last(:)
+        !> The index in `hist` of the normal multipliers (nominal pressure, `multiplier`)
+        !> [slave edge control points]: the trial values are the current ones.
+        integer :: h_lambda = 0
         !> Tangential multipliers (mu > 0) [slave edge control points]; the committed
         !> ones are the mortar pair's `traction`.
         real(dp), allocatable :: tau(:)
@@ -76,7 +76,6 @@ module voiga_contact_alm
         procedure :: setup_history => alm_setup_history
         procedure :: commit => alm_commit
         procedure :: reset_trial => alm_reset_trial
-        procedure :: history => alm_history
         procedure :: set_history => alm_set_history
         procedure :: has_multipliers => alm_has_multipliers
         procedure :: constraint_test => alm_constraint_test
@@ -86,6 +85,14 @@ module voiga_contact_alm
     end type alm_pair_t
 
 contains
+
+    !> An empty augmented Lagrangian pair with constraint tolerance `tolerance`
+    !> (`automatic`: `default_alm_tolerance`).
+    pure function alm_pair(tolerance) result(pair)
+        real(dp), intent(in) :: tolerance
+        type(alm_pair_t) :: pair
+        if (tolerance /= automatic) pair%tolerance = tolerance
+    end function alm_pair
 
     pure function alm_method_name(self) result(name)
         class(alm_pair_t), intent(in) :: self
@@ -108,12 +115,12 @@ contains
         self%d = d_a
         self%ds = ds_a
         do a = 1, size(g_a)
-            if (g_a(a) < huge(1.0_dp)) g_a(a) = g_a(a) - self%lambda(a)*d_a(a)/self%law%eps_n
+            if (g_a(a) < huge(1.0_dp)) g_a(a) = g_a(a) - self%hist%field(self%h_lambda)%trial(a)*d_a(a)/self%law%eps_n
             t_old = 0.0_dp
             if (allocated(self%tau)) t_old = self%tau(a)
             call control_point_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), &
                                    st_a(a), t_tr(a))
-            if (allocated(self%traction)) self%trial_traction(a) = t_a(a)
+            if (self%h_traction > 0) self%hist%field(self%h_traction)%trial(a) = t_a(a)
         end do
         self%state = st_a
         self%p_last = p_a
@@ -162,10 +169,9 @@ contains
         integer :: n, i
         call self%mortar_pair_t%setup_history()
         n = size(self%node_first)
-        allocate (self%lambda(n), self%lambda_last(n), self%g(n), self%d(n), self%ds(n), self%state(n), &
+        call self%hist%add('multiplier', n, self%h_lambda)
+        allocate (self%g(n), self%d(n), self%ds(n), self%state(n), &
                   self%p_last(n), self%t_last(n), self%v(n), self%m(n), self%q(n), self%h(n))
-        self%lambda = 0.0_dp
-        self%lambda_last = 0.0_dp
         self%g = huge(1.0_dp)
         self%d = 0.0_dp
         self%ds = 0.0_dp
@@ -182,53 +188,34 @@ contains
         end do
     end subroutine alm_setup_history
 
-    !> The step converged: the multipliers become the committed ones.
+    !> The step converged (the multipliers become the committed ones), a step is
+    !> retried, or the history is set (a restart): the tangential multipliers go on
+    !> from the committed tractions, so that a run does not depend on whether it was
+    !> interrupted (at convergence they agree to the tolerance).
     pure subroutine alm_commit(self)
         class(alm_pair_t), intent(inout) :: self
         call self%mortar_pair_t%commit()
-        self%lambda_last = self%lambda
-        ! the tangential multipliers go on from the committed tractions, as after a
-        ! retry (`reset_trial`) or a restart (`set_history`): the run does not depend on
-        ! whether it was interrupted (at convergence they agree to the tolerance)
-        if (allocated(self%tau)) self%tau = self%traction
+        call tau_from_traction(self)
     end subroutine alm_commit
 
-    !> A step is retried: back to the multipliers of the last converged state.
     pure subroutine alm_reset_trial(self)
         class(alm_pair_t), intent(inout) :: self
         call self%mortar_pair_t%reset_trial()
-        self%lambda = self%lambda_last
-        if (allocated(self%tau)) self%tau = self%traction
+        call tau_from_traction(self)
     end subroutine alm_reset_trial
-
-    !> `multiplier` (the committed normal multipliers), then the mortar pair's.
-    pure function alm_history(self) result(items)
-        class(alm_pair_t), intent(in) :: self
-        type(history_item_t), allocatable :: items(:)
-        type(history_item_t) :: multiplier
-        multiplier%name = 'multiplier'
-        multiplier%values = self%lambda_last
-        items = [multiplier, self%mortar_pair_t%history()]
-    end function alm_history
 
     pure subroutine alm_set_history(self, items, error)
         class(alm_pair_t), intent(inout) :: self
         type(history_item_t), intent(in) :: items(:)
         type(error_t), allocatable, intent(out) :: error
-        integer :: i
         call self%mortar_pair_t%set_history(items, error)
-        if (allocated(error)) return
-        do i = 1, size(items)
-            if (trim(items(i)%name) /= 'multiplier') cycle
-            if (size(items(i)%values) /= size(self%lambda_last)) then
-                call fatal_error(error, 'history multiplier: wrong length', error_code%input)
-                return
-            end if
-            self%lambda_last = items(i)%values
-        end do
-        self%lambda = self%lambda_last
-        if (allocated(self%tau)) self%tau = self%traction
+        call tau_from_traction(self)
     end subroutine alm_set_history
+
+    pure subroutine tau_from_traction(self)
+        class(alm_pair_t), intent(inout) :: self
+        if (allocated(self%tau)) self%tau = self%hist%field(self%h_traction)%last
+    end subroutine tau_from_traction
 
     pure logical function alm_has_multipliers(self)
         class(alm_pair_t), intent(in) :: self
@@ -244,7 +231,7 @@ contains
         real(dp), intent(out) :: residual
         integer :: a
         residual = 0.0_dp
-        do a = 1, size(self%lambda)
+        do a = 1, size(self%state)
             if (self%state(a) == state_inactive .or. self%h(a) <= 0.0_dp .or. self%d(a) <= 0.0_dp) cycle
             residual = max(residual, abs(self%g(a)/self%d(a))/self%h(a))
             if (allocated(self%tau) .and. self%law%mu > 0.0_dp .and. self%state(a) == state_stick) &
@@ -293,14 +280,16 @@ contains
         real(dp), intent(in) :: delta(:)
         integer :: a, j
         j = 0
-        do a = 1, size(self%state)
-            if (self%state(a) == state_inactive) then
-                self%lambda(a) = 0.0_dp
-            else
-                j = j + 1
-                self%lambda(a) = max(0.0_dp, self%lambda(a) + delta(j))
-            end if
-        end do
+        associate (lambda => self%hist%field(self%h_lambda)%trial)
+            do a = 1, size(self%state)
+                if (self%state(a) == state_inactive) then
+                    lambda(a) = 0.0_dp
+                else
+                    j = j + 1
+                    lambda(a) = max(0.0_dp, lambda(a) + delta(j))
+                end if
+            end do
+        end associate
         if (.not. allocated(self%tau)) return
         do a = 1, size(self%state)
             if (self%law%mu > 0.0_dp .and. self%state(a) == state_stick) then

@@ -1,19 +1,25 @@
-!> The contact methods by name (`&contact method`), and the settings of one
-!> contact pair as a case gives them (`&contact`; read by `voiga_io_case_contact`).
-!> A new method is a new extension of `contact_pair_t` plus one line here.
+!> The contact methods by name (`&contact method`), the settings of one contact
+!> pair as a case gives them (`&contact`; read by `voiga_io_case_contact`), and the
+!> one place a pair is built: its method, law (with the automatic penalty),
+!> quadrature, history and reference state, from the settings and the bodies the
+!> model gives. A new method is a new extension of `contact_pair_t` plus one line
+!> here (docs/theory.md, section 7, "Adding a contact method").
 module voiga_contact_factory
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_surface, only: contact_surface_t, element_lengths
+    use voiga_contact_master, only: contact_master_t
+    use voiga_contact_pair, only: contact_pair_t, automatic
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
-    use voiga_contact_alm, only: alm_pair_t, default_alm_tolerance
+    use voiga_contact_alm, only: alm_pair
     use voiga_contact_segment, only: segment_pair_t
     implicit none
     private
 
-    public :: contact_settings_t, contact_method_names, new_contact_pair, automatic_penalty, default_method
+    public :: contact_settings_t, contact_method_names, new_contact_pair, build_pair, automatic_penalty, &
+              default_method, automatic
 
     !> The automatic normal penalty is this multiple of E* q / h (`automatic_penalty`).
     real(dp), parameter :: penalty_factor = 10.0_dp
@@ -44,9 +50,10 @@ module voiga_contact_factory
         !> The rigid master's translation at the end of each load phase, shape
         !> [2, n_phases] (linear within a phase, zero at time 0); unallocated: fixed.
         real(dp), allocatable :: rigid_motion(:, :)
-        !> Penalties (0: automatic, `automatic_penalty`; penalty_tangent 0: the normal
-        !> one) and the friction coefficient (the largest, when it changes with the phase).
-        real(dp) :: penalty_normal = 0.0_dp, penalty_tangent = 0.0_dp, friction = 0.0_dp
+        !> Penalties (`automatic`: `automatic_penalty`, and the normal one for the
+        !> tangential one) and the friction coefficient (the largest, when it changes
+        !> with the phase).
+        real(dp) :: penalty_normal = automatic, penalty_tangent = automatic, friction = 0.0_dp
         !> The friction coefficient of each load phase [n_phases], when the case gives
         !> one per phase (unallocated: `friction` in every phase).
         real(dp), allocatable :: friction_phases(:)
@@ -55,8 +62,9 @@ module voiga_contact_factory
         integer :: n_gauss = 0
         !> One of `contact_method_names`.
         character(len=16) :: method = 'gpts'
-        !> Augmented Lagrangian: constraint tolerance relative to the slave element size.
-        real(dp) :: tolerance = default_alm_tolerance
+        !> Augmented Lagrangian: constraint tolerance relative to the slave element
+        !> size (`automatic`: the method's default).
+        real(dp) :: tolerance = automatic
         !> Run although most slave points start inside the master (an intended
         !> interference fit); else such a set-up is refused (`voiga_model_checks`).
         logical :: allow_overlap = .false.
@@ -75,9 +83,66 @@ contains
         end if
     end function default_method
 
-    !> An empty pair of the method `settings%method`, with the method's own
-    !> settings (its shared data is set by the caller, then `setup`).
-    subroutine new_contact_pair(pair, settings, error)
+    !> The pair `settings` describe between the contact edge `slave` of body
+    !> `bodies(1)` and `master` (of body `bodies(2)`, 0 for a rigid one), whose
+    !> plane-strain modulus is `e_star` (1/E* = sum over its deformable bodies of
+    !> (1 - nu^2)/E): its method's type with the method's own settings, its law
+    !> (the automatic penalty where the case gives none), its slave points and
+    !> history (`setup`), and its history started from the projections in the
+    !> reference configuration (`ndof` DOFs, all zero).
+    subroutine new_contact_pair(pair, settings, slave, master, bodies, e_star, ndof, error)
+        class(contact_pair_t), allocatable, intent(out) :: pair
+        type(contact_settings_t), intent(in) :: settings
+        type(contact_surface_t), intent(in) :: slave
+        class(contact_master_t), intent(in) :: master
+        integer, intent(in) :: bodies(2), ndof
+        real(dp), intent(in) :: e_star
+        type(error_t), allocatable, intent(out) :: error
+        call new_method(pair, settings, error)
+        if (allocated(error)) return
+        call build_pair(pair, settings, slave, master, bodies, e_star, ndof, error)
+    end subroutine new_contact_pair
+
+    !> Everything `new_contact_pair` does after choosing the method, on a pair of any
+    !> method (a test builds a method that is not in the factory with it).
+    subroutine build_pair(pair, settings, slave, master, bodies, e_star, ndof, error)
+        class(contact_pair_t), intent(inout) :: pair
+        type(contact_settings_t), intent(in) :: settings
+        type(contact_surface_t), intent(in) :: slave
+        class(contact_master_t), intent(in) :: master
+        integer, intent(in) :: bodies(2), ndof
+        real(dp), intent(in) :: e_star
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: u0(:), r0(:)
+        pair%slave_name = settings%slave
+        pair%master_name = settings%master
+        pair%slave_body = bodies(1)
+        pair%master_body = bodies(2)
+        pair%slave = slave
+        allocate (pair%master, source=master)
+        pair%eps_automatic = automatic_penalty(e_star, slave%degree, minval(element_lengths(slave)))
+        pair%law%eps_n = settings%penalty_normal
+        if (pair%law%eps_n == automatic) pair%law%eps_n = pair%eps_automatic
+        pair%law%eps_t = settings%penalty_tangent
+        if (pair%law%eps_t == automatic) pair%law%eps_t = pair%law%eps_n
+        ! the largest coefficient decides what friction history the pair keeps; the
+        ! one of the first phase holds from the start (the model's `set_contact_time`)
+        pair%law%mu = settings%friction
+        pair%n_gauss = settings%n_gauss
+        call pair%setup()
+        if (allocated(settings%friction_phases)) pair%law%mu = settings%friction_phases(1)
+        allocate (u0(ndof), r0(ndof))
+        u0 = 0.0_dp
+        r0 = 0.0_dp
+        call pair%evaluate(u0, r0, error)
+        if (allocated(error)) return
+        call pair%commit()
+        pair%n_evaluations = 0
+        pair%n_friction = 0
+    end subroutine build_pair
+
+    !> An empty pair of the method `settings%method`, with the method's own settings.
+    subroutine new_method(pair, settings, error)
         class(contact_pair_t), allocatable, intent(out) :: pair
         type(contact_settings_t), intent(in) :: settings
         type(error_t), allocatable, intent(out) :: error
@@ -87,13 +152,13 @@ contains
         case ('mortar')
             allocate (mortar_pair_t :: pair)
         case ('alm')
-            pair = alm_pair_t(tolerance=settings%tolerance)
+            pair = alm_pair(settings%tolerance)
         case ('segment')
             allocate (segment_pair_t :: pair)
         case default
             call fatal_error(error, "unknown contact method '"//trim(settings%method)//"'", error_code%input)
         end select
-    end subroutine new_contact_pair
+    end subroutine new_method
 
     !> The normal penalty used when the case gives none: `penalty_factor` E* q / h,
     !> with E* the plane-strain modulus of the pair (1/E* = sum over its deformable

@@ -19,8 +19,7 @@ module voiga_contact_gpts
     use voiga_contact_law, only: contact_law_t, state_inactive, state_stick, state_slip
     use voiga_contact_kinematics, only: point_operators
     use voiga_text, only: str, real_str
-    use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
-                                  pair_reset_trial, pair_history, pair_set_history
+    use voiga_contact_pair, only: contact_pair_t, add_matrix
     implicit none
     private
 
@@ -39,9 +38,9 @@ module voiga_contact_gpts
 
     !> A GPTS pair.
     type, extends(contact_pair_t) :: gpts_pair_t
-        !> Committed and trial stick anchors (master convective coordinate) [npts],
-        !> allocated only when mu > 0.
-        real(dp), allocatable :: anchor(:), trial_anchor(:)
+        !> The index in `hist` of the stick anchors (master convective coordinate)
+        !> [npts]; 0 without friction.
+        integer :: h_anchor = 0
         !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
         !> slave point is this prescribed traction instead of mu p_N (never committed).
         real(dp), allocatable :: slip_bound(:)
@@ -53,10 +52,6 @@ module voiga_contact_gpts
         procedure :: n_blocks => gpts_n_blocks
         procedure :: block_dofs => gpts_block_dofs
         procedure :: setup_history => gpts_setup_history
-        procedure :: commit => gpts_commit
-        procedure :: reset_trial => gpts_reset_trial
-        procedure :: history => gpts_history
-        procedure :: set_history => gpts_set_history
         procedure :: takes_outer => gpts_takes_outer
         procedure :: outer_capture => gpts_outer_capture
         procedure :: outer_apply => gpts_outer_apply
@@ -97,11 +92,11 @@ contains
         call self%master%prepare(u)
         do k = 1, size(self%xi)
             call self%project_point(u, k, sp, mp, found, converged)
-            if (allocated(self%anchor)) then
-                self%trial_xi(k) = mp%xi
-                self%trial_active(k) = .false.
-                self%trial_anchor(k) = mp%xi
-                self%trial_gap(k) = self%out(k)%gap
+            if (self%h_anchor > 0) then
+                self%hist%field(self%h_xi)%trial(k) = mp%xi
+                self%hist%field(self%h_active)%trial(k) = 0.0_dp
+                self%hist%field(self%h_anchor)%trial(k) = mp%xi
+                self%hist%field(self%h_gap)%trial(k) = self%out(k)%gap
             end if
             if (.not. found) cycle
             if (self%out(k)%gap >= self%gap_tol) cycle
@@ -114,12 +109,12 @@ contains
             anchor = mp%xi
             touch = .false.
             gap0 = huge(1.0_dp)
-            if (allocated(self%anchor)) then
+            if (self%h_anchor > 0) then
                 ! a point open at the last converged state touched in this step: its slip
                 ! counts from where its gap, interpolated linearly from there, vanished
-                anchor = merge(self%anchor(k), self%xi_last(k), self%active_last(k))
-                touch = .not. self%active_last(k)
-                gap0 = self%gap_last(k)
+                touch = self%hist%field(self%h_active)%last(k) == 0.0_dp
+                anchor = merge(self%hist%field(self%h_xi)%last(k), self%hist%field(self%h_anchor)%last(k), touch)
+                gap0 = self%hist%field(self%h_gap)%last(k)
                 self%n_friction = self%n_friction + 1
             end if
             nd = size(sp%dofs) + size(mp%dofs)
@@ -157,11 +152,11 @@ contains
             ! the point's traction acts per current length (da = |a_s| w)
             self%out(k)%pn0 = pn*self%out(k)%stretch
             self%out(k)%pt0 = pt*self%out(k)%stretch
-            if (allocated(self%anchor)) then
-                self%trial_active(k) = .true.
+            if (self%h_anchor > 0) then
+                self%hist%field(self%h_active)%trial(k) = 1.0_dp
                 ! frictionless (a phase without friction): the point slides freely
                 if (self%law%mu <= 0.0_dp) new_anchor = mp%xi
-                self%trial_anchor(k) = new_anchor
+                self%hist%field(self%h_anchor)%trial(k) = new_anchor
             end if
         end do
     end subroutine gpts_evaluate
@@ -185,57 +180,12 @@ contains
             dofs = [self%element_dofs(b), mdofs(2*self%mlo(b) - 1:2*self%mhi(b))]
     end function gpts_block_dofs
 
-    !> With friction: the shared history and a stick anchor per slave point.
+    !> With friction: a stick anchor per slave point (`anchor`).
     pure subroutine gpts_setup_history(self)
         class(gpts_pair_t), intent(inout) :: self
-        call pair_setup_history(self)
         if (self%law%mu <= 0.0_dp) return
-        allocate (self%anchor(size(self%xi)), self%trial_anchor(size(self%xi)))
-        self%anchor = 0.0_dp
-        self%trial_anchor = 0.0_dp
+        call self%hist%add('anchor', size(self%xi), self%h_anchor)
     end subroutine gpts_setup_history
-
-    pure subroutine gpts_commit(self)
-        class(gpts_pair_t), intent(inout) :: self
-        if (allocated(self%anchor)) self%anchor = self%trial_anchor
-        call pair_commit(self)
-    end subroutine gpts_commit
-
-    pure subroutine gpts_reset_trial(self)
-        class(gpts_pair_t), intent(inout) :: self
-        if (allocated(self%anchor)) self%trial_anchor = self%anchor
-        call pair_reset_trial(self)
-    end subroutine gpts_reset_trial
-
-    !> `anchor`, then the shared history (empty without friction).
-    pure function gpts_history(self) result(items)
-        class(gpts_pair_t), intent(in) :: self
-        type(history_item_t), allocatable :: items(:)
-        type(history_item_t) :: anchor
-        items = pair_history(self)
-        if (.not. allocated(self%anchor)) return
-        anchor%name = 'anchor'
-        anchor%values = self%anchor
-        items = [anchor, items]
-    end function gpts_history
-
-    pure subroutine gpts_set_history(self, items, error)
-        class(gpts_pair_t), intent(inout) :: self
-        type(history_item_t), intent(in) :: items(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        call pair_set_history(self, items, error)
-        if (allocated(error) .or. .not. allocated(self%anchor)) return
-        do i = 1, size(items)
-            if (trim(items(i)%name) /= 'anchor') cycle
-            if (size(items(i)%values) /= size(self%anchor)) then
-                call fatal_error(error, 'history anchor: wrong length', error_code%input)
-                return
-            end if
-            self%anchor = items(i)%values
-            self%trial_anchor = self%anchor
-        end do
-    end subroutine gpts_set_history
 
     !> The Tresca fixed point applies to a frictional GPTS pair (its slip limits
     !> belong to slave points).

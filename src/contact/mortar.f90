@@ -23,8 +23,8 @@ module voiga_contact_mortar
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_mortar_kernels, only: mortar_point, node_touch_factors
-    use voiga_contact_pair, only: contact_pair_t, add_matrix, history_item_t, pair_setup_history, pair_commit, &
-                                  pair_reset_trial, pair_history, pair_set_history
+    use voiga_contact_pair, only: contact_pair_t, add_matrix
+    use voiga_contact_history, only: flag_value
     implicit none
     private
 
@@ -57,16 +57,14 @@ module voiga_contact_mortar
         !> first and last slave element of each node's support [nodes].
         integer, allocatable :: point_nodes(:, :), node_first(:), node_last(:)
         real(dp), allocatable :: point_values(:, :)
-        !> Friction history (mu > 0) [nodes]: committed and trial tangential traction
-        !> t_A (along the master tangent).
-        real(dp), allocatable :: traction(:), trial_traction(:)
-        !> Friction history (mu > 0) [nodes]: the mean gap g_A / D_A (huge where
-        !> nothing projected) and whether the node was in contact, at the last converged
-        !> state; committed and trial. A node that was open there touched in this step
-        !> where its mean gap, interpolated linearly from there, vanished: only its slip
-        !> after that counts (`touch_factors`).
-        real(dp), allocatable :: node_gap(:), trial_node_gap(:)
-        logical, allocatable :: node_active(:), trial_node_active(:)
+        !> The indices in `hist` of the friction history (mu > 0; 0 without) [nodes]:
+        !> the tangential traction t_A (along the master tangent, `traction`), and the
+        !> mean gap g_A / D_A (huge where nothing projected, `node_gap`) and whether
+        !> the node was in contact (`node_active`, a flag) at the last converged state.
+        !> A node that was open there touched in this step where its mean gap,
+        !> interpolated linearly from there, vanished: only its slip after that
+        !> counts (`touch_factors`).
+        integer :: h_traction = 0, h_node_gap = 0, h_node_active = 0
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
         type(mortar_snapshot_t) :: last, accepted
@@ -76,10 +74,6 @@ module voiga_contact_mortar
         procedure :: n_blocks => mortar_n_blocks
         procedure :: block_dofs => mortar_block_dofs
         procedure :: setup_history => mortar_setup_history
-        procedure :: commit => mortar_commit
-        procedure :: reset_trial => mortar_reset_trial
-        procedure :: history => mortar_history
-        procedure :: set_history => mortar_set_history
         procedure :: accept_iterate => mortar_accept_iterate
         procedure :: contact_last => mortar_contact_last
         procedure :: step_limit => mortar_step_limit
@@ -146,13 +140,15 @@ contains
         ! open where no point of its support has a projection: its weighted gap is
         ! then empty, not zero
         where (wk%d_seen <= 0.0_dp) wk%g_a = huge(1.0_dp)
-        if (allocated(self%node_gap)) then
+        if (self%h_node_gap > 0) then
             call touch_factors(self, wk)
-            self%trial_node_gap = huge(1.0_dp)
-            where (wk%g_a < huge(1.0_dp) .and. wk%d_a > 0.0_dp) self%trial_node_gap = wk%g_a/wk%d_a
+            associate (trial_gap => self%hist%field(self%h_node_gap)%trial)
+                trial_gap = huge(1.0_dp)
+                where (wk%g_a < huge(1.0_dp) .and. wk%d_a > 0.0_dp) trial_gap = wk%g_a/wk%d_a
+            end associate
         end if
         call self%control_laws(wk%g_a, wk%d_a, wk%ds_a, wk%p_a, wk%t_a, wk%st_a, wk%t_tr)
-        if (allocated(self%node_active)) self%trial_node_active = wk%st_a /= state_inactive
+        if (self%h_node_active > 0) self%hist%field(self%h_node_active)%trial = flag_value(wk%st_a /= state_inactive)
         call mortar_points(self, r, wk, miss, add)
         self%last = mortar_snapshot_t(wk%g_a, wk%d_a, wk%t_tr, wk%st_a)
         if (.not. present(add) .or. miss) return
@@ -190,9 +186,9 @@ contains
                 a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
                 wk%w0(k) = norm2(a0)*self%w(k)
                 wk%d_a(nodes) = wk%d_a(nodes) + wk%w0(k)*phi
-                if (allocated(self%xi_last)) then
-                    self%trial_xi(k) = mp%xi
-                    self%trial_active(k) = .false.
+                if (self%h_xi > 0) then
+                    self%hist%field(self%h_xi)%trial(k) = mp%xi
+                    self%hist%field(self%h_active)%trial(k) = 0.0_dp
                 end if
                 if (.not. found) cycle
                 if (.not. converged) then
@@ -203,11 +199,11 @@ contains
                 wk%valid(k) = .true.
                 wk%d_seen(nodes) = wk%d_seen(nodes) + wk%w0(k)*phi
                 wk%g_a(nodes) = wk%g_a(nodes) + wk%w0(k)*phi*out%gap
-                if (allocated(self%xi_last)) then
-                    self%trial_active(k) = .true.
-                    if (self%active_last(k)) then
+                if (self%h_xi > 0) then
+                    self%hist%field(self%h_active)%trial(k) = 1.0_dp
+                    if (self%hist%field(self%h_active)%last(k) /= 0.0_dp) then
                         wk%slip(k) = .true.
-                        wk%dxi(k) = mp%xi - self%xi_last(k)
+                        wk%dxi(k) = mp%xi - self%hist%field(self%h_xi)%last(k)
                         wk%ds_a(nodes) = wk%ds_a(nodes) + wk%w0(k)*phi*wk%dxi(k)*norm2(mp%a)
                     end if
                 end if
@@ -221,7 +217,8 @@ contains
         class(mortar_pair_t), intent(in) :: self
         type(mortar_work_t), intent(inout) :: wk
         allocate (wk%f_a(size(wk%g_a)), wk%df_a(size(wk%g_a)))
-        call node_touch_factors(self%node_active, self%node_gap, wk%g_a, wk%d_a, wk%f_a, wk%df_a)
+        call node_touch_factors(self%hist%field(self%h_node_active)%last /= 0.0_dp, &
+                                self%hist%field(self%h_node_gap)%last, wk%g_a, wk%d_a, wk%f_a, wk%df_a)
         wk%ds_raw = wk%ds_a
         wk%ds_a = wk%f_a*wk%ds_raw
     end subroutine touch_factors
@@ -257,7 +254,7 @@ contains
                                   rl, kl, vec%gn, vec%gt, vec%m)
                 vec%dofs = [sp%dofs, mp%dofs]
                 self%n_evaluations = self%n_evaluations + 1
-                if (allocated(self%traction)) self%n_friction = self%n_friction + 1
+                if (self%h_traction > 0) self%n_friction = self%n_friction + 1
                 r(vec%dofs) = r(vec%dofs) + rl
                 self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
                 self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
@@ -354,10 +351,10 @@ contains
         integer :: a
         do a = 1, size(g_a)
             t_old = 0.0_dp
-            if (allocated(self%traction)) t_old = self%traction(a)
+            if (self%h_traction > 0) t_old = self%hist%field(self%h_traction)%last(a)
             call control_point_law(self%law, g_a(a), d_a(a), ds_a(a), t_old, self%gap_tol, p_a(a), t_a(a), &
                                    st_a(a), t_tr(a))
-            if (allocated(self%traction)) self%trial_traction(a) = t_a(a)
+            if (self%h_traction > 0) self%hist%field(self%h_traction)%trial(a) = t_a(a)
         end do
     end subroutine mortar_control_laws
 
@@ -404,18 +401,13 @@ contains
     !> traction per node.
     pure subroutine mortar_setup_history(self)
         class(mortar_pair_t), intent(inout) :: self
-        call pair_setup_history(self)
+        integer :: n
         call setup_multipliers(self)
         if (self%law%mu <= 0.0_dp) return
-        allocate (self%traction(size(self%node_first)), self%trial_traction(size(self%node_first)))
-        self%traction = 0.0_dp
-        self%trial_traction = 0.0_dp
-        allocate (self%node_gap(size(self%node_first)), self%trial_node_gap(size(self%node_first)))
-        allocate (self%node_active(size(self%node_first)), self%trial_node_active(size(self%node_first)))
-        self%node_gap = huge(1.0_dp)
-        self%trial_node_gap = huge(1.0_dp)
-        self%node_active = .false.
-        self%trial_node_active = .false.
+        n = size(self%node_first)
+        call self%hist%add('traction', n, self%h_traction)
+        call self%hist%add('node_gap', n, self%h_node_gap, initial=huge(1.0_dp))
+        call self%hist%add('node_active', n, self%h_node_active, flags=.true.)
     end subroutine mortar_setup_history
 
     !> The multiplier basis at the slave points and the supports of its nodes: the
@@ -464,76 +456,11 @@ contains
         end do
     end subroutine setup_multipliers
 
-    pure subroutine mortar_commit(self)
-        class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) then
-            self%traction = self%trial_traction
-            self%node_gap = self%trial_node_gap
-            self%node_active = self%trial_node_active
-        end if
-        call pair_commit(self)
-    end subroutine mortar_commit
-
-    pure subroutine mortar_reset_trial(self)
-        class(mortar_pair_t), intent(inout) :: self
-        if (allocated(self%traction)) then
-            self%trial_traction = self%traction
-            self%trial_node_gap = self%node_gap
-            self%trial_node_active = self%node_active
-        end if
-        call pair_reset_trial(self)
-    end subroutine mortar_reset_trial
-
-    !> `traction`, then the shared history (empty without friction).
-    pure function mortar_history(self) result(items)
-        class(mortar_pair_t), intent(in) :: self
-        type(history_item_t), allocatable :: items(:)
-        type(history_item_t) :: traction, gap, active
-        items = pair_history(self)
-        if (.not. allocated(self%traction)) return
-        traction%name = 'traction'
-        traction%values = self%traction
-        gap%name = 'node_gap'
-        gap%values = self%node_gap
-        active%name = 'node_active'
-        active%flags = merge(1, 0, self%node_active)
-        items = [traction, gap, active, items]
-    end function mortar_history
-
-    pure subroutine mortar_set_history(self, items, error)
-        class(mortar_pair_t), intent(inout) :: self
-        type(history_item_t), intent(in) :: items(:)
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        call pair_set_history(self, items, error)
-        if (allocated(error) .or. .not. allocated(self%traction)) return
-        do i = 1, size(items)
-            select case (trim(items(i)%name))
-            case ('traction', 'node_gap')
-                if (size(items(i)%values) /= size(self%traction)) then
-                    call fatal_error(error, 'history '//trim(items(i)%name)//': wrong length', error_code%input)
-                    return
-                end if
-                if (trim(items(i)%name) == 'traction') self%traction = items(i)%values
-                if (trim(items(i)%name) == 'node_gap') self%node_gap = items(i)%values
-            case ('node_active')
-                if (size(items(i)%flags) /= size(self%traction)) then
-                    call fatal_error(error, 'history node_active: wrong length', error_code%input)
-                    return
-                end if
-                self%node_active = items(i)%flags /= 0
-            end select
-        end do
-        self%trial_traction = self%traction
-        self%trial_node_gap = self%node_gap
-        self%trial_node_active = self%node_active
-    end subroutine mortar_set_history
-
     !> A control point was in contact at the last converged state (friction only).
     pure logical function mortar_contact_last(self)
         class(mortar_pair_t), intent(in) :: self
         mortar_contact_last = .false.
-        if (allocated(self%node_active)) mortar_contact_last = any(self%node_active)
+        if (self%h_node_active > 0) mortar_contact_last = any(self%hist%field(self%h_node_active)%last /= 0.0_dp)
     end function mortar_contact_last
 
     !> The last evaluation is an accepted Newton iterate: the reference of `step_limit`.

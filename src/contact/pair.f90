@@ -1,9 +1,12 @@
 !> A contact pair: the slave body's contact edge integrated with Gauss points
-!> (full pass: forces on slave and master), a master (another body's contact edge
-!> or a rigid line), the penalty/friction law, and the friction history (only
-!> when mu > 0). `contact_pair_t` is abstract: each contact method extends it
-!> (`voiga_contact_gpts`: Gauss-point-to-surface, `voiga_contact_mortar`: the
-!> mortar-type penalty) and `voiga_contact_factory` builds the one a case names.
+!> (full pass: forces on slave and master), a master (another body's contact edge,
+!> a rigid line or a rigid curve), the penalty/friction law, and its history (a list
+!> of named fields, `voiga_contact_history`: the friction history every method keeps
+!> when mu > 0, and the method's own). `contact_pair_t` is abstract: each contact
+!> method extends it (`voiga_contact_gpts`: Gauss-point-to-surface,
+!> `voiga_contact_mortar`: the mortar-type penalty, `voiga_contact_alm`: augmented
+!> Lagrangian, `voiga_contact_segment`: segment-based mortar) and
+!> `voiga_contact_factory` builds the one a case names, whole.
 !>
 !> What the solver needs of a pair: `evaluate` (residual and tangent, trial
 !> history), `commit` and `reset_trial` (a step converged, a step is retried),
@@ -11,7 +14,9 @@
 !> (step control inside a Newton iteration), the outer-loop hooks
 !> (`takes_outer`, `outer_capture`, `outer_apply`, `outer_release`),
 !> `failure_diagnosis`, and `history`/`set_history` (the committed history a
-!> result file keeps for a restart).
+!> result file keeps for a restart). Code outside contact/ changes a pair only
+!> through its bindings (`set_friction`, `move_master`, `set_penalties`,
+!> `set_warm`, `set_pattern_miss`, `refit_ranges`), never its components.
 module voiga_contact_pair
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
@@ -21,14 +26,18 @@ module voiga_contact_pair
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive
     use voiga_text, only: str, real_str
+    use voiga_contact_history, only: history_t, history_item_t
     implicit none
     private
 
     public :: contact_pair_t, pair_slot_t, contact_point_out_t, history_item_t, add_matrix, &
-              sparse_vector_t, constraint_set_t
-    !> The shared parts of the history operations, for extensions that add their own
-    !> (gfortran does not call a binding of an abstract parent through the parent component).
-    public :: pair_setup_history, pair_commit, pair_reset_trial, pair_history, pair_set_history
+              sparse_vector_t, constraint_set_t, automatic
+
+    !> The value of a setting (`voiga_contact_factory`'s `contact_settings_t`) that
+    !> leaves it to the pair: the automatic normal penalty, the normal penalty for
+    !> the tangential one, the method's default tolerance. The one encoding of
+    !> "automatic" (a case reader maps a value it was not given to it).
+    real(dp), parameter :: automatic = 0.0_dp
 
     !> Per-slave-point output of the last evaluation.
     type :: contact_point_out_t
@@ -45,17 +54,6 @@ module voiga_contact_pair
         integer :: first = 1, last = 0
         integer :: state = state_inactive
     end type contact_point_out_t
-
-    !> One array of a pair's committed history, named as the result file stores it
-    !> (`history/<name>`): real values, or integer flags.
-    type :: history_item_t
-        character(len=16) :: name = ''
-        real(dp), allocatable :: values(:)
-        integer, allocatable :: flags(:)
-        !> The most values a restart may read for it (-1: as many as it holds now;
-        !> a pair whose number of points changes between steps gives its bound).
-        integer :: most = -1
-    end type history_item_t
 
     !> A vector on a few global DOFs.
     type :: sparse_vector_t
@@ -90,8 +88,9 @@ module voiga_contact_pair
         type(contact_surface_t) :: slave
         class(contact_master_t), allocatable :: master
         type(contact_law_t) :: law
-        !> The automatic normal penalty of the pair (what `penalty_normal` defaults
-        !> to, `voiga_contact_factory`'s `automatic_penalty`), set by the model.
+        !> The value of the automatic normal penalty of the pair (what an `automatic`
+        !> `penalty_normal` becomes, `voiga_contact_factory`'s `automatic_penalty`;
+        !> the floor of ALM's softening).
         real(dp) :: eps_automatic = 0.0_dp
         !> Gauss points per slave element.
         integer :: n_gauss = 0
@@ -101,16 +100,16 @@ module voiga_contact_pair
         !> The slave functions at each point (they do not change): values, first and
         !> second derivatives [p + 1, 3, npts] (`surface_basis`).
         real(dp), allocatable :: slave_basis(:, :, :)
-        !> Friction history shared by the methods (allocated only when mu > 0)
+        !> The pair's history (`voiga_contact_history`): the fields every method
+        !> keeps with friction (mu > 0) and those its method adds (`setup_history`).
+        type(history_t) :: hist
+        !> The shared friction fields' indices in `hist` (0: none, without friction)
         !> [npts]: whether the point was in contact (GPTS) or had a projection
-        !> (mortar) at the last converged state, and its projection there;
-        !> committed and trial.
-        real(dp), allocatable :: xi_last(:), trial_xi(:)
-        logical, allocatable :: active_last(:), trial_active(:)
-        !> The normal gap at the last converged state (huge without a projection),
-        !> committed and trial [npts]: where between that state and this one a point
-        !> that was open first touched (friction only).
-        real(dp), allocatable :: gap_last(:), trial_gap(:)
+        !> (mortar) at the last converged state (`active_last`, a flag), its
+        !> projection there (`xi_last`), and its normal gap there (`gap_last`, huge
+        !> without a projection: where between that state and this one a point that
+        !> was open first touched).
+        integer :: h_xi = 0, h_active = 0, h_gap = 0
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
         !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
@@ -144,14 +143,17 @@ module voiga_contact_pair
         procedure(block_dofs_interface), deferred :: block_dofs
         !> Place the slave points and the history arrays (set the master first).
         procedure :: setup => pair_setup
-        procedure :: setup_history => pair_setup_history
+        !> Add the method's own history fields to `hist` (default: none).
+        procedure :: setup_history => pair_no_op
         !> The step converged: the trial history becomes the committed one.
         procedure :: commit => pair_commit
         !> Forget the trial history (a step is retried).
         procedure :: reset_trial => pair_reset_trial
-        !> The committed history, and setting it (a restart).
+        !> The committed history, and setting it (a restart); the most points a
+        !> restart may read for a field per point (-1: as many as now).
         procedure :: history => pair_history
         procedure :: set_history => pair_set_history
+        procedure :: most_points => pair_most_points
         !> Step control inside a Newton iteration (default: none).
         procedure :: accept_iterate => pair_accept_iterate
         procedure :: step_limit => pair_step_limit
@@ -189,6 +191,17 @@ module voiga_contact_pair
         !> places its points otherwise (`voiga_contact_segment`).
         procedure :: point_range => pair_point_range
         procedure :: point_element => pair_point_element
+        !> What the model and the solver change in a pair, so that nothing outside
+        !> contact/ writes its components: the friction coefficient of a load phase,
+        !> a rigid master's prescribed translation, the penalties a restart reads back,
+        !> whether the last projections start the next ones (`warm`), the pattern flag,
+        !> and the master ranges fitted to the last evaluation.
+        procedure :: set_friction => pair_set_friction
+        procedure :: move_master => pair_move_master
+        procedure :: set_penalties => pair_set_penalties
+        procedure :: set_warm => pair_set_warm
+        procedure :: set_pattern_miss => pair_set_pattern_miss
+        procedure :: refit_ranges => pair_refit_ranges
     end type contact_pair_t
 
     !> An element of an array of pairs of any methods.
@@ -267,56 +280,37 @@ contains
         self%mhi = 0
         if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/2
         self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
+        call shared_history(self)
         call self%setup_history()
     end subroutine pair_setup
 
-    !> The friction history every method keeps (mu > 0): projections and contact at
-    !> the last converged state. Extensions add theirs and call this.
-    pure subroutine pair_setup_history(self)
+    !> The friction history every method keeps (mu > 0): projections, contact and
+    !> gaps at the last converged state, one entry per slave point.
+    pure subroutine shared_history(self)
         class(contact_pair_t), intent(inout) :: self
         integer :: n
         if (self%law%mu <= 0.0_dp) return
         n = size(self%xi)
-        allocate (self%xi_last(n), self%trial_xi(n), self%active_last(n), self%trial_active(n))
-        allocate (self%gap_last(n), self%trial_gap(n))
-        self%gap_last = huge(1.0_dp)
-        self%trial_gap = huge(1.0_dp)
-        self%xi_last = 0.0_dp
-        self%trial_xi = 0.0_dp
-        self%active_last = .false.
-        self%trial_active = .false.
-    end subroutine pair_setup_history
+        call self%hist%add('xi_last', n, self%h_xi, per_point=.true.)
+        call self%hist%add('active_last', n, self%h_active, flags=.true., per_point=.true.)
+        call self%hist%add('gap_last', n, self%h_gap, initial=huge(1.0_dp), per_point=.true.)
+    end subroutine shared_history
 
     pure subroutine pair_commit(self)
         class(contact_pair_t), intent(inout) :: self
-        if (.not. allocated(self%xi_last)) return
-        self%active_last = self%trial_active
-        self%xi_last = self%trial_xi
-        self%gap_last = self%trial_gap
+        call self%hist%commit()
     end subroutine pair_commit
 
     pure subroutine pair_reset_trial(self)
         class(contact_pair_t), intent(inout) :: self
-        if (.not. allocated(self%xi_last)) return
-        self%trial_active = self%active_last
-        self%trial_xi = self%xi_last
-        self%trial_gap = self%gap_last
+        call self%hist%reset_trial()
     end subroutine pair_reset_trial
 
-    !> The shared friction history: `xi_last`, `active_last` (empty without friction).
+    !> Every field of `hist` (none without friction and method history).
     pure function pair_history(self) result(items)
         class(contact_pair_t), intent(in) :: self
         type(history_item_t), allocatable :: items(:)
-        allocate (items(0))
-        if (.not. allocated(self%xi_last)) return
-        deallocate (items)
-        allocate (items(3))
-        items(1)%name = 'xi_last'
-        items(1)%values = self%xi_last
-        items(2)%name = 'active_last'
-        items(2)%flags = merge(1, 0, self%active_last)
-        items(3)%name = 'gap_last'
-        items(3)%values = self%gap_last
+        items = self%hist%items(self%most_points())
     end function pair_history
 
     !> Set the committed (and trial) history from `items` (as `history` names them).
@@ -324,39 +318,13 @@ contains
         class(contact_pair_t), intent(inout) :: self
         type(history_item_t), intent(in) :: items(:)
         type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        if (.not. allocated(self%xi_last)) return
-        do i = 1, size(items)
-            select case (trim(items(i)%name))
-            case ('xi_last')
-                call take(items(i)%values, self%xi_last, error)
-                if (allocated(error)) return
-            case ('gap_last')
-                call take(items(i)%values, self%gap_last, error)
-                if (allocated(error)) return
-            case ('active_last')
-                if (size(items(i)%flags) /= size(self%active_last)) then
-                    call fatal_error(error, 'history active_last: wrong length', error_code%input)
-                    return
-                end if
-                self%active_last = items(i)%flags /= 0
-            end select
-        end do
-        self%trial_xi = self%xi_last
-        self%trial_active = self%active_last
-        self%trial_gap = self%gap_last
-    contains
-        pure subroutine take(values, target, error)
-            real(dp), intent(in) :: values(:)
-            real(dp), intent(inout) :: target(:)
-            type(error_t), allocatable, intent(out) :: error
-            if (size(values) /= size(target)) then
-                call fatal_error(error, 'history '//trim(items(i)%name)//': wrong length', error_code%input)
-                return
-            end if
-            target = values
-        end subroutine take
+        call self%hist%set_items(items, error)
     end subroutine pair_set_history
+
+    pure integer function pair_most_points(self) result(n)
+        class(contact_pair_t), intent(in) :: self
+        n = -1
+    end function pair_most_points
 
     pure subroutine pair_accept_iterate(self)
         class(contact_pair_t), intent(inout) :: self
@@ -422,7 +390,7 @@ contains
     pure logical function pair_contact_last(self)
         class(contact_pair_t), intent(in) :: self
         pair_contact_last = .false.
-        if (allocated(self%active_last)) pair_contact_last = any(self%active_last)
+        if (self%h_active > 0) pair_contact_last = any(self%hist%field(self%h_active)%last /= 0.0_dp)
     end function pair_contact_last
 
     pure subroutine pair_soften(self, changed, text)
@@ -593,5 +561,55 @@ contains
         integer, intent(in) :: k
         e = (k - 1)/self%n_gauss + 1
     end function pair_point_element
+
+    pure subroutine pair_set_friction(self, mu)
+        class(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: mu
+        self%law%mu = mu
+    end subroutine pair_set_friction
+
+    !> Put a rigid master at translation `d` from its reference place (no effect on
+    !> a deformable one, which moves with its body's displacement).
+    pure subroutine pair_move_master(self, d)
+        class(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: d(2)
+        call self%master%move(d)
+    end subroutine pair_move_master
+
+    pure subroutine pair_set_penalties(self, eps_n, eps_t)
+        class(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: eps_n, eps_t
+        self%law%eps_n = eps_n
+        self%law%eps_t = eps_t
+    end subroutine pair_set_penalties
+
+    pure subroutine pair_set_warm(self, warm)
+        class(contact_pair_t), intent(inout) :: self
+        logical, intent(in) :: warm
+        self%warm = warm
+    end subroutine pair_set_warm
+
+    pure subroutine pair_set_pattern_miss(self, miss)
+        class(contact_pair_t), intent(inout) :: self
+        logical, intent(in) :: miss
+        self%pattern_miss = miss
+    end subroutine pair_set_pattern_miss
+
+    !> A deformable master's ranges to `wanted_ranges` (blocks of `block` control
+    !> points); `changed`: whether one changed (the pattern must be rebuilt).
+    pure subroutine pair_refit_ranges(self, block, changed)
+        class(contact_pair_t), intent(inout) :: self
+        integer, intent(in) :: block
+        logical, intent(out) :: changed
+        integer, allocatable :: lo(:), hi(:)
+        changed = .false.
+        if (.not. self%master%deformable) return
+        allocate (lo(size(self%mlo)), hi(size(self%mhi)))
+        call self%wanted_ranges(size(self%master%all_dofs())/2, block, lo, hi)
+        changed = any(lo /= self%mlo) .or. any(hi /= self%mhi)
+        if (.not. changed) return
+        self%mlo = lo
+        self%mhi = hi
+    end subroutine pair_refit_ranges
 
 end module voiga_contact_pair

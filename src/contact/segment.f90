@@ -34,6 +34,7 @@ module voiga_contact_segment
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_contact_law, only: state_inactive, state_stick, state_slip
     use voiga_contact_pair, only: add_matrix, history_item_t
+    use voiga_contact_history, only: flag_value
     use voiga_contact_mortar, only: mortar_pair_t, mortar_evaluate
     implicit none
     private
@@ -62,6 +63,7 @@ module voiga_contact_segment
         procedure :: commit => segment_commit
         procedure :: history => segment_history
         procedure :: set_history => segment_set_history
+        procedure :: most_points => segment_most_points
         procedure :: point_range => segment_point_range
         procedure :: point_element => segment_point_element
     end type segment_pair_t
@@ -163,17 +165,14 @@ contains
         do k = 1, size(self%xi)
             call self%project_point(u, k, sp, mp, found, converged)
             found = found .and. converged
-            if (allocated(self%xi_last)) then
-                self%xi_last(k) = mp%xi
-                self%active_last(k) = found
+            if (self%h_xi > 0) then
+                self%hist%field(self%h_xi)%last(k) = mp%xi
+                self%hist%field(self%h_active)%last(k) = flag_value(found)
             end if
             if (found) call interpolated_output(self, k)
         end do
         self%warm = warm
-        if (allocated(self%xi_last)) then
-            self%trial_xi = self%xi_last
-            self%trial_active = self%active_last
-        end if
+        call self%hist%reset_trial()
     end subroutine resegment
 
     !> Point `k`'s tractions and state from the control points' at the last
@@ -192,7 +191,7 @@ contains
                 a = nodes(i)
                 if (self%last%state(a) == state_inactive) cycle
                 pbar = pbar - phi(i)*self%law%eps_n*self%last%g(a)/self%last%d(a)
-                if (allocated(self%traction)) tbar = tbar + phi(i)*self%traction(a)
+                if (self%h_traction > 0) tbar = tbar + phi(i)*self%hist%field(self%h_traction)%last(a)
             end do
             out%pn0 = pbar
             out%pt0 = tbar
@@ -405,16 +404,7 @@ contains
         end do
         if (allocated(self%out)) deallocate (self%out)
         allocate (self%out(n))
-        if (.not. allocated(self%xi_last)) return
-        deallocate (self%xi_last, self%trial_xi, self%active_last, self%trial_active, self%gap_last, self%trial_gap)
-        allocate (self%xi_last(n), self%trial_xi(n), self%active_last(n), self%trial_active(n), self%gap_last(n), &
-                  self%trial_gap(n))
-        self%xi_last = 0.0_dp
-        self%trial_xi = 0.0_dp
-        self%active_last = .false.
-        self%trial_active = .false.
-        self%gap_last = huge(1.0_dp)
-        self%trial_gap = huge(1.0_dp)
+        call self%hist%resize_points(n)
     end subroutine place_points
 
     !> The points (`point_xi`, `point_w`, `point_element`), then the mortar pair's
@@ -423,31 +413,22 @@ contains
         class(segment_pair_t), intent(in) :: self
         type(history_item_t), allocatable :: items(:)
         type(history_item_t) :: xi, w, elem
-        integer :: i
         xi%name = 'point_xi'
         xi%values = self%xi
         w%name = 'point_w'
         w%values = self%w
         elem%name = 'point_element'
         elem%flags = self%elem
-        xi%most = most_points(self)
+        xi%most = self%most_points()
         w%most = xi%most
         elem%most = xi%most
-        items = [xi, w, elem, self%mortar_pair_t%history()]
-        ! the mortar pair's arrays per point (xi_last, ...) have as many
-        do i = 4, size(items)
-            if (allocated(items(i)%values)) then
-                if (size(items(i)%values) == size(self%xi)) items(i)%most = xi%most
-            else if (allocated(items(i)%flags)) then
-                if (size(items(i)%flags) == size(self%xi)) items(i)%most = xi%most
-            end if
-        end do
+        items = [xi, w, elem, self%hist%items(xi%most)]
     end function segment_history
 
     !> The most points a segmentation can have: per slave element, `n_gauss` on each
     !> of its segments, at most 2q + 2 cuts (one per bracket of `element_cuts`) for
     !> each of the master's normal lines (at most two per breakpoint).
-    pure integer function most_points(self) result(n)
+    pure integer function segment_most_points(self) result(n)
         class(segment_pair_t), intent(in) :: self
         integer :: n_lines
         n_lines = 0
@@ -458,7 +439,7 @@ contains
             n_lines = 2*size(m%surf%breaks)
         end select
         n = size(self%slave%spans)*self%n_gauss*(1 + (2*self%slave%degree + 2)*n_lines)
-    end function most_points
+    end function segment_most_points
 
     !> Continue on the points of `items` (checked to be a segmentation of this slave
     !> edge with `n_gauss` points per segment), then the mortar pair's history.

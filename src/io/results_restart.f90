@@ -99,10 +99,15 @@ contains
         character(len=*), intent(in) :: c
         class(contact_pair_t), intent(inout) :: pair
         type(error_t), allocatable, intent(out) :: error
+        real(dp) :: eps_n, eps_t
         if (.not. pair%has_multipliers()) return
-        if (h5%has_attr(c, 'penalty_normal')) call h5%read_attr_real(c, 'penalty_normal', pair%law%eps_n, error)
+        eps_n = pair%law%eps_n
+        eps_t = pair%law%eps_t
+        if (h5%has_attr(c, 'penalty_normal')) call h5%read_attr_real(c, 'penalty_normal', eps_n, error)
         if (allocated(error)) return
-        if (h5%has_attr(c, 'penalty_tangent')) call h5%read_attr_real(c, 'penalty_tangent', pair%law%eps_t, error)
+        if (h5%has_attr(c, 'penalty_tangent')) call h5%read_attr_real(c, 'penalty_tangent', eps_t, error)
+        if (allocated(error)) return
+        call pair%set_penalties(eps_n, eps_t)
     end subroutine read_penalties
 
     !> Read the committed history `pair` keeps (its `history` names the arrays) from

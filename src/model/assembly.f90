@@ -67,13 +67,13 @@ contains
         ! a substep's first evaluation projects without the last projections as starts
         if (fit) then
             do ip = 1, size(model%pairs)
-                model%pairs(ip)%pair%warm = .false.
+                call model%pairs(ip)%pair%set_warm(.false.)
             end do
         end if
         do pass = 1, 3
             call assemble_contact(model, u, r, stats, error, k)
             do ip = 1, size(model%pairs)
-                model%pairs(ip)%pair%warm = .true.
+                call model%pairs(ip)%pair%set_warm(.true.)
             end do
             if (allocated(error) .or. .not. present(k)) return
             if (fit) then
@@ -81,13 +81,13 @@ contains
                 if (refit_contact_ranges(model)) then
                     ! the ranges now hold every projection of this evaluation
                     do ip = 1, size(model%pairs)
-                        model%pairs(ip)%pair%pattern_miss = .true.
+                        call model%pairs(ip)%pair%set_pattern_miss(.true.)
                     end do
                 end if
             end if
             if (.not. any([(model%pairs(ip)%pair%pattern_miss, ip=1, size(model%pairs))])) return
             do ip = 1, size(model%pairs)
-                model%pairs(ip)%pair%pattern_miss = .false.
+                call model%pairs(ip)%pair%set_pattern_miss(.false.)
             end do
             if (keep) then
                 call rebuild_pattern(model, k, error, map, k_bulk)
@@ -134,7 +134,7 @@ contains
         if (allocated(error)) return
         call assemble_contact(model, u, r, stats, error, fit_only=.true.)
         do ip = 1, size(model%pairs)
-            model%pairs(ip)%pair%warm = .true.
+            call model%pairs(ip)%pair%set_warm(.true.)
         end do
         if (allocated(error)) return
         fits = .not. any([(model%pairs(ip)%pair%pattern_miss, ip=1, size(model%pairs))])
@@ -145,21 +145,12 @@ contains
     function refit_contact_ranges(model) result(changed)
         type(model_t), intent(inout) :: model
         logical :: changed
-        integer, allocatable :: lo(:), hi(:)
+        logical :: one
         integer :: ip
         changed = .false.
         do ip = 1, size(model%pairs)
-            associate (pair => model%pairs(ip)%pair)
-                if (.not. pair%master%deformable) cycle
-                allocate (lo(size(pair%mlo)), hi(size(pair%mhi)))
-                call pair%wanted_ranges(size(pair%master%all_dofs())/2, 8, lo, hi)
-                if (any(lo /= pair%mlo) .or. any(hi /= pair%mhi)) then
-                    changed = .true.
-                    pair%mlo = lo
-                    pair%mhi = hi
-                end if
-                deallocate (lo, hi)
-            end associate
+            call model%pairs(ip)%pair%refit_ranges(8, one)
+            changed = changed .or. one
         end do
     end function refit_contact_ranges
 

@@ -9,8 +9,9 @@ module voiga_model
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
                                  obstacle_motion_t, phase_friction_t, phase_of
     use voiga_contact_pair, only: pair_slot_t
-    use voiga_contact_factory, only: contact_settings_t, new_contact_pair, automatic_penalty
-    use voiga_contact_surface, only: new_contact_surface, element_lengths
+    use voiga_contact_factory, only: contact_settings_t, new_contact_pair
+    use voiga_contact_surface, only: contact_surface_t, new_contact_surface
+    use voiga_contact_master, only: contact_master_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
     use voiga_contact_master_curve, only: rigid_curve_t, new_rigid_curve
@@ -144,66 +145,42 @@ contains
         p%values = inp%values
     end subroutine new_pressure
 
-    !> Build a contact pair of the method the settings name; its history starts
-    !> from the projections in the reference configuration.
+    !> The slave edge and the master of the pair `inp` describes, from the bodies,
+    !> and the pair the contact factory builds on them.
     subroutine new_pair(self, inp, slot, error)
         type(model_t), intent(in) :: self
         type(contact_settings_t), intent(in) :: inp
         type(pair_slot_t), intent(out) :: slot
         type(error_t), allocatable, intent(out) :: error
+        type(contact_surface_t) :: slave
+        class(contact_master_t), allocatable :: master
         type(rigid_line_t) :: rigid
         type(rigid_curve_t) :: curve
-        type(nurbs_master_t) :: master
-        real(dp), allocatable :: u0(:), r0(:)
-        integer :: ib
+        type(nurbs_master_t) :: body_master
+        integer :: ib, im
 
-        call new_contact_pair(slot%pair, inp, error)
-        if (allocated(error)) return
-        associate (pair => slot%pair)
-            pair%slave_name = inp%slave
-            pair%master_name = inp%master
-            ib = find_body(self, inp%slave)
-            pair%slave_body = ib
-            call new_contact_surface(pair%slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
-            if (trim(inp%master) == 'rigid' .and. len_trim(inp%rigid_curve) > 0) then
-                if (.not. allocated(inp%curve%w)) then
-                    call fatal_error(error, "contact: the rigid curve '"//trim(inp%rigid_curve)// &
-                                     "' was not read", error_code%input)
-                    return
-                end if
-                call new_rigid_curve(curve, inp%curve)
-                curve%name = inp%rigid_curve
-                allocate (pair%master, source=curve)
-            else if (trim(inp%master) == 'rigid') then
-                call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
-                allocate (pair%master, source=rigid)
-            else
-                ib = find_body(self, inp%master)
-                pair%master_body = ib
-                call new_nurbs_master(master, self%bodies(ib)%disc, self%bodies(ib)%dof0)
-                allocate (pair%master, source=master)
+        ib = find_body(self, inp%slave)
+        im = 0
+        call new_contact_surface(slave, self%bodies(ib)%disc, self%bodies(ib)%dof0)
+        if (trim(inp%master) == 'rigid' .and. len_trim(inp%rigid_curve) > 0) then
+            if (.not. allocated(inp%curve%w)) then
+                call fatal_error(error, "contact: the rigid curve '"//trim(inp%rigid_curve)// &
+                                 "' was not read", error_code%input)
+                return
             end if
-            pair%eps_automatic = automatic_penalty(plane_modulus(self, pair%slave_body, pair%master_body), &
-                                                   pair%slave%degree, minval(element_lengths(pair%slave)))
-            pair%law%eps_n = inp%penalty_normal
-            if (pair%law%eps_n <= 0.0_dp) pair%law%eps_n = pair%eps_automatic
-            pair%law%eps_t = inp%penalty_tangent
-            if (pair%law%eps_t <= 0.0_dp) pair%law%eps_t = pair%law%eps_n
-            ! the largest coefficient decides what friction history the pair keeps; the
-            ! one of the first phase holds from the start (`set_contact_time`)
-            pair%law%mu = inp%friction
-            pair%n_gauss = inp%n_gauss
-            call pair%setup()
-            if (allocated(inp%friction_phases)) pair%law%mu = inp%friction_phases(1)
-            allocate (u0(self%ndof), r0(self%ndof))
-            u0 = 0.0_dp
-            r0 = 0.0_dp
-            call pair%evaluate(u0, r0, error)
-            if (allocated(error)) return
-            call pair%commit()
-            pair%n_evaluations = 0
-            pair%n_friction = 0
-        end associate
+            call new_rigid_curve(curve, inp%curve)
+            curve%name = inp%rigid_curve
+            allocate (master, source=curve)
+        else if (trim(inp%master) == 'rigid') then
+            call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
+            allocate (master, source=rigid)
+        else
+            im = find_body(self, inp%master)
+            call new_nurbs_master(body_master, self%bodies(im)%disc, self%bodies(im)%dof0)
+            allocate (master, source=body_master)
+        end if
+        call new_contact_pair(slot%pair, inp, slave, master, [ib, im], plane_modulus(self, ib, im), self%ndof, &
+                              error)
     end subroutine new_pair
 
     !> The plane-strain modulus E* of a pair: 1/E* = sum over its deformable bodies
@@ -260,13 +237,13 @@ contains
         integer :: k
         do k = 1, size(model%frictions)
             associate (f => model%frictions(k))
-                model%pairs(f%pair)%pair%law%mu = f%values(phase_of(t, size(f%values)))
+                call model%pairs(f%pair)%pair%set_friction(f%values(phase_of(t, size(f%values))))
             end associate
         end do
         do k = 1, size(model%motions)
             associate (m => model%motions(k))
-                call model%pairs(m%pair)%pair%master%move([phase_value(m%values(1, :), t), &
-                                                           phase_value(m%values(2, :), t)])
+                call model%pairs(m%pair)%pair%move_master([phase_value(m%values(1, :), t), &
+                                                            phase_value(m%values(2, :), t)])
             end associate
         end do
     end subroutine set_contact_time

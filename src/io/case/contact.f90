@@ -7,8 +7,7 @@ module voiga_io_case_contact
     use voiga_io_case_values, only: check_length, unset, is_unset, max_value, max_phases, body_index, quoted, &
         phase_values
     use voiga_model_body, only: body_settings_t
-    use voiga_contact_factory, only: contact_settings_t, contact_method_names, default_method
-    use voiga_contact_alm, only: default_alm_tolerance
+    use voiga_contact_factory, only: contact_settings_t, contact_method_names, default_method, automatic
     implicit none
     private
 
@@ -47,7 +46,7 @@ contains
         friction = unset()
         n_gauss = 0
         method = ''
-        tolerance = default_alm_tolerance
+        tolerance = unset()
         rigid_curve = ''
         rigid_ux = unset()
         rigid_uy = unset()
@@ -76,9 +75,11 @@ contains
         if (len_trim(entry%method) == 0) entry%method = default_method(trim(entry%master) == 'rigid')
         call check_law(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
-        ! not given: automatic (0, `automatic_penalty`); the tangential one, the normal one's
-        if (is_unset(entry%penalty_normal)) entry%penalty_normal = 0.0_dp
+        ! not given: left to the pair (the automatic penalty, the tangential one the
+        ! normal one's, the method's tolerance)
+        if (is_unset(entry%penalty_normal)) entry%penalty_normal = automatic
         if (is_unset(entry%penalty_tangent)) entry%penalty_tangent = entry%penalty_normal
+        if (is_unset(entry%tolerance)) entry%tolerance = automatic
         call rigid_motion(entry, rigid_ux, rigid_uy, nph, path//trim(msg)//' ', error)
     contains
         subroutine try_contact(text, ios, msg)
@@ -199,7 +200,7 @@ contains
         else if (c%friction > 0.0_dp .and. given_not_positive(c%penalty_tangent)) then
             call fatal_error(error, where//'penalty_tangent must be finite and > 0 (or not given)', &
                              error_code%input)
-        else if (.not. (c%tolerance > 0.0_dp .and. c%tolerance < 1.0_dp)) then
+        else if (given_outside_unit(c%tolerance)) then
             call fatal_error(error, where//'tolerance must lie in (0, 1)', error_code%input)
         else if (c%n_gauss < 0 .or. c%n_gauss > 30) then
             call fatal_error(error, where//'n_gauss must be between 0 (automatic) and 30', error_code%input)
@@ -220,6 +221,17 @@ contains
                              "the largest Young's modulus of the two bodies (the stiffness matrix would "// &
                              'lose its significant digits)', error_code%input)
     end subroutine check_law
+
+    !> Given (not `unset`) and not in (0, 1); an unset value is never compared (an
+    !> ordered comparison with its NaN raises IEEE_INVALID).
+    elemental logical function given_outside_unit(x) result(bad)
+        real(dp), intent(in) :: x
+        bad = .false.
+        if (is_unset(x)) return
+        bad = .true.
+        if (.not. ieee_is_finite(x)) return
+        bad = .not. (x > 0.0_dp .and. x < 1.0_dp)
+    end function given_outside_unit
 
     !> Is `x` given (not `unset`) but not a finite positive number? Tested without
     !> comparing a NaN.
