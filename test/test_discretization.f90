@@ -8,7 +8,7 @@ module test_discretization
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval
     use voiga_discretization_layout, only: layout_t
-    use voiga_discretization_patch, only: discretization_t, new_discretization
+    use voiga_discretization_patch, only: discretization_t, new_discretization, contact_boundary
     use voiga_discretization_size, only: body_size_t, body_size
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle
@@ -184,7 +184,7 @@ contains
             call check(error, b%interface_dofs, a%interface_dofs, 'interface DOFs with contact edge '// &
                        trim(edges(k)))
             if (allocated(error)) return
-            call check(error, trim(b%edges(4)%name), trim(edges(k)), 'contact edge is eta = 1')
+            call check(error, trim(b%boundaries(contact_boundary(b))%name), trim(edges(k)), 'contact edge is eta = 1')
             if (allocated(error)) return
             ! every point of the oriented map lies in the slab, and the contact edge on its edge
             do i = 1, 200

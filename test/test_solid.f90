@@ -260,7 +260,7 @@ contains
             allocate (boundary(d%ncp))
             boundary = .false.
             do k = 1, 4
-                boundary(d%edges(k)%cps) = .true.
+                boundary(d%boundaries(k)%cps) = .true.
             end do
             do a = 1, d%ncp
                 if (.not. boundary(a)) d%x(:, a) = d%x(:, a) + amount*[rng%uniform() - 0.5_dp, &

@@ -1,5 +1,5 @@
 !> The discretized body: refined bulk patch, optional varying-order (VO) layer,
-!> global control-point numbering, elements, named edges and DOF counts.
+!> global control-point numbering, elements, named boundary entities and DOF counts.
 !>
 !> The patch is oriented so that the contact edge is eta = 1 with xi along it.
 !> With a layer, the bulk control points of the last eta row are replaced by the
@@ -17,7 +17,8 @@ module voiga_discretization_patch
     implicit none
     private
 
-    public :: discretization_t, element_t, edge_t, new_discretization, edge_cps, new_knots
+    public :: discretization_t, element_t, boundary_t, new_discretization, boundary_cps, boundary_index, &
+              contact_boundary, contact_name, new_knots
     !> An ascending copy of a short real vector (also the contact segments' cuts).
     public :: sorted
 
@@ -34,15 +35,22 @@ module voiga_discretization_patch
         integer, allocatable :: conn(:)
     end type element_t
 
-    !> A named boundary edge and its control points.
-    type :: edge_t
+    !> A named boundary entity of the patch: an edge of a two-dimensional patch, a
+    !> face of a three-dimensional one (docs/theory.md, "Dimension as data").
+    type :: boundary_t
         character(len=32) :: name = ''
-        !> Global ids of the control points on the edge, in parameter order.
+        !> The parametric direction it is normal to, and its end in that direction
+        !> (0: the parameter's start, 1: its end).
+        integer :: direction = 0, side = 0
+        !> Global ids of the control points on it, in its parameter order.
         integer, allocatable :: cps(:)
-    end type edge_t
+    end type boundary_t
 
     !> A discretized body.
     type :: discretization_t
+        !> Spatial dimension (DOFs per control point) and parametric dimension of the
+        !> patch (2 and 2: a plane body).
+        integer :: nsd = 2, pdim = 2
         !> Refined bulk patch (for L1: the degree-1 patch).
         type(nurbs_surface_t) :: bulk
         !> Is there a VO layer on the contact edge?
@@ -63,9 +71,11 @@ module voiga_discretization_patch
         !> Elements per direction and in total.
         integer :: nel_xi = 0, nel_eta = 0, nel = 0
         type(element_t), allocatable :: elements(:)
-        !> The four edges: xi0, xi1, eta0, eta1 (after re-orientation).
-        type(edge_t) :: edges(4)
-        !> DOF counts (2 per control point): on the contact edge, the rest, all.
+        !> The boundary entities [2 pdim], direction by direction, the start before the
+        !> end: xi0, xi1, eta0, eta1 (after re-orientation; the contact edge, if any,
+        !> is the last: `contact_boundary`).
+        type(boundary_t), allocatable :: boundaries(:)
+        !> DOF counts (`nsd` per control point): on the contact edge, the rest, all.
         integer :: interface_dofs = 0, bulk_dofs = 0, total_dofs = 0
     end type discretization_t
 
@@ -127,9 +137,9 @@ contains
         end if
         call number_control_points(self)
         call build_elements(self)
-        call build_edges(self)
-        self%total_dofs = 2*self%ncp
-        if (self%has_contact) self%interface_dofs = 2*size(self%edges(4)%cps)
+        call build_boundaries(self)
+        self%total_dofs = self%nsd*self%ncp
+        if (self%has_contact) self%interface_dofs = self%nsd*size(self%boundaries(contact_boundary(self))%cps)
         self%bulk_dofs = self%total_dofs - self%interface_dofs
     end subroutine new_discretization
 
@@ -310,41 +320,73 @@ contains
         end do
     end subroutine build_elements
 
-    !> Control points of the four edges (names from the oriented patch).
-    pure subroutine build_edges(self)
+    !> The boundary entities of the plane patch, its four edges (names from the
+    !> oriented patch), and their control points.
+    pure subroutine build_boundaries(self)
         type(discretization_t), intent(inout) :: self
-        integer :: nx, ny, nl
+        integer :: nx, ny, nl, k
 
         nx = size(self%bulk_id, 1)
         ny = size(self%bulk_id, 2)
-        self%edges(:)%name = self%bulk%edge_names
-        if (self%has_layer) then
-            nl = size(self%layer_id)
-            self%edges(1)%cps = [self%bulk_id(1, 1:ny - 1), self%layer_id(1)]
-            self%edges(2)%cps = [self%bulk_id(nx, 1:ny - 1), self%layer_id(nl)]
-            self%edges(4)%cps = self%layer_id
-        else
-            self%edges(1)%cps = self%bulk_id(1, :)
-            self%edges(2)%cps = self%bulk_id(nx, :)
-            self%edges(4)%cps = self%bulk_id(:, ny)
-        end if
-        self%edges(3)%cps = self%bulk_id(:, 1)
-    end subroutine build_edges
+        allocate (self%boundaries(2*self%pdim))
+        do k = 1, size(self%boundaries)
+            self%boundaries(k)%name = self%bulk%edge_names(k)
+            self%boundaries(k)%direction = (k + 1)/2
+            self%boundaries(k)%side = 1 - mod(k, 2)
+        end do
+        associate (b => self%boundaries)
+            if (self%has_layer) then
+                nl = size(self%layer_id)
+                b(1)%cps = [self%bulk_id(1, 1:ny - 1), self%layer_id(1)]
+                b(2)%cps = [self%bulk_id(nx, 1:ny - 1), self%layer_id(nl)]
+                b(4)%cps = self%layer_id
+            else
+                b(1)%cps = self%bulk_id(1, :)
+                b(2)%cps = self%bulk_id(nx, :)
+                b(4)%cps = self%bulk_id(:, ny)
+            end if
+            b(3)%cps = self%bulk_id(:, 1)
+        end associate
+    end subroutine build_boundaries
 
-    !> Control points of the edge called `name`; error if there is none.
-    subroutine edge_cps(self, name, cps, error)
+    !> The index in `boundaries` of the contact edge or face: the end of the last
+    !> parametric direction (the patch is oriented so).
+    pure integer function contact_boundary(self)
+        type(discretization_t), intent(in) :: self
+        contact_boundary = 2*self%pdim
+    end function contact_boundary
+
+    !> The name of the contact edge or face (as the case file knows it).
+    pure function contact_name(self) result(name)
+        type(discretization_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = trim(self%boundaries(contact_boundary(self))%name)
+    end function contact_name
+
+    !> The index in `boundaries` of the entity called `name`, 0 if there is none.
+    pure integer function boundary_index(self, name)
+        type(discretization_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer :: i
+        boundary_index = 0
+        do i = 1, size(self%boundaries)
+            if (trim(self%boundaries(i)%name) == trim(name)) boundary_index = i
+        end do
+    end function boundary_index
+
+    !> Control points of the boundary entity called `name`; error if there is none.
+    subroutine boundary_cps(self, name, cps, error)
         type(discretization_t), intent(in) :: self
         character(len=*), intent(in) :: name
         integer, allocatable, intent(out) :: cps(:)
         type(error_t), allocatable, intent(out) :: error
         integer :: i
-        do i = 1, 4
-            if (trim(self%edges(i)%name) == trim(name)) then
-                cps = self%edges(i)%cps
-                return
-            end if
-        end do
-        call fatal_error(error, "no edge named '"//trim(name)//"'", error_code%input)
-    end subroutine edge_cps
+        i = boundary_index(self, name)
+        if (i == 0) then
+            call fatal_error(error, "no edge named '"//trim(name)//"'", error_code%input)
+            return
+        end if
+        cps = self%boundaries(i)%cps
+    end subroutine boundary_cps
 
 end module voiga_discretization_patch

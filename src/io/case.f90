@@ -21,7 +21,7 @@ module voiga_io_case
     use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_solver_settings, only: solver_settings_t
-    use voiga_discretization_patch, only: discretization_t
+    use voiga_discretization_patch, only: discretization_t, boundary_index
     implicit none
     private
 
@@ -271,7 +271,7 @@ contains
         type(discretization_t), intent(in) :: disc
         character(len=*), intent(in) :: name
         integer :: i
-        has_edge = any([(trim(disc%edges(i)%name) == trim(name), i=1, 4)])
+        has_edge = boundary_index(disc, name) > 0
     end function has_edge
 
     pure function edge_names(disc) result(list)
@@ -279,9 +279,9 @@ contains
         character(len=:), allocatable :: list
         integer :: i
         list = ''
-        do i = 1, 4
-            list = list//"'"//trim(disc%edges(i)%name)//"'"
-            if (i < 4) list = list//', '
+        do i = 1, size(disc%boundaries)
+            list = list//"'"//trim(disc%boundaries(i)%name)//"'"
+            if (i < size(disc%boundaries)) list = list//', '
         end do
     end function edge_names
 

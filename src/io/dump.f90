@@ -142,8 +142,8 @@ contains
         if (allocated(error)) return
         call h5%write(g//'/elements/range', ranges, error)
         if (allocated(error)) return
-        do k = 1, 4
-            call h5%write(g//'/edges/'//trim(disc%edges(k)%name), disc%edges(k)%cps, error)
+        do k = 1, size(disc%boundaries)
+            call h5%write(g//'/edges/'//trim(disc%boundaries(k)%name), disc%boundaries(k)%cps, error)
             if (allocated(error)) return
         end do
     end subroutine write_elements

@@ -17,6 +17,7 @@ module voiga_model_checks
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str, real_str, short_str
     use voiga_model, only: model_t
+    use voiga_discretization_patch, only: contact_name
     use voiga_contact_pair, only: contact_pair_t
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
     use voiga_contact_master, only: master_point_t
@@ -278,9 +279,9 @@ contains
         class default
             text = "a contact edge is on the wrong side of its body (the master's outward normal then "// &
                    "points into the slave): check contact_edge of the slave '"//trim(pair%slave_name)// &
-                   "' (now '"//trim(model%bodies(pair%slave_body)%disc%edges(4)%name)//"') and of the "// &
+                   "' (now '"//contact_name(model%bodies(pair%slave_body)%disc)//"') and of the "// &
                    "master '"//trim(pair%master_name)//"' (now '"// &
-                   trim(model%bodies(pair%master_body)%disc%edges(4)%name)//"'), or move the bodies apart"
+                   contact_name(model%bodies(pair%master_body)%disc)//"'), or move the bodies apart"
         end select
     end function overlap_remedy
 
@@ -324,7 +325,7 @@ contains
         if (dot_product(ns, mp%n) <= 0.0_dp) return
         list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '//point_str(sp%x)// &
                                 ", faces away from it: the slave's contact_edge = '"// &
-                                trim(model%bodies(pair%slave_body)%disc%edges(4)%name)// &
+                                contact_name(model%bodies(pair%slave_body)%disc)// &
                                 "' is on the side of its body away from the master; choose the edge that faces it"// &
                                 rigid_alternative(pair), topic=pair_label(pair)//'the slave faces away from the master')]
     end subroutine facing_warning

@@ -4,7 +4,7 @@
 module voiga_model
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_discretization_patch, only: discretization_t, edge_cps
+    use voiga_discretization_patch, only: discretization_t, boundary_cps, boundary_index
     use voiga_model_body, only: body_t, body_settings_t, new_body
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
                                  obstacle_motion_t, phase_friction_t, phase_of
@@ -108,7 +108,7 @@ contains
         integer, allocatable :: cps(:)
         integer :: ib
         ib = find_body(self, inp%body)
-        call edge_cps(self%bodies(ib)%disc, inp%edge, cps, error)
+        call boundary_cps(self%bodies(ib)%disc, inp%edge, cps, error)
         if (allocated(error)) then
             error%message = 'dirichlet: '//error%message//" of body '"//trim(inp%body)//"'"
             return
@@ -133,10 +133,7 @@ contains
         integer :: ib, i
         ib = find_body(self, inp%body)
         p%body = ib
-        p%edge = 0
-        do i = 1, 4
-            if (trim(self%bodies(ib)%disc%edges(i)%name) == trim(inp%edge)) p%edge = i
-        end do
+        p%edge = boundary_index(self%bodies(ib)%disc, inp%edge)
         if (p%edge == 0) then
             call fatal_error(error, "pressure: no edge named '"//trim(inp%edge)//"' on body '"// &
                              trim(inp%body)//"'", error_code%input)
