@@ -241,6 +241,47 @@ module voiga_contact_pair
         end function block_dofs_interface
     end interface
 
+    !> The stiffness pattern of a pair (`voiga_contact_pair_pattern`): which master
+    !> control points each slave element is coupled with.
+    interface
+        !> `inside`: whether the master functions of slave point `k`'s projection lie in
+        !> its element's range of the stiffness pattern; if not, the range is widened and
+        !> `pattern_miss` set (the caller rebuilds the pattern and assembles again).
+        pure module subroutine pair_fit_pattern(self, k, mp, inside)
+            class(contact_pair_t), intent(inout) :: self
+            integer, intent(in) :: k
+            type(master_point_t), intent(in) :: mp
+            logical, intent(out) :: inside
+        end subroutine pair_fit_pattern
+
+        !> Global DOFs of slave element `e`'s control points on the contact edge.
+        pure module function pair_element_dofs(self, e) result(dofs)
+            class(contact_pair_t), intent(in) :: self
+            integer, intent(in) :: e
+            integer, allocatable :: dofs(:)
+        end function pair_element_dofs
+
+        !> The master ranges each slave element should be coupled with, from the last
+        !> evaluation: the control points of the projections of its points that are
+        !> closer than the element's size (gap < diameter of its points' box), widened
+        !> by one span on each side and rounded outward to blocks of `block` control
+        !> points (so that the pattern changes seldom while the bodies slide).
+        !> `n_master` is the master's number of control points.
+        pure module subroutine pair_wanted_ranges(self, n_master, block, lo, hi)
+            class(contact_pair_t), intent(in) :: self
+            integer, intent(in) :: n_master, block
+            integer, intent(out) :: lo(:), hi(:)
+        end subroutine pair_wanted_ranges
+
+        !> A deformable master's ranges to `wanted_ranges` (blocks of `block` control
+        !> points); `changed`: whether one changed (the pattern must be rebuilt).
+        pure module subroutine pair_refit_ranges(self, block, changed)
+            class(contact_pair_t), intent(inout) :: self
+            integer, intent(in) :: block
+            logical, intent(out) :: changed
+        end subroutine pair_refit_ranges
+    end interface
+
 contains
 
     !> Place the slave Gauss points (n_gauss per slave element; 0: degree + 1), the
@@ -476,78 +517,6 @@ contains
                          error_code%numeric)
     end subroutine pair_projection_error
 
-    !> `inside`: whether the master functions of slave point `k`'s projection lie in
-    !> its element's range of the stiffness pattern; if not, the range is widened and
-    !> `pattern_miss` set (the caller rebuilds the pattern and assembles again).
-    pure subroutine pair_fit_pattern(self, k, mp, inside)
-        class(contact_pair_t), intent(inout) :: self
-        integer, intent(in) :: k
-        type(master_point_t), intent(in) :: mp
-        logical, intent(out) :: inside
-        integer :: e
-        e = self%point_element(k)
-        inside = mp%first >= self%mlo(e) .and. mp%last <= self%mhi(e)
-        if (inside) return
-        if (self%mlo(e) > self%mhi(e)) then
-            self%mlo(e) = mp%first
-            self%mhi(e) = mp%last
-        else
-            self%mlo(e) = min(self%mlo(e), mp%first)
-            self%mhi(e) = max(self%mhi(e), mp%last)
-        end if
-        self%pattern_miss = .true.
-    end subroutine pair_fit_pattern
-
-    !> Global DOFs of slave element `e`'s control points on the contact edge.
-    pure function pair_element_dofs(self, e) result(dofs)
-        class(contact_pair_t), intent(in) :: self
-        integer, intent(in) :: e
-        integer, allocatable :: dofs(:)
-        integer :: s, p
-        p = self%slave%degree
-        s = self%slave%spans(e)
-        dofs = reshape(self%slave%dofs(:, s - p:s), [2*(p + 1)])
-    end function pair_element_dofs
-
-    !> The master ranges each slave element should be coupled with, from the last
-    !> evaluation: the control points of the projections of its points that are
-    !> closer than the element's size (gap < diameter of its points' box),
-    !> widened by one span on each side and rounded outward to blocks of
-    !> `block` control points (so that the pattern changes seldom while the
-    !> bodies slide). `n_master` is the master's number of control points.
-    pure subroutine pair_wanted_ranges(self, n_master, block, lo, hi)
-        class(contact_pair_t), intent(in) :: self
-        integer, intent(in) :: n_master, block
-        integer, intent(out) :: lo(:), hi(:)
-        real(dp) :: h
-        integer :: e, k, ng, w, rng(2)
-        lo = 1
-        hi = 0
-        do e = 1, size(lo)
-            rng = self%point_range(e)
-            ng = rng(2) - rng(1) + 1
-            if (ng <= 0) cycle
-            associate (pts => self%out(rng(1):rng(2)))
-                h = norm2(maxval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2) - &
-                          minval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2))
-                do k = 1, ng
-                    if (pts(k)%first > pts(k)%last .or. pts(k)%gap >= h) cycle
-                    w = pts(k)%last - pts(k)%first
-                    if (lo(e) > hi(e)) then
-                        lo(e) = pts(k)%first - w
-                        hi(e) = pts(k)%last + w
-                    else
-                        lo(e) = min(lo(e), pts(k)%first - w)
-                        hi(e) = max(hi(e), pts(k)%last + w)
-                    end if
-                end do
-            end associate
-            if (lo(e) > hi(e)) cycle
-            lo(e) = max(1, ((lo(e) - 1)/block)*block + 1)
-            hi(e) = min(n_master, ((hi(e) + block - 1)/block)*block)
-        end do
-    end subroutine pair_wanted_ranges
-
     !> Points n_gauss (e - 1) + 1 .. n_gauss e: the Gauss points `setup` places.
     pure function pair_point_range(self, e) result(range)
         class(contact_pair_t), intent(in) :: self
@@ -594,22 +563,5 @@ contains
         logical, intent(in) :: miss
         self%pattern_miss = miss
     end subroutine pair_set_pattern_miss
-
-    !> A deformable master's ranges to `wanted_ranges` (blocks of `block` control
-    !> points); `changed`: whether one changed (the pattern must be rebuilt).
-    pure subroutine pair_refit_ranges(self, block, changed)
-        class(contact_pair_t), intent(inout) :: self
-        integer, intent(in) :: block
-        logical, intent(out) :: changed
-        integer, allocatable :: lo(:), hi(:)
-        changed = .false.
-        if (.not. self%master%deformable) return
-        allocate (lo(size(self%mlo)), hi(size(self%mhi)))
-        call self%wanted_ranges(size(self%master%all_dofs())/2, block, lo, hi)
-        changed = any(lo /= self%mlo) .or. any(hi /= self%mhi)
-        if (.not. changed) return
-        self%mlo = lo
-        self%mhi = hi
-    end subroutine pair_refit_ranges
 
 end module voiga_contact_pair

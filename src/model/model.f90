@@ -23,6 +23,9 @@ module voiga_model
     !> Everything the solver needs to know of the physics.
     type :: model_t
         type(body_t), allocatable :: bodies(:)
+        !> Spatial dimension (the first body's; every body has the same; DOFs per
+        !> control point), and the number of DOFs.
+        integer :: nsd = 2
         integer :: ndof = 0
         type(dirichlet_t), allocatable :: dirichlet(:)
         type(pressure_t), allocatable :: pressure(:)
@@ -58,10 +61,11 @@ contains
 
         allocate (self%bodies(size(bodies)))
         self%ndof = 0
+        if (size(discs) > 0) self%nsd = discs(1)%nsd
         do i = 1, size(bodies)
             call new_body(self%bodies(i), bodies(i), discs(i), self%ndof, n_gauss, error)
             if (allocated(error)) return
-            self%ndof = self%ndof + 2*self%bodies(i)%disc%ncp
+            self%ndof = self%ndof + self%nsd*self%bodies(i)%disc%ncp
             self%finite_strain = self%finite_strain .or. self%bodies(i)%mat%finite_strain
         end do
         allocate (self%fixed(self%ndof))
@@ -106,7 +110,7 @@ contains
         type(dirichlet_t), intent(out) :: d
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: cps(:)
-        integer :: ib
+        integer :: ib, c
         ib = find_body(self, inp%body)
         call boundary_cps(self%bodies(ib)%disc, inp%edge, cps, error)
         if (allocated(error)) then
@@ -117,11 +121,11 @@ contains
         d%edge = inp%edge
         d%fix = inp%fix
         d%values = inp%values
-        allocate (d%dofs(2, size(cps)))
-        d%dofs(1, :) = self%bodies(ib)%dof0 + 2*cps - 1
-        d%dofs(2, :) = self%bodies(ib)%dof0 + 2*cps
-        if (d%fix(1)) self%fixed(d%dofs(1, :)) = .true.
-        if (d%fix(2)) self%fixed(d%dofs(2, :)) = .true.
+        allocate (d%dofs(self%nsd, size(cps)))
+        do c = 1, self%nsd
+            d%dofs(c, :) = self%bodies(ib)%dof0 + self%nsd*(cps - 1) + c
+            if (d%fix(c)) self%fixed(d%dofs(c, :)) = .true.
+        end do
     end subroutine new_dirichlet
 
     !> A pressure on its edge (by the edge's index in the oriented patch).
@@ -215,7 +219,7 @@ contains
         real(dp), intent(inout) :: u(:)
         integer :: j, c
         do j = 1, size(model%dirichlet)
-            do c = 1, 2
+            do c = 1, size(model%dirichlet(j)%dofs, 1)
                 if (model%dirichlet(j)%fix(c)) then
                     u(model%dirichlet(j)%dofs(c, :)) = phase_value(model%dirichlet(j)%values(c, :), t)
                 end if
