@@ -2,7 +2,7 @@
 !> `contact_pair_t` (here, in the test) that declares its history field and computes
 !> its kinematics, and nothing else. The base pair commits, resets, writes and reads
 !> the field back; the factory's `build_pair` builds it like the methods it names
-!> (docs/theory.md, section 7, "Adding a contact method").
+!> (docs/architecture.md, "Adding a contact method").
 module test_method
     use voiga_kinds, only: dp
     use voiga_error, only: error_t

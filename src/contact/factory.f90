@@ -3,7 +3,7 @@
 !> one place a pair is built: its method, law (with the automatic penalty),
 !> quadrature, history and reference state, from the settings and the bodies the
 !> model gives. A new method is a new extension of `contact_pair_t` plus one line
-!> here (docs/theory.md, section 7, "Adding a contact method").
+!> here (docs/architecture.md, "Adding a contact method").
 module voiga_contact_factory
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code

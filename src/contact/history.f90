@@ -3,8 +3,8 @@
 !> (a step converged), resets (a step is retried), writes to a result file and
 !> sets from one (a restart) for every method alike. A method declares its fields
 !> in `setup_history` (`add`) and reads and writes their values; it writes no
-!> commit, reset or serialisation code of its own (docs/theory.md, section 7,
-!> "Adding a contact method").
+!> commit, reset or serialisation code of its own (docs/architecture.md, "Adding a
+!> contact method").
 module voiga_contact_history
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code

@@ -25,7 +25,7 @@ contains
         integer :: s, p
         p = self%slave%degree
         s = self%slave%spans(e)
-        dofs = reshape(self%slave%dofs(:, s - p:s), [2*(p + 1)])
+        dofs = reshape(self%slave%dofs(:, s - p:s), [size(self%slave%dofs, 1)*(p + 1)])
     end procedure pair_element_dofs
 
     module procedure pair_wanted_ranges

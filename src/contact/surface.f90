@@ -19,7 +19,7 @@ module voiga_contact_surface
         integer :: degree = 0
         !> Knot vector [n + degree + 1] and weights [n].
         real(dp), allocatable :: knots(:), w(:)
-        !> Body-local control point ids [n] and their global DOFs [2, n].
+        !> Body-local control point ids [n] and their global DOFs [nsd, n].
         integer, allocatable :: cps(:), dofs(:, :)
         !> Reference control points [2, n].
         real(dp), allocatable :: x0(:, :)
@@ -49,7 +49,7 @@ contains
         type(contact_surface_t), intent(out) :: self
         type(discretization_t), intent(in) :: disc
         integer, intent(in) :: dof0
-        integer :: ny
+        integer :: ny, c
         if (disc%has_layer) then
             self%degree = disc%layer%degree
             self%knots = disc%layer%knots
@@ -62,9 +62,10 @@ contains
             self%w = disc%bulk%w(:, ny)
             self%cps = disc%bulk_id(:, ny)
         end if
-        allocate (self%dofs(2, size(self%cps)))
-        self%dofs(1, :) = dof0 + 2*self%cps - 1
-        self%dofs(2, :) = dof0 + 2*self%cps
+        allocate (self%dofs(disc%nsd, size(self%cps)))
+        do c = 1, disc%nsd
+            self%dofs(c, :) = dof0 + disc%nsd*(self%cps - 1) + c
+        end do
         self%x0 = disc%x(:, self%cps)
         call set_spans(self)
     end subroutine new_contact_surface

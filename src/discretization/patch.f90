@@ -36,7 +36,7 @@ module voiga_discretization_patch
     end type element_t
 
     !> A named boundary entity of the patch: an edge of a two-dimensional patch, a
-    !> face of a three-dimensional one (docs/theory.md, "Dimension as data").
+    !> face of a three-dimensional one (docs/architecture.md, "Dimension as data").
     type :: boundary_t
         character(len=32) :: name = ''
         !> The parametric direction it is normal to, and its end in that direction
