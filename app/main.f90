@@ -316,8 +316,8 @@ contains
     end function get_arg
 
     subroutine usage()
-        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--overwrite] [--allow-overlap] [--quiet] '// &
-            '[--verbose]', &
+        write (*, '(a)') 'usage: voiga CASE.nml [--check] [--dump FILE.h5] [--overwrite] [--allow-overlap] '// &
+            '[--quiet] [--verbose]', &
             '       voiga [CASE.nml] --restart RESULT.h5 [--force-restart] [--quiet] [--verbose]', &
             '  (no option)       solve the case and write the result file it names', &
             '  --check           validate the case, build the discretization, print DOF counts', &

@@ -22,8 +22,20 @@ import sys
 import time
 from pathlib import Path
 
-from .run import (IRONING_SHORT, ROOT, STAGES, VOIGA, Run, Workdir, best_of, fit_exponent,
-                  header, hertz_errors, interleaved)
+from .run import (
+    IRONING_SHORT,
+    ROOT,
+    STAGES,
+    VOIGA,
+    Run,
+    Workdir,
+    best_of,
+    fit_exponent,
+    header,
+    hertz_errors,
+    interleaved,
+)
+
 
 def ms(x: float) -> str:
     return f"{1e3 * x:9.2f}"
@@ -100,7 +112,7 @@ def section_accuracy(w: Workdir, repeat: int) -> dict:
            "hertz_comparison, last step: reference configuration)")
     pairs = [("m3-NN2.2", "m3-N2"), ("m3-NN2.2", "m4-N2"), ("m4-NN2.2", "m5-N2")]
     names = sorted({n for p in pairs for n in p})
-    runs = dict(zip(names, interleaved([w.case("hertz", n) for n in names], repeat)))
+    runs = dict(zip(names, interleaved([w.case("hertz", n) for n in names], repeat), strict=True))
     errs = {n: hertz_errors(r.result) for n, r in runs.items()}
     print(f"{'case':10s} {'dofs':>6s} {'iters':>5s} {'wall s':>8s} {'L2 (ref.)':>11s} "
           f"{'a_fit/a-1':>10s} {'p0_fit/p0-1':>12s}")
@@ -171,7 +183,7 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
     if "direct" in rows and "multigrid" in rows:
         print("\nwall time per iteration, direct / multigrid:")
         print("  ".join(f"{a['mesh']} {a['wall'] / a['iterations'] / (b['wall'] / b['iterations']):.2f}"
-                        for a, b in zip(rows["direct"], rows["multigrid"])))
+                        for a, b in zip(rows["direct"], rows["multigrid"], strict=False)))  # direct stops earlier
     return {"rows": rows, "exponents": fits}
 
 

@@ -132,7 +132,7 @@ def _sub(name: str, nodes=(), elems=(), conds=()) -> list[str]:
     body = (_block("SubModelPartNodes", [str(int(i)) for i in nodes])
             + _block("SubModelPartElements", [str(int(i)) for i in elems])
             + _block("SubModelPartConditions", [str(int(i)) for i in conds]))
-    return [f"Begin SubModelPart {name}", *body, f"End SubModelPart"]
+    return [f"Begin SubModelPart {name}", *body, "End SubModelPart"]
 
 
 def write_mdpa(path: Path, mesh: str, split: str) -> dict:

@@ -20,8 +20,7 @@ from pathlib import Path
 import KratosMultiphysics as KM
 import KratosMultiphysics.ContactStructuralMechanicsApplication as CSMA  # noqa: F401
 import KratosMultiphysics.LinearSolversApplication  # noqa: F401
-from KratosMultiphysics.StructuralMechanicsApplication.structural_mechanics_analysis import (
-    StructuralMechanicsAnalysis)
+from KratosMultiphysics.StructuralMechanicsApplication.structural_mechanics_analysis import StructuralMechanicsAnalysis
 
 
 class CountingAnalysis(StructuralMechanicsAnalysis):

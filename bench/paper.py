@@ -197,7 +197,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.against:
         diff = differences(rows, read_summary(args.against), args.rtol)
         tol = f" by more than {args.rtol:g} relative" if args.rtol > 0 else ""
-        print(f"  measures against {args.against}: {len(diff)} cells differ{tol}" + "".join(f"\n    {d}" for d in diff[:10]))
+        print(f"  measures against {args.against}: {len(diff)} cells differ{tol}"
+              + "".join(f"\n    {d}" for d in diff[:10]))
         status = status or (1 if diff else 0)
     return status
 

@@ -138,8 +138,8 @@ def _cmd_plot_contact(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     if args.step == 0:
-        print(f"python -m post plot-contact: step 0 is the reference configuration, which has no "
-              f"contact output; give a step >= 1 or -1 for the last", file=sys.stderr)
+        print("python -m post plot-contact: step 0 is the reference configuration, which has no "
+              "contact output; give a step >= 1 or -1 for the last", file=sys.stderr)
         return 1
     try:
         chosen = result.select_step(args.step)

@@ -4,6 +4,7 @@ plot-contact``). The Hertz comparison is :mod:`post.hertz`."""
 
 from __future__ import annotations
 
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -71,7 +72,7 @@ def pressure_field(result: Result, step: int = -1, pair: int = 0, per_span: int 
     eps = float(c.attrs["penalty_normal"])
     curve, moved = _slave_edges(result, st, pair)
     breaks = np.unique(curve.knots)
-    t = np.unique(np.concatenate([np.linspace(a, b, per_span) for a, b in zip(breaks[:-1], breaks[1:])])) \
+    t = np.unique(np.concatenate([np.linspace(a, b, per_span) for a, b in pairwise(breaks)])) \
         if params is None else np.asarray(params, dtype=float)
     x = np.asarray(curve_to_splipy(moved)(t), dtype=float).reshape(-1, 2)
     gap = (x - c.rigid_point) @ c.rigid_normal

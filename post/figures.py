@@ -380,7 +380,7 @@ def study_figures(rows: list[dict[str, object]], params: list[str], out: Path) -
         bars = np.array([(c.median - c.lo, c.hi - c.median) if c else (0.0, 0.0) for c in costs]).T
         values = [_num(r, m) for r in ok]
         ax.errorbar(walls, values, xerr=bars, fmt="o", ms=5, capsize=2, elinewidth=0.8)
-        for r, w, v in zip(ok, walls, values):
+        for r, w, v in zip(ok, walls, values, strict=True):
             ax.annotate(label(r, axes), (w, v), fontsize=7, xytext=(3, 3), textcoords="offset points")
         if min(walls) > 0 and max(walls) > 10 * min(walls):
             ax.set_xscale("log")

@@ -55,7 +55,7 @@ def write_history_csv(result: Result, output: str | Path | None = None,
         w.writerow(names)
         for row in rows:
             w.writerow([int(v) if n in integer or n.startswith("points_in_contact") else repr(float(v))
-                        for n, v in zip(names, row)])
+                        for n, v in zip(names, row, strict=True)])
     return path
 
 

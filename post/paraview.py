@@ -42,6 +42,7 @@ Field data of every file: ``units``, ``title``, ``case_file``, ``voiga_version``
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -68,7 +69,7 @@ def element_samples(breaks: np.ndarray, samples: int, minimum: int = MIN_SAMPLES
     parts: ``samples``, or more when needed for ``minimum`` in all."""
     spans = max(len(breaks) - 1, 1)
     n = max(samples, -(-minimum // spans))
-    parts = [np.linspace(a, b, n + 1)[:-1] for a, b in zip(breaks[:-1], breaks[1:])]
+    parts = [np.linspace(a, b, n + 1)[:-1] for a, b in pairwise(breaks)]
     return np.concatenate(parts + [breaks[-1:]])
 
 

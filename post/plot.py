@@ -16,6 +16,7 @@ scale.
 from __future__ import annotations
 
 import textwrap
+from itertools import pairwise
 from pathlib import Path
 
 import matplotlib
@@ -58,7 +59,7 @@ def sample_parameters(breaks: np.ndarray, minimum: int = MIN_SAMPLES) -> np.ndar
     same number (>= 4) of parts, at least ``minimum`` in total."""
     spans = max(len(breaks) - 1, 1)
     n = max(4, int(np.ceil(minimum / spans)))
-    parts = [np.linspace(a, b, n + 1)[:-1] for a, b in zip(breaks[:-1], breaks[1:])]
+    parts = [np.linspace(a, b, n + 1)[:-1] for a, b in pairwise(breaks)]
     return np.concatenate(parts + [breaks[-1:]])
 
 
@@ -289,8 +290,9 @@ def deformed_figure(result: Result, step: int = -1, scale: float | str = "auto",
     needs a step with sampled fields). ``colour_scale``: ``'body'`` (each body its
     own range and colour bar: a body that translates far does not flatten the
     others) or ``'shared'``; default ``'body'`` for a displacement, ``'shared'``
-    for a stress or strain (continuous across bodies in contact). Rigid masters (lines, curves) are drawn in both panels,
-    in the first moved by their prescribed motion times ``scale``.
+    for a stress or strain (continuous across bodies in contact). Rigid masters (lines,
+    curves) are drawn in both panels, in the first moved by their prescribed motion
+    times ``scale``.
     """
     if not result.bodies:
         raise ValueError(f"{result.path}: no bodies")
@@ -376,7 +378,7 @@ def _draw_rigid_masters(ax: plt.Axes, s: Step | None, scale: float, size: float)
     line_offsets = [offset(c) for c in contact if c.rigid_point is not None and c.rigid_normal is not None]
     curve_offsets = [offset(c) for c in contact if c.rigid_curve is not None]
     note = "" if scale == 1.0 else f" (its motion x {scale:g}, as the bodies)"
-    moved_lines = [(p + (scale - 1.0) * d, n, lab) for (p, n, lab), d in zip(lines, line_offsets)]
+    moved_lines = [(p + (scale - 1.0) * d, n, lab) for (p, n, lab), d in zip(lines, line_offsets, strict=True)]
     if moved_lines:
         xl, yl = ax.get_xlim(), ax.get_ylim()
         for p, n, lab in moved_lines:
@@ -384,7 +386,7 @@ def _draw_rigid_masters(ax: plt.Axes, s: Step | None, scale: float, size: float)
         ax.set_xlim(min(xl[0], *(p[0] - 0.05 * size for p, _, _ in moved_lines)),
                     max(xl[1], *(p[0] + 0.05 * size for p, _, _ in moved_lines)))
         ax.set_ylim(min(yl[0], *(p[1] - 0.06 * size for p, _, _ in moved_lines)), yl[1])
-    for (pts, n, lab), d in zip(curves, curve_offsets):
+    for (pts, n, lab), d in zip(curves, curve_offsets, strict=True):
         draw_rigid_curve(ax, pts + (scale - 1.0) * d, n, 0.04 * size, lab + note)
     if lines or curves:
         ax.autoscale_view()

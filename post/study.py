@@ -241,7 +241,7 @@ class Study:
         """Every combination of the grid, for every list entry (one empty change set
         when the study changes nothing)."""
         keys = list(self.grid)
-        grid = [dict(zip(keys, combo)) for combo in itertools.product(*self.grid.values())]
+        grid = [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*self.grid.values())]
         sets = []
         for point in self.points or [{}]:
             for g in grid:

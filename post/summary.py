@@ -84,7 +84,7 @@ def summary_lines(result: Result) -> list[str]:
         return lines + warnings_for(result)
     last = steps[-1]
     lines.append(f"last converged step {last.step}, load time {last.time:g}:")
-    for d, r in zip(result.dirichlet, last.reactions):
+    for d, r in zip(result.dirichlet, last.reactions, strict=True):
         lines.append(f"  reaction on {d.body}/{d.edge}: {_vec(r)} {u.line_force}")
     for c in last.contact:
         active = c.active

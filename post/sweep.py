@@ -117,7 +117,7 @@ def estimated_cost(case: Path, text: str | None = None) -> float:
     for b in bodies:
         p, q = int(b.get("degree_xi", 2)), int(b.get("degree_eta", 2))
 
-        def nel(direction: str) -> int:
+        def nel(direction: str, b: dict = b) -> int:
             knots = b.get(f"knots_{direction}")
             if knots is not None:
                 return len(knots if isinstance(knots, list) else [knots]) + 1
@@ -203,9 +203,9 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
             rows = list(pool.map(_row, tasks, chunksize=4))
     else:
         rows = [_row(task) for task in tasks]
-    for run, row in zip(runs, rows):
+    for run, row in zip(runs, rows, strict=True):
         if str(row["scene"]).startswith("ironing") and "amp_px" in row:
-            n2 = [r for u, r in zip(runs, rows) if u.scene == run.scene and u.mesh == run.mesh
+            n2 = [r for u, r in zip(runs, rows, strict=True) if u.scene == run.scene and u.mesh == run.mesh
                   and u.layout == "N2" and u.changes == run.changes and "amp_px" in r]
             if n2:
                 row["px_pct_n2"] = 100.0 * float(row["amp_px"]) / float(n2[0]["amp_px"])

@@ -24,7 +24,7 @@ class Units:
     force: str = "force"
 
     @classmethod
-    def parse(cls, text: str | None) -> "Units":
+    def parse(cls, text: str | None) -> Units:
         """Units from a ``units`` attribute: ``"<length>, <force>"`` (e.g. ``"mm, N"``);
         anything else gives the generic ``length`` / ``force``."""
         m = _PAIR.match(text or "")

@@ -21,8 +21,16 @@ import numpy as np
 from .files import write_text
 from .h5io import write_geometry
 from .layouts import parse_layout
-from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, arc_parameter_exact, hertz_eta_knots,
-                     hertz_radial_elements, hertz_xi_knots, mesh_level, nest)
+from .meshes import (
+    HERTZ_A_EXP,
+    HERTZ_H_SURFACE,
+    arc_parameter_exact,
+    hertz_eta_knots,
+    hertz_radial_elements,
+    hertz_xi_knots,
+    mesh_level,
+    nest,
+)
 from .scenes import RINGS_LOWER, RINGS_UPPER, scene_bodies
 
 Groups = dict[str, Any]

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -88,7 +89,7 @@ def half_annulus(centre: tuple[float, float], radius: float, start: float) -> Pa
     for r in (R_IN * radius, radius):
         pts: list[np.ndarray] = []
         wts: list[float] = []
-        for k, (a0, a1) in enumerate(zip(angles[:-1], angles[1:])):
+        for k, (a0, a1) in enumerate(pairwise(angles)):
             p, w = arc_piece(centre, r, a0, a1)
             pts.extend(p if k == 0 else p[1:])
             wts.extend(w if k == 0 else w[1:])

@@ -27,16 +27,24 @@ only chooses the inputs and checks the result.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 import splipy
 from splipy import curve_factory, surface_factory
 
 from .h5io import write_geometry
-from .nurbs import (EDGE_KEYS, Curve, Patch, curve_from_splipy, curve_to_splipy, evaluate_patch,
-                    patch_from_splipy, patch_to_splipy)
+from .nurbs import (
+    EDGE_KEYS,
+    Curve,
+    Patch,
+    curve_from_splipy,
+    curve_to_splipy,
+    evaluate_patch,
+    patch_from_splipy,
+    patch_to_splipy,
+)
 from .scenes import annular_sector as _quarter_sector
 from .scenes import rectangle as _rectangle
 
@@ -265,7 +273,7 @@ def _match_edges(patch: Patch, sides: list[splipy.Curve], names: list[str]) -> d
     """Name the patch edges after the side curves they coincide with."""
     t = np.linspace(0.0, 1.0, 7)
     out = {}
-    for curve, name in zip(sides, names):
+    for curve, name in zip(sides, names, strict=True):
         pts = np.asarray(curve(np.linspace(curve.start(0), curve.end(0), 7)))[:, :2]
         best = min(EDGE_KEYS, key=lambda k: min(np.abs(_edge_points(patch, k, t) - pts).max(),
                                                 np.abs(_edge_points(patch, k, t)[::-1] - pts).max()))

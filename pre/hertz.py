@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -44,8 +45,16 @@ from .cases import GEOMETRY_FILE, HERTZ_DISPLACEMENT, hertz_case, to_namelist_te
 from .files import check_output, write_text
 from .h5io import write_geometry
 from .layouts import parse_layout
-from .meshes import (HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_R_IN, HERTZ_R_OUT,
-                     arc_parameter_exact, hertz_radial_elements, hertz_theta_c, mesh_level)
+from .meshes import (
+    HERTZ_A_EXP,
+    HERTZ_H_SURFACE,
+    HERTZ_R_IN,
+    HERTZ_R_OUT,
+    arc_parameter_exact,
+    hertz_radial_elements,
+    hertz_theta_c,
+    mesh_level,
+)
 from .scenes import HERTZ, annular_sector
 
 MAX_INDENTATION = 0.1
@@ -119,7 +128,7 @@ def split_spans(knots: list[float], parameters: list[tuple[float, float]],
     ``(t0, t1)`` split into ``factor`` equal parameter spans."""
     full = [0.0, *knots, 1.0]
     out: list[float] = []
-    for k0, k1 in zip(full[:-1], full[1:]):
+    for k0, k1 in pairwise(full):
         n = factor if any(k1 > t0 and k0 < t1 for t0, t1 in parameters) else 1
         out.extend(k0 + (k1 - k0) * j / n for j in range(n))
     return out[1:]

@@ -16,6 +16,7 @@ so ``t = (1 + tan(theta / 2) / tan(a / 2)) / 2`` exactly. (Derivation: with
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import numpy as np
 from scipy.optimize import brentq
@@ -70,7 +71,7 @@ def nest(breaks: np.ndarray, factor: int) -> np.ndarray:
     ``factor`` equal parameter spans."""
     full = np.concatenate([[0.0], np.asarray(breaks, float), [1.0]])
     out = []
-    for k0, k1 in zip(full[:-1], full[1:]):
+    for k0, k1 in pairwise(full):
         out.extend(k0 + (k1 - k0) * j / factor for j in range(factor))
     return np.array(out[1:])
 

@@ -105,7 +105,7 @@ def plot_bases(cases: list[tuple[str, BodyDiscretization]], out: str | Path) -> 
     fig, axes = plt.subplots(len(cases), 1, figsize=(8, 1.9 * len(cases)), sharex=True,
                              layout="constrained")
     t = np.linspace(0.0, 1.0, 1201)
-    for ax, (label, body) in zip(np.atleast_1d(axes), cases):
+    for ax, (label, body) in zip(np.atleast_1d(axes), cases, strict=True):
         curve, what = contact_curve(body)
         basis = rational_basis(curve, t)
         for k in range(basis.shape[1]):

@@ -29,9 +29,19 @@ import numpy as np
 
 from .cases import case_bodies, read_case
 from .files import new_file
-from .h5io import _str, read_curve, read_geometry, read_patch, write_curve, write_patch, attrs_dict
-from .nurbs import (KNOT_TOL, Curve, Patch, curve_from_splipy, curve_to_splipy, eta1_curve,
-                    interior_breakpoints, patch_from_splipy, patch_to_splipy, unique_knots)
+from .h5io import _str, attrs_dict, read_curve, read_geometry, read_patch, write_curve, write_patch
+from .nurbs import (
+    KNOT_TOL,
+    Curve,
+    Patch,
+    curve_from_splipy,
+    curve_to_splipy,
+    eta1_curve,
+    interior_breakpoints,
+    patch_from_splipy,
+    patch_to_splipy,
+    unique_knots,
+)
 
 DOFS_PER_NODE = 2
 

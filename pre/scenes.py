@@ -19,7 +19,8 @@ Values (``docs/pre.md`` and ``docs/benchmarks.md`` section 3):
 from __future__ import annotations
 
 import math
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
+from itertools import pairwise
 
 import numpy as np
 
@@ -46,7 +47,7 @@ def arc_row(centre: Sequence[float], radius: float, angles_deg: Sequence[int]) -
     c = np.asarray(centre, dtype=float)
     pts: list[np.ndarray] = []
     wts: list[float] = []
-    for k, (a0, a1) in enumerate(zip(angles_deg[:-1], angles_deg[1:])):
+    for k, (a0, a1) in enumerate(pairwise(angles_deg)):
         if abs(a1 - a0) != 90 or a0 % 90:
             raise ValueError("arc_row needs breakpoints at multiples of 90 deg, 90 deg apart")
         d0, d1 = _direction(a0), _direction(a1)

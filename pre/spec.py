@@ -28,9 +28,22 @@ from typing import Any
 from .cases import to_namelist_text
 from .changes import geometry_changes, namelist_changes
 from .files import check_output, write_text
-from .geometry import (annular_sector, body, check_curve, check_patch, edge_length, ellipse_sector, obstacle,
-                       obstacle_arc, obstacle_ellipse, obstacle_polyline, polygon, read_g2, rectangle,
-                       write_bodies)
+from .geometry import (
+    annular_sector,
+    body,
+    check_curve,
+    check_patch,
+    edge_length,
+    ellipse_sector,
+    obstacle,
+    obstacle_arc,
+    obstacle_ellipse,
+    obstacle_polyline,
+    polygon,
+    read_g2,
+    rectangle,
+    write_bodies,
+)
 from .layouts import parse_layout
 from .namelists import NAMELISTS
 from .nurbs import Curve, Patch

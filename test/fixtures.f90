@@ -2,6 +2,7 @@
 !> deterministic pseudo-random sequence, and a scene built from plain settings
 !> (no case file).
 module voiga_test_fixtures
+    use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_nurbs_surface, only: nurbs_surface_t
@@ -30,7 +31,7 @@ module voiga_test_fixtures
 
     !> Park-Miller generator: same numbers on every compiler and run.
     type :: lcg_t
-        integer(8) :: state = 12345_8
+        integer(int64) :: state = 12345_int64
     contains
         procedure :: uniform => lcg_uniform
     end type lcg_t
@@ -121,7 +122,7 @@ contains
     real(dp) function lcg_uniform(self)
         class(lcg_t), intent(inout) :: self
         ! Park-Miller minimal standard: no integer overflow in 64 bits
-        self%state = modulo(16807_8*self%state, 2147483647_8)
+        self%state = modulo(16807_int64*self%state, 2147483647_int64)
         lcg_uniform = real(self%state - 1, dp)/2147483646.0_dp
     end function lcg_uniform
 

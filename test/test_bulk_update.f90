@@ -147,6 +147,7 @@ contains
             if (ios /= 0) exit
             if (line(1:8) == 'Threads:') then
                 read (line(9:), *, iostat=ios) n
+                if (ios /= 0) n = -1
                 exit
             end if
         end do

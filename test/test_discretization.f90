@@ -404,7 +404,8 @@ contains
                     do el = 1, d%nel
                         entries = entries + (2_int64*size(d%elements(el)%conn))**2
                     end do
-                    call check(error, counted%ncp == d%ncp .and. counted%nel == d%nel .and. counted%entries == entries, &
+                    call check(error, counted%ncp == d%ncp .and. counted%nel == d%nel .and. &
+                               counted%entries == entries, &
                                'counts of '//trim(names(k))//' with contact edge '//trim(edges(e)))
                     if (allocated(error)) return
                 end do

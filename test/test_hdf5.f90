@@ -153,10 +153,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer(hid_t) :: fid, sid, tid, did, i64
         integer :: st, bad
-        character(len=8), target :: words(3) = [character(len=8) :: 'one', 'two', 'three']
-        integer(int64), target :: wide(2, 2) = reshape([1_int64, -7_int64, 1_int64, 2_int64**40], &
+        character(len=8), target, save :: words(3) = [character(len=8) :: 'one', 'two', 'three']
+        integer(int64), target, save :: wide(2, 2) = reshape([1_int64, -7_int64, 1_int64, 2_int64**40], &
                                                        [2, 2])
-        integer, target :: three(3) = [1, 2, 3]
+        integer, target, save :: three(3) = [1, 2, 3]
 
         bad = 0
         call h5open_f(st)

@@ -9,11 +9,22 @@ from pathlib import Path
 
 import pytest
 
-from post.cost import (ONCE, RepeatPolicy, Sample, Spread, cheapest, cost_columns, cost_path, ratio,
-                       read_costs, timed_run, write_costs)
+from post.cost import (
+    ONCE,
+    RepeatPolicy,
+    Sample,
+    Spread,
+    cheapest,
+    cost_columns,
+    cost_path,
+    ratio,
+    read_costs,
+    timed_run,
+    write_costs,
+)
 from post.engine import Task, connect, run_all, run_task
-from post.sweep import find_cases
 from post.figures import accuracy_cost
+from post.sweep import find_cases
 
 BURN = "import time\nwhile time.process_time() < {0}: pass\n"
 """A child that uses ``{0}`` CPU seconds, however busy the machine is."""

@@ -33,7 +33,7 @@ def test_parallel_figures_equal_serial(tmp_path: Path) -> None:
     assert [p.name for p in serial] == [p.name for p in parallel]
     # the three hertz error plots (mesh and time each) and the two pressure plots
     assert len(serial) == 8
-    for a, b in zip(serial, parallel):
+    for a, b in zip(serial, parallel, strict=True):
         assert a.read_bytes() == b.read_bytes(), a.name
     assert (tmp_path / "one" / "accuracy-cost.md").read_text() == (tmp_path / "two" / "accuracy-cost.md").read_text()
 

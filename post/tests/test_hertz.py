@@ -17,8 +17,15 @@ import pytest
 from scipy.integrate import quad
 
 from post.__main__ import main
-from post.hertz import (EDGE_LEVEL, EDGE_ZONE, HertzError, hertz_comparison, hertz_pressure,
-                        hertz_reference, profile_error)
+from post.hertz import (
+    EDGE_LEVEL,
+    EDGE_ZONE,
+    HertzError,
+    hertz_comparison,
+    hertz_pressure,
+    hertz_reference,
+    profile_error,
+)
 from post.reader import read_result
 
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -31,7 +31,7 @@ def test_history_csv_equals_the_file(press_h5: Path, tmp_path: Path,
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == len(result.steps)
-    for row, s in zip(rows, result.steps):
+    for row, s in zip(rows, result.steps, strict=True):
         assert int(row["step"]) == s.step and float(row["time"]) == s.time
         for k, d in enumerate(result.dirichlet):
             assert float(row[f"reaction_x {d.body}/{d.edge}"]) == s.reactions[k, 0]

@@ -9,11 +9,10 @@ import numpy as np
 import pytest
 
 from post.cost import RepeatPolicy
+from post.engine import connect, run_all
 from post.figures import accuracy_cost
 from post.measures import detrended_amplitude, profile_error
-from post.engine import connect, run_all
-from post.sweep import (estimated_cost, find_cases, longest_first, previous_times, summarize, up_to_date,
-                        write_summary)
+from post.sweep import estimated_cost, find_cases, longest_first, previous_times, summarize, up_to_date, write_summary
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -58,7 +58,7 @@ def test_stretch_series_matches_the_exact_field(stretch_h5: Path, tmp_path: Path
     series = _series(pvd)
     assert [t for t, _, _ in series] == [0.0] + [s.time for s in result.steps]
     assert all(name == "bodies" for _, name, _ in series)  # no contact in this case
-    for (time, _, path), step in zip(series[1:], result.steps):
+    for time, _, path in series[1:]:
         grid = _read(path)
         x, u = _points(grid)[:, :2], _pdata(grid, "displacement")
         assert np.all(_points(grid)[:, 2] == 0) and np.all(u[:, 2] == 0)
@@ -110,7 +110,7 @@ def test_contact_edge_fields(which: str, request: pytest.FixtureRequest, tmp_pat
     assert main(["vtk", str(path), "--out", str(tmp_path)]) == 0
     contact = [(t, p) for t, name, p in _series(tmp_path / f"{path.stem}.pvd") if name == "contact"]
     assert len(contact) == len(result.steps)
-    for (time, vtu), step in zip(contact, result.steps):
+    for (_time, vtu), step in zip(contact, result.steps, strict=True):
         grid = _read(vtu)
         c = step.contact[0]
         order = np.argsort(c.xi_slave, kind="stable")

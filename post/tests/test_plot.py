@@ -87,8 +87,8 @@ def test_stress_field_of_the_stretch(fields_h5: Path, tmp_path: Path,
     strain, free sides). `plot-deformed --field` colours by it (issue 38, item 3: no
     figure showed stress); the interpolation between samples returns the solver's
     values at its sample points and the uniform value everywhere."""
-    from post.quantity import sampled_quantity
     from post.plot import deformed_figure
+    from post.quantity import sampled_quantity
 
     result = read_result(fields_h5)
     step = result.steps[-1]

@@ -235,24 +235,24 @@ def test_lazy_read_gives_the_same_values(which: str, request: pytest.FixtureRequ
     assert lazy.attrs == eager.attrs and list(lazy.bodies) == list(eager.bodies)
     assert [s.step for s in lazy.steps] == [s.step for s in eager.steps]
     assert len(eager.steps) == {"two": 3, "hertz": 5}[which]
-    for a, b in zip(lazy.steps, eager.steps):
+    for a, b in zip(lazy.steps, eager.steps, strict=True):
         assert (a.iterations, a.cuts, a.seconds) == (b.iterations, b.cuts, b.seconds)
         np.testing.assert_array_equal(a.reactions, b.reactions)
         assert not a._data  # nothing else read yet
-    for a, b in zip(lazy.steps, eager.steps):
+    for a, b in zip(lazy.steps, eager.steps, strict=True):
         np.testing.assert_array_equal(a.displacement, b.displacement)
         assert (a.time, a.substeps) == (b.time, b.substeps)
         np.testing.assert_array_equal(a.residual_norms, b.residual_norms)
         np.testing.assert_array_equal(a.energy_norms, b.energy_norms)
         assert len(a.contact) == len(b.contact) == {"two": 0, "hertz": 1}[which]
-        for ca, cb in zip(a.contact, b.contact):
+        for ca, cb in zip(a.contact, b.contact, strict=True):
             assert (ca.slave, ca.master, ca.attrs) == (cb.slave, cb.master, cb.attrs)
             for key in ("force", "xi_slave", "x_ref", "x", "gap", "p_n", "p_t", "xi_master", "state"):
                 np.testing.assert_array_equal(getattr(ca, key), getattr(cb, key))
     for name in eager.bodies:
         np.testing.assert_array_equal(body_displacement(lazy, name), body_displacement(eager, name))
     for k in range(len(eager.dirichlet)):
-        for x, y in zip(reaction_history(lazy, k), reaction_history(eager, k)):
+        for x, y in zip(reaction_history(lazy, k), reaction_history(eager, k), strict=True):
             np.testing.assert_array_equal(x, y)
 
 
@@ -269,7 +269,7 @@ def test_lazy_read_checks_the_displacement_when_used(two_h5: Path, tmp_path: Pat
     res = read_result(path, lazy=True)
     assert len(res.steps[0].displacement) == res.n_dofs
     with pytest.raises(ValueError, match="displacement has"):
-        res.steps[1].displacement
+        _ = res.steps[1].displacement
 
 
 def _damaged(source: Path, folder: Path, edit) -> Path:

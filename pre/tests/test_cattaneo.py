@@ -8,8 +8,7 @@ import f90nml
 import numpy as np
 import pytest
 
-from pre.cattaneo import (R_IN, CattaneoCaseError, CattaneoScene, arc_knots, cattaneo_case,
-                          half_annulus, write_cattaneo)
+from pre.cattaneo import R_IN, CattaneoCaseError, CattaneoScene, arc_knots, cattaneo_case, half_annulus, write_cattaneo
 from pre.nurbs import evaluate_patch
 
 

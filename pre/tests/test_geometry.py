@@ -13,8 +13,7 @@ import splipy
 from splipy import surface_factory
 
 from pre.__main__ import main
-from pre.geometry import (annular_sector, check_patch, edge_length, polygon, rectangle,
-                          write_bodies)
+from pre.geometry import annular_sector, check_patch, edge_length, polygon, rectangle, write_bodies
 from pre.h5io import read_geometry
 from pre.nurbs import evaluate_patch
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import os
 import subprocess
+from itertools import pairwise
 from pathlib import Path
 
 import f90nml
@@ -17,8 +18,7 @@ import pytest
 from pre.__main__ import main
 from pre.cases import STUDIES, hertz_case
 from pre.h5io import read_geometry
-from pre.hertz import (Cylinder, HertzCaseError, cylinder_case, expected_half_width,
-                       grading_half_width, write_hertz_case)
+from pre.hertz import Cylinder, HertzCaseError, cylinder_case, expected_half_width, grading_half_width, write_hertz_case
 from pre.meshes import HERTZ_A_EXP, HERTZ_H_SURFACE, HERTZ_N_CONTACT, arc_angle, hertz_theta_c
 
 from .conftest import CASES, REPO
@@ -205,7 +205,7 @@ def test_edge_refinement(tmp_path: Path) -> None:
     theta_c = hertz_theta_c(grading_half_width(0.0025))
     first_coarse = int(np.flatnonzero(angles[:-1] >= theta_c * (1 - 1e-12))[0])
     hit = [(lo < math.asin(1.1 * a)) and (hi > math.asin(0.9 * a)) or k == first_coarse
-           for k, (lo, hi) in enumerate(zip(angles[:-1], angles[1:]))]
+           for k, (lo, hi) in enumerate(pairwise(angles))]
     assert 2 <= sum(hit) <= 7 and hit[first_coarse] and not hit[first_coarse - 1]
     assert len(fine) == len(plain) + 2 * sum(hit)
     assert set(plain) <= set(fine)

@@ -9,8 +9,17 @@ import pytest
 
 from pre.cases import RINGS_A_EXP, rings_m1_angles, rings_m1_breaks, rings_xi_knots
 from pre.layouts import parse_layout
-from pre.meshes import (HERTZ_A_EXP, arc_angle, arc_parameter, hertz_eta_knots, hertz_m1_angles,
-                        hertz_theta_c, hertz_xi_knots, nest, uniform_interior)
+from pre.meshes import (
+    HERTZ_A_EXP,
+    arc_angle,
+    arc_parameter,
+    hertz_eta_knots,
+    hertz_m1_angles,
+    hertz_theta_c,
+    hertz_xi_knots,
+    nest,
+    uniform_interior,
+)
 from pre.nurbs import evaluate_patch
 from pre.scenes import RINGS_LOWER, RINGS_UPPER, scene_bodies
 

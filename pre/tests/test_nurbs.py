@@ -7,8 +7,16 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import BSpline
 
-from pre.nurbs import (Curve, Patch, curve_from_splipy, curve_to_splipy, evaluate_curve,
-                       evaluate_patch, patch_from_splipy, patch_to_splipy)
+from pre.nurbs import (
+    Curve,
+    Patch,
+    curve_from_splipy,
+    curve_to_splipy,
+    evaluate_curve,
+    evaluate_patch,
+    patch_from_splipy,
+    patch_to_splipy,
+)
 from pre.scenes import scene_bodies
 
 

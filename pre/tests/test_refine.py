@@ -13,7 +13,7 @@ from pre.__main__ import main
 from pre.cases import all_cases
 from pre.h5io import read_geometry
 from pre.nurbs import eta1_curve, evaluate_curve, evaluate_patch, unique_knots
-from pre.refine import (discretize_body, discretize_case, orient, read_dump, write_dump)
+from pre.refine import discretize_body, discretize_case, orient, read_dump, write_dump
 from pre.scenes import scene_bodies
 
 # Table 2 (ironing, m1): die (interface, bulk, total), slab (...), total.
@@ -101,7 +101,7 @@ def test_geometry_invariance_all_cases(generated: Path) -> None:
 
 def _multiplicities(knots: np.ndarray) -> dict[float, int]:
     vals, counts = np.unique(knots, return_counts=True)
-    return dict(zip(vals.tolist(), counts.tolist()))
+    return dict(zip(vals.tolist(), counts.tolist(), strict=True))
 
 
 def test_knot_structure(generated: Path) -> None:

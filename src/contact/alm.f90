@@ -261,8 +261,8 @@ contains
             set%c(j) = self%g(a)
             set%rows(j) = self%v(a)
             set%cols(j) = sparse_vector_t(self%v(a)%dofs, -self%v(a)%values)
-            if (self%state(a) == state_slip) set%cols(j)%values = set%cols(j)%values - &
-                                                                  self%law%mu*sign(1.0_dp, self%t_last(a))*self%q(a)%values
+            if (self%state(a) == state_slip) set%cols(j)%values = set%cols(j)%values &
+                - self%law%mu*sign(1.0_dp, self%t_last(a))*self%q(a)%values
         end do
         do j = 1, size(stick)
             a = stick(j)

@@ -458,6 +458,8 @@ contains
                 w = items(i)%values
             case ('point_element')
                 elem = items(i)%flags
+            case default
+                ! the mortar pair's fields: read by its set_history below
             end select
         end do
         if (.not. (allocated(xi) .and. allocated(w) .and. allocated(elem))) then

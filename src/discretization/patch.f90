@@ -103,7 +103,7 @@ contains
             edge = edge_index(coarse, layout%contact_edge)
             if (edge == 0) then
                 call fatal_error(error, where//"contact_edge = '"//trim(layout%contact_edge)// &
-                                 "' is not an edge of this body (edges: "//edge_list(coarse)//")", &
+                                 "' is not an edge of this body (edges: "//edge_list(coarse)//')', &
                                  error_code%input)
                 return
             end if

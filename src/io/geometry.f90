@@ -179,7 +179,7 @@ contains
         where = h5%path//': '//what//" '"//trim(name)//"': "
         if (.not. h5%exists(g)) then
             call fatal_error(error, h5%path//': no '//what//" '"//trim(name)//"' (group "//g// &
-                             " is missing)", error_code%input)
+                             ' is missing)', error_code%input)
             return
         end if
         call h5%read(g//'/degree', degree, error, 16_int64)

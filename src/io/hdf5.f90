@@ -275,8 +275,8 @@ contains
         call h5fclose_f(self%id, st)
         self%id = -1
         self%known = ''
-        if (st /= 0) call fatal_error(error, self%path//": closing the file failed in H5Fclose "// &
-                                      "(what was written may not be on disk)")
+        if (st /= 0) call fatal_error(error, self%path//': closing the file failed in H5Fclose '// &
+                                      '(what was written may not be on disk)')
     end subroutine file_close
 
     !> Last resort for a file nobody closed: close it, ignoring the status (there
@@ -309,8 +309,8 @@ contains
         integer :: st
         if (self%id < 0) return
         call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, st)
-        if (st /= 0) call fatal_error(error, self%path//": flushing the file failed in "// &
-                                      "H5Fflush (is the disk full?)")
+        if (st /= 0) call fatal_error(error, self%path//': flushing the file failed in '// &
+                                      'H5Fflush (is the disk full?)')
     end subroutine file_flush
 
     !> Does the object (group or dataset) at `path` exist? (No, when HDF5 fails.)

@@ -122,7 +122,7 @@ contains
         sid = -1
         object = self%path//": attribute '"//name//"' of '"//path//"'"
         if (.not. self%has_attr(path, name)) then
-            call fatal_error(error, object//" is missing", error_code%input)
+            call fatal_error(error, object//' is missing', error_code%input)
             return
         end if
         steps: block
@@ -145,11 +145,11 @@ contains
         end block steps
         call release(sid, failed)
         if (allocated(failed)) then
-            call fatal_error(error, object//": reading failed in "//failed, error_code%input)
+            call fatal_error(error, object//': reading failed in '//failed, error_code%input)
         else if (npoints /= 1) then
-            call fatal_error(error, object//" holds more than one value", error_code%input)
+            call fatal_error(error, object//' holds more than one value', error_code%input)
         else if (all(classes /= type_class)) then
-            call fatal_error(error, object//" holds "//class_name(type_class)//", not "//what, &
+            call fatal_error(error, object//' holds '//class_name(type_class)//', not '//what, &
                              error_code%input)
         end if
         if (allocated(error)) call attr_close(oid, aid, tid, failed)

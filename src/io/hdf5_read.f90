@@ -72,7 +72,7 @@ contains
         character(len=12) :: buf
         write (buf, '(i0)') array_rank
         call fatal_error(error, self%path//": reading dataset '"//path// &
-                         "' into an array of rank "//trim(buf)//" is not supported")
+                         "' into an array of rank "//trim(buf)//' is not supported')
     end subroutine unsupported_rank
 
     !> Shape (Fortran order) of dataset `path`, checked to be readable as an array of
@@ -108,7 +108,7 @@ contains
         if (.not. (type_class == H5T_INTEGER_F .or. &
                    (as_real .and. type_class == H5T_FLOAT_F))) then
             call fatal_error(error, self%path//": dataset '"//path//"' holds "// &
-                             class_name(type_class)//", not "//trim(expected), error_code%input)
+                             class_name(type_class)//', not '//trim(expected), error_code%input)
             return
         end if
         if (array_rank == 0 .and. product(dims) == 1 .and. size(dims) <= 1) then

@@ -76,7 +76,7 @@ contains
             if (text(pos:pos) /= '&' .and. text(pos:pos) /= '$') then
                 call fatal_error(error, path//': line '//str(line)//": text outside any namelist group: '"// &
                                  clip(text(pos:line_end(text, pos)))//"' (a group starts with &name and "// &
-                                 "ends with /)", error_code%input)
+                                 'ends with /)', error_code%input)
                 return
             end if
             first = pos

@@ -9,8 +9,8 @@
 module voiga_io_outputs
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_io_os, only: canonical_path, companion, file_info_t, file_status, path_kind, same_file, kind_name, what_is, &
-                           kind_missing, kind_regular, kind_folder, kind_unknown
+    use voiga_io_os, only: canonical_path, companion, file_info_t, file_status, path_kind, same_file, kind_name, &
+                           what_is, kind_missing, kind_regular, kind_folder, kind_unknown
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_case, only: case_t
     implicit none

@@ -473,8 +473,8 @@ contains
 
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and the
     !> run's counters of `stats` (every cut as /cuts when there is one, the Tresca
-    !> fixed point's, the multiplier updates), and close. The file is closed whatever fails (the first error is returned)
-    !> and given its name (`result_file_t%settle`); a broken file is not touched
+    !> fixed point's, the multiplier updates), and close. The file is closed whatever fails (the first error is
+    !> returned) and given its name (`result_file_t%settle`); a broken file is not touched
     !> (`abandon`), nor one with no room left for the status, nor one moved, replaced
     !> or removed under the run (`lost`; they stay 'running', every step written
     !> readable).

@@ -20,8 +20,8 @@ module voiga_linalg_blas
         [character(len=20) :: 'OPENBLAS_NUM_THREADS', 'GOTO_NUM_THREADS', 'OMP_NUM_THREADS']
 
     !> OpenBLAS's kernels were switched by `choose_blas_kernels`, from these.
-    logical, save :: kernels_switched = .false.
-    character(len=32), save :: kernels_detected = ''
+    logical :: kernels_switched = .false.
+    character(len=32) :: kernels_detected = ''
 
     interface
         pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)

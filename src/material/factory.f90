@@ -31,7 +31,6 @@ contains
         case default
             call fatal_error(error, "unknown material '"//trim(name)//"'", error_code%input)
             return
-            return
         end select
         call lame_from_young(mat, youngs_modulus, poisson_ratio)
     end subroutine new_material

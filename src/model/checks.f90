@@ -327,7 +327,8 @@ contains
                                 ", faces away from it: the slave's contact_edge = '"// &
                                 contact_name(model%bodies(pair%slave_body)%disc)// &
                                 "' is on the side of its body away from the master; choose the edge that faces it"// &
-                                rigid_alternative(pair), topic=pair_label(pair)//'the slave faces away from the master')]
+                                rigid_alternative(pair), &
+                                topic=pair_label(pair)//'the slave faces away from the master')]
     end subroutine facing_warning
 
     !> For a rigid master: that its own side may be the wrong one instead.
@@ -364,7 +365,7 @@ contains
         es = model%bodies(pair%slave_body)%mat%youngs_modulus
         em = model%bodies(pair%master_body)%mat%youngs_modulus
         why = ''
-        if (es > em) why = "stiffer (E = "//trim(adjustl(real_str(es, 'es10.3')))//' against '// &
+        if (es > em) why = 'stiffer (E = '//trim(adjustl(real_str(es, 'es10.3')))//' against '// &
                            trim(adjustl(real_str(em, 'es10.3')))//')'
         if (hs > coarser_factor*hm) then
             if (len(why) > 0) why = why//' and '
@@ -372,7 +373,7 @@ contains
                   trim(adjustl(real_str(hm, 'es10.3')))//' on average along the contact edges)'
         end if
         if (len(why) == 0) return
-        list = [list, warning_t(pair_label(pair)//"the slave is "//why//' than its master: the master '// &
+        list = [list, warning_t(pair_label(pair)//'the slave is '//why//' than its master: the master '// &
                                 "may then penetrate between the slave's points; the usual choice is the "// &
                                 'softer, finer body as slave (swap slave and master), or more slave points '// &
                                 '(n_gauss)', topic=pair_label(pair)//'the slave is '//why//' than its master')]

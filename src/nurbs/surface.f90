@@ -210,6 +210,8 @@ contains
             call turn(old, .true., surf%cp, surf%w)
             ! new xi0 = old eta0, new xi1 = old eta1, new eta0 = old xi1, new eta1 = old xi0
             surf%edge_names = old%edge_names([3, 4, 2, 1])
+        case default
+            ! edge 4 (returned above) is eta1 already
         end select
     end subroutine surface_reorient
 

@@ -4,9 +4,11 @@
 !> knows the sign of det K (`has_determinant`), which the load stepping uses to
 !> recognize folds of the incremental problem; an iterative one solves only to the
 !> accuracy it is asked for (`solve_accuracy_t`) and counts its iterations.
-!> Implementations: `voiga_solver_umfpack` (direct LU) and `voiga_solver_multigrid`
-!> (GMRES with a multigrid preconditioner); `voiga_solver_linear_factory` builds
-!> the one a case names.
+!> Implementations: `voiga_solver_supernodal` (the direct LU, handing the matrices it
+!> does not take to `voiga_solver_umfpack`), `voiga_solver_bulk_update` (direct solves
+!> as updates of the bodies' Cholesky factor, `voiga_solver_cholmod`, when every body
+!> is linear-elastic) and `voiga_solver_multigrid` (GMRES with a multigrid
+!> preconditioner); `voiga_solver_linear_factory` builds the one a case names.
 module voiga_solver_linear
     use voiga_kinds, only: dp
     use voiga_error, only: error_t

@@ -1,4 +1,5 @@
-!> Direct sparse LU solves with UMFPACK (SuiteSparse), `double` values with `int` or, for large matrices, `long` indices.
+!> Direct sparse LU solves with UMFPACK (SuiteSparse), `double` values with `int` or, for large
+!> matrices, `long` indices.
 !>
 !> `umfpack_t` owns the opaque Symbolic and Numeric objects of UMFPACK. The
 !> symbolic analysis (fill-reducing ordering) depends only on the sparsity

@@ -39,16 +39,16 @@ import sys
 import tempfile
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import f90nml
 import h5py
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from attack_inputs import BASE, REPO, Attack, all_attacks, stage  # noqa: E402
+from attack_inputs import REPO, Attack, all_attacks, stage  # noqa: E402
 
 TIMEOUT = 120.0
 """Seconds before an attack counts as a hang (the base case takes a fifth of one)."""
@@ -346,8 +346,8 @@ def geometry_problem(path: Path) -> str | None:
 
 
 def _geometry_problem(path: Path) -> str | None:
-    from pre.nurbs import Patch
     from pre.geometry import jacobian_signs
+    from pre.nurbs import Patch
     try:
         with h5py.File(path, "r") as f:
             g = f["bodies/slab"]

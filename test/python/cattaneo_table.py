@@ -71,7 +71,8 @@ def run(binary: str, folder: Path, scene: CattaneoScene) -> str:
     result = read_result(folder / "case.h5")
     try:
         press = cattaneo_comparison(result, step=scene.press_steps)
-        residual = f"{press.stick_traction:.3f} / {scatter(press.x, press.q, press.state, press.a, press.friction * press.p0):.3f}"
+        spread = scatter(press.x, press.q, press.state, press.a, press.friction * press.p0)
+        residual = f"{press.stick_traction:.3f} / {spread:.3f}"
     except CattaneoError:
         residual = "(frictionless)"
     if proc.returncode != 0:

@@ -22,9 +22,9 @@ import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import f90nml
 import h5py
@@ -208,7 +208,7 @@ def alm_softened(given: float, floor: float, forces: tuple[float, float],
             problems.append(f"penalty_normal at the end {last:g}: not softened into "
                             f"[{floor:g}, {0.1 * given:g}]")
         m = ironing_measures(read_result(f.filename))
-        for key, want in zip(("mean_px", "mean_py"), forces):
+        for key, want in zip(("mean_px", "mean_py"), forces, strict=True):
             if abs(m[key] / want - 1) > rel:
                 problems.append(f"{key} {m[key]:.7g} differs from {want:.7g} by more than {rel:g}")
         return problems

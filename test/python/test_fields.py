@@ -31,8 +31,8 @@ import pytest
 from scipy.optimize import brentq
 
 from conftest import REPO
-from post.hertz import hertz_reference
 from post.field import evaluate
+from post.hertz import hertz_reference
 from post.paraview import write_vtk
 from post.reader import read_result
 from pre.cases import to_namelist_text

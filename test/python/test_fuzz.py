@@ -5,7 +5,6 @@ not. Deterministic (seeded); 520 inputs, half of them from a base case with the
 mortar-type contact penalty."""
 from __future__ import annotations
 
-import math
 import random
 import shutil
 import subprocess

@@ -6,11 +6,10 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import REPO
-import numpy as np
-
 from post.contact import pressure_field
 from post.hertz import hertz_comparison
 from post.reader import read_result

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import pytest
 
 from conftest import REPO
 
@@ -24,7 +23,7 @@ def make_case(tmp: Path, scene: str, name: str, solver: str, **changes: str) -> 
     for key, value in changes.items():
         pat = re.compile(rf"^(\s*){key}\s*=.*?(?=^\s*[A-Za-z_]\w*\s*=|^\s*/)", re.M | re.S)
         assert pat.search(text), key
-        text = pat.sub(lambda m: f"{m.group(1)}{key} = {value}\n", text, count=1)
+        text = pat.sub(lambda m, key=key, value=value: f"{m.group(1)}{key} = {value}\n", text, count=1)
     text = re.sub(r"^&solver\b", f"&solver\n  linear_solver = '{solver}'", text, count=1, flags=re.M)
     path = tmp / f"{name}-{solver}.nml"
     path.write_text(text)

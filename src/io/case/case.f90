@@ -105,6 +105,7 @@ contains
             character(len=*), intent(in) :: text
             integer, intent(out) :: ios
             character(len=*), intent(inout) :: msg
+            ! allow(C181): ios goes back to the caller, which reports it
             read (text, nml=case, iostat=ios, iomsg=msg)
         end subroutine try_case
     end subroutine read_case_group

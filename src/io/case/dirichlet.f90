@@ -66,6 +66,7 @@ contains
             character(len=*), intent(in) :: text
             integer, intent(out) :: ios
             character(len=*), intent(inout) :: msg
+            ! allow(C181): ios goes back to the caller, which reports it
             read (text, nml=dirichlet, iostat=ios, iomsg=msg)
         end subroutine try_dirichlet
     end subroutine read_dirichlet

@@ -89,6 +89,7 @@ contains
             character(len=*), intent(in) :: text
             integer, intent(out) :: ios
             character(len=*), intent(inout) :: msg
+            ! allow(C181): ios goes back to the caller, which reports it
             read (text, nml=output, iostat=ios, iomsg=msg)
         end subroutine try_output
     end subroutine read_output

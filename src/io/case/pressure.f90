@@ -55,6 +55,7 @@ contains
             character(len=*), intent(in) :: text
             integer, intent(out) :: ios
             character(len=*), intent(inout) :: msg
+            ! allow(C181): ios goes back to the caller, which reports it
             read (text, nml=pressure, iostat=ios, iomsg=msg)
         end subroutine try_pressure
     end subroutine read_pressure

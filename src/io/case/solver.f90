@@ -97,6 +97,7 @@ contains
             character(len=*), intent(in) :: text
             integer, intent(out) :: ios
             character(len=*), intent(inout) :: msg
+            ! allow(C181): ios goes back to the caller, which reports it
             read (text, nml=solver, iostat=ios, iomsg=msg)
         end subroutine try_solver
     end subroutine read_solver
@@ -142,7 +143,7 @@ contains
                              "': must be "//either(damping_names), error_code%input)
         else if (trim(s%damping) == 'natural' .and. trim(s%linear_solver) == 'multigrid') then
             call fatal_error(error, where//"damping = 'natural' needs linear_solver = 'direct' "// &
-                             "(its test solves with the last factorization)", error_code%input)
+                             '(its test solves with the last factorization)', error_code%input)
         end if
     end subroutine check_solver
 
