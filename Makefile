@@ -17,10 +17,15 @@ export OMP_NUM_THREADS ?= 1
 
 # The Python modules voiga's tools need; deps finds them without importing them (an
 # import of all of them took 2.7 s, paid by every target: make paper included).
-PY_MODULES := numpy h5py matplotlib splipy f90nml tqdm scipy vtk pytest wheel dask distributed pyarrow
+PY_MODULES := numpy h5py matplotlib splipy f90nml tqdm scipy vtk pytest wheel dask distributed pyarrow \
+              fortitude ruff
 export PY_MISSING := import importlib.util as u, sys; sys.exit(any(u.find_spec(m) is None for m in sys.argv[1:]))
+# The packages requirements.txt pins (name==version: the linters, whose findings change
+# from one version to the next); deps installs them when another version is there.
+PY_PINNED := $(shell sed -n 's/^\([A-Za-z0-9_.-]*==[^ #]*\).*/\1/p' requirements.txt)
+export PY_OTHER_VERSION := import importlib.metadata as m, sys; sys.exit(any(m.version(n) != v for n, v in (a.split('==') for a in sys.argv[1:])))
 
-.PHONY: all deps build run test test-fortran test-python clean bench paper stress regress attack
+.PHONY: all deps build run test lint test-fortran test-python clean bench paper stress regress attack
 
 all: build
 
@@ -39,6 +44,7 @@ deps:
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq $(APT_PKGS) >/dev/null; \
 	fi
 	@if ! $(PYTHON) -c "$$PY_MISSING" $(PY_MODULES) 2>/dev/null \
+	   || ! $(PYTHON) -c "$$PY_OTHER_VERSION" $(PY_PINNED) 2>/dev/null \
 	   || ! command -v fpm >/dev/null 2>&1; then \
 	  echo "deps: installing Python packages from requirements.txt"; \
 	  $(PYTHON) -m pip install -q -r requirements.txt; \
@@ -69,8 +75,17 @@ RUN_OUT ?= build/run/$(notdir $(patsubst %/,%,$(dir $(abspath $(CASE)))))-$(base
 run: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post run $(CASE) --out $(RUN_OUT)
 
-## test: Fortran unit tests (fpm test) and Python tests (pytest)
-test: build test-fortran test-python
+## test: lint, then Fortran unit tests (fpm test) and Python tests (pytest)
+test: lint build test-fortran test-python
+
+## lint: fortitude on the Fortran (settings: fpm.toml [extra.fortitude]), ruff on the
+## Python (pyproject.toml [tool.ruff]) and the docs check (test/python/check_docs.py:
+## paths, files and code names that README.md and docs/ mention but the tree no longer
+## has); the versions are pinned in requirements.txt
+lint: deps
+	$(PYTHON) -m fortitude check --output-format concise src app test
+	$(PYTHON) -m ruff check pre post bench test/python
+	$(PYTHON) test/python/check_docs.py
 
 test-fortran: deps
 	fpm test

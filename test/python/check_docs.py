@@ -42,7 +42,8 @@ CODE_FILE = re.compile(r"^[A-Za-z0-9_.-]+\.(?:f90|F90|c|h|py)$")
 EXTERNAL = {"dgemm_kernel", "raise_order_implicit"}
 
 TICK = re.compile(r"`([^`\n]+)`")
-PATH = re.compile(r"(?<![\w./~:-])(?:%s)/[\w./*<>{},+-]*" % "|".join(TOP))
+TOPS = "|".join(TOP)
+PATH = re.compile(rf"(?<![\w./~:-])(?:{TOPS})/[\w./*<>{{}},+-]*")
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
 NAME = re.compile(rf"{IDENT}")
 # `(file.f90, name, name)` or `file.f90` (`name`, `name`) or `name` in `file.f90`
@@ -80,16 +81,15 @@ class Tree:
         self.words = words
 
     def path_exists(self, path: str) -> bool:
-        """A file or folder of the repository; placeholders and globs match any name."""
-        path = path.rstrip("/.,;")
-        for alt in expand_braces(path):
-            pattern = re.sub(r"<[^>/]*>", "*", alt)
-            if "*" in pattern:
-                if any(fnmatch(f, pattern) or fnmatch(f, pattern + "/*") for f in self.files):
-                    return True
-            elif pattern in self.folders or pattern in self.files:
-                return True
-        return False
+        """A file or folder of the repository; placeholders and globs match any name,
+        ``{a,b}`` needs each of its names."""
+        return all(self._exists(alt) for alt in expand_braces(path.rstrip("/.,;")))
+
+    def _exists(self, path: str) -> bool:
+        pattern = re.sub(r"<[^>/]*>", "*", path)
+        if "*" in pattern:
+            return any(fnmatch(f, pattern) or fnmatch(f, pattern + "/*") for f in self.files)
+        return pattern in self.folders or pattern in self.files
 
     def defined_in(self, file: str) -> set[str]:
         """The names that every Fortran file named like ``file`` (a path or a bare name)
@@ -211,7 +211,7 @@ def stale_mentions(pages: Iterable[Path], root: Path = REPO) -> list[str]:
     out = []
     for page in pages:
         shown = page.relative_to(root) if page.is_relative_to(root) else page
-        found = sorted(set(check_page(page, tree)), key=lambda s: int(s.split(":")[0]))
+        found = sorted(set(check_page(page, tree)), key=lambda s: (int(s.split(":")[0]), s))
         out += [f"{shown}:{s}" for s in found]
     return out
 
