@@ -5,13 +5,13 @@ method owns its state and the factory is the one place a pair is built."""
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 from conftest import REPO
 
 PAIR = REPO / "src" / "contact" / "pair.f90"
 # the designator an assignment starts with: parts `name` or `name(...)` joined by `%`
-DESIGNATOR = re.compile(r"\s*((?:\w+\s*(?:\((?:[^()]|\([^()]*\))*\))?\s*%\s*)*\w+)\s*(?:\((?:[^()]|\([^()]*\))*\))?\s*=(?![=>])")
+ARGS = r"(?:\((?:[^()]|\([^()]*\))*\))"  # `(...)`, one level of parentheses inside
+DESIGNATOR = re.compile(rf"\s*((?:\w+\s*{ARGS}?\s*%\s*)*\w+)\s*{ARGS}?\s*=(?![=>])")
 
 
 def statement(code: str) -> str:
