@@ -227,8 +227,6 @@ contains
         end do
     end subroutine set_prescribed
 
-    !> Put every moving rigid master where its prescribed motion has it at load
-    !> time `t` (before the contact pairs are evaluated at `t`).
     !> The contact pairs at load time `t`: where the rigid masters that move are
     !> (`&contact rigid_ux, rigid_uy`), and the friction coefficient of the phase of
     !> the pairs whose friction changes with it.
