@@ -28,6 +28,7 @@ contains
                     new_unittest('round_trip_every_rank', test_round_trip), &
                     new_unittest('attributes_round_trip', test_attributes), &
                     new_unittest('write_to_read_only_file_fails', test_read_only), &
+                    new_unittest('writes_without_error_keep_the_first', test_kept_failure), &
                     new_unittest('closed_file_refused', test_closed), &
                     new_unittest('string_dataset_read_as_numbers_refused', test_string_dataset), &
                     new_unittest('wrong_type_or_rank_refused', test_wrong_type), &
@@ -374,6 +375,51 @@ contains
         if (allocated(error)) return
         call close_scratch(h5, path, error)
     end subroutine test_read_only
+
+    !> Writes without an error argument keep their first failure in the file: the
+    !> writes after it do nothing (they open nothing and write nothing, not even
+    !> where they could), `check` hands over the first failure once, and a write
+    !> with its own `error` is not affected.
+    subroutine test_kept_failure(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: got
+        type(h5file_t) :: h5, back
+        character(len=:), allocatable :: path
+        integer :: before
+
+        path = scratch('kept-failure')
+        call h5%open(path, 'w', error)
+        if (allocated(error)) return
+        call h5%write('/a', [1.0_dp])
+        call check(error, .not. h5%failed(), 'a write that succeeds keeps nothing')
+        if (allocated(error)) return
+        before = open_objects(h5)
+        ! (the dataset's parent '/a' is a dataset, not a group: H5Dcreate fails)
+        call h5%write('/a/b', [2.0_dp])
+        call h5%write_attr('/', 'later', 1)
+        call h5%write('/c', [3])
+        call h5%create_group('/g')
+        call check(error, h5%failed() .and. open_objects(h5) == before, 'failed, every handle closed')
+        if (allocated(error)) return
+        call h5%write_attr('/', 'with_error', 2, got)
+        call check(error, .not. allocated(got), 'a write with its own error argument still writes')
+        if (allocated(error)) return
+        call h5%check(got)
+        call check_error(error, got, 'the kept failure', "'/a/b'")
+        if (allocated(error)) return
+        deallocate (got)
+        call h5%check(got)
+        call check(error, .not. (allocated(got) .or. h5%failed()), 'handed over once')
+        if (allocated(error)) return
+        call h5%close(error)
+        if (allocated(error)) return
+        call back%open(path, 'r', error)
+        if (allocated(error)) return
+        call check(error, back%has_attr('/', 'with_error') .and. .not. (back%has_attr('/', 'later') .or. &
+                   back%exists('/c') .or. back%exists('/g')), 'nothing written after the failure')
+        if (allocated(error)) return
+        call close_scratch(back, path, error)
+    end subroutine test_kept_failure
 
     !> A file object that is not open refuses writes and reads; closing it is harmless.
     subroutine test_closed(error)

@@ -2,13 +2,15 @@
 !> or a rigid obstacle without DOFs (a straight line, or any NURBS curve of the
 !> geometry file). Each answers the closest-point projection of a slave point
 !> with a `master_point_t`; a rigid one is moved by its prescribed motion
-!> (`move`, called by the model at the load time before every assembly).
+!> (`move`, called by the model at the load time before every assembly). Each
+!> also says what of it a step's contact output records (`output`).
 module voiga_contact_master
     use voiga_kinds, only: dp
+    use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
 
-    public :: contact_master_t, master_point_t, master_no_dofs
+    public :: contact_master_t, master_point_t, master_no_dofs, master_output_t
 
     !> The master at the projection of a slave point.
     type :: master_point_t
@@ -25,6 +27,20 @@ module voiga_contact_master
         integer :: first = 1, last = 0
     end type master_point_t
 
+    !> What a master's kind adds to a pair's output at a step (docs/hdf5.md,
+    !> `/steps/<k>/contact/<p>`): named vectors and, for a rigid curve, the curve
+    !> where it is. The result writer (`voiga_io_results`) stores it as it is, in
+    !> this order, so the master decides what describes it and contact/ calls no
+    !> HDF5.
+    type :: master_output_t
+        !> A curve written first as the group `curve_name` (empty: none).
+        character(len=:), allocatable :: curve_name
+        type(nurbs_curve_t) :: curve
+        !> Datasets of two values each: `names(j)` holds `vectors(:, j)`; shape [2, n].
+        character(len=16), allocatable :: names(:)
+        real(dp), allocatable :: vectors(:, :)
+    end type master_output_t
+
     !> A master surface.
     type, abstract :: contact_master_t
         !> Does it carry DOFs?
@@ -35,6 +51,9 @@ module voiga_contact_master
         procedure :: all_dofs => master_no_dofs
         procedure :: prepare => master_prepare
         procedure :: move => master_move
+        !> What a step's contact output records of it; default: nothing (a
+        !> deformable master is in its body's displacement).
+        procedure :: output => master_output
     end type contact_master_t
 
     abstract interface
@@ -80,5 +99,14 @@ contains
         class(contact_master_t), intent(inout) :: self
         real(dp), intent(in) :: offset(2)
     end subroutine master_move
+
+    !> Nothing: a deformable master's position is its body's.
+    pure function master_output(self) result(out)
+        class(contact_master_t), intent(in) :: self
+        type(master_output_t) :: out
+        out%curve_name = ''
+        allocate (out%names(0), out%vectors(2, 0))
+        if (self%deformable) return   ! (whatever the master; a rigid one overrides this)
+    end function master_output
 
 end module voiga_contact_master

@@ -12,7 +12,7 @@
 module voiga_contact_master_curve
     use voiga_kinds, only: dp
     use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_contact_master, only: master_point_t, master_no_dofs
+    use voiga_contact_master, only: master_point_t, master_no_dofs, master_output_t
     use voiga_contact_master_nurbs, only: nurbs_master_t, nurbs_prepare, nurbs_project
     use voiga_contact_surface, only: new_curve_surface
     implicit none
@@ -36,6 +36,7 @@ module voiga_contact_master_curve
         procedure :: all_dofs => curve_all_dofs
         procedure :: prepare => curve_prepare
         procedure :: move => curve_move
+        procedure :: output => curve_output
     end type rigid_curve_t
 
 contains
@@ -93,5 +94,14 @@ contains
         self%surf%x0(1, :) = self%x_ref(1, :) + offset(1)
         self%surf%x0(2, :) = self%x_ref(2, :) + offset(2)
     end subroutine curve_move
+
+    !> The curve where it is at this step, and its translation from load time 0.
+    pure function curve_output(self) result(out)
+        class(rigid_curve_t), intent(in) :: self
+        type(master_output_t) :: out
+        out = master_output_t(curve_name='rigid_curve', &
+                              curve=nurbs_curve_t(self%surf%degree, self%surf%knots, self%surf%x0, self%surf%w), &
+                              names=[character(len=16) :: 'rigid_offset'], vectors=reshape(self%offset, [2, 1]))
+    end function curve_output
 
 end module voiga_contact_master_curve

@@ -3,7 +3,7 @@
 !> A prescribed motion translates it (`move`: p0 = p_ref + offset).
 module voiga_contact_master_rigid
     use voiga_kinds, only: dp
-    use voiga_contact_master, only: contact_master_t, master_point_t
+    use voiga_contact_master, only: contact_master_t, master_point_t, master_output_t
     implicit none
     private
 
@@ -17,6 +17,7 @@ module voiga_contact_master_rigid
     contains
         procedure :: project => rigid_project
         procedure :: move => rigid_move
+        procedure :: output => rigid_output
     end type rigid_line_t
 
 contains
@@ -55,5 +56,15 @@ contains
         real(dp), intent(in) :: offset(2)
         self%p0 = self%p_ref + offset
     end subroutine rigid_move
+
+    !> Where the line is at this step: a point, its normal, and the translation
+    !> from load time 0.
+    pure function rigid_output(self) result(out)
+        class(rigid_line_t), intent(in) :: self
+        type(master_output_t) :: out
+        out = master_output_t(curve_name='', names=[character(len=16) :: 'rigid_point', 'rigid_normal', &
+                                                    'rigid_offset'], &
+                              vectors=reshape([self%p0, self%n, self%p0 - self%p_ref], [2, 3]))
+    end function rigid_output
 
 end module voiga_contact_master_rigid

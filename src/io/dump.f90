@@ -35,22 +35,15 @@ contains
             call h5%abandon()
             return
         end if
-        steps: block
-            call h5%write_attr('/', 'title', case%title, error)
-            if (allocated(error)) exit steps
-            call h5%write_attr('/', 'scene', case%scene, error)
-            if (allocated(error)) exit steps
-            call h5%write_attr('/', 'mesh', case%mesh, error)
-            if (allocated(error)) exit steps
-            call h5%write_attr('/', 'layout', case%layout, error)
-            if (allocated(error)) exit steps
-            call h5%write_attr('/', 'voiga_version', voiga_version_string, error)
-            if (allocated(error)) exit steps
-            do i = 1, size(discs)
-                call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i), error)
-                if (allocated(error)) exit steps
-            end do
-        end block steps
+        call h5%write_attr('/', 'title', case%title)
+        call h5%write_attr('/', 'scene', case%scene)
+        call h5%write_attr('/', 'mesh', case%mesh)
+        call h5%write_attr('/', 'layout', case%layout)
+        call h5%write_attr('/', 'voiga_version', voiga_version_string)
+        do i = 1, size(discs)
+            call write_discretization(h5, '/bodies/'//trim(case%bodies(i)%name), discs(i))
+        end do
+        call h5%check(error)
         if (allocated(error)) then
             ! nothing of a failed dump is kept
             call h5%close(ignored)
@@ -60,69 +53,53 @@ contains
         call h5%settle(.true., error)
     end subroutine write_dump
 
-    !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`.
-    subroutine write_discretization(h5, group, disc, error)
+    !> Write `disc` under group `group` (e.g. '/bodies/die') of the open file `h5`;
+    !> a failure is kept in `h5` (`h5file_t%check`).
+    subroutine write_discretization(h5, group, disc)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: group
         type(discretization_t), intent(in) :: disc
-        type(error_t), allocatable, intent(out) :: error
-
-        call h5%create_group(group, error)
-        if (allocated(error)) return
-        call h5%write_attr(group, 'interface_dofs', disc%interface_dofs, error)
-        if (allocated(error)) return
-        call h5%write_attr(group, 'bulk_dofs', disc%bulk_dofs, error)
-        if (allocated(error)) return
-        call h5%write_attr(group, 'total_dofs', disc%total_dofs, error)
-        if (allocated(error)) return
-        call h5%write_attr(group, 'n_elements', disc%nel, error)
-        if (allocated(error)) return
-        call h5%write(group//'/bulk/degree', disc%bulk%degree, error)
-        if (allocated(error)) return
-        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots_xi, error)
-        if (allocated(error)) return
-        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots_eta, error)
-        if (allocated(error)) return
-        call h5%write(group//'/bulk/control_points', disc%bulk%cp, error)
-        if (allocated(error)) return
-        call h5%write(group//'/bulk/weights', disc%bulk%w, error)
-        if (allocated(error)) return
-        if (disc%has_layer) call write_curve(h5, group//'/layer', disc%layer, error)
+        call h5%create_group(group)
+        call h5%write_attr(group, 'interface_dofs', disc%interface_dofs)
+        call h5%write_attr(group, 'bulk_dofs', disc%bulk_dofs)
+        call h5%write_attr(group, 'total_dofs', disc%total_dofs)
+        call h5%write_attr(group, 'n_elements', disc%nel)
+        call h5%write(group//'/bulk/degree', disc%bulk%degree)
+        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots_xi)
+        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots_eta)
+        call h5%write(group//'/bulk/control_points', disc%bulk%cp)
+        call h5%write(group//'/bulk/weights', disc%bulk%w)
+        if (disc%has_layer) call write_curve(h5, group//'/layer', disc%layer)
     end subroutine write_discretization
 
     !> Write `curve` as the group `group` (degree (1,), knots, control_points (n, 2)
-    !> and weights in h5py's shapes; the schema of the VO layer in docs/formats.md).
-    subroutine write_curve(h5, group, curve, error)
+    !> and weights in h5py's shapes; the schema of the VO layer in docs/formats.md);
+    !> a failure is kept in `h5`.
+    subroutine write_curve(h5, group, curve)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: group
         type(nurbs_curve_t), intent(in) :: curve
-        type(error_t), allocatable, intent(out) :: error
-        call h5%write(group//'/degree', [curve%degree], error)
-        if (allocated(error)) return
-        call h5%write(group//'/knots', curve%knots, error)
-        if (allocated(error)) return
-        call h5%write(group//'/control_points', curve%cp, error)
-        if (allocated(error)) return
-        call h5%write(group//'/weights', curve%w, error)
+        call h5%write(group//'/degree', [curve%degree])
+        call h5%write(group//'/knots', curve%knots)
+        call h5%write(group//'/control_points', curve%cp)
+        call h5%write(group//'/weights', curve%w)
     end subroutine write_curve
 
     !> The refined control net of `disc` under group `g` of a result file, and its
     !> element layout as post reads it: elements/ptr and conn (CSR of each element's
     !> control points), elements/vo (1 in the VO layer), elements/range ([xi0, xi1,
-    !> eta0, eta1] per element) and each edge's control points (docs/hdf5.md).
-    subroutine write_elements(h5, g, disc, error)
+    !> eta0, eta1] per element) and each edge's control points (docs/hdf5.md); a
+    !> failure is kept in `h5`.
+    subroutine write_elements(h5, g, disc)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(discretization_t), intent(in) :: disc
-        type(error_t), allocatable, intent(out) :: error
         integer :: k
         integer, allocatable :: ptr(:), conn(:), vo(:)
         real(dp), allocatable :: ranges(:, :)
 
-        call h5%write(g//'/control_points', disc%x, error)
-        if (allocated(error)) return
-        call h5%write(g//'/weights', disc%w, error)
-        if (allocated(error)) return
+        call h5%write(g//'/control_points', disc%x)
+        call h5%write(g//'/weights', disc%w)
         allocate (ptr(disc%nel + 1), vo(disc%nel), ranges(4, disc%nel))
         ptr(1) = 1
         do k = 1, disc%nel
@@ -134,17 +111,12 @@ contains
         do k = 1, disc%nel
             conn(ptr(k):ptr(k + 1) - 1) = disc%elements(k)%conn
         end do
-        call h5%write(g//'/elements/ptr', ptr, error)
-        if (allocated(error)) return
-        call h5%write(g//'/elements/conn', conn, error)
-        if (allocated(error)) return
-        call h5%write(g//'/elements/vo', vo, error)
-        if (allocated(error)) return
-        call h5%write(g//'/elements/range', ranges, error)
-        if (allocated(error)) return
+        call h5%write(g//'/elements/ptr', ptr)
+        call h5%write(g//'/elements/conn', conn)
+        call h5%write(g//'/elements/vo', vo)
+        call h5%write(g//'/elements/range', ranges)
         do k = 1, size(disc%boundaries)
-            call h5%write(g//'/edges/'//trim(disc%boundaries(k)%name), disc%boundaries(k)%cps, error)
-            if (allocated(error)) return
+            call h5%write(g//'/edges/'//trim(disc%boundaries(k)%name), disc%boundaries(k)%cps)
         end do
     end subroutine write_elements
 

@@ -31,41 +31,30 @@ contains
     end subroutine sample_bodies
 
     !> The sampled fields `settings` asks for (`samples`, from `sample_bodies`), of
-    !> every body of `model`, under `g`/fields/<body> (docs/hdf5.md).
-    subroutine write_fields(h5, g, settings, model, samples, error)
+    !> every body of `model`, under `g`/fields/<body> (docs/hdf5.md); a failure is
+    !> kept in `h5` (`h5file_t%check`).
+    subroutine write_fields(h5, g, settings, model, samples)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(output_settings_t), intent(in) :: settings
         type(model_t), intent(in) :: model
         type(field_samples_t), intent(in) :: samples(:)
-        type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: b
         integer :: ib
         do ib = 1, size(model%bodies)
             associate (f => samples(ib))
             b = g//'/fields/'//trim(model%bodies(ib)%name)
-            call h5%create_group(b, error)
-            if (allocated(error)) return
-            call h5%write_attr(b, 'samples', settings%samples, error)
-            if (allocated(error)) return
-            call h5%write_attr(b, 'components', 'xx yy zz xy', error)
-            if (allocated(error)) return
-            call h5%write_attr(b, 'stress_measure', 'Cauchy', error)
-            if (allocated(error)) return
-            call h5%write_attr(b, 'strain_measure', model%bodies(ib)%mat%strain_name(), error)
-            if (allocated(error)) return
-            call h5%write(b//'/xi', f%xi, error)
-            if (allocated(error)) return
-            call h5%write(b//'/eta', f%eta, error)
-            if (allocated(error)) return
-            call h5%write(b//'/element', f%element, error)
-            if (allocated(error)) return
-            if (settings%fields(1)) call h5%write(b//'/'//trim(field_names(1)), f%stress, error)
-            if (allocated(error)) return
-            if (settings%fields(2)) call h5%write(b//'/'//trim(field_names(2)), f%strain, error)
-            if (allocated(error)) return
-            if (settings%fields(3)) call h5%write(b//'/'//trim(field_names(3)), f%von_mises, error)
-            if (allocated(error)) return
+            call h5%create_group(b)
+            call h5%write_attr(b, 'samples', settings%samples)
+            call h5%write_attr(b, 'components', 'xx yy zz xy')
+            call h5%write_attr(b, 'stress_measure', 'Cauchy')
+            call h5%write_attr(b, 'strain_measure', model%bodies(ib)%mat%strain_name())
+            call h5%write(b//'/xi', f%xi)
+            call h5%write(b//'/eta', f%eta)
+            call h5%write(b//'/element', f%element)
+            if (settings%fields(1)) call h5%write(b//'/'//trim(field_names(1)), f%stress)
+            if (settings%fields(2)) call h5%write(b//'/'//trim(field_names(2)), f%strain)
+            if (settings%fields(3)) call h5%write(b//'/'//trim(field_names(3)), f%von_mises)
             end associate
         end do
     end subroutine write_fields

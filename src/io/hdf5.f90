@@ -13,6 +13,13 @@
 !> (a full disk), so those report errors too. The queries `exists`, `has_attr` and
 !> `shape` answer "no" (or an empty shape) when HDF5 fails.
 !>
+!> A write (`write`, `write_attr`, `create_group`) called without its `error`
+!> argument keeps its failure in the object instead: the first one is kept, later
+!> writes without `error` do nothing, and `check(error)` hands it over. A writer
+!> of many objects (a result file's step) so checks once, where its writing ends,
+!> instead of after every call; nothing is opened after the failure, and what the
+!> failed call opened it closed.
+!>
 !> Arrays are written in Fortran order, so h5py shows them with the axes reversed
 !> (docs/formats.md); reals as 64-bit floats, integers as the native (32-bit) integer,
 !> a scalar as a dataset of one element and shape (1,). Strings are written as
@@ -55,6 +62,8 @@ module voiga_io_hdf5
         !> Every attribute and dataset of a step checked its path level by level
         !> with H5Lexists (a path traversal each): a third of the output's time.
         character(len=:), allocatable, private :: known
+        !> The first failure of a write made without an `error` argument (`check`).
+        type(error_t), allocatable, private :: failure
     contains
         procedure :: open => file_open
         procedure :: close => file_close
@@ -78,16 +87,23 @@ module voiga_io_hdf5
         procedure :: has_attr => attr_exists
         procedure :: shape => dataset_shape
         procedure :: create_group => group_create
+        !> Has a write without an `error` argument failed (since the last `check`)?
+        procedure :: failed => file_failed
+        procedure :: check => file_check
+        !> (gfortran emits a private procedure of the module that the submodules
+        !> call only when it is a binding.)
+        procedure, private :: skips, hand_over
         final :: file_finalize
     end type h5file_t
 
     interface
 
-        !> Write a string attribute (fixed-length ASCII; an empty string is stored as ' ').
+        !> Write a string attribute (fixed-length ASCII; an empty string is stored as
+        !> ' '). Without `error`, as every write: a failure is kept (`check`).
         module subroutine attr_write_str(self, path, name, value, error)
             class(h5file_t), intent(inout) :: self
             character(len=*), intent(in) :: path, name, value
-            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable, intent(out), optional :: error
         end subroutine attr_write_str
 
         !> Write an integer attribute (native integer).
@@ -95,7 +111,7 @@ module voiga_io_hdf5
             class(h5file_t), intent(inout) :: self
             character(len=*), intent(in) :: path, name
             integer, target, intent(in) :: value
-            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable, intent(out), optional :: error
         end subroutine attr_write_int
 
         !> Write a real attribute (64-bit float).
@@ -103,7 +119,7 @@ module voiga_io_hdf5
             class(h5file_t), intent(inout) :: self
             character(len=*), intent(in) :: path, name
             real(dp), target, intent(in) :: value
-            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable, intent(out), optional :: error
         end subroutine attr_write_real
 
         !> Does object `path` have attribute `name`? (No, when HDF5 fails.)
@@ -253,6 +269,8 @@ contains
         call h5pclose_f(fapl, st)
         if (.not. allocated(error)) self%path = path
         self%known = ''
+        ! (a failure belongs to the file it happened in)
+        if (allocated(self%failure)) deallocate (self%failure)
     end subroutine file_open
 
     !> Finish the flush a killed writer of the file `path` left half done, if it
@@ -358,6 +376,17 @@ contains
     subroutine group_create(self, path, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out), optional :: error
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
+        call make_groups(self, path, outcome)
+        call self%hand_over(outcome, error)
+    end subroutine group_create
+
+    !> Create the group `path` and any missing parents (`group_create`).
+    subroutine make_groups(self, path, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: error
         integer :: i, st
         integer(hid_t) :: gid
@@ -380,16 +409,19 @@ contains
             end if
         end do
         self%known = path
-    end subroutine group_create
+    end subroutine make_groups
 
     !> Write a real array of any rank (a scalar as one element) as 64-bit floats.
     subroutine write_real(self, path, array, error)
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         real(dp), contiguous, target, intent(in) :: array(..)
-        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable, intent(out), optional :: error
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
         call write_dataset(self, path, H5T_NATIVE_DOUBLE, &
-                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), outcome)
+        call self%hand_over(outcome, error)
     end subroutine write_real
 
     !> Write an integer array of any rank (a scalar as one element) as native integers.
@@ -397,10 +429,55 @@ contains
         class(h5file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         integer, contiguous, target, intent(in) :: array(..)
-        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable, intent(out), optional :: error
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
         call write_dataset(self, path, H5T_NATIVE_INTEGER, &
-                           written_dims(shape(array, kind=hsize_t)), c_loc(array), error)
+                           written_dims(shape(array, kind=hsize_t)), c_loc(array), outcome)
+        call self%hand_over(outcome, error)
     end subroutine write_int
+
+    !> Whether a write without `error` (`has_error` false) is skipped: a write
+    !> without one failed before.
+    pure logical function skips(self, has_error)
+        class(h5file_t), intent(in) :: self
+        logical, intent(in) :: has_error
+        skips = .not. has_error .and. allocated(self%failure)
+    end function skips
+
+    !> The `outcome` of a write to its caller's `error`, or, without one, kept as
+    !> the file's failure (the first one only: later writes were skipped).
+    subroutine hand_over(self, outcome, error)
+        class(h5file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(inout) :: outcome
+        type(error_t), allocatable, intent(out), optional :: error
+        if (.not. allocated(outcome)) return
+        if (present(error)) then
+            call move_alloc(outcome, error)
+        else
+            call move_alloc(outcome, self%failure)
+        end if
+    end subroutine hand_over
+
+    !> Has a write without an `error` argument failed since the last `check`?
+    pure logical function file_failed(self)
+        class(h5file_t), intent(in) :: self
+        file_failed = allocated(self%failure)
+    end function file_failed
+
+    !> Hand over the failure of the writes made without an `error` argument (the
+    !> first one; the file forgets it): `error` is set only when one failed and it
+    !> holds none yet (an earlier error of the caller's stays the first).
+    subroutine file_check(self, error)
+        class(h5file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(inout) :: error
+        if (.not. allocated(self%failure)) return
+        if (allocated(error)) then
+            deallocate (self%failure)
+        else
+            call move_alloc(self%failure, error)
+        end if
+    end subroutine file_check
 
     !> The dataset shape of an array of shape `array_shape`: a scalar is one element.
     pure function written_dims(array_shape) result(dims)

@@ -13,6 +13,31 @@ submodule(voiga_io_hdf5) voiga_io_hdf5_attributes
 contains
 
     module procedure attr_write_str
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
+        call write_string(self, path, name, value, outcome)
+        call self%hand_over(outcome, error)
+    end procedure attr_write_str
+
+    module procedure attr_write_int
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
+        call write_attribute(self, path, name, H5T_NATIVE_INTEGER, c_loc(value), outcome)
+        call self%hand_over(outcome, error)
+    end procedure attr_write_int
+
+    module procedure attr_write_real
+        type(error_t), allocatable :: outcome
+        if (self%skips(present(error))) return
+        call write_attribute(self, path, name, H5T_NATIVE_DOUBLE, c_loc(value), outcome)
+        call self%hand_over(outcome, error)
+    end procedure attr_write_real
+
+    !> Write the string attribute `name` of `path` (`attr_write_str`).
+    subroutine write_string(self, path, name, value, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path, name, value
+        type(error_t), allocatable, intent(out) :: error
         character(len=max(len(value), 1)), target :: text
         integer(hid_t) :: tid
         integer :: st
@@ -31,15 +56,7 @@ contains
         if (allocated(failed) .and. .not. allocated(error)) &
             call fatal_error(error, self%path//": writing attribute '"//name//"' of '"//path// &
                              "' failed in "//failed)
-    end procedure attr_write_str
-
-    module procedure attr_write_int
-        call write_attribute(self, path, name, H5T_NATIVE_INTEGER, c_loc(value), error)
-    end procedure attr_write_int
-
-    module procedure attr_write_real
-        call write_attribute(self, path, name, H5T_NATIVE_DOUBLE, c_loc(value), error)
-    end procedure attr_write_real
+    end subroutine write_string
 
     !> Write the scalar attribute `name` of object `path` (a group is created if
     !> `path` is missing; '/' is the root) from `buf`, of type `dtype` in memory and

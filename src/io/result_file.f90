@@ -191,11 +191,13 @@ contains
         self%patient = held
     end subroutine file_begin_write
 
-    !> After a write: flush it (unless `error`, which marks the file broken and gets
-    !> its likely cause), give back the space it did not use, let readers in again.
+    !> After a write: flush it (unless `error`, or a failure its writes without an
+    !> error argument kept (`check`): either marks the file broken and gets its
+    !> likely cause), give back the space it did not use, let readers in again.
     subroutine file_end_write(self, error)
         class(result_file_t), intent(inout) :: self
         type(error_t), allocatable, intent(inout) :: error
+        call self%check(error)
         if (.not. allocated(error)) call self%flush(error)
         if (allocated(error)) then
             self%broken = .true.

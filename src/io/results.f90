@@ -21,10 +21,8 @@ module voiga_io_results
     use voiga_model, only: model_t
     use voiga_model_fields, only: output_settings_t, field_samples_t
     use voiga_io_fields, only: write_fields, sample_bodies
-    use voiga_contact_master_rigid, only: rigid_line_t
-    use voiga_contact_master_curve, only: rigid_curve_t
-    use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t
+    use voiga_contact_master, only: master_output_t
+    use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t, contact_point_out_t
     use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t
     use voiga_solver_progress, only: progress_t, step_report_t
     use voiga_solver_stepping, only: resume_t
@@ -92,99 +90,79 @@ contains
         logical, intent(in) :: replace
         type(error_t), allocatable, intent(out) :: error
         integer :: i, k
-        character(len=:), allocatable :: g
-        character(len=16) :: buf
 
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
         call self%h5%create(case%output, replace, error)
         if (allocated(error)) return
-        call self%h5%write_attr('/', 'voiga_version', voiga_version_string, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'title', case%title, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'scene', case%scene, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'mesh', case%mesh, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'layout', case%layout, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'case_file', case%path, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'status', 'running', error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'n_dofs', model%ndof, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver), error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'damping', trim(case%solver%damping), error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps(), error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'n_steps_done', 0, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'n_cuts', 0, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'wall_time', 0.0_dp, error)
-        if (allocated(error)) return
+        ! (each write keeps its failure in the file: checked once, below)
+        call self%h5%write_attr('/', 'voiga_version', voiga_version_string)
+        call self%h5%write_attr('/', 'title', case%title)
+        call self%h5%write_attr('/', 'scene', case%scene)
+        call self%h5%write_attr('/', 'mesh', case%mesh)
+        call self%h5%write_attr('/', 'layout', case%layout)
+        call self%h5%write_attr('/', 'case_file', case%path)
+        call self%h5%write_attr('/', 'status', 'running')
+        call self%h5%write_attr('/', 'n_dofs', model%ndof)
+        call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver))
+        call self%h5%write_attr('/', 'damping', trim(case%solver%damping))
+        call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps())
+        call self%h5%write_attr('/', 'n_steps_done', 0)
+        call self%h5%write_attr('/', 'n_cuts', 0)
+        call self%h5%write_attr('/', 'wall_time', 0.0_dp)
         ! the run's warnings, one per line (results_warning); none yet
-        call self%h5%write_attr('/', 'warnings', '', error)
-        if (allocated(error)) return
+        call self%h5%write_attr('/', 'warnings', '')
         do i = 1, size(model%bodies)
-            call write_body(self%h5, model, i, trim(case%bodies(i)%material), error)
-            if (allocated(error)) return
+            call write_body(self%h5, model, i, trim(case%bodies(i)%material))
         end do
         do k = 1, size(model%dirichlet)
-            write (buf, '(i0)') k
-            g = '/dirichlet/'//trim(buf)
-            call self%h5%create_group(g, error)
-            if (allocated(error)) return
-            call self%h5%write_attr(g, 'body', trim(model%bodies(model%dirichlet(k)%body)%name), &
-                                    error)
-            if (allocated(error)) return
-            call self%h5%write_attr(g, 'edge', trim(model%dirichlet(k)%edge), error)
-            if (allocated(error)) return
-            call self%h5%write_attr(g, 'fix_x', merge(1, 0, model%dirichlet(k)%fix(1)), error)
-            if (allocated(error)) return
-            call self%h5%write_attr(g, 'fix_y', merge(1, 0, model%dirichlet(k)%fix(2)), error)
-            if (allocated(error)) return
-            call self%h5%write(g//'/values', model%dirichlet(k)%values, error)
-            if (allocated(error)) return
+            call write_dirichlet(self%h5, model, k)
         end do
         ! the geometry's units ('mm, N' from pre), else just consistent ones
-        call self%h5%write_attr('/', 'units', geometry_units(case%geometry, 'consistent'), error)
-        if (allocated(error)) return
-        call write_provenance(self%h5, case, error)
-        if (allocated(error)) return
-        call self%h5%flush(error)
+        call self%h5%write_attr('/', 'units', geometry_units(case%geometry, 'consistent'))
+        if (.not. self%h5%failed()) call write_provenance(self%h5, case, error)
+        call self%h5%check(error)
+        if (.not. allocated(error)) call self%h5%flush(error)
     end subroutine results_open
 
     !> The discretization, material and element layout of body `i` of `model` under
     !> /bodies/<name>.
-    subroutine write_body(h5, model, i, material, error)
+    subroutine write_body(h5, model, i, material)
         class(h5file_t), intent(inout) :: h5
         type(model_t), intent(in) :: model
         integer, intent(in) :: i
         !> Name of the body's material law.
         character(len=*), intent(in) :: material
-        type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: g
 
         associate (b => model%bodies(i))
             g = '/bodies/'//trim(b%name)
-            call write_discretization(h5, g, b%disc, error)
-            if (allocated(error)) return
-            call h5%write_attr(g, 'material', material, error)
-            if (allocated(error)) return
-            call h5%write_attr(g, 'youngs_modulus', b%mat%youngs_modulus, error)
-            if (allocated(error)) return
-            call h5%write_attr(g, 'poisson_ratio', b%mat%poisson_ratio, error)
-            if (allocated(error)) return
-            call h5%write_attr(g, 'dof_offset', b%dof0, error)
-            if (allocated(error)) return
-            call write_elements(h5, g, b%disc, error)
+            call write_discretization(h5, g, b%disc)
+            call h5%write_attr(g, 'material', material)
+            call h5%write_attr(g, 'youngs_modulus', b%mat%youngs_modulus)
+            call h5%write_attr(g, 'poisson_ratio', b%mat%poisson_ratio)
+            call h5%write_attr(g, 'dof_offset', b%dof0)
+            call write_elements(h5, g, b%disc)
         end associate
     end subroutine write_body
+
+    !> Dirichlet condition `k` of `model` under /dirichlet/<k>.
+    subroutine write_dirichlet(h5, model, k)
+        class(h5file_t), intent(inout) :: h5
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: k
+        character(len=:), allocatable :: g
+
+        associate (d => model%dirichlet(k))
+            g = '/dirichlet/'//str(k)
+            call h5%create_group(g)
+            call h5%write_attr(g, 'body', trim(model%bodies(d%body)%name))
+            call h5%write_attr(g, 'edge', trim(d%edge))
+            call h5%write_attr(g, 'fix_x', merge(1, 0, d%fix(1)))
+            call h5%write_attr(g, 'fix_y', merge(1, 0, d%fix(2)))
+            call h5%write(g//'/values', d%values)
+        end associate
+    end subroutine write_dirichlet
 
     !> Reopen the result file of an earlier run of `case` to continue it in place
     !> (its writer's lock taken first): status 'running', the steps it holds counted
@@ -211,7 +189,8 @@ contains
     end subroutine results_reopen
 
     !> Write one converged step (space reserved, readers kept out, flushed); the
-    !> first step gives the file its name.
+    !> first step gives the file its name. Its writes keep their failure in the
+    !> file, which `end_write` hands over: one check per step.
     subroutine results_write_step(self, rec, u, wall, pairs, cuts, n_cuts, next_fraction, r0_max, &
                                   error, model)
         class(results_t), intent(inout) :: self
@@ -245,15 +224,14 @@ contains
         ! and metadata, generously
         call self%h5%begin_write(max(1048576_int64, 64_int64*size(u, kind=int64)), error)
         if (allocated(error)) return
-        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
-        if (.not. allocated(error)) call write_counters(self, wall, n_cuts, error)
+        call write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, model, samples)
+        call write_counters(self, wall, n_cuts)
         call self%h5%end_write(error)
-        if (allocated(error)) return
-        call self%h5%place(error)
+        if (.not. allocated(error)) call self%h5%place(error)
     end subroutine results_write_step
 
-    !> Write one converged step and the current displacement; flush.
-    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, error, model, samples)
+    !> Write one converged step and the current displacement.
+    subroutine write_step_groups(self, rec, u, pairs, cuts, next_fraction, r0_max, model, samples)
         class(results_t), intent(inout) :: self
         type(step_record_t), intent(in) :: rec
         real(dp), intent(in) :: u(:)
@@ -264,7 +242,6 @@ contains
         !> Solver state needed to restart after this step: the substep fraction carried
         !> to the next step and the run's largest first residual.
         real(dp), intent(in), optional :: next_fraction, r0_max
-        type(error_t), allocatable, intent(out) :: error
         !> The model of `u` and its bodies' sampled fields (allocated when `&output`
         !> asks for them at this step).
         type(model_t), intent(in), optional :: model
@@ -277,182 +254,142 @@ contains
         call system_clock(c0, rate)
         write (buf, '(i6.6)') rec%step
         g = '/steps/'//trim(buf)
-        call self%h5%create_group(g, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'step', rec%step, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'time', rec%time, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'iterations', rec%iterations, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations), &
-                                error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'linear_iterations', rec%linear_iterations, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'substeps', rec%substeps, error)
-        if (allocated(error)) return
-        call self%h5%write_attr(g, 'cuts', rec%cuts, error)
-        if (allocated(error)) return
-        if (present(next_fraction)) &
-            call self%h5%write_attr(g, 'next_fraction', next_fraction, error)
-        if (allocated(error)) return
-        if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max, error)
-        if (allocated(error)) return
+        call self%h5%create_group(g)
+        call self%h5%write_attr(g, 'step', rec%step)
+        call self%h5%write_attr(g, 'time', rec%time)
+        call self%h5%write_attr(g, 'iterations', rec%iterations)
+        call self%h5%write_attr(g, 'iterations_total', max(rec%iterations_total, rec%iterations))
+        call self%h5%write_attr(g, 'tangent_det_sign', rec%det_sign)
+        call self%h5%write_attr(g, 'linear_iterations', rec%linear_iterations)
+        call self%h5%write_attr(g, 'substeps', rec%substeps)
+        call self%h5%write_attr(g, 'cuts', rec%cuts)
+        if (present(next_fraction)) call self%h5%write_attr(g, 'next_fraction', next_fraction)
+        if (present(r0_max)) call self%h5%write_attr(g, 'r0_max', r0_max)
         if (present(cuts)) then
-            if (size(cuts) > 0) call write_cuts(self%h5, g, cuts, error)
-            if (allocated(error)) return
+            if (size(cuts) > 0) call write_cuts(self%h5, g, cuts)
         end if
         do k = 1, size(stage_names)
-            call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k), error)
-            if (allocated(error)) return
+            call self%h5%write_attr(g, 'seconds_'//trim(stage_names(k)), rec%seconds(k))
         end do
-        call self%h5%write(g//'/residual_norms', rec%residual_norms, error)
-        if (allocated(error)) return
-        call self%h5%write(g//'/energy_norms', rec%energy_norms, error)
-        if (allocated(error)) return
-        if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions, error)
-        if (allocated(error)) return
-        call self%h5%write(g//'/displacement', u, error)
-        if (allocated(error)) return
+        call self%h5%write(g//'/residual_norms', rec%residual_norms)
+        call self%h5%write(g//'/energy_norms', rec%energy_norms)
+        if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
+        call self%h5%write(g//'/displacement', u)
         do k = 1, size(pairs)
-            call write_contact(self%h5, g, k, pairs(k)%pair, error)
-            if (allocated(error)) return
+            call write_contact(self%h5, g//'/contact/'//str(k), pairs(k)%pair)
         end do
         if (present(model) .and. present(samples)) then
-            if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples, error)
-            if (allocated(error)) return
+            if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples)
         end if
         ! this step's own output time (the record was made before it was written)
         call system_clock(c1)
-        call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp), error)
+        call self%h5%write_attr(g, 'seconds_output', real(c1 - c0, dp)/real(rate, dp))
     end subroutine write_step_groups
 
     !> The root's counters after a step, flushed with it: the flush is journaled
     !> (journal_vfd.c), so the step and its count reach the file together or not at
     !> all, and n_steps_done counts whole steps only.
-    subroutine write_counters(self, wall, n_cuts, error)
+    subroutine write_counters(self, wall, n_cuts)
         class(results_t), intent(inout) :: self
         real(dp), intent(in) :: wall
         integer, intent(in), optional :: n_cuts
-        type(error_t), allocatable, intent(out) :: error
         self%n_written = self%n_written + 1
-        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'n_steps_done', self%n_written, error)
-        if (allocated(error)) return
-        call self%h5%write_attr('/', 'wall_time', wall, error)
+        if (present(n_cuts)) call self%h5%write_attr('/', 'n_cuts', n_cuts)
+        call self%h5%write_attr('/', 'n_steps_done', self%n_written)
+        call self%h5%write_attr('/', 'wall_time', wall)
     end subroutine write_counters
 
-    !> Per-slave-point contact output of pair `k` under step group `g`.
-    subroutine write_contact(h5, g, k, pair, error)
+    !> Per-slave-point contact output of `pair` as the group `c`: the pair's law,
+    !> what its master's kind records (`contact_master_t%output`), the points'
+    !> output of the last evaluation and the committed history.
+    subroutine write_contact(h5, c, pair)
         class(h5file_t), intent(inout) :: h5
-        character(len=*), intent(in) :: g
-        integer, intent(in) :: k
+        character(len=*), intent(in) :: c
         class(contact_pair_t), intent(in) :: pair
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: c
-        character(len=8) :: buf
-        integer :: i, n
-        real(dp), allocatable :: a2(:, :), a1(:)
-        integer, allocatable :: st(:)
-        type(history_item_t), allocatable :: history(:)
+        call h5%create_group(c)
+        call h5%write_attr(c, 'slave', trim(pair%slave_name))
+        call h5%write_attr(c, 'master', trim(pair%master_name))
+        call h5%write_attr(c, 'penalty_normal', pair%law%eps_n)
+        call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t)
+        call h5%write_attr(c, 'friction', pair%law%mu)
+        call h5%write_attr(c, 'method', pair%method_name())
+        call write_master(h5, c, pair%master%output())
+        call h5%write(c//'/force', pair%force)
+        call write_points(h5, c, pair%out)
+        call h5%write(c//'/xi_slave', pair%xi)
+        ! committed friction history: what a restart needs
+        call write_history(h5, c//'/history/', pair%history())
+    end subroutine write_contact
 
-        write (buf, '(i0)') k
-        c = g//'/contact/'//trim(buf)
-        n = size(pair%out)
-        call h5%create_group(c, error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'slave', trim(pair%slave_name), error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'master', trim(pair%master_name), error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'penalty_normal', pair%law%eps_n, error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'penalty_tangent', pair%law%eps_t, error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'friction', pair%law%mu, error)
-        if (allocated(error)) return
-        call h5%write_attr(c, 'method', pair%method_name(), error)
-        if (allocated(error)) return
-        select type (m => pair%master)
-        type is (rigid_line_t)
-            call h5%write(c//'/rigid_point', m%p0, error)
-            if (allocated(error)) return
-            call h5%write(c//'/rigid_normal', m%n, error)
-            if (allocated(error)) return
-            call h5%write(c//'/rigid_offset', m%p0 - m%p_ref, error)
-            if (allocated(error)) return
-        type is (rigid_curve_t)
-            ! where the obstacle is at this step, and its translation from time 0
-            call write_curve(h5, c//'/rigid_curve', nurbs_curve_t(m%surf%degree, m%surf%knots, m%surf%x0, &
-                                                                  m%surf%w), error)
-            if (allocated(error)) return
-            call h5%write(c//'/rigid_offset', m%offset, error)
-            if (allocated(error)) return
-        end select
-        call h5%write(c//'/force', pair%force, error)
-        if (allocated(error)) return
-        allocate (a2(2, n), a1(n), st(n))
-        do i = 1, n
-            a2(:, i) = pair%out(i)%x0
+    !> What a master's kind records at a step, under the pair's group `c`.
+    subroutine write_master(h5, c, master)
+        class(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: c
+        type(master_output_t), intent(in) :: master
+        integer :: j
+        if (len(master%curve_name) > 0) call write_curve(h5, c//'/'//master%curve_name, master%curve)
+        do j = 1, size(master%names)
+            call h5%write(c//'/'//trim(master%names(j)), master%vectors(:, j))
         end do
-        call h5%write(c//'/x_ref', a2, error)
-        if (allocated(error)) return
-        do i = 1, n
-            a2(:, i) = pair%out(i)%x
+    end subroutine write_master
+
+    !> Each slave point's output `out` as one dataset per quantity under `c`.
+    subroutine write_points(h5, c, out)
+        class(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: c
+        type(contact_point_out_t), intent(in) :: out(:)
+        real(dp), allocatable :: a2(:, :), a1(:)
+        integer :: i
+        allocate (a2(2, size(out)))
+        do i = 1, size(out)
+            a2(:, i) = out(i)%x0
         end do
-        call h5%write(c//'/x', a2, error)
-        if (allocated(error)) return
-        a1 = pair%out%gap
+        call h5%write(c//'/x_ref', a2)
+        do i = 1, size(out)
+            a2(:, i) = out(i)%x
+        end do
+        call h5%write(c//'/x', a2)
+        a1 = out%gap
         ! no orthogonal projection onto the master: NaN
         where (a1 > 1.0e300_dp) a1 = ieee_value(1.0_dp, ieee_quiet_nan)
-        call h5%write(c//'/gap', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%pn
-        call h5%write(c//'/p_n', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%pt
-        call h5%write(c//'/p_t', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%pn0
-        call h5%write(c//'/p_n_nominal', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%pt0
-        call h5%write(c//'/p_t_nominal', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%stretch
-        call h5%write(c//'/stretch', a1, error)
-        if (allocated(error)) return
-        a1 = pair%out%xi_m
-        call h5%write(c//'/xi_master', a1, error)
-        if (allocated(error)) return
-        st = pair%out%state
-        call h5%write(c//'/state', st, error)
-        if (allocated(error)) return
-        call h5%write(c//'/xi_slave', pair%xi, error)
-        if (allocated(error)) return
-        ! committed friction history: what a restart needs
-        history = pair%history()
+        call h5%write(c//'/gap', a1)
+        ! (copies: the components of an array of points are not contiguous)
+        a1 = out%pn
+        call h5%write(c//'/p_n', a1)
+        a1 = out%pt
+        call h5%write(c//'/p_t', a1)
+        a1 = out%pn0
+        call h5%write(c//'/p_n_nominal', a1)
+        a1 = out%pt0
+        call h5%write(c//'/p_t_nominal', a1)
+        a1 = out%stretch
+        call h5%write(c//'/stretch', a1)
+        a1 = out%xi_m
+        call h5%write(c//'/xi_master', a1)
+        call h5%write(c//'/state', [out%state])
+    end subroutine write_points
+
+    !> A pair's committed history items, each as the dataset `prefix`<name>.
+    subroutine write_history(h5, prefix, history)
+        class(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: prefix
+        type(history_item_t), intent(in) :: history(:)
+        integer :: i
         do i = 1, size(history)
             if (allocated(history(i)%values)) then
-                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%values, error)
+                call h5%write(prefix//trim(history(i)%name), history(i)%values)
             else
-                call h5%write(c//'/history/'//trim(history(i)%name), history(i)%flags, error)
+                call h5%write(prefix//trim(history(i)%name), history(i)%flags)
             end if
-            if (allocated(error)) return
         end do
-    end subroutine write_contact
+    end subroutine write_history
 
     !> Cuts as the dataset `g`/cuts, shape [4, n] (h5py: (n, 4)), rows (step, time,
     !> fraction, new fraction), with their reasons as its attribute `reasons` (one line each).
-    subroutine write_cuts(h5, g, cuts, error)
+    subroutine write_cuts(h5, g, cuts)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
         type(cut_record_t), intent(in) :: cuts(:)
-        type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: rows(:, :)
         character(len=:), allocatable :: reasons
         integer :: i, width
@@ -466,9 +403,8 @@ contains
             if (i > 1) reasons = reasons//new_line('a')
             reasons = reasons//trim(cuts(i)%reason(1:min(width, len(cuts(i)%reason))))
         end do
-        call h5%write(g//'/cuts', rows, error)
-        if (allocated(error)) return
-        call h5%write_attr(g//'/cuts', 'reasons', reasons, error)
+        call h5%write(g//'/cuts', rows)
+        call h5%write_attr(g//'/cuts', 'reasons', reasons)
     end subroutine write_cuts
 
     !> Set the final status ('converged', 'failed: <reason>' or 'interrupted') and the
@@ -494,30 +430,19 @@ contains
             return
         end if
         if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)
-        records: block
-            if (allocated(error) .or. .not. self%h5%is_open()) exit records
-            call self%h5%write_attr('/', 'n_cuts', size(stats%cut_records), error)
-            if (allocated(error)) exit records
-            if (size(stats%cut_records) > 0) call write_cuts(self%h5, '', stats%cut_records, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'tresca_retries', stats%tresca_retries, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'tresca_accepted', stats%tresca_accepted, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'fixed_point_iterations', stats%fixed_point_iterations, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'stick_predictions', stats%stick_predictions, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'newton_iterations', stats%iterations, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'status', status, error)
-            if (allocated(error)) exit records
-            call self%h5%write_attr('/', 'wall_time', wall, error)
-            if (allocated(error)) exit records
+        if (self%h5%is_open() .and. .not. allocated(error)) then
+            call self%h5%write_attr('/', 'n_cuts', size(stats%cut_records))
+            if (size(stats%cut_records) > 0) call write_cuts(self%h5, '', stats%cut_records)
+            call self%h5%write_attr('/', 'tresca_retries', stats%tresca_retries)
+            call self%h5%write_attr('/', 'tresca_accepted', stats%tresca_accepted)
+            call self%h5%write_attr('/', 'fixed_point_iterations', stats%fixed_point_iterations)
+            call self%h5%write_attr('/', 'multiplier_updates', stats%multiplier_updates)
+            call self%h5%write_attr('/', 'stick_predictions', stats%stick_predictions)
+            call self%h5%write_attr('/', 'newton_iterations', stats%iterations)
+            call self%h5%write_attr('/', 'status', status)
+            call self%h5%write_attr('/', 'wall_time', wall)
             call self%h5%end_write(error)
-        end block records
+        end if
         if (self%h5%broken) then
             call self%h5%abandon()
         else
