@@ -1,5 +1,5 @@
-!> The terminal side of a run: the result file's progress hooks (`results_t`)
-!> plus one line per converged step, cut and retry (none with --quiet), and with
+!> The terminal side of a run, an observer of its progress beside the result file
+!> (`voiga_solver_observers`): one line per converged step, cut and retry (none with --quiet), and with
 !> --verbose one per Newton iteration and linear solve; warnings go to stderr
 !> (also with --quiet). On a terminal (not a pipe or a file; not with --quiet or
 !> --verbose) a live line shows where a long step is: step, substep, cuts, the
@@ -12,16 +12,15 @@ module voiga_app_console
     use voiga_text, only: str, fixed_str, real_str
     use voiga_error, only: error_t
     use voiga_model, only: model_t
-    use voiga_io_results, only: results_t
     use voiga_solver_records, only: cut_record_t, wall_seconds
-    use voiga_solver_progress, only: iteration_report_t, fixed_point_report_t, step_report_t
+    use voiga_solver_progress, only: progress_t, iteration_report_t, fixed_point_report_t, step_report_t
     implicit none
     private
 
     public :: console_t
 
-    !> Writes the result file and prints.
-    type, extends(results_t) :: console_t
+    !> Prints.
+    type, extends(progress_t) :: console_t
         logical :: quiet = .false., verbose = .false.
         !> Show the live line (a terminal, neither --quiet nor --verbose); is it shown now?
         logical :: live = .false., shown = .false.
@@ -57,8 +56,6 @@ contains
         class(console_t), intent(inout) :: self
         integer, intent(in) :: level_dofs(:)
         type(error_t), allocatable, intent(out) :: error
-        call self%results_t%set_up(level_dofs, error)
-        if (allocated(error)) return
         call self%clear_live()
         if (.not. self%quiet) write (*, '(a,i0,a,*(1x,i0))') 'multigrid: ', size(level_dofs), &
             ' levels, DOFs', level_dofs
@@ -206,21 +203,22 @@ contains
             '  constraint residual ', residual, ' of the element size'
     end subroutine console_multipliers_updated
 
-    !> The step goes to the result file, then one line: step, load time, Newton
-    !> iterations, residual, seconds (the file's writing included), substeps and cuts.
+    !> One line: step, load time, Newton iterations, residual, seconds (the result
+    !> file's writing included: the result file is the observer before this one),
+    !> substeps and cuts.
     subroutine console_step_done(self, report, u, model, error)
         class(console_t), intent(inout) :: self
         type(step_report_t), intent(in) :: report
         real(dp), intent(in) :: u(:)
         type(model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
-        real(dp) :: tic, seconds
-        tic = wall_seconds()
+        real(dp) :: seconds
         call self%clear_live()
-        call self%results_t%step_done(report, u, model, error)
-        if (allocated(error) .or. self%quiet) return
+        if (self%quiet) return
         associate (rec => report%record)
-            seconds = sum(rec%seconds(1:4)) + wall_seconds() - tic
+            ! the step's stages and what passed since the report was made (report%wall,
+            ! from the run's origin t0)
+            seconds = sum(rec%seconds(1:4)) + wall_seconds() - (self%t0 + report%wall)
             write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)', advance='no') 'step ', rec%step, '/', &
                 report%n_steps, '  t=', rec%time, '  it=', rec%iterations, '  |r|=', report%residual, '  ', &
                 seconds, ' s'
@@ -232,11 +230,10 @@ contains
         end associate
     end subroutine console_step_done
 
-    !> `voiga: warning: <text>` on stderr, and into the result file.
+    !> `voiga: warning: <text>` on stderr.
     subroutine console_warning(self, text)
         class(console_t), intent(inout) :: self
         character(len=*), intent(in) :: text
-        call self%results_t%warning(text)
         call self%clear_live()
         write (0, '(a)') 'voiga: warning: '//text
     end subroutine console_warning

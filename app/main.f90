@@ -1,7 +1,8 @@
 !> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet] ...`.
 !> Parses the arguments, reads the case, checks where the run writes and that it
-!> fits, builds the model and runs the solver; the terminal output is
-!> `voiga_app_console`'s.
+!> fits, builds the model and runs the solver. The run's progress goes to two
+!> observers side by side: the result file (`voiga_io_results`) and the terminal
+!> (`voiga_app_console`).
 program voiga_main
     use voiga_error, only: error_t, error_code
     use voiga_version, only: voiga_version_string
@@ -10,7 +11,7 @@ program voiga_main
     use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
     use voiga_io_outputs, only: check_outputs, resolve_restart, restart_file
     use voiga_io_provenance, only: check_restart
-    use voiga_io_results, only: restart_case, read_restart
+    use voiga_io_results, only: results_t, restart_case, read_restart
     use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
                                 memory_available, stdout_is_terminal
     use voiga_linalg_blas, only: warm_up_blas, default_library_threads, choose_blas_kernels
@@ -21,6 +22,7 @@ program voiga_main
     use voiga_solver_stepping, only: solve_steps, resume_t
     use voiga_solver_signals, only: catch_signals, signal_name
     use voiga_solver_heap, only: keep_freed_memory
+    use voiga_solver_observers, only: observers_t
     use voiga_app_console, only: console_t
     use voiga_kinds, only: dp
     use voiga_text, only: fixed_str
@@ -34,7 +36,9 @@ program voiga_main
     type(error_t), allocatable :: error, finish_error
     type(model_t) :: model
     type(resume_t) :: resume
-    type(console_t) :: results
+    type(results_t), target :: results
+    type(console_t), target :: console
+    type(observers_t) :: observers
     type(solver_stats_t) :: stats
     type(warning_t), allocatable :: warnings(:)
     real(dp), allocatable :: u(:)
@@ -72,7 +76,7 @@ program voiga_main
     end if
     if (allocated(error)) call fail(error)
     ! a second writer of the result file is refused before anything is built
-    if (allocated(restart_path) .or. .not. check) call results%h5%claim(case%output, error)
+    if (allocated(restart_path) .or. .not. check) call results%claim(case%output, error)
     if (allocated(error)) call fail(error)
     call discretize_bodies(case, discs, error, memory_check)
     if (allocated(error)) call fail(error)
@@ -112,22 +116,25 @@ program voiga_main
         if (allocated(error)) call fail(error)
         stop
     end if
-    results%quiet = quiet
-    results%verbose = verbose
-    results%live = stdout_is_terminal() .and. .not. (quiet .or. verbose)
-    results%t0 = t0
+    console%quiet = quiet
+    console%verbose = verbose
+    console%live = stdout_is_terminal() .and. .not. (quiet .or. verbose)
+    console%t0 = t0
     if (allocated(restart_path)) then
         call restart_in_place()
     else
         call results%open(case, model, overwrite .or. case%overwrite, error)
         ! a write that failed (a full disk): no exit handler may flush the rest
-        if (allocated(error) .and. results%h5%is_open()) call stop_writing(error)
+        if (allocated(error) .and. results%is_open()) call stop_writing(error)
         if (allocated(error)) call fail(error)
     end if
     ! from here on SIGINT/SIGTERM stop the solve between iterations and close the file
     call catch_signals()
-    call solve_steps(model, case%solver, u, stats, error, results, resume, t0)
-    call results%clear_live()
+    ! the result file first: a step is written before the terminal says so
+    call observers%add(results)
+    call observers%add(console)
+    call solve_steps(model, case%solver, u, stats, error, observers, resume, t0)
+    call console%clear_live()
     if (stats%signal /= 0) then
         call finish('interrupted')
         write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
@@ -137,7 +144,7 @@ program voiga_main
     end if
     if (allocated(error)) then
         call finish('failed: '//error%message)
-        if (results%n_written == 0 .and. .not. results%h5%kept_earlier) then
+        if (results%status_only()) then
             write (0, '(a)') 'voiga: no step converged; '//case%output//' keeps the status and the warnings '// &
                 '(python -m post summary '//case%output//')'
         else
@@ -248,7 +255,7 @@ contains
         character(len=:), allocatable :: resolved
         call restart_file(restart_path, resolved, error)
         if (allocated(error)) call fail(error)
-        call results%h5%claim(resolved, error)
+        call results%claim(resolved, error)
         if (allocated(error)) call fail(error)
     end subroutine claim_restart_file
 
@@ -262,7 +269,7 @@ contains
         call read_restart(case%output, model, resume, error)
         if (allocated(error)) call fail(error)
         call results%reopen(case%output, case, error, note)
-        if (allocated(error) .and. results%h5%broken) call stop_writing(error)
+        if (allocated(error) .and. results%broken()) call stop_writing(error)
         if (allocated(error)) call fail(error)
         if (.not. quiet) write (*, '(a,i0)') 'restart after step ', resume%step
     end subroutine restart_in_place
@@ -272,7 +279,7 @@ contains
     subroutine finish(status)
         character(len=*), intent(in) :: status
         call results%finish(status, wall_seconds() - t0, stats, finish_error)
-        if (.not. (allocated(finish_error) .or. results%h5%broken)) return
+        if (.not. (allocated(finish_error) .or. results%broken())) return
         if (allocated(error)) then
             if (allocated(finish_error)) write (0, '(a)') 'voiga: error: '//error%message
             if (.not. allocated(finish_error)) call move_alloc(error, finish_error)
@@ -285,25 +292,17 @@ contains
     !> the run).
     function where_kept() result(text)
         character(len=:), allocatable :: text
-        text = results%h5%where_steps()
+        text = results%where_steps()
     end function where_kept
 
     !> A write to the result file failed: say so and what is on disk, and leave
     !> without exit handlers (HDF5's would write the half-written step).
     subroutine stop_writing(err)
         type(error_t), intent(in) :: err
-        character(len=:), allocatable :: text
+        character(len=:), allocatable :: kept
         write (0, '(a)') 'voiga: error: '//err%message
-        call results%h5%abandon()
-        text = results%h5%where_steps()
-        if (results%h5%in_place .and. index(text, 'are in ') == 1) then
-            write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before are readable in '// &
-                case%output//" (its status may still say 'running')"
-        else if (results%h5%in_place .or. results%h5%lost .or. results%h5%stuck) then
-            write (0, '(a,i0,a)') 'voiga: the ', results%n_written, ' steps written before '//text
-        else if (results%h5%kept_earlier) then
-            write (0, '(a)') 'voiga: '//case%output//' is kept as it was'
-        end if
+        call results%abandon(kept)
+        if (len(kept) > 0) write (0, '(a)') 'voiga: '//kept
         call leave(1)
     end subroutine stop_writing
 
@@ -363,7 +362,7 @@ contains
     subroutine fail(err)
         type(error_t), intent(in) :: err
         write (0, '(a)') 'voiga: error: '//err%message
-        call results%h5%abandon()
+        call results%abandon()
         call exit_code(exit_status(err))
     end subroutine fail
 

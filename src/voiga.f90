@@ -19,6 +19,7 @@ module voiga
     use voiga_model, only: model_t, new_model
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_progress, only: progress_t
+    use voiga_solver_observers, only: observers_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
     use voiga_io_results, only: results_t

@@ -36,7 +36,9 @@ module voiga_io_results
     integer, parameter :: max_reasons = 60000
 
     !> An open result file; as a `progress_t` it writes every converged step the
-    !> solver reports (and the levels of a multigrid solver).
+    !> solver reports (and the levels of a multigrid solver). It is one observer of
+    !> a run beside the terminal (`voiga_solver_observers`); the program asks it,
+    !> not its file, what became of the file.
     type, extends(progress_t) :: results_t
         type(result_file_t) :: h5
         integer :: n_written = 0
@@ -46,6 +48,8 @@ module voiga_io_results
         !> A step's fields could not be sampled (warned once; the steps are written).
         logical :: fields_failed = .false.
     contains
+        !> Take the writer's lock of the file (before anything is built or read).
+        procedure :: claim => results_claim
         procedure :: open => results_open
         procedure :: reopen => results_reopen
         procedure :: write_step => results_write_step
@@ -55,6 +59,11 @@ module voiga_io_results
         procedure :: set_up => results_set_up
         procedure :: step_done => results_step_done
         procedure :: warning => results_warning
+        procedure :: is_open => results_is_open
+        procedure :: broken => results_broken
+        procedure :: status_only => results_status_only
+        procedure :: where_steps => results_where_steps
+        procedure :: abandon => results_abandon
     end type results_t
 
     interface
@@ -79,6 +88,14 @@ module voiga_io_results
     end interface
 
 contains
+
+    !> Take the writer's lock of the result file `path` (`result_file_t%claim`).
+    subroutine results_claim(self, path, error)
+        class(results_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
+        call self%h5%claim(path, error)
+    end subroutine results_claim
 
     !> Create the file (status 'running') with metadata and the discretization of
     !> each body; it replaces an earlier file at its name (once it has a step) only
@@ -502,5 +519,55 @@ contains
         call self%h5%write('/multigrid_level_dofs', level_dofs, error)
         call self%h5%end_write(error)
     end subroutine results_write_multigrid
+
+    !> Is the file open (written to since `open` or `reopen`)?
+    logical function results_is_open(self)
+        class(results_t), intent(in) :: self
+        results_is_open = self%h5%is_open()
+    end function results_is_open
+
+    !> Has a write to the file failed (nothing more may reach it: `abandon`, and
+    !> leave without HDF5's exit handlers)?
+    logical function results_broken(self)
+        class(results_t), intent(in) :: self
+        results_broken = self%h5%broken
+    end function results_broken
+
+    !> Does the file at the output's name hold this run's status and warnings but
+    !> no step (none written, and no earlier file kept in its place)?
+    logical function results_status_only(self)
+        class(results_t), intent(in) :: self
+        results_status_only = self%n_written == 0 .and. .not. self%h5%kept_earlier
+    end function results_status_only
+
+    !> Where the steps this run wrote are ('are in <file>', or why they are not).
+    function results_where_steps(self) result(text)
+        class(results_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = self%h5%where_steps()
+    end function results_where_steps
+
+    !> Leave the file as it is on disk (`result_file_t%abandon`: no HDF5 call) after
+    !> a failed write or a failed run's set-up. `kept`: what a user finds on disk, one
+    !> line ('' when there is nothing to say).
+    subroutine results_abandon(self, kept)
+        class(results_t), intent(inout) :: self
+        character(len=:), allocatable, intent(out), optional :: kept
+        character(len=:), allocatable :: text
+        call self%h5%abandon()
+        if (.not. present(kept)) return
+        kept = ''
+        if (self%h5%in_place .or. self%h5%lost .or. self%h5%stuck) then
+            text = self%h5%where_steps()
+            if (self%h5%in_place .and. index(text, 'are in ') == 1) then
+                kept = 'the '//str(self%n_written)//' steps written before are readable in '// &
+                       self%h5%final_path//" (its status may still say 'running')"
+            else
+                kept = 'the '//str(self%n_written)//' steps written before '//text
+            end if
+        else if (self%h5%kept_earlier) then
+            kept = self%h5%final_path//' is kept as it was'
+        end if
+    end subroutine results_abandon
 
 end module voiga_io_results
