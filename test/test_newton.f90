@@ -9,7 +9,8 @@ module test_newton
     use voiga_model, only: model_t, set_prescribed
     use voiga_model_assembly, only: assemble, assembly_stats_t
     use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_records, only: solver_stats_t, step_record_t
+    use voiga_solver_records, only: solver_stats_t
+    use voiga_solver_context, only: context_t
     use voiga_solver_stepping, only: solve_steps
     use voiga_solver_newton, only: newton_t, new_newton, newton_attempt, attempt_t
     use voiga_solver_progress, only: progress_t, iteration_report_t
@@ -143,18 +144,19 @@ contains
         type(scene_t), intent(in) :: c
         real(dp), intent(in) :: t, u(:)
         logical, intent(in) :: keep
-        type(outcome_t), intent(inout) :: out
+        type(outcome_t), intent(inout), target :: out
         type(error_t), allocatable, intent(out) :: error
-        type(solver_stats_t) :: stats
-        type(step_record_t) :: rec
+        type(context_t) :: ctx
         type(attempt_t) :: attempt
         out%model = model
         out%u = u
         allocate (out%floors%floor(0))
-        call new_newton(out%newton, out%model, c%solver, stats%assembly, error)
+        call new_newton(out%newton, out%model, c%solver, ctx%stats%assembly, error)
         if (allocated(error)) return
-        call newton_attempt(out%newton, out%model, 16, t, out%u, stats, rec, out%floors, attempt, error, &
-                            keep_tangent=keep)
+        ctx%step = 16
+        ctx%time = t
+        ctx%progress => out%floors
+        call newton_attempt(out%newton, out%model, ctx, out%u, attempt, error, keep_tangent=keep)
         out%iterations = attempt%iterations
     end subroutine one_attempt
 

@@ -21,8 +21,9 @@ module voiga_solver_newton
     use voiga_solver_linear_factory, only: new_linear_solver
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_signals, only: caught_signal, signal_name
-    use voiga_solver_records, only: solver_stats_t, step_record_t, wall_seconds
-    use voiga_solver_progress, only: progress_t, iteration_report_t
+    use voiga_solver_records, only: solver_stats_t, wall_seconds
+    use voiga_solver_progress, only: iteration_report_t
+    use voiga_solver_context, only: context_t
     use voiga_solver_convergence, only: convergence_t, converged, at_roundoff, residual_floor, floor_cap, &
                                         divergence_ratio
     use voiga_text, only: str, real_str
@@ -132,24 +133,19 @@ contains
         self%r = 0.0_dp
     end subroutine new_newton
 
-    !> Newton iterations at load time `t` from `u` (prescribed values set). On
-    !> success `rec` holds the iteration's norms. A numerical failure returns an
-    !> error with code `numeric` and its reason; an interrupt sets stats%signal and
-    !> returns a generic error. With `r0_ref` the relative tests (tol_residual,
+    !> Newton iterations at the load time of `ctx` from `u` (prescribed values set).
+    !> On success `ctx%record` holds the iteration's norms. A numerical failure
+    !> returns an error with code `numeric` and its reason; an interrupt sets
+    !> ctx%stats%signal and returns a generic error. With `r0_ref` the relative tests (tol_residual,
     !> energy, divergence) use it instead of the first residual (the Tresca solves of
     !> a fixed point, measured against the substep's). `keep_tangent`: `self%k` holds
     !> the tangent at the converged iterate on return (else it may be an earlier
     !> iterate's: the converged one's is not assembled when it is not needed).
-    subroutine newton_attempt(self, model, step, t, u, stats, rec, progress, attempt, error, r0_ref, &
-                              keep_tangent)
+    subroutine newton_attempt(self, model, ctx, u, attempt, error, r0_ref, keep_tangent)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t
+        type(context_t), intent(inout) :: ctx
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         type(attempt_t), intent(out) :: attempt
         type(error_t), allocatable, intent(out) :: error
         real(dp), intent(in), optional :: r0_ref
@@ -161,22 +157,22 @@ contains
         if (present(keep_tangent)) st%keep_tangent = keep_tangent
         do
             if (caught_signal() /= 0) then
-                stats%signal = caught_signal()
-                call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
+                ctx%stats%signal = caught_signal()
+                call fatal_error(error, 'interrupted by '//signal_name(ctx%stats%signal))
                 exit
             end if
-            call evaluate(self, model, t, u, st, stats, rec, error)
+            call evaluate(self, model, ctx, u, st, error)
             if (allocated(error)) exit
-            if (shortened(self, model, st, stats, error)) then
+            if (shortened(self, model, st, ctx%stats, error)) then
                 u = st%u_prev + st%alpha*st%du
                 cycle
             end if
             if (allocated(error)) exit
-            call accept_iterate(model, st, stats, r0_ref)
-            call report_iteration(model, step, st, progress)
+            call accept_iterate(model, st, ctx%stats, r0_ref)
+            call report_iteration(model, ctx, st)
             call assess(self%settings, self%natural, st, attempt, done, error)
             if (done) exit
-            call direction(self, model, st, stats, rec, progress, attempt, error)
+            call direction(self, model, ctx, st, attempt, error)
             if (allocated(error)) exit
             call advance(self, st)
             st%u_prev = u
@@ -185,12 +181,12 @@ contains
         end do
         attempt%iterations = st%it
         attempt%residual = st%c%residual
-        stats%iterations = stats%iterations + st%it
-        rec%iterations_total = rec%iterations_total + st%it
+        ctx%stats%iterations = ctx%stats%iterations + st%it
+        ctx%record%iterations_total = ctx%record%iterations_total + st%it
         if (allocated(error)) return
-        rec%iterations = st%it
-        rec%residual_norms = st%norms(1:st%it + 1)
-        rec%energy_norms = st%energies(1:st%it)
+        ctx%record%iterations = st%it
+        ctx%record%residual_norms = st%norms(1:st%it + 1)
+        ctx%record%energy_norms = st%energies(1:st%it)
     end subroutine newton_attempt
 
     !> A fresh attempt's state.
@@ -210,24 +206,25 @@ contains
     !> The substep's first assembly also fits the contact pattern to its start. A
     !> trial point expected to converge (`expect_converged`) is first evaluated
     !> without the tangent (`converged_without_tangent`).
-    subroutine evaluate(self, model, t, u, st, stats, rec, error)
+    subroutine evaluate(self, model, ctx, u, st, error)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
-        real(dp), intent(in) :: t, u(:)
+        type(context_t), intent(inout) :: ctx
+        real(dp), intent(in) :: u(:)
         type(iterate_t), intent(inout) :: st
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
         type(error_t), allocatable, intent(out) :: error
         real(dp) :: bulk0, contact0
         logical :: enough
-        bulk0 = stats%assembly%seconds_bulk
-        contact0 = stats%assembly%seconds_contact
-        enough = .false.
-        if (expect_converged(self, st)) enough = converged_without_tangent(self, model, t, u, st, stats)
-        if (.not. enough) call assemble(model, u, t, self%r, stats%assembly, error, self%k, self%map, &
-                                        refit=(st%it == 0 .and. st%nls == 0))
-        rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
-        rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+        associate (stats => ctx%stats, rec => ctx%record)
+            bulk0 = stats%assembly%seconds_bulk
+            contact0 = stats%assembly%seconds_contact
+            enough = .false.
+            if (expect_converged(self, st)) enough = converged_without_tangent(self, model, ctx%time, u, st, stats)
+            if (.not. enough) call assemble(model, u, ctx%time, self%r, stats%assembly, error, self%k, self%map, &
+                                            refit=(st%it == 0 .and. st%nls == 0))
+            rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
+            rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+        end associate
         if (enough .or. allocated(error)) return
         st%c%residual = norm2(merge(0.0_dp, self%r, model%fixed))
         if (.not. ieee_is_finite(st%c%residual)) then
@@ -380,14 +377,13 @@ contains
     end subroutine accept_iterate
 
     !> One line's worth of the iteration for the progress hooks.
-    subroutine report_iteration(model, step, st, progress)
+    subroutine report_iteration(model, ctx, st)
         type(model_t), intent(in) :: model
-        integer, intent(in) :: step
+        type(context_t), intent(in) :: ctx
         type(iterate_t), intent(in) :: st
-        class(progress_t), intent(inout) :: progress
         type(iteration_report_t) :: report
         integer :: ip
-        report%step = step
+        report%step = ctx%step
         report%iteration = st%it
         report%residual = st%c%residual
         report%energy = merge(st%c%energy, 0.0_dp, st%it > 0)
@@ -401,7 +397,7 @@ contains
                 report%points(ip) = size(out)
             end associate
         end do
-        call progress%iteration(report)
+        call ctx%progress%iteration(report)
     end subroutine report_iteration
 
     !> Converged, or failed with a reason, or go on (`done` false): the single
@@ -470,13 +466,11 @@ contains
 
     !> The Newton correction: factor the tangent (with its determinant's sign where
     !> the linear solver knows it) and solve K du = -r.
-    subroutine direction(self, model, st, stats, rec, progress, attempt, error)
+    subroutine direction(self, model, ctx, st, attempt, error)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(in) :: model
+        type(context_t), intent(inout) :: ctx
         type(iterate_t), intent(inout) :: st
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         type(attempt_t), intent(inout) :: attempt
         type(error_t), allocatable, intent(out) :: error
         type(solve_accuracy_t) :: accuracy
@@ -493,9 +487,9 @@ contains
             ! change marks a fold of the incremental problem (voiga_solver_stepping)
             call self%linear%determinant(attempt%det_sign, log_det, error)
             if (attempt%det_sign <= 0) attempt%nonpositive_det = attempt%nonpositive_det + 1
-            if (.not. allocated(error)) call progress%factorized(attempt%det_sign, log_det)
+            if (.not. allocated(error)) call ctx%progress%factorized(attempt%det_sign, log_det)
         end if
-        rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
+        ctx%record%seconds(3) = ctx%record%seconds(3) + wall_seconds() - tic
         if (allocated(error)) return
         tic = wall_seconds()
         st%rhs = -merge(0.0_dp, self%r, model%fixed)
@@ -507,12 +501,13 @@ contains
         if (changing) accuracy = solve_accuracy_t(max(accuracy%rtol, active_set_forcing), soft_iterations, &
                                                   soft_forcing)
         call self%linear%solve(self%k, st%rhs, st%du, error, accuracy)
-        if (caught_signal() /= 0) stats%signal = caught_signal()
+        if (caught_signal() /= 0) ctx%stats%signal = caught_signal()
         if (self%linear%iterative()) then
-            rec%linear_iterations = rec%linear_iterations + self%linear%last_iterations()
-            call progress%linear_solved(self%linear%last_iterations(), self%linear%last_residual(), accuracy%rtol)
+            ctx%record%linear_iterations = ctx%record%linear_iterations + self%linear%last_iterations()
+            call ctx%progress%linear_solved(self%linear%last_iterations(), self%linear%last_residual(), &
+                                            accuracy%rtol)
         end if
-        rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
+        ctx%record%seconds(4) = ctx%record%seconds(4) + wall_seconds() - tic
     end subroutine direction
 
     !> After the correction: its energy norm, the previous iterate kept for the step

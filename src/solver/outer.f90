@@ -23,8 +23,9 @@ module voiga_solver_outer
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, set_prescribed
     use voiga_model_assembly, only: assemble
-    use voiga_solver_records, only: solver_stats_t, step_record_t
-    use voiga_solver_progress, only: progress_t, fixed_point_report_t
+    use voiga_solver_records, only: step_record_t
+    use voiga_solver_progress, only: fixed_point_report_t
+    use voiga_solver_context, only: context_t
     use voiga_solver_convergence, only: convergence_t, converged, residual_floor
     use voiga_solver_newton, only: newton_t, newton_attempt, attempt_t
     use voiga_solver_records, only: wall_seconds
@@ -51,7 +52,7 @@ module voiga_solver_outer
 
 contains
 
-    !> Solve the substep at load time `t` from `u` (prescribed values set): Newton,
+    !> Solve the substep of `ctx` from `u` (prescribed values set): Newton,
     !> inside the augmented Lagrangian's multiplier updates when a pair has
     !> multipliers: after each Newton solve, if a pair's constraints do not hold to its
     !> tolerance, the multipliers take a Newton step on the constraints
@@ -60,15 +61,11 @@ contains
     !> sets: after `stall` updates without a new smallest constraint residual the
     !> steps are halved. Fails like a Newton attempt, or when `max_updates` updates do
     !> not satisfy the constraints.
-    subroutine substep_attempt(newton, model, step, t, u, stats, rec, progress, attempt, error)
+    subroutine substep_attempt(newton, model, ctx, u, attempt, error)
         type(newton_t), intent(inout) :: newton
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t
+        type(context_t), intent(inout) :: ctx
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         type(attempt_t), intent(out) :: attempt
         type(error_t), allocatable, intent(out) :: error
         type(attempt_t) :: inner
@@ -77,7 +74,7 @@ contains
         logical :: satisfied
 
         if (.not. any([(model%pairs(k)%pair%has_multipliers(), k=1, size(model%pairs))])) then
-            call newton_attempt(newton, model, step, t, u, stats, rec, progress, attempt, error)
+            call newton_attempt(newton, model, ctx, u, attempt, error)
             return
         end if
         best = huge(1.0_dp)
@@ -87,11 +84,9 @@ contains
             ! after the first solve, Newton's tolerance is relative to the substep's
             ! first residual (a multiplier update leaves a small one)
             if (k == 1) then
-                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, &
-                                    keep_tangent=.true.)
+                call newton_attempt(newton, model, ctx, u, inner, error, keep_tangent=.true.)
             else
-                call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, error, r0, &
-                                    keep_tangent=.true.)
+                call newton_attempt(newton, model, ctx, u, inner, error, r0, keep_tangent=.true.)
             end if
             attempt%iterations = attempt%iterations + inner%iterations
             attempt%residual = inner%residual
@@ -101,9 +96,9 @@ contains
             attempt%nonpositive_det = attempt%nonpositive_det + inner%nonpositive_det
             attempt%switching = inner%switching
             if (allocated(error)) return
-            if (k == 1) r0 = rec%residual_norms(1)
+            if (k == 1) r0 = ctx%record%residual_norms(1)
             call constraint_test(model, satisfied, worst)
-            call progress%multipliers_updated(step, k, worst)
+            call ctx%progress%multipliers_updated(ctx%step, k, worst)
             if (satisfied) return
             ! full steps (a semi-smooth Newton step may raise the residual while the
             ! active set settles); halved after `stall` updates without a new
@@ -119,8 +114,8 @@ contains
                     stalled = 0
                 end if
             end if
-            call multiplier_step(newton, model, damping, u, rec, error)
-            stats%multiplier_updates = stats%multiplier_updates + 1
+            call multiplier_step(newton, model, damping, u, ctx%record, error)
+            ctx%stats%multiplier_updates = ctx%stats%multiplier_updates + 1
             if (allocated(error)) return
         end do
         call fatal_error(error, 'the augmented Lagrangian did not satisfy the contact constraints in '// &
@@ -239,22 +234,18 @@ contains
         frictional = any([(model%pairs(ip)%pair%takes_outer(), ip=1, size(model%pairs))])
     end function frictional
 
-    !> Retry a frictional substep at load time `t` by the Tresca fixed point. `u`
+    !> Retry a frictional substep (`ctx`) by the Tresca fixed point. `u`
     !> holds the last converged state on entry, the accepted one on success; the
     !> contact pairs' trial history is then that of the Coulomb evaluation at it, and
     !> `attempt` holds the Newton iterations of all Tresca solves, the Coulomb
     !> residual and the sign of det K of the Coulomb tangent there. Fails (error code
     !> numeric) when a Tresca solve fails, the bound changes grow three times in a
     !> row, or after `max_fixed_point` solves.
-    subroutine tresca_fixed_point(newton, model, step, t, u, stats, rec, progress, attempt, error)
+    subroutine tresca_fixed_point(newton, model, ctx, u, attempt, error)
         type(newton_t), intent(inout) :: newton
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t
+        type(context_t), intent(inout) :: ctx
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         type(attempt_t), intent(out) :: attempt
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: inner_error
@@ -265,35 +256,35 @@ contains
         integer :: fp, growing
         logical :: accepted
 
-        stats%tresca_retries = stats%tresca_retries + 1
+        ctx%stats%tresca_retries = ctx%stats%tresca_retries + 1
         ! initial bounds: mu p_N at the last converged state (p_N depends on u only)
-        call assemble(model, u, t, newton%r, stats%assembly, error)
+        call assemble(model, u, ctx%time, newton%r, ctx%stats%assembly, error)
         if (allocated(error)) return
         call capture_slip_bounds(model, rep%change, rep%largest)
         ! the reference of the convergence test: the Coulomb residual at the substep's
         ! start, the first residual of the plain Newton attempt that failed
-        call set_prescribed(model, t, u)
-        call assemble(model, u, t, newton%r, stats%assembly, error)
+        call set_prescribed(model, ctx%time, u)
+        call assemble(model, u, ctx%time, newton%r, ctx%stats%assembly, error)
         if (allocated(error)) return
         c%first = norm2(merge(0.0_dp, newton%r, model%fixed))
         ! Newton's own tests, on the Coulomb residual, as after a Newton step
         c%iteration = 1
-        rep%step = step
-        rep%time = t
+        rep%step = ctx%step
+        rep%time = ctx%time
         rep%reference = c%first
         last_change = huge(1.0_dp)
         growing = 0
         growth = 0.0_dp
         accepted = .false.
         do fp = 1, max_fixed_point
-            stats%fixed_point_iterations = stats%fixed_point_iterations + 1
+            ctx%stats%fixed_point_iterations = ctx%stats%fixed_point_iterations + 1
             call apply_slip_bounds(model)
-            call newton_attempt(newton, model, step, t, u, stats, rec, progress, inner, inner_error, c%first)
+            call newton_attempt(newton, model, ctx, u, inner, inner_error, c%first)
             call release_slip_bounds(model)
             attempt%iterations = attempt%iterations + inner%iterations
             attempt%det_sign = inner%det_sign
             if (allocated(inner_error)) then
-                if (stats%signal /= 0) then
+                if (ctx%stats%signal /= 0) then
                     call move_alloc(inner_error, error)
                     return
                 end if
@@ -302,17 +293,17 @@ contains
                 return
             end if
             ! the Coulomb residual and tangent at the Tresca solution, and the new bounds
-            call assemble(model, u, t, newton%r, stats%assembly, error, newton%k, newton%map)
+            call assemble(model, u, ctx%time, newton%r, ctx%stats%assembly, error, newton%k, newton%map)
             if (allocated(error)) return
             c%residual = norm2(merge(0.0_dp, newton%r, model%fixed))
             c%floor = residual_floor(newton%k, newton%x0 + u, model%fixed)
-            c%scale = max(c%first, stats%r0_max)
+            c%scale = max(c%first, ctx%stats%r0_max)
             attempt%residual = c%residual
             call capture_slip_bounds(model, rep%change, rep%largest)
             rep%iteration = fp
             rep%newton_iterations = inner%iterations
             rep%residual = c%residual
-            call progress%fixed_point(rep)
+            call ctx%progress%fixed_point(rep)
             if (converged(c, newton%settings%tol_residual, newton%settings%tol_energy)) then
                 accepted = .true.
                 exit
@@ -337,13 +328,13 @@ contains
             call newton%linear%determinant(attempt%det_sign, log_det, error)
             if (allocated(error)) return
         end if
-        stats%tresca_accepted = stats%tresca_accepted + 1
+        ctx%stats%tresca_accepted = ctx%stats%tresca_accepted + 1
         rep%iteration = fp
         rep%newton_iterations = attempt%iterations
         rep%floor = c%floor
         rep%scale = c%scale
         rep%det_sign = attempt%det_sign
-        call progress%fixed_point_done(rep)
+        call ctx%progress%fixed_point_done(rep)
     end subroutine tresca_fixed_point
 
     !> Why the fixed point ended without converging after `n` iterations.

@@ -25,6 +25,7 @@ module voiga_solver_stepping
     use voiga_solver_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, step_record_t, cut_record_t, append_cut, wall_seconds
     use voiga_solver_progress, only: progress_t, step_report_t
+    use voiga_solver_context, only: context_t
     use voiga_solver_newton, only: newton_t, new_newton, attempt_t
     use voiga_solver_stick_predictor, only: stick_predictor
     use voiga_solver_outer, only: tresca_fixed_point, frictional, substep_attempt
@@ -71,6 +72,9 @@ module voiga_solver_stepping
         type(warning_t), allocatable :: warned(:)
         !> The run's Newton iterations when the last substep converged (or the step began).
         integer :: stall_start = 0
+        !> The substep's context: its step and load time, the step's record, the
+        !> run's counters, the progress observer.
+        type(context_t) :: ctx
     end type stepper_t
 
 contains
@@ -92,61 +96,88 @@ contains
         !> Wall time origin of the run (for the times reported).
         real(dp), intent(in), optional :: t0
         type(progress_t), target :: silent
-        class(progress_t), pointer :: out
         type(stepper_t) :: sp
-        type(warning_t), allocatable :: warnings(:)
-        integer :: step, first
-        real(dp) :: t
+        integer :: first
 
-        out => silent
-        if (present(progress)) out => progress
+        sp%ctx%progress => silent
+        if (present(progress)) sp%ctx%progress => progress
         sp%start = wall_seconds()
         if (present(t0)) sp%start = t0
         sp%settings = settings
         if (.not. allocated(sp%settings%n_steps)) sp%settings%n_steps = [1]
-        call new_newton(sp%newton, model, sp%settings, stats%assembly, error)
-        if (allocated(error)) return
-        stats%multigrid_levels = sp%newton%linear%level_dofs()
-        if (size(stats%multigrid_levels) > 0) call out%set_up(stats%multigrid_levels, error)
-        if (allocated(error)) return
-        allocate (u(model%ndof))
-        u = 0.0_dp
-        sp%u_conv = u
-        sp%u_step = u
-        allocate (stats%records(0), stats%cut_records(0))
+        call set_up(sp, model, u, first, error, resume)
+        if (.not. allocated(error)) then
+            call run_steps(sp, model, first, u, error)
+            call sp%newton%linear%factorizations(sp%ctx%stats%symbolic_factorizations, &
+                                                 sp%ctx%stats%numeric_factorizations)
+        end if
+        stats = sp%ctx%stats
+    end subroutine solve_steps
+
+    !> The Newton attempts' set-up (a hierarchical linear solver's levels reported),
+    !> the start (zero, or `resume`) and the set-up warnings; `first`: the first step
+    !> to solve.
+    subroutine set_up(sp, model, u, first, error, resume)
+        type(stepper_t), intent(inout) :: sp
+        type(model_t), intent(inout) :: model
+        real(dp), allocatable, intent(out) :: u(:)
+        integer, intent(out) :: first
+        type(error_t), allocatable, intent(out) :: error
+        type(resume_t), intent(in), optional :: resume
+        associate (stats => sp%ctx%stats)
+            call new_newton(sp%newton, model, sp%settings, stats%assembly, error)
+            if (allocated(error)) return
+            stats%multigrid_levels = sp%newton%linear%level_dofs()
+            if (size(stats%multigrid_levels) > 0) call sp%ctx%progress%set_up(stats%multigrid_levels, error)
+            if (allocated(error)) return
+            allocate (u(model%ndof))
+            u = 0.0_dp
+            sp%u_conv = u
+            sp%u_step = u
+            allocate (stats%records(0), stats%cut_records(0))
+        end associate
         first = 1
-        if (present(resume)) call resume_from(sp, resume, u, stats, first)
+        if (present(resume)) call resume_from(sp, resume, u, first)
         call new_contact_watch(sp%watch, model)
         allocate (sp%warned(0))
-        call report_warnings(sp, out, setup_warnings(model))
-        t = 0.0_dp
+        call report_warnings(sp, setup_warnings(model))
+    end subroutine set_up
+
+    !> Every load step from `first`, then the warnings at the end; a failed run's
+    !> error names its step and load time (and the warnings it may follow from).
+    subroutine run_steps(sp, model, first, u, error)
+        type(stepper_t), intent(inout) :: sp
+        type(model_t), intent(inout) :: model
+        integer, intent(in) :: first
+        real(dp), intent(inout) :: u(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(warning_t), allocatable :: warnings(:)
+        integer :: step
         do step = first, sp%settings%total_steps()
-            call solve_step(sp, model, step, u, stats, out, t, error)
+            call solve_step(sp, model, step, u, error)
             if (allocated(error)) exit
             ! (a signal during the last step's output: the run is complete anyway)
             if (caught_signal() /= 0 .and. step < sp%settings%total_steps()) then
-                stats%signal = caught_signal()
-                call fatal_error(error, 'interrupted by '//signal_name(stats%signal))
+                sp%ctx%stats%signal = caught_signal()
+                call fatal_error(error, 'interrupted by '//signal_name(sp%ctx%stats%signal))
                 exit
             end if
         end do
         if (.not. allocated(error)) then
             call sp%watch%at_end(model, sp%settings%total_steps() - first + 1, warnings)
-            call report_warnings(sp, out, warnings)
+            call report_warnings(sp, warnings)
         end if
-        if (allocated(error) .and. stats%signal == 0) then
-            call prefix_step(error, step, t)
+        if (allocated(error) .and. sp%ctx%stats%signal == 0) then
+            call prefix_step(error, step, sp%ctx%time)
             if (error%code == error_code%numeric) call point_back(error, sp%warned)
         end if
-        call sp%newton%linear%factorizations(stats%symbolic_factorizations, stats%numeric_factorizations)
-    end subroutine solve_steps
+    end subroutine run_steps
 
     !> Start from the state after `resume%step` of an interrupted run.
-    subroutine resume_from(sp, resume, u, stats, first)
+    subroutine resume_from(sp, resume, u, first)
         type(stepper_t), intent(inout) :: sp
         type(resume_t), intent(in) :: resume
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
         integer, intent(inout) :: first
         if (.not. allocated(resume%u)) return
         u = resume%u
@@ -154,19 +185,18 @@ contains
         sp%u_step = u
         if (allocated(resume%u_before)) sp%u_step_before = resume%u_before
         sp%frac = resume%fraction
-        stats%r0_max = resume%r0_max
+        sp%ctx%stats%r0_max = resume%r0_max
         sp%conv_det_sign = resume%det_sign
         first = resume%step + 1
     end subroutine resume_from
 
-    !> Every warning of `list` to `progress`; the stepper keeps them.
-    subroutine report_warnings(sp, progress, list)
+    !> Every warning of `list` to the progress observer; the stepper keeps them.
+    subroutine report_warnings(sp, list)
         type(stepper_t), intent(inout) :: sp
-        class(progress_t), intent(inout) :: progress
         type(warning_t), intent(in) :: list(:)
         integer :: i
         do i = 1, size(list)
-            call progress%warning(trim(list(i)%text))
+            call sp%ctx%progress%warning(trim(list(i)%text))
         end do
         sp%warned = [sp%warned, list]
     end subroutine report_warnings
@@ -196,17 +226,14 @@ contains
     end subroutine prefix_step
 
     !> Nominal step `step`: substeps until it is complete, cutting the increment on
-    !> failure; then its reactions and report. `t`: the load time of the last attempt.
-    subroutine solve_step(sp, model, step, u, stats, progress, t, error)
+    !> failure; then its reactions and report. `sp%ctx%time`: the load time of the
+    !> last attempt.
+    subroutine solve_step(sp, model, step, u, error)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
         integer, intent(in) :: step
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        class(progress_t), intent(inout) :: progress
-        real(dp), intent(out) :: t
         type(error_t), allocatable, intent(out) :: error
-        type(step_record_t) :: rec
         type(attempt_t) :: attempt
         real(dp) :: t_begin, t_end, ds
         integer :: first_cut
@@ -214,52 +241,47 @@ contains
 
         t_begin = sp%settings%step_time(step - 1)
         t_end = sp%settings%step_time(step)
-        rec = step_record_t()
-        rec%step = step
-        rec%time = t_end
-        rec%substeps = 0
-        first_cut = size(stats%cut_records) + 1
-        sp%stall_start = stats%iterations
+        sp%ctx%step = step
+        sp%ctx%record = step_record_t(step=step, time=t_end, substeps=0)
+        first_cut = size(sp%ctx%stats%cut_records) + 1
+        sp%stall_start = sp%ctx%stats%iterations
         sp%fold_iterations = 0
         sp%fold_total = 0
         sp%s = 0.0_dp
         do while (sp%s < 1.0_dp)
             ds = min(sp%frac, 1.0_dp - sp%s)
-            t = t_end
-            if (sp%s + ds < 1.0_dp) t = t_begin + (sp%s + ds)*(t_end - t_begin)
-            call progress%substep(step, sp%settings%total_steps(), rec%substeps + 1, rec%cuts, stats%cuts, t, ds)
-            call attempt_substep(sp, model, step, t, ds, u, stats, rec, progress, attempt, predicted, error)
+            sp%ctx%time = t_end
+            if (sp%s + ds < 1.0_dp) sp%ctx%time = t_begin + (sp%s + ds)*(t_end - t_begin)
+            call sp%ctx%progress%substep(step, sp%settings%total_steps(), sp%ctx%record%substeps + 1, &
+                                         sp%ctx%record%cuts, sp%ctx%stats%cuts, sp%ctx%time, ds)
+            call attempt_substep(sp, model, ds, u, attempt, predicted, error)
             if (.not. allocated(error)) then
-                call accept_substep(sp, model, ds, u, attempt, stats, rec)
+                call accept_substep(sp, model, ds, u, attempt)
                 cycle
             end if
-            call handle_failure(sp, model, step, t, t_begin, t_end, ds, predicted, u, stats, rec, progress, &
-                                stop_run, error)
+            call handle_failure(sp, model, t_begin, t_end, ds, predicted, u, stop_run, error)
             if (stop_run) return
         end do
-        call finish_step(sp, model, step, u, attempt, stats, rec, first_cut, progress, error)
+        call finish_step(sp, model, u, attempt, first_cut, error)
     end subroutine solve_step
 
-    !> One attempt at the substep ending at load time `t` (increment `ds`): from
-    !> the predictor or the converged state, Newton (or, with `tresca_always`, the
-    !> Tresca fixed point); a frictional attempt from the converged state that failed
-    !> with contact states switching is retried by the Tresca fixed point.
-    subroutine attempt_substep(sp, model, step, t, ds, u, stats, rec, progress, attempt, predicted, error)
+    !> One attempt at the substep of `sp%ctx` (increment `ds`): from the predictor
+    !> or the converged state, Newton (or, with `tresca_always`, the Tresca fixed
+    !> point); a frictional attempt from the converged state that failed with
+    !> contact states switching is retried by the Tresca fixed point.
+    subroutine attempt_substep(sp, model, ds, u, attempt, predicted, error)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t, ds
+        real(dp), intent(in) :: ds
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         type(attempt_t), intent(out) :: attempt
         logical, intent(out) :: predicted
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: tresca_error
-        integer :: ip
+        integer :: ip, step
         logical :: retry
 
+        step = sp%ctx%step
         predicted = .false.
         retry = sp%unpredicted_retry
         if (sp%settings%predictor .and. .not. retry .and. allocated(sp%u_step_before) &
@@ -273,17 +295,18 @@ contains
         if (sp%settings%tresca_always .and. frictional(model)) then
             u = sp%u_conv
             predicted = .false.
-            call tresca_fixed_point(sp%newton, model, step, t, u, stats, rec, progress, attempt, error)
+            call tresca_fixed_point(sp%newton, model, sp%ctx, u, attempt, error)
             return
         end if
-        call set_prescribed(model, t, u)
-        if (.not. predicted .and. .not. retry .and. sp%settings%stick_predictor .and. sliding_start(model, t)) then
+        call set_prescribed(model, sp%ctx%time, u)
+        if (.not. predicted .and. .not. retry .and. sp%settings%stick_predictor .and. &
+            sliding_start(model, sp%ctx%time)) then
             ! (a failure from this start is retried once from the converged state)
-            call stick_predictor(sp%newton, model, t, u, stats, rec, error)
+            call stick_predictor(sp%newton, model, sp%ctx, u, error)
             if (allocated(error)) return
             predicted = .true.
         end if
-        call substep_attempt(sp%newton, model, step, t, u, stats, rec, progress, attempt, error)
+        call substep_attempt(sp%newton, model, sp%ctx, u, attempt, error)
         if (.not. allocated(error) .or. predicted) return
         sp%fold_iterations = attempt%nonpositive_det
         sp%fold_total = attempt%iterations
@@ -291,16 +314,16 @@ contains
         ! cap with switches; at a fold det K also changes sign, but the stick/slip
         ! switch of a stiff penalty stalls Newton with det K > 0 as well): retry the
         ! same increment with the Tresca fixed point before cutting
-        if (error%code /= error_code%numeric .or. stats%signal /= 0 .or. .not. attempt%switching .or. &
+        if (error%code /= error_code%numeric .or. sp%ctx%stats%signal /= 0 .or. .not. attempt%switching .or. &
             .not. frictional(model)) return
         u = sp%u_conv
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%reset_trial()
         end do
-        call tresca_fixed_point(sp%newton, model, step, t, u, stats, rec, progress, attempt, tresca_error)
+        call tresca_fixed_point(sp%newton, model, sp%ctx, u, attempt, tresca_error)
         if (.not. allocated(tresca_error)) then
             deallocate (error)
-        else if (stats%signal /= 0) then
+        else if (sp%ctx%stats%signal /= 0) then
             call move_alloc(tresca_error, error)
         else
             error%message = error%message//'; retried with the Tresca fixed point: '//tresca_error%message
@@ -323,55 +346,48 @@ contains
 
     !> The substep converged: it is the new converged state; the increment grows
     !> after an easy substep.
-    subroutine accept_substep(sp, model, ds, u, attempt, stats, rec)
+    subroutine accept_substep(sp, model, ds, u, attempt)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: ds, u(:)
         type(attempt_t), intent(in) :: attempt
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
         integer :: ip
         if (attempt%iterations > 0) sp%conv_det_sign = attempt%det_sign
         sp%u_conv = u
-        sp%stall_start = stats%iterations
+        sp%stall_start = sp%ctx%stats%iterations
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%commit()
         end do
         sp%s = sp%s + ds
-        rec%substeps = rec%substeps + 1
-        stats%substeps = stats%substeps + 1
+        sp%ctx%record%substeps = sp%ctx%record%substeps + 1
+        sp%ctx%stats%substeps = sp%ctx%stats%substeps + 1
         if (attempt%iterations <= sp%settings%grow_iterations) sp%frac = min(1.0_dp, 2.0_dp*sp%frac)
     end subroutine accept_substep
 
     !> A failed substep: back to the last converged state; then retry a predicted
     !> start once from there, or cut the increment, or (at the limit, on a signal or
     !> a non-numerical failure) end the run with the error (`stop_run`).
-    subroutine handle_failure(sp, model, step, t, t_begin, t_end, ds, predicted, u, stats, rec, progress, &
-                              stop_run, error)
+    subroutine handle_failure(sp, model, t_begin, t_end, ds, predicted, u, stop_run, error)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t, t_begin, t_end, ds
+        real(dp), intent(in) :: t_begin, t_end, ds
         logical, intent(in) :: predicted
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
-        class(progress_t), intent(inout) :: progress
         logical, intent(out) :: stop_run
         type(error_t), allocatable, intent(inout) :: error
         type(cut_record_t) :: cut
-        integer :: ip
+        integer :: ip, stalled
 
         u = sp%u_conv
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%reset_trial()
         end do
-        stop_run = stats%signal /= 0 .or. error%code /= error_code%numeric
+        stop_run = sp%ctx%stats%signal /= 0 .or. error%code /= error_code%numeric
         if (stop_run) return
-        if (softened(model, step, t, progress, error%message)) then
+        if (softened(model, sp%ctx, error%message)) then
             ! a penalty that does not decide the solution was made softer: the same
             ! increment again, as it was attempted
-            stats%softenings = stats%softenings + 1
+            sp%ctx%stats%softenings = sp%ctx%stats%softenings + 1
             sp%unpredicted_retry = .not. predicted
             deallocate (error)
             return
@@ -380,40 +396,38 @@ contains
             ! a predicted start that fails is retried once from the last converged
             ! state, at the same increment, before the increment is cut
             sp%unpredicted_retry = .true.
-            stats%predictor_retries = stats%predictor_retries + 1
-            call progress%retried(step, t, error%message)
+            sp%ctx%stats%predictor_retries = sp%ctx%stats%predictor_retries + 1
+            call sp%ctx%progress%retried(sp%ctx%step, sp%ctx%time, error%message)
             deallocate (error)
             return
         end if
-        if (sp%settings%max_stalled_iterations > 0 .and. &
-            stats%iterations - sp%stall_start >= sp%settings%max_stalled_iterations) then
-            call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, rec, stats, error, &
-                                 stalled=stats%iterations - sp%stall_start)
+        stalled = sp%ctx%stats%iterations - sp%stall_start
+        if (sp%settings%max_stalled_iterations > 0 .and. stalled >= sp%settings%max_stalled_iterations) then
+            call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, error, stalled=stalled)
             stop_run = .true.
             return
         end if
-        if (rec%cuts >= sp%settings%max_cuts .or. &
+        if (sp%ctx%record%cuts >= sp%settings%max_cuts .or. &
             0.5_dp*ds < sp%settings%min_step_fraction*(1.0_dp - 1.0e-12_dp)) then
-            call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, rec, stats, error)
+            call explain_failure(sp, model, t_begin + sp%s*(t_end - t_begin), ds, error)
             stop_run = .true.
             return
         end if
-        cut = cut_record_t(step=step, time=t, fraction=ds, new_fraction=0.5_dp*ds, reason=error%message)
-        call append_cut(stats%cut_records, cut)
-        stats%cuts = stats%cuts + 1
-        rec%cuts = rec%cuts + 1
+        cut = cut_record_t(step=sp%ctx%step, time=sp%ctx%time, fraction=ds, new_fraction=0.5_dp*ds, &
+                           reason=error%message)
+        call append_cut(sp%ctx%stats%cut_records, cut)
+        sp%ctx%stats%cuts = sp%ctx%stats%cuts + 1
+        sp%ctx%record%cuts = sp%ctx%record%cuts + 1
         sp%frac = 0.5_dp*ds
-        call progress%cut(cut, error%message)
+        call sp%ctx%progress%cut(cut, error%message)
         deallocate (error)
     end subroutine handle_failure
 
     !> Let every pair soften its penalties after a failed substep (`reason`); whether
-    !> one did (each says what it changed through `progress`).
-    logical function softened(model, step, t, progress, reason) result(any_changed)
+    !> one did (each says what it changed through the progress observer).
+    logical function softened(model, ctx, reason) result(any_changed)
         type(model_t), intent(inout) :: model
-        integer, intent(in) :: step
-        real(dp), intent(in) :: t
-        class(progress_t), intent(inout) :: progress
+        type(context_t), intent(in) :: ctx
         character(len=*), intent(in) :: reason
         character(len=:), allocatable :: what
         logical :: changed
@@ -423,7 +437,7 @@ contains
             call model%pairs(ip)%pair%soften(changed, what)
             if (.not. changed) cycle
             any_changed = .true.
-            call progress%softened(step, t, ip, what, reason)
+            call ctx%progress%softened(ctx%step, ctx%time, ip, what, reason)
         end do
     end function softened
 
@@ -431,30 +445,28 @@ contains
     !> failed attempts since the last converged substep) is given up as hopeless:
     !> the limits it reached, and the diagnoses at the last converged state (load
     !> time `t_conv`).
-    subroutine explain_failure(sp, model, t_conv, ds, rec, stats, error, stalled)
+    subroutine explain_failure(sp, model, t_conv, ds, error, stalled)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: t_conv, ds
-        type(step_record_t), intent(in) :: rec
-        type(solver_stats_t), intent(inout) :: stats
         type(error_t), intent(inout) :: error
         integer, intent(in), optional :: stalled
         if (present(stalled)) then
             error%message = error%message//'; gave the step up: its attempts since the last converged substep '// &
                             'took '//str(stalled)//' Newton iterations without converging (the budget, &solver '// &
                             'max_stalled_iterations = '//str(sp%settings%max_stalled_iterations)//'; '// &
-                            str(rec%cuts)//' cuts, increment '//real_str(ds, 'es9.2')//' of the nominal step). '// &
+                            str(sp%ctx%record%cuts)//' cuts, increment '//real_str(ds, 'es9.2')//' of the nominal step). '// &
                             'The load of a step is likely too large to follow: give more load steps (&solver '// &
                             'n_steps'//steps_now(sp%settings%n_steps)//') or smaller motions per step'
-        else if (rec%cuts > 0 .or. sp%settings%max_cuts > 0) then
-            error%message = error%message//' (after '//str(rec%cuts)//' cuts; increment '// &
+        else if (sp%ctx%record%cuts > 0 .or. sp%settings%max_cuts > 0) then
+            error%message = error%message//' (after '//str(sp%ctx%record%cuts)//' cuts; increment '// &
                             real_str(ds, 'es9.2')//' of the nominal step, minimum '// &
                             real_str(sp%settings%min_step_fraction, 'es9.2')//', max_cuts '// &
                             str(sp%settings%max_cuts)//')'
         end if
         if (sp%fold_iterations > 0 .and. (sp%fold_iterations < sp%fold_total .or. sp%conv_det_sign > 0)) &
             error%message = error%message//fold_diagnosis(model, sp%fold_iterations, sp%fold_total)
-        call append_pair_diagnoses(model, sp%u_conv, t_conv, stats%assembly, error%message)
+        call append_pair_diagnoses(model, sp%u_conv, t_conv, sp%ctx%stats%assembly, error%message)
     end subroutine explain_failure
 
     !> " now a, b" (the load steps of each phase).
@@ -471,16 +483,12 @@ contains
 
     !> The nominal step converged: its reactions, its report (the result file writes
     !> it), its record.
-    subroutine finish_step(sp, model, step, u, attempt, stats, rec, first_cut, progress, error)
+    subroutine finish_step(sp, model, u, attempt, first_cut, error)
         type(stepper_t), intent(inout) :: sp
         type(model_t), intent(in) :: model
-        integer, intent(in) :: step
         real(dp), intent(in) :: u(:)
         type(attempt_t), intent(in) :: attempt
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
         integer, intent(in) :: first_cut
-        class(progress_t), intent(inout) :: progress
         type(error_t), allocatable, intent(out) :: error
         type(step_report_t) :: report
         type(warning_t), allocatable :: warnings(:)
@@ -490,23 +498,25 @@ contains
         sp%u_conv = u
         sp%u_step_before = sp%u_step
         sp%u_step = u
-        stats%steps = step
-        rec%det_sign = sp%conv_det_sign
-        allocate (rec%reactions(2, size(model%dirichlet)))
-        do j = 1, size(model%dirichlet)
-            do c = 1, 2
-                rec%reactions(c, j) = sum(sp%newton%r(model%dirichlet(j)%dofs(c, :)))
+        associate (stats => sp%ctx%stats, rec => sp%ctx%record)
+            stats%steps = rec%step
+            rec%det_sign = sp%conv_det_sign
+            allocate (rec%reactions(2, size(model%dirichlet)))
+            do j = 1, size(model%dirichlet)
+                do c = 1, 2
+                    rec%reactions(c, j) = sum(sp%newton%r(model%dirichlet(j)%dofs(c, :)))
+                end do
             end do
-        end do
-        tic = wall_seconds()
-        report = step_report_t(record=rec, n_steps=sp%settings%total_steps(), residual=attempt%residual, &
-                               wall=tic - sp%start, cuts=stats%cut_records(first_cut:), n_cuts=stats%cuts, &
-                               next_fraction=sp%frac, r0_max=stats%r0_max)
-        call progress%step_done(report, u, model, error)
-        call sp%watch%after_step(model, step, warnings)
-        call report_warnings(sp, progress, warnings)
-        rec%seconds(5) = wall_seconds() - tic
-        stats%records = [stats%records, rec]
+            tic = wall_seconds()
+            report = step_report_t(record=rec, n_steps=sp%settings%total_steps(), residual=attempt%residual, &
+                                   wall=tic - sp%start, cuts=stats%cut_records(first_cut:), n_cuts=stats%cuts, &
+                                   next_fraction=sp%frac, r0_max=stats%r0_max)
+        end associate
+        call sp%ctx%progress%step_done(report, u, model, error)
+        call sp%watch%after_step(model, sp%ctx%step, warnings)
+        call report_warnings(sp, warnings)
+        sp%ctx%record%seconds(5) = wall_seconds() - tic
+        sp%ctx%stats%records = [sp%ctx%stats%records, sp%ctx%record]
     end subroutine finish_step
 
 end module voiga_solver_stepping

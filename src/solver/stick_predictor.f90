@@ -8,7 +8,8 @@ module voiga_solver_stick_predictor
     use voiga_model, only: model_t
     use voiga_model_assembly, only: assemble
     use voiga_solver_newton, only: newton_t
-    use voiga_solver_records, only: solver_stats_t, step_record_t, wall_seconds
+    use voiga_solver_records, only: wall_seconds
+    use voiga_solver_context, only: context_t
     implicit none
     private
 
@@ -16,7 +17,7 @@ module voiga_solver_stick_predictor
 
 contains
 
-    !> The stick predictor of a frictional substep at load time `t` that starts from
+    !> The stick predictor of a frictional substep (`ctx`) that starts from
     !> the last converged state `u` (prescribed values set): one linear step with
     !> every active contact point sticking (the elastic predictor of its traction kept
     !> whatever its size, `contact_law_t%return_map`). When a rigid obstacle or a
@@ -28,13 +29,11 @@ contains
     !> the points held, which most of them do. Newton then starts there with the true
     !> law, its tolerances relative to the residual there; the step counts as one
     !> iteration.
-    subroutine stick_predictor(self, model, t, u, stats, rec, error)
+    subroutine stick_predictor(self, model, ctx, u, error)
         type(newton_t), intent(inout) :: self
         type(model_t), intent(inout) :: model
-        real(dp), intent(in) :: t
+        type(context_t), intent(inout) :: ctx
         real(dp), intent(inout) :: u(:)
-        type(solver_stats_t), intent(inout) :: stats
-        type(step_record_t), intent(inout) :: rec
         type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: du(:), rhs(:)
         real(dp) :: bulk0, contact0, tic
@@ -43,11 +42,11 @@ contains
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%stick_trial(.true.)
         end do
-        bulk0 = stats%assembly%seconds_bulk
-        contact0 = stats%assembly%seconds_contact
-        call assemble(model, u, t, self%r, stats%assembly, error, self%k, self%map, refit=.true.)
-        rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
-        rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
+        bulk0 = ctx%stats%assembly%seconds_bulk
+        contact0 = ctx%stats%assembly%seconds_contact
+        call assemble(model, u, ctx%time, self%r, ctx%stats%assembly, error, self%k, self%map, refit=.true.)
+        ctx%record%seconds(1) = ctx%record%seconds(1) + ctx%stats%assembly%seconds_bulk - bulk0
+        ctx%record%seconds(2) = ctx%record%seconds(2) + ctx%stats%assembly%seconds_contact - contact0
         do ip = 1, size(model%pairs)
             call model%pairs(ip)%pair%stick_trial(.false.)
             call model%pairs(ip)%pair%reset_trial()
@@ -57,22 +56,22 @@ contains
         call self%k%fix_dofs(model%fixed)
         call self%linear%renew_analysis()
         call self%linear%factor(self%k, error)
-        rec%seconds(3) = rec%seconds(3) + wall_seconds() - tic
+        ctx%record%seconds(3) = ctx%record%seconds(3) + wall_seconds() - tic
         if (allocated(error)) return
         tic = wall_seconds()
         rhs = -merge(0.0_dp, self%r, model%fixed)
         allocate (du(size(u)))
         call self%linear%solve(self%k, rhs, du, error)
-        rec%seconds(4) = rec%seconds(4) + wall_seconds() - tic
+        ctx%record%seconds(4) = ctx%record%seconds(4) + wall_seconds() - tic
         if (allocated(error)) return
         if (.not. all(ieee_is_finite(du))) then
             call fatal_error(error, 'the stick predictor is not finite', error_code%numeric)
             return
         end if
         u = u + du
-        stats%iterations = stats%iterations + 1
-        rec%iterations_total = rec%iterations_total + 1
-        stats%stick_predictions = stats%stick_predictions + 1
+        ctx%stats%iterations = ctx%stats%iterations + 1
+        ctx%record%iterations_total = ctx%record%iterations_total + 1
+        ctx%stats%stick_predictions = ctx%stats%stick_predictions + 1
     end subroutine stick_predictor
 
 end module voiga_solver_stick_predictor
