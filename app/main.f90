@@ -43,7 +43,7 @@ program voiga_main
     type(warning_t), allocatable :: warnings(:)
     real(dp), allocatable :: u(:)
     real(dp) :: t0
-    integer :: i, total, length
+    integer :: i, length
     logical :: heap_ok
 
     call choose_blas_kernels()
@@ -84,14 +84,7 @@ program voiga_main
     if (allocated(error)) call fail(error)
 
     ! the DOF lines are what --check is for; a --quiet run does without them
-    total = 0
-    do i = 1, size(discs)
-        if (check .or. .not. quiet) write (*, '(a,4(a,i0))') 'dofs '//trim(case%bodies(i)%name), ' interface=', &
-            discs(i)%interface_dofs, ' bulk=', discs(i)%bulk_dofs, ' total=', discs(i)%total_dofs, &
-            ' elements=', discs(i)%nel
-        total = total + discs(i)%total_dofs
-    end do
-    if (check .or. .not. quiet) write (*, '(a,i0)') 'dofs all total=', total
+    if (check .or. .not. quiet) call print_dofs()
     call check_edges(case, discs, error)
     if (allocated(error)) call fail(error)
 
@@ -135,33 +128,52 @@ program voiga_main
     call observers%add(console)
     call solve_steps(model, case%solver, u, stats, error, observers, resume, t0)
     call console%clear_live()
-    if (stats%signal /= 0) then
-        call finish('interrupted')
-        write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
-            ' completed steps '//where_kept()
-        ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
-        call exit_code(128 + stats%signal)
-    end if
-    if (allocated(error)) then
-        call finish('failed: '//error%message)
-        if (results%status_only()) then
-            write (0, '(a)') 'voiga: no step converged; '//case%output//' keeps the status and the warnings '// &
-                '(python -m post summary '//case%output//')'
-        else
-            write (0, '(a)') 'voiga: results of the converged steps '//where_kept()
-        end if
-        write (0, '(a)') 'voiga: error: '//error%message
-        call exit_code(exit_status(error))
-    end if
-    call finish('converged')
-    write (*, '(a,i0,a,i0,a,i0,a,i0,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
-        ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, '// &
-        fixed_str(wall_seconds() - t0, 3)//' s; wrote '//case%output
-    if (stats%tresca_retries > 0) write (*, '(a,i0,a,i0,a,i0,a)') 'Tresca fixed point: ', &
-        stats%tresca_retries, ' substeps retried, ', stats%tresca_accepted, ' accepted, ', &
-        stats%fixed_point_iterations, ' fixed-point iterations'
+    call end_run()
 
 contains
+
+    !> Each body's DOFs and elements, and the total.
+    subroutine print_dofs()
+        integer :: i, total
+        total = 0
+        do i = 1, size(discs)
+            write (*, '(a,4(a,i0))') 'dofs '//trim(case%bodies(i)%name), ' interface=', &
+                discs(i)%interface_dofs, ' bulk=', discs(i)%bulk_dofs, ' total=', discs(i)%total_dofs, &
+                ' elements=', discs(i)%nel
+            total = total + discs(i)%total_dofs
+        end do
+        write (*, '(a,i0)') 'dofs all total=', total
+    end subroutine print_dofs
+
+    !> The run ended (interrupted, failed or converged): the result file's final
+    !> status, the last lines and the exit code.
+    subroutine end_run()
+        if (stats%signal /= 0) then
+            call finish('interrupted')
+            write (0, '(a,i0,a)') 'voiga: interrupted by '//signal_name(stats%signal)//'; ', stats%steps, &
+                ' completed steps '//where_kept()
+            ! the shell convention: 128 + the signal number (130 SIGINT, 143 SIGTERM)
+            call exit_code(128 + stats%signal)
+        end if
+        if (allocated(error)) then
+            call finish('failed: '//error%message)
+            if (results%status_only()) then
+                write (0, '(a)') 'voiga: no step converged; '//case%output//' keeps the status and the warnings '// &
+                    '(python -m post summary '//case%output//')'
+            else
+                write (0, '(a)') 'voiga: results of the converged steps '//where_kept()
+            end if
+            write (0, '(a)') 'voiga: error: '//error%message
+            call exit_code(exit_status(error))
+        end if
+        call finish('converged')
+        write (*, '(a,i0,a,i0,a,i0,a,i0,a)') 'converged: ', stats%steps, ' steps (', stats%substeps, &
+            ' substeps, ', stats%cuts, ' cuts), ', stats%iterations, ' Newton iterations, '// &
+            fixed_str(wall_seconds() - t0, 3)//' s; wrote '//case%output
+        if (stats%tresca_retries > 0) write (*, '(a,i0,a,i0,a,i0,a)') 'Tresca fixed point: ', &
+            stats%tresca_retries, ' substeps retried, ', stats%tresca_accepted, ' accepted, ', &
+            stats%fixed_point_iterations, ' fixed-point iterations'
+    end subroutine end_run
 
     !> Under an address-space limit (`ulimit -v`) an OpenBLAS thread that cannot map
     !> its work buffer (128 MiB of address space each) retries for ever, and the

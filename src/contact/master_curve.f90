@@ -99,9 +99,10 @@ contains
     pure function curve_output(self) result(out)
         class(rigid_curve_t), intent(in) :: self
         type(master_output_t) :: out
-        out = master_output_t(curve_name='rigid_curve', &
-                              curve=nurbs_curve_t(self%surf%degree, self%surf%knots, self%surf%x0, self%surf%w), &
-                              names=[character(len=16) :: 'rigid_offset'], vectors=reshape(self%offset, [2, 1]))
+        out%curve_name = 'rigid_curve'
+        out%curve = nurbs_curve_t(self%surf%degree, self%surf%knots, self%surf%x0, self%surf%w)
+        out%names = [character(len=16) :: 'rigid_offset']
+        out%vectors = reshape(self%offset, [2, 1])
     end function curve_output
 
 end module voiga_contact_master_curve

@@ -62,9 +62,9 @@ contains
     pure function rigid_output(self) result(out)
         class(rigid_line_t), intent(in) :: self
         type(master_output_t) :: out
-        out = master_output_t(curve_name='', names=[character(len=16) :: 'rigid_point', 'rigid_normal', &
-                                                    'rigid_offset'], &
-                              vectors=reshape([self%p0, self%n, self%p0 - self%p_ref], [2, 3]))
+        out%curve_name = ''
+        out%names = [character(len=16) :: 'rigid_point', 'rigid_normal', 'rigid_offset']
+        out%vectors = reshape([self%p0, self%n, self%p0 - self%p_ref], [2, 3])
     end function rigid_output
 
 end module voiga_contact_master_rigid

@@ -417,11 +417,8 @@ contains
         character(len=*), intent(in) :: path
         real(dp), contiguous, target, intent(in) :: array(..)
         type(error_t), allocatable, intent(out), optional :: error
-        type(error_t), allocatable :: outcome
-        if (self%skips(present(error))) return
-        call write_dataset(self, path, H5T_NATIVE_DOUBLE, &
-                           written_dims(shape(array, kind=hsize_t)), c_loc(array), outcome)
-        call self%hand_over(outcome, error)
+        call write_array(self, path, H5T_NATIVE_DOUBLE, written_dims(shape(array, kind=hsize_t)), &
+                         c_loc(array), error)
     end subroutine write_real
 
     !> Write an integer array of any rank (a scalar as one element) as native integers.
@@ -430,12 +427,23 @@ contains
         character(len=*), intent(in) :: path
         integer, contiguous, target, intent(in) :: array(..)
         type(error_t), allocatable, intent(out), optional :: error
+        call write_array(self, path, H5T_NATIVE_INTEGER, written_dims(shape(array, kind=hsize_t)), &
+                         c_loc(array), error)
+    end subroutine write_int
+
+    !> `write_dataset`, its failure to `error` or, without one, kept by the file.
+    subroutine write_array(self, path, dtype, dims, buf, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer(hid_t), intent(in) :: dtype
+        integer(hsize_t), intent(in) :: dims(:)
+        type(c_ptr), intent(in) :: buf
+        type(error_t), allocatable, intent(out), optional :: error
         type(error_t), allocatable :: outcome
         if (self%skips(present(error))) return
-        call write_dataset(self, path, H5T_NATIVE_INTEGER, &
-                           written_dims(shape(array, kind=hsize_t)), c_loc(array), outcome)
+        call write_dataset(self, path, dtype, dims, buf, outcome)
         call self%hand_over(outcome, error)
-    end subroutine write_int
+    end subroutine write_array
 
     !> Whether a write without `error` (`has_error` false) is skipped: a write
     !> without one failed before.

@@ -20,18 +20,25 @@ contains
     end procedure attr_write_str
 
     module procedure attr_write_int
-        type(error_t), allocatable :: outcome
-        if (self%skips(present(error))) return
-        call write_attribute(self, path, name, H5T_NATIVE_INTEGER, c_loc(value), outcome)
-        call self%hand_over(outcome, error)
+        call write_scalar(self, path, name, H5T_NATIVE_INTEGER, c_loc(value), error)
     end procedure attr_write_int
 
     module procedure attr_write_real
+        call write_scalar(self, path, name, H5T_NATIVE_DOUBLE, c_loc(value), error)
+    end procedure attr_write_real
+
+    !> `write_attribute`, its failure to `error` or, without one, kept by the file.
+    subroutine write_scalar(self, path, name, dtype, buf, error)
+        class(h5file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path, name
+        integer(hid_t), intent(in) :: dtype
+        type(c_ptr), intent(in) :: buf
+        type(error_t), allocatable, intent(out), optional :: error
         type(error_t), allocatable :: outcome
         if (self%skips(present(error))) return
-        call write_attribute(self, path, name, H5T_NATIVE_DOUBLE, c_loc(value), outcome)
+        call write_attribute(self, path, name, dtype, buf, outcome)
         call self%hand_over(outcome, error)
-    end procedure attr_write_real
+    end subroutine write_scalar
 
     !> Write the string attribute `name` of `path` (`attr_write_str`).
     subroutine write_string(self, path, name, value, error)

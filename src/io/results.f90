@@ -3,7 +3,9 @@
 !> when the step converges, and a final status ('converged', 'failed: ...',
 !> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
 !> Every write goes through `result_file_t`'s guards (what readers see, a second
-!> writer, a full disk: voiga_io_result_file).
+!> writer, a full disk: voiga_io_result_file). The writes of one step or record
+!> keep their first failure in the file (`h5file_t%check`), which the end of the
+!> write (`end_write`) reports: one check per step, not one per call.
 module voiga_io_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use, intrinsic :: iso_fortran_env, only: int64
@@ -198,9 +200,9 @@ contains
         if (allocated(error)) return
         call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
-        call self%h5%write_attr('/', 'status', 'running', error)
-        if (.not. allocated(error) .and. present(note)) then
-            if (len(note) > 0) call self%h5%write_attr('/', 'restart_forced', note, error)
+        call self%h5%write_attr('/', 'status', 'running')
+        if (present(note)) then
+            if (len(note) > 0) call self%h5%write_attr('/', 'restart_forced', note)
         end if
         call self%h5%end_write(error)
     end subroutine results_reopen
@@ -355,34 +357,21 @@ contains
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: c
         type(contact_point_out_t), intent(in) :: out(:)
-        real(dp), allocatable :: a2(:, :), a1(:)
+        real(dp), allocatable :: a1(:)
         integer :: i
-        allocate (a2(2, size(out)))
-        do i = 1, size(out)
-            a2(:, i) = out(i)%x0
-        end do
-        call h5%write(c//'/x_ref', a2)
-        do i = 1, size(out)
-            a2(:, i) = out(i)%x
-        end do
-        call h5%write(c//'/x', a2)
+        call h5%write(c//'/x_ref', reshape([(out(i)%x0, i=1, size(out))], [2, size(out)]))
+        call h5%write(c//'/x', reshape([(out(i)%x, i=1, size(out))], [2, size(out)]))
         a1 = out%gap
         ! no orthogonal projection onto the master: NaN
         where (a1 > 1.0e300_dp) a1 = ieee_value(1.0_dp, ieee_quiet_nan)
         call h5%write(c//'/gap', a1)
-        ! (copies: the components of an array of points are not contiguous)
-        a1 = out%pn
-        call h5%write(c//'/p_n', a1)
-        a1 = out%pt
-        call h5%write(c//'/p_t', a1)
-        a1 = out%pn0
-        call h5%write(c//'/p_n_nominal', a1)
-        a1 = out%pt0
-        call h5%write(c//'/p_t_nominal', a1)
-        a1 = out%stretch
-        call h5%write(c//'/stretch', a1)
-        a1 = out%xi_m
-        call h5%write(c//'/xi_master', a1)
+        ! ([ ]: contiguous copies of the points' components)
+        call h5%write(c//'/p_n', [out%pn])
+        call h5%write(c//'/p_t', [out%pt])
+        call h5%write(c//'/p_n_nominal', [out%pn0])
+        call h5%write(c//'/p_t_nominal', [out%pt0])
+        call h5%write(c//'/stretch', [out%stretch])
+        call h5%write(c//'/xi_master', [out%xi_m])
         call h5%write(c//'/state', [out%state])
     end subroutine write_points
 

@@ -219,9 +219,10 @@ contains
             bulk0 = stats%assembly%seconds_bulk
             contact0 = stats%assembly%seconds_contact
             enough = .false.
-            if (expect_converged(self, st)) enough = converged_without_tangent(self, model, ctx%time, u, st, stats)
-            if (.not. enough) call assemble(model, u, ctx%time, self%r, stats%assembly, error, self%k, self%map, &
-                                            refit=(st%it == 0 .and. st%nls == 0))
+            if (expect_converged(self, st)) &
+                enough = converged_without_tangent(self, model, ctx%time, u, st, stats)
+            if (.not. enough) call assemble(model, u, ctx%time, self%r, stats%assembly, error, self%k, &
+                                            self%map, refit=(st%it == 0 .and. st%nls == 0))
             rec%seconds(1) = rec%seconds(1) + stats%assembly%seconds_bulk - bulk0
             rec%seconds(2) = rec%seconds(2) + stats%assembly%seconds_contact - contact0
         end associate
