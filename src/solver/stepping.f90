@@ -455,7 +455,8 @@ contains
             error%message = error%message//'; gave the step up: its attempts since the last converged substep '// &
                             'took '//str(stalled)//' Newton iterations without converging (the budget, &solver '// &
                             'max_stalled_iterations = '//str(sp%settings%max_stalled_iterations)//'; '// &
-                            str(sp%ctx%record%cuts)//' cuts, increment '//real_str(ds, 'es9.2')//' of the nominal step). '// &
+                            str(sp%ctx%record%cuts)//' cuts, increment '//real_str(ds, 'es9.2')// &
+                            ' of the nominal step). '// &
                             'The load of a step is likely too large to follow: give more load steps (&solver '// &
                             'n_steps'//steps_now(sp%settings%n_steps)//') or smaller motions per step'
         else if (sp%ctx%record%cuts > 0 .or. sp%settings%max_cuts > 0) then
