@@ -12,7 +12,7 @@ module voiga_app_console
     use voiga_text, only: str, fixed_str, real_str
     use voiga_error, only: error_t
     use voiga_model, only: model_t
-    use voiga_io_results, only: results_t
+    use voiga_io_output_results, only: results_t
     use voiga_solver_records, only: cut_record_t, wall_seconds
     use voiga_solver_progress, only: iteration_report_t, fixed_point_report_t, step_report_t
     implicit none

@@ -5,11 +5,11 @@ module test_files
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_io_sha256, only: sha256_file, sha256_text
-    use voiga_io_namelist, only: nml_group_t, scan_groups
-    use voiga_io_os, only: canonical_path, path_exists, remove_file
-    use voiga_io_lock, only: lock_t, acquire_lock, release_lock
-    use voiga_io_process, only: memory_available
+    use voiga_platform_sha256, only: sha256_file, sha256_text
+    use voiga_io_input_namelist, only: nml_group_t, scan_groups
+    use voiga_platform_os, only: canonical_path, path_exists, remove_file
+    use voiga_platform_lock, only: lock_t, acquire_lock, release_lock
+    use voiga_platform_process, only: memory_available
     implicit none
     private
 

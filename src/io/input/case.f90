@@ -1,21 +1,21 @@
 !> The case file: a Fortran namelist with a `&case` group, one `&body` group per
 !> body and the groups of the solver, the loads and the contact pairs (reference in
-!> docs/formats.md). Each group has its reader and settings type in `io/case/`;
+!> docs/formats.md). Each group has its reader and settings type in `io/input/case/`;
 !> here the file is opened, its groups are listed and checked, and each is read.
 !> Every value is validated and every error names the file, the group and the
 !> variable.
-module voiga_io_case
+module voiga_io_input_case
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_io_namelist, only: nml_group_t, scan_groups
-    use voiga_io_os, only: path_kind, kind_name, kind_missing, kind_regular
-    use voiga_io_case_case, only: case_settings_t, read_case_group, resolve_path
-    use voiga_io_case_body, only: read_body
-    use voiga_io_case_solver, only: read_solver
-    use voiga_io_case_dirichlet, only: read_dirichlet
-    use voiga_io_case_pressure, only: read_pressure
-    use voiga_io_case_contact, only: read_contact
-    use voiga_io_case_output, only: read_output
+    use voiga_io_input_namelist, only: nml_group_t, scan_groups
+    use voiga_platform_os, only: path_kind, kind_name, kind_missing, kind_regular
+    use voiga_io_input_case_case, only: case_settings_t, read_case_group, resolve_path
+    use voiga_io_input_case_body, only: read_body
+    use voiga_io_input_case_solver, only: read_solver
+    use voiga_io_input_case_dirichlet, only: read_dirichlet
+    use voiga_io_input_case_pressure, only: read_pressure
+    use voiga_io_input_case_contact, only: read_contact
+    use voiga_io_input_case_output, only: read_output
     use voiga_model_fields, only: output_settings_t
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
@@ -285,4 +285,4 @@ contains
         end do
     end function edge_names
 
-end module voiga_io_case
+end module voiga_io_input_case

@@ -4,7 +4,7 @@
 !>
 !> 32-bit words are held in 64-bit integers and masked after every operation
 !> (Fortran has no unsigned type, and signed overflow is not defined).
-module voiga_io_sha256
+module voiga_platform_sha256
     use, intrinsic :: iso_fortran_env, only: int8, int64
     use voiga_error, only: error_t, fatal_error, error_code
     implicit none
@@ -178,4 +178,4 @@ contains
         end do
     end subroutine compress
 
-end module voiga_io_sha256
+end module voiga_platform_sha256

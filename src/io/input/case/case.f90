@@ -1,9 +1,9 @@
 !> The `&case` group: what the run is (title, scene, mesh, layout), where its
 !> geometry is and where its result goes, and how many bodies it has.
-module voiga_io_case_case
+module voiga_io_input_case_case
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length
     implicit none
     private
 
@@ -110,4 +110,4 @@ contains
         end subroutine try_case
     end subroutine read_case_group
 
-end module voiga_io_case_case
+end module voiga_io_input_case_case

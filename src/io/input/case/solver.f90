@@ -1,11 +1,11 @@
 !> The `&solver` group: load steps, Newton's tolerances, adaptive stepping, the
 !> linear solver and the step damping (docs/formats.md).
-module voiga_io_case_solver
+module voiga_io_input_case_solver
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use, intrinsic :: iso_fortran_env, only: int64
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length, max_phases, either
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length, max_phases, either
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_linear_factory, only: linear_solver_names
     use voiga_solver_step_length, only: damping_names
@@ -147,4 +147,4 @@ contains
         end if
     end subroutine check_solver
 
-end module voiga_io_case_solver
+end module voiga_io_input_case_solver

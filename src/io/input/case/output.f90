@@ -1,10 +1,10 @@
 !> The `&output` group: which sampled fields the result file gets, at which steps,
 !> with how many samples per element (docs/formats.md). Without the group no field
 !> is computed.
-module voiga_io_case_output
+module voiga_io_input_case_output
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: quoted, check_length
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: quoted, check_length
     use voiga_model_fields, only: output_settings_t, field_names
     implicit none
     private
@@ -94,4 +94,4 @@ contains
         end subroutine try_output
     end subroutine read_output
 
-end module voiga_io_case_output
+end module voiga_io_input_case_output

@@ -3,18 +3,18 @@
 !> file are told from two files), files created without following links and
 !> without replacing anything, regular files opened without blocking on a FIFO,
 !> renames that replace only when asked, descriptors' `flock`, and space reserved
-!> for a write (`fallocate`). The locks built on them are `voiga_io_lock`'s, the
-!> process's own limits `voiga_io_process`'s.
+!> for a write (`fallocate`). The locks built on them are `voiga_platform_lock`'s, the
+!> process's own limits `voiga_platform_process`'s.
 !>
 !> The raw interfaces are private; the calls that need the system's constants are
-!> in os_calls.c (which includes the system headers: no flag value is written
+!> in libc.c (which includes the system headers: no flag value is written
 !> here) and return -errno on failure.
-module voiga_io_os
+module voiga_platform_os
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_long, &
                                            c_size_t, c_associated, c_f_pointer, c_int64_t
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_sha256, only: sha256_text
+    use voiga_platform_sha256, only: sha256_text
     use voiga_kinds, only: dp
     use voiga_text, only: fixed_str
     implicit none
@@ -27,7 +27,7 @@ module voiga_io_os
     public :: kind_unknown, kind_missing, kind_regular, kind_folder, kind_link, kind_fifo, kind_char, &
               kind_block, kind_socket
 
-    !> What a path names (os_calls.c's KIND_*); `kind_unknown` when its status
+    !> What a path names (libc.c's KIND_*); `kind_unknown` when its status
     !> could not be taken.
     integer, parameter :: kind_unknown = -1, kind_missing = 0, kind_regular = 1, kind_folder = 2, &
                           kind_link = 3, kind_fifo = 4, kind_char = 5, kind_block = 6, kind_socket = 7
@@ -547,4 +547,4 @@ contains
         st = c_release(fd)
     end subroutine release_space
 
-end module voiga_io_os
+end module voiga_platform_os

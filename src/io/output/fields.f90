@@ -1,6 +1,6 @@
 !> The sampled fields of a step in the result file (`/steps/<k>/fields/<body>`,
 !> docs/hdf5.md): what `&output` asks for, computed by `voiga_model_fields`.
-module voiga_io_fields
+module voiga_io_output_fields
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_io_hdf5, only: h5file_t
@@ -70,4 +70,4 @@ contains
         end do
     end subroutine write_fields
 
-end module voiga_io_fields
+end module voiga_io_output_fields

@@ -1,9 +1,10 @@
 !> The `&pressure` group: a pressure on a named edge of a body.
-module voiga_io_case_pressure
+module voiga_io_input_case_pressure
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length, unset, max_phases, phase_values, check_body_edge
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length, unset, max_phases, phase_values, &
+                                          check_body_edge
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: pressure_settings_t
     implicit none
@@ -60,4 +61,4 @@ contains
         end subroutine try_pressure
     end subroutine read_pressure
 
-end module voiga_io_case_pressure
+end module voiga_io_input_case_pressure

@@ -1,13 +1,13 @@
 !> Writing a body's discretization (refined bulk patch, VO layer, DOF counts)
 !> to HDF5, in the schema of docs/formats.md ("discretization dump").
-module voiga_io_dump
+module voiga_io_output_dump
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_io_hdf5, only: h5file_t
     use voiga_discretization_patch, only: discretization_t
     use voiga_nurbs_curve, only: nurbs_curve_t
-    use voiga_io_case, only: case_t
-    use voiga_io_result_file, only: result_file_t
+    use voiga_io_input_case, only: case_t
+    use voiga_io_output_result_file, only: result_file_t
     use voiga_version, only: voiga_version_string
     implicit none
     private
@@ -148,4 +148,4 @@ contains
         end do
     end subroutine write_elements
 
-end module voiga_io_dump
+end module voiga_io_output_dump

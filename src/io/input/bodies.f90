@@ -1,13 +1,13 @@
 !> From a case to the discretized bodies: read each body's coarse patch from the
 !> geometry file, check that the discretizations the case asks for fit (their
-!> size counted first, `voiga_io_resources`), then build each with the case's layout;
+!> size counted first, `voiga_io_input_resources`), then build each with the case's layout;
 !> and read the curves of the rigid obstacles the contact pairs name.
-module voiga_io_bodies
+module voiga_io_input_bodies
     use voiga_error, only: error_t
-    use voiga_io_case, only: case_t
+    use voiga_io_input_case, only: case_t
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_geometry, only: read_patch, read_curve
-    use voiga_io_resources, only: check_size
+    use voiga_io_input_geometry, only: read_patch, read_curve
+    use voiga_io_input_resources, only: check_size
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_size, only: body_size_t, body_size
@@ -110,4 +110,4 @@ contains
         if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine read_rigid_curves
 
-end module voiga_io_bodies
+end module voiga_io_input_bodies

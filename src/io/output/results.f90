@@ -3,8 +3,8 @@
 !> when the step converges, and a final status ('converged', 'failed: ...',
 !> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
 !> Every write goes through `result_file_t`'s guards (what readers see, a second
-!> writer, a full disk: voiga_io_result_file).
-module voiga_io_results
+!> writer, a full disk: voiga_io_output_result_file).
+module voiga_io_output_results
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp, i8
@@ -12,15 +12,15 @@ module voiga_io_results
     use voiga_version, only: voiga_version_string
     use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_case, only: case_t
-    use voiga_io_dump, only: write_discretization, write_curve, write_elements
-    use voiga_io_geometry, only: geometry_units
-    use voiga_io_os, only: path_exists
-    use voiga_io_result_file, only: result_file_t
-    use voiga_io_provenance, only: write_provenance
+    use voiga_io_input_case, only: case_t
+    use voiga_io_output_dump, only: write_discretization, write_curve, write_elements
+    use voiga_io_input_geometry, only: geometry_units
+    use voiga_platform_os, only: path_exists
+    use voiga_io_output_result_file, only: result_file_t
+    use voiga_io_output_provenance, only: write_provenance
     use voiga_model, only: model_t
     use voiga_model_fields, only: output_settings_t, field_samples_t
-    use voiga_io_fields, only: write_fields, sample_bodies
+    use voiga_io_output_fields, only: write_fields, sample_bodies
     use voiga_contact_master_rigid, only: rigid_line_t
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_nurbs_curve, only: nurbs_curve_t
@@ -578,4 +578,4 @@ contains
         call self%h5%end_write(error)
     end subroutine results_write_multigrid
 
-end module voiga_io_results
+end module voiga_io_output_results

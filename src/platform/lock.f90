@@ -9,11 +9,12 @@
 !> file with one name holding a process id); anything else at its name (a link, a
 !> FIFO, a device, a second name of another file, other content) is never opened
 !> for writing, never truncated and never removed: the run is refused naming it.
-module voiga_io_lock
+module voiga_platform_lock
     use, intrinsic :: iso_c_binding, only: c_int
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_os, only: file_info_t, fd_status, names_file, kind_name, what_is, create_new, open_regular, close_fd, &
-                           lock_fd, write_text, read_text, remove_file, strerror, kind_missing, kind_regular
+    use voiga_platform_os, only: file_info_t, fd_status, names_file, kind_name, what_is, &
+                                 create_new, open_regular, close_fd, lock_fd, write_text, &
+                                 read_text, remove_file, strerror, kind_missing, kind_regular
     implicit none
     private
 
@@ -218,4 +219,4 @@ contains
         st = c_usleep(int(1000*ms, c_int))
     end subroutine sleep_ms
 
-end module voiga_io_lock
+end module voiga_platform_lock

@@ -7,7 +7,7 @@
 !> The scanner reads the whole file, finds every group wherever it starts,
 !> refuses text outside groups and groups that do not end, and hands each group's
 !> own text to its reader, which reads it from that text (an internal file).
-module voiga_io_namelist
+module voiga_io_input_namelist
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
     implicit none
@@ -581,4 +581,4 @@ contains
         end do
     end function lower
 
-end module voiga_io_namelist
+end module voiga_io_input_namelist

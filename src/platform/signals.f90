@@ -7,7 +7,7 @@
 !> has no argument through which it could reach the caller's state. It is
 !> `volatile` (set asynchronously) and `protected` (only the handler and
 !> `clear_signal` change it).
-module voiga_solver_signals
+module voiga_platform_signals
     use, intrinsic :: iso_c_binding, only: c_int, c_funptr, c_funloc, c_null_funptr
     use voiga_text, only: str
     implicit none
@@ -74,4 +74,4 @@ contains
         end select
     end function signal_name
 
-end module voiga_solver_signals
+end module voiga_platform_signals

@@ -1,13 +1,13 @@
 !> Compressed-sparse-row (CSR) matrices for the multigrid solver: conversion from
-!> and to the CSC stiffness (`voiga_solver_sparse`), transpose, product, matvec.
+!> and to the CSC stiffness (`voiga_linalg_sparse`), transpose, product, matvec.
 !>
 !> Indices are 1-based. Every routine that builds a matrix sorts the column
 !> indices of each row (through a counting-sort transpose), so the results are
 !> deterministic and `csr_to_csc` hands UMFPACK what it wants.
-module voiga_solver_csr
+module voiga_linalg_csr
     use, intrinsic :: iso_c_binding, only: c_int
     use voiga_kinds, only: dp
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     implicit none
     private
 
@@ -258,4 +258,4 @@ contains
         end do
     end function csr_diagonal_positions
 
-end module voiga_solver_csr
+end module voiga_linalg_csr

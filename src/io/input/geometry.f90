@@ -1,7 +1,7 @@
 !> Reading the coarse exact patches of a scene and the curves of its rigid
 !> obstacles from its geometry HDF5 file (schema in docs/formats.md), with every
 !> value validated.
-module voiga_io_geometry
+module voiga_io_input_geometry
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
@@ -294,4 +294,4 @@ contains
         end if
     end subroutine check_jacobian
 
-end module voiga_io_geometry
+end module voiga_io_input_geometry

@@ -7,16 +7,16 @@
 !> load steps, the solver, the Dirichlet conditions and the contact laws), unless
 !> the restart is forced (`--force-restart`), which the file then records. It also
 !> records the thread counts its timings were measured with (`library_threads`).
-module voiga_io_provenance
+module voiga_io_output_provenance
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str, real_str
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_sha256, only: sha256_file
-    use voiga_io_os, only: canonical_path
-    use voiga_io_case, only: case_t
+    use voiga_platform_sha256, only: sha256_file
+    use voiga_platform_os, only: canonical_path
+    use voiga_io_input_case, only: case_t
     use voiga_model_loads, only: phase_of
-    use voiga_linalg_blas, only: library_threads, blas_kernels
+    use voiga_platform_libraries, only: library_threads, blas_kernels
     implicit none
     private
 
@@ -287,4 +287,4 @@ contains
         end if
     end subroutine compare_values
 
-end module voiga_io_provenance
+end module voiga_io_output_provenance

@@ -6,7 +6,7 @@
 !> column pointers and row indices, rows sorted within each column), so a solve
 !> converts nothing. The pattern is structurally symmetric and always holds the
 !> full diagonal.
-module voiga_solver_sparse
+module voiga_linalg_sparse
     use, intrinsic :: iso_c_binding, only: c_int, c_double
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
@@ -555,4 +555,4 @@ contains
         end do
     end subroutine csc_fix_dofs
 
-end module voiga_solver_sparse
+end module voiga_linalg_sparse

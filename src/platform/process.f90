@@ -5,11 +5,11 @@
 !> The raw libc interfaces are private. The constants are Linux's (asm-generic,
 !> x86-64 and arm64): `getrlimit` RLIMIT_FSIZE 1, RLIMIT_AS 9, RLIM_INFINITY all
 !> bits set; SIGXFSZ 25; `signal`'s SIG_IGN 1.
-module voiga_io_process
+module voiga_platform_process
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_loc, &
                                            c_int64_t, c_funptr, c_intptr_t
     use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
-    use voiga_io_os, only: c_str
+    use voiga_platform_os, only: c_str
     implicit none
     private
 
@@ -180,4 +180,4 @@ contains
         yes = c_isatty(1_c_int) == 1_c_int
     end function stdout_is_terminal
 
-end module voiga_io_process
+end module voiga_platform_process

@@ -1,9 +1,9 @@
-!> Reading a result file back for a restart (`voiga_io_results`): the case the run
+!> Reading a result file back for a restart (`voiga_io_output_results`): the case the run
 !> was started from and the state after its last written step, read as
 !> `results_write_step` wrote it (symmetric persistence: the writer's module reads
 !> it back). A submodule only to keep the files short; the interfaces and their
 !> documentation are in the module.
-submodule(voiga_io_results) voiga_io_results_restart
+submodule(voiga_io_output_results) voiga_io_output_results_restart
     implicit none
 
 contains
@@ -141,4 +141,4 @@ contains
         call pair%set_history(history, error)
     end subroutine read_history
 
-end submodule voiga_io_results_restart
+end submodule voiga_io_output_results_restart

@@ -6,13 +6,14 @@
 !> node, a socket is never opened, whatever the options), and so must the `.part`
 !> and `.lock` files beside it; an existing output is replaced only when the run may
 !> (`--overwrite` or `&case overwrite = .true.`).
-module voiga_io_outputs
+module voiga_io_output_outputs
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_io_os, only: canonical_path, companion, file_info_t, file_status, path_kind, same_file, kind_name, &
-                           what_is, kind_missing, kind_regular, kind_folder, kind_unknown
+    use voiga_platform_os, only: canonical_path, companion, file_info_t, file_status, path_kind, &
+                                 same_file, kind_name, what_is, kind_missing, kind_regular, &
+                                 kind_folder, kind_unknown
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_case, only: case_t
+    use voiga_io_input_case, only: case_t
     implicit none
     private
 
@@ -221,4 +222,4 @@ contains
         end do
     end subroutine resolve_restart
 
-end module voiga_io_outputs
+end module voiga_io_output_outputs

@@ -10,12 +10,12 @@
 !> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
 !> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows
 !> like n log n) or 2.3 x log2(DOFs) with multigrid.
-module voiga_io_resources
+module voiga_io_input_resources
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_discretization_size, only: body_size_t
-    use voiga_io_process, only: memory_available
+    use voiga_platform_process, only: memory_available
     implicit none
     private
 
@@ -92,4 +92,4 @@ contains
         if (text(1:1) == '.') text = '0'//text
     end function gib
 
-end module voiga_io_resources
+end module voiga_io_input_resources

@@ -18,15 +18,17 @@
 !> - once a write to it has failed, is `broken`: nothing more may reach it (the
 !>   program must leave without HDF5's exit handlers, which would write half a step
 !>   over the last flush).
-module voiga_io_result_file
+module voiga_io_output_result_file
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5, only: h5file_t, finish_interrupted_flush
-    use voiga_io_os, only: file_info_t, file_status, fd_status, path_kind, fd_size, names_file, kind_name, what_is, &
-                           reserve_space, release_space, rename_file, remove_file, path_exists, companion, &
-                           kind_missing, kind_regular
-    use voiga_io_lock, only: lock_t, acquire_lock, release_lock, lock_intact, hold_file, let_go_file
-    use voiga_io_process, only: write_failure_cause
+    use voiga_platform_os, only: file_info_t, file_status, fd_status, path_kind, fd_size, &
+                                 names_file, kind_name, what_is, reserve_space, release_space, &
+                                 rename_file, remove_file, path_exists, companion, kind_missing, &
+                                 kind_regular
+    use voiga_platform_lock, only: lock_t, acquire_lock, release_lock, lock_intact, hold_file, &
+                                   let_go_file
+    use voiga_platform_process, only: write_failure_cause
     implicit none
     private
 
@@ -291,4 +293,4 @@ contains
         end if
     end function file_where_steps
 
-end module voiga_io_result_file
+end module voiga_io_output_result_file

@@ -1,9 +1,10 @@
 !> The `&body` group: a body's name, material and discretization (layout).
-module voiga_io_case_body
+module voiga_io_input_case_body
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length, unset, is_unset, max_knots, max_value, take_knots, quoted, either
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length, unset, is_unset, max_knots, max_value, &
+                                          take_knots, quoted, either
     use voiga_model_body, only: body_settings_t
     use voiga_material_factory, only: material_names
     implicit none
@@ -148,4 +149,4 @@ contains
         end if
     end subroutine check_material
 
-end module voiga_io_case_body
+end module voiga_io_input_case_body

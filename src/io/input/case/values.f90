@@ -1,7 +1,7 @@
 !> What the readers of the case file's groups share: the marker of a namelist
 !> array entry the file did not set, the limits of list lengths, per-phase values
 !> and knot lists taken from namelist arrays, and the lookup of a body by name.
-module voiga_io_case_values
+module voiga_io_input_case_values
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
@@ -144,7 +144,7 @@ contains
     end function body_index
 
     !> A load group names a body of the case and an edge (checked against the
-    !> body's edges once it is discretized, `voiga_io_case`).
+    !> body's edges once it is discretized, `voiga_io_input_case`).
     subroutine check_body_edge(bodies, body, edge, where, error)
         type(body_settings_t), intent(in) :: bodies(:)
         character(len=*), intent(in) :: body, edge, where
@@ -157,4 +157,4 @@ contains
         if (len_trim(edge) == 0) call fatal_error(error, where//'edge is required', error_code%input)
     end subroutine check_body_edge
 
-end module voiga_io_case_values
+end module voiga_io_input_case_values

@@ -13,7 +13,7 @@
 !>
 !> The raw `mallopt` interface is private; the parameter numbers are glibc's
 !> (`malloc.h`: M_TRIM_THRESHOLD = -1, M_MMAP_THRESHOLD = -3).
-module voiga_solver_heap
+module voiga_platform_heap
     use, intrinsic :: iso_c_binding, only: c_int
     implicit none
     private
@@ -48,4 +48,4 @@ contains
         ok = mallopt(m_trim_threshold, threshold) == 1_c_int .and. ok
     end subroutine keep_freed_memory
 
-end module voiga_solver_heap
+end module voiga_platform_heap

@@ -1,9 +1,10 @@
 !> The `&dirichlet` group: a prescribed displacement on a named edge of a body.
-module voiga_io_case_dirichlet
+module voiga_io_input_case_dirichlet
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length, unset, max_phases, phase_values, check_body_edge
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length, unset, max_phases, phase_values, &
+                                          check_body_edge
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: dirichlet_settings_t
     implicit none
@@ -71,4 +72,4 @@ contains
         end subroutine try_dirichlet
     end subroutine read_dirichlet
 
-end module voiga_io_case_dirichlet
+end module voiga_io_input_case_dirichlet

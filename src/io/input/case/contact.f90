@@ -1,11 +1,11 @@
 !> The `&contact` group: a contact pair, its method and its law.
-module voiga_io_case_contact
+module voiga_io_input_case_contact
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_io_namelist, only: group_error
-    use voiga_io_case_values, only: check_length, unset, is_unset, max_value, max_phases, body_index, quoted, &
-        phase_values
+    use voiga_io_input_namelist, only: group_error
+    use voiga_io_input_case_values, only: check_length, unset, is_unset, max_value, max_phases, &
+                                          body_index, quoted, phase_values
     use voiga_model_body, only: body_settings_t
     use voiga_contact_factory, only: contact_settings_t, contact_method_names, default_method, automatic
     implicit none
@@ -253,4 +253,4 @@ contains
         given_above = x > limit
     end function given_above
 
-end module voiga_io_case_contact
+end module voiga_io_input_case_contact
