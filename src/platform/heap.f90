@@ -11,8 +11,8 @@
 !> Raising both thresholds keeps the freed memory for the next factorization.
 !> Nothing numerical changes: the result files are identical bit for bit.
 !>
-!> The raw `mallopt` interface is private; the parameter numbers are glibc's
-!> (`malloc.h`: M_TRIM_THRESHOLD = -1, M_MMAP_THRESHOLD = -3).
+!> `mallopt` is called in libc.c, where glibc's `malloc.h` names its parameters
+!> (M_MMAP_THRESHOLD, M_TRIM_THRESHOLD).
 module voiga_platform_heap
     use, intrinsic :: iso_c_binding, only: c_int
     implicit none
@@ -20,20 +20,18 @@ module voiga_platform_heap
 
     public :: keep_freed_memory
 
-    !> glibc malloc.h parameter numbers.
-    integer(c_int), parameter :: m_trim_threshold = -1_c_int, m_mmap_threshold = -3_c_int
-
     !> Blocks below this size come from the heap, and this much free memory may stay
     !> at its top (bytes; 1 GiB: the largest Numeric object of `make bench`, hertz m8,
     !> is about 1 GB; larger blocks are still mapped and unmapped).
     integer(c_int), parameter :: threshold = 1073741824_c_int
 
     interface
-        function mallopt(param, value) result(status) bind(c, name='mallopt')
+        !> Both thresholds set to `bytes` (libc.c): 1 when glibc took both.
+        function c_keep_freed_memory(bytes) result(ok) bind(c, name='voiga_keep_freed_memory')
             import :: c_int
-            integer(c_int), value :: param, value
-            integer(c_int) :: status
-        end function mallopt
+            integer(c_int), value :: bytes
+            integer(c_int) :: ok
+        end function c_keep_freed_memory
     end interface
 
 contains
@@ -44,8 +42,7 @@ contains
     !> program works either way, only slower).
     subroutine keep_freed_memory(ok)
         logical, intent(out) :: ok
-        ok = mallopt(m_mmap_threshold, threshold) == 1_c_int
-        ok = mallopt(m_trim_threshold, threshold) == 1_c_int .and. ok
+        ok = c_keep_freed_memory(threshold) == 1_c_int
     end subroutine keep_freed_memory
 
 end module voiga_platform_heap

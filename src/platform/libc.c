@@ -1,20 +1,31 @@
-/* voiga's file-system calls (Linux, glibc) behind os.f90 and lock.f90, with their
- * constants from the system headers (the Fortran side never sees a flag value):
- * what is at a path (its kind, device, inode, links, size), files created without
- * following links and without replacing anything (O_CREAT | O_EXCL | O_NOFOLLOW),
- * existing files opened only when they are regular files (a FIFO or a device node
- * is refused, without blocking on it), flock, renames that must not replace their
- * target (renameat2 RENAME_NOREPLACE, else link and unlink), and disk space
- * reserved beyond a file's end (fallocate).
+/* voiga's calls into the C library (Linux, glibc), with their constants, types and
+ * macros from the system headers: the Fortran side never sees a flag value, a
+ * signal or limit number, or a struct layout.
  *
- * Every call returns 0, a count or a descriptor on success and -errno on failure. */
+ * Behind os.f90 and lock.f90: what is at a path (its kind, device, inode, links,
+ * size), files created without following links and without replacing anything
+ * (O_CREAT | O_EXCL | O_NOFOLLOW), existing files opened only when they are
+ * regular files (a FIFO or a device node is refused, without blocking on it),
+ * flock, renames that must not replace their target (renameat2 RENAME_NOREPLACE,
+ * else link and unlink), disk space reserved beyond a file's end (fallocate),
+ * errno, NAME_MAX and PATH_MAX. Behind process.f90: the soft limits on address
+ * space and file size (getrlimit), SIGXFSZ ignored, whether standard output is a
+ * terminal. Behind signals.f90: SIGINT and SIGTERM caught into a flag. Behind
+ * heap.f90: glibc's malloc thresholds (mallopt).
+ *
+ * The file calls return 0, a count or a descriptor on success and -errno on
+ * failure. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <malloc.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -61,11 +72,12 @@ int voiga_fd_status(int fd, int64_t *out)
     return described(&st, out);
 }
 
-/* A new regular file at `path`, open for reading and writing: never through a
- * symbolic link, never over anything that is there (EEXIST). */
-int voiga_create_new(const char *path, int mode)
+/* A new regular file at `path`, open for reading and writing (rw-r--r-- before the
+ * umask): never through a symbolic link, never over anything that is there
+ * (EEXIST). */
+int voiga_create_new(const char *path)
 {
-    int fd = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, (mode_t)mode);
+    int fd = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, S_IRUSR | S_IWUSR | S_IRGRP | S_IROTH);
     return fd >= 0 ? fd : -errno;
 }
 
@@ -184,4 +196,103 @@ int voiga_enoent(void)
 int voiga_eexist(void)
 {
     return EEXIST;
+}
+
+/* The longest name of a file in a folder (NAME_MAX, bytes). */
+int voiga_name_max(void)
+{
+    return NAME_MAX;
+}
+
+/* The longest path (PATH_MAX, bytes with the terminating zero). */
+int voiga_path_max(void)
+{
+    return PATH_MAX;
+}
+
+/* The current errno (glibc keeps it per thread behind a function: no Fortran
+ * binding to that function's name). */
+int voiga_errno(void)
+{
+    return errno;
+}
+
+/* The soft limit `resource` (bytes), or -1 when it is unlimited or unknown. */
+static int64_t soft_limit(int resource)
+{
+    struct rlimit limit;
+    if (getrlimit(resource, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1;
+    return limit.rlim_cur > (rlim_t)INT64_MAX ? INT64_MAX : (int64_t)limit.rlim_cur;
+}
+
+/* The address-space limit (`ulimit -v`, RLIMIT_AS) in bytes; -1: none. */
+int64_t voiga_address_space_limit(void)
+{
+    return soft_limit(RLIMIT_AS);
+}
+
+/* The file-size limit (`ulimit -f`, RLIMIT_FSIZE) in bytes; -1: none. */
+int64_t voiga_file_size_limit(void)
+{
+    return soft_limit(RLIMIT_FSIZE);
+}
+
+/* A write beyond the file-size limit fails with EFBIG instead of killing the
+ * process with SIGXFSZ. */
+void voiga_ignore_file_size_signal(void)
+{
+    signal(SIGXFSZ, SIG_IGN);
+}
+
+/* 1 when standard output is a terminal. */
+int voiga_stdout_is_terminal(void)
+{
+    return isatty(STDOUT_FILENO);
+}
+
+/* The last SIGINT or SIGTERM caught since the start or the last
+ * voiga_clear_signal (0: none). */
+static volatile sig_atomic_t caught_signal = 0;
+
+/* Record the signal and restore the default action, so that a second Ctrl-C ends
+ * a run stuck in a long factorization at once. Both are async-signal safe. */
+static void on_signal(int signum)
+{
+    caught_signal = signum;
+    signal(signum, SIG_DFL);
+}
+
+/* Route SIGINT and SIGTERM to the flag. */
+void voiga_catch_signals(void)
+{
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+}
+
+int voiga_caught_signal(void)
+{
+    return caught_signal;
+}
+
+void voiga_clear_signal(void)
+{
+    caught_signal = 0;
+}
+
+int voiga_sigint(void)
+{
+    return SIGINT;
+}
+
+int voiga_sigterm(void)
+{
+    return SIGTERM;
+}
+
+/* glibc's mmap and trim thresholds both raised to `bytes` (heap.f90 says why):
+ * 1 when glibc took both. */
+int voiga_keep_freed_memory(int bytes)
+{
+    int ok = mallopt(M_MMAP_THRESHOLD, bytes) == 1;
+    return (mallopt(M_TRIM_THRESHOLD, bytes) == 1) && ok;
 }

@@ -3,12 +3,12 @@
 !> file are told from two files), files created without following links and
 !> without replacing anything, regular files opened without blocking on a FIFO,
 !> renames that replace only when asked, descriptors' `flock`, and space reserved
-!> for a write (`fallocate`). The locks built on them are `voiga_platform_lock`'s, the
-!> process's own limits `voiga_platform_process`'s.
+!> for a write (`fallocate`). The locks built on them are `voiga_platform_lock`'s,
+!> the process's own limits `voiga_platform_process`'s.
 !>
-!> The raw interfaces are private; the calls that need the system's constants are
-!> in libc.c (which includes the system headers: no flag value is written
-!> here) and return -errno on failure.
+!> The raw interfaces are private; the calls that need the system's constants or
+!> macros (flags, `errno`) are in libc.c, which includes the system headers: no
+!> flag value is written here. They return -errno on failure.
 module voiga_platform_os
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_long, &
                                            c_size_t, c_associated, c_f_pointer, c_int64_t
@@ -63,10 +63,10 @@ module voiga_platform_os
             integer(c_int), value :: errnum
             type(c_ptr) :: p
         end function c_strerror
-        function c_errno_location() bind(c, name='__errno_location') result(p)
-            import :: c_ptr
-            type(c_ptr) :: p
-        end function c_errno_location
+        function c_errno() bind(c, name='voiga_errno') result(e)
+            import :: c_int
+            integer(c_int) :: e
+        end function c_errno
         function c_enoent() bind(c, name='voiga_enoent') result(e)
             import :: c_int
             integer(c_int) :: e
@@ -75,6 +75,14 @@ module voiga_platform_os
             import :: c_int
             integer(c_int) :: e
         end function c_eexist
+        function c_name_max() bind(c, name='voiga_name_max') result(n)
+            import :: c_int
+            integer(c_int) :: n
+        end function c_name_max
+        function c_path_max() bind(c, name='voiga_path_max') result(n)
+            import :: c_int
+            integer(c_int) :: n
+        end function c_path_max
         function c_readlink(path, buf, n) bind(c, name='readlink') result(length)
             import :: c_char, c_size_t, c_long
             character(kind=c_char), intent(in) :: path(*)
@@ -95,10 +103,9 @@ module voiga_platform_os
             integer(c_int64_t), intent(out) :: out(4)
             integer(c_int) :: kind
         end function c_fd_status
-        function c_create_new(path, mode) bind(c, name='voiga_create_new') result(fd)
+        function c_create_new(path) bind(c, name='voiga_create_new') result(fd)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
-            integer(c_int), value :: mode
             integer(c_int) :: fd
         end function c_create_new
         function c_open_regular(path, writable, follow, kind) bind(c, name='voiga_open_regular') result(fd)
@@ -179,9 +186,7 @@ contains
 
     !> The current `errno`.
     integer function errno()
-        integer(c_int), pointer :: e
-        call c_f_pointer(c_errno_location(), e)
-        errno = int(e)
+        errno = int(c_errno())
     end function errno
 
     !> The system's text for error number `e` ("No space left on device").
@@ -231,9 +236,10 @@ contains
         character(len=*), intent(in) :: path
         character(len=:), allocatable, intent(out) :: target
         logical, intent(out) :: ok
-        character(kind=c_char) :: buf(4096)
+        character(kind=c_char), allocatable :: buf(:)
         integer(c_long) :: n
         integer :: i
+        allocate (buf(c_path_max()))
         n = c_readlink(c_str(path), buf, int(size(buf), c_size_t))
         ok = n >= 0 .and. n < size(buf)
         if (.not. ok) return
@@ -299,15 +305,16 @@ contains
 
     !> The file beside `path` that a writer keeps with it: `path` with `suffix`
     !> ('.part', '.lock'), or, when that name would be longer than a file name may
-    !> be (255 bytes), the first 200 characters of the name, '-', 16 hex digits of
-    !> the name's SHA-256 and `suffix` (the same for every writer of `path`).
+    !> be (NAME_MAX: 255 bytes on Linux), the first 200 characters of the name, '-',
+    !> 16 hex digits of the name's SHA-256 and `suffix` (the same for every writer of
+    !> `path`).
     function companion(path, suffix) result(name)
         character(len=*), intent(in) :: path, suffix
         character(len=:), allocatable :: name
         character(len=64) :: hex
         integer :: i
         i = index(path, '/', back=.true.)
-        if (len(path) - i + len(suffix) <= 255) then
+        if (len(path) - i + len(suffix) <= c_name_max()) then
             name = path//suffix
         else
             hex = sha256_text(path(i + 1:))
@@ -441,7 +448,7 @@ contains
         integer(c_int), intent(out) :: fd
         integer, intent(out) :: e
         logical, intent(out) :: exists
-        fd = c_create_new(c_str(path), int(o'644', c_int))
+        fd = c_create_new(c_str(path))
         e = int(max(-fd, 0_c_int))
         exists = e == c_eexist()
     end subroutine create_new

@@ -2,12 +2,12 @@
 !> use (/proc/meminfo, /proc/self/status, `getrlimit`), the file-size limit, leaving
 !> without exit handlers, running itself again, and SIGXFSZ.
 !>
-!> The raw libc interfaces are private. The constants are Linux's (asm-generic,
-!> x86-64 and arm64): `getrlimit` RLIMIT_FSIZE 1, RLIMIT_AS 9, RLIM_INFINITY all
-!> bits set; SIGXFSZ 25; `signal`'s SIG_IGN 1.
+!> The raw libc interfaces are private. The calls that need the system's constants
+!> (RLIMIT_AS, RLIMIT_FSIZE, RLIM_INFINITY, SIGXFSZ, SIG_IGN, STDOUT_FILENO) or its
+!> `struct rlimit` are in libc.c, which includes the system headers.
 module voiga_platform_process
     use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_ptr, c_null_char, c_loc, &
-                                           c_int64_t, c_funptr, c_intptr_t
+                                           c_int64_t
     use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
     use voiga_platform_os, only: c_str
     implicit none
@@ -16,25 +16,17 @@ module voiga_platform_process
     public :: memory_available, address_space_limited, write_failure_cause, leave
     public :: reexec_with_environment, ignore_file_size_signal, stdout_is_terminal
 
-    integer(c_int), parameter :: rlimit_as = 9, rlimit_fsize = 1
-    !> SIGXFSZ (a write beyond `ulimit -f`), and `signal`'s SIG_IGN.
-    integer(c_int), parameter :: sigxfsz = 25
-    integer(c_intptr_t), parameter :: sig_ign = 1
-    !> `rlim_t` RLIM_INFINITY (all bits set).
-    integer(c_int64_t), parameter :: rlim_infinity = -1_c_int64_t
-
-    !> `struct rlimit`.
-    type, bind(c) :: rlimit_t
-        integer(c_int64_t) :: cur, max
-    end type rlimit_t
-
     interface
-        function c_getrlimit(resource, limit) bind(c, name='getrlimit') result(st)
-            import :: c_int, rlimit_t
-            integer(c_int), value :: resource
-            type(rlimit_t), intent(out) :: limit
-            integer(c_int) :: st
-        end function c_getrlimit
+        !> The soft limits (bytes; -1 when unlimited or unknown) of `ulimit -v` and
+        !> `ulimit -f` (libc.c).
+        function c_address_space_limit() bind(c, name='voiga_address_space_limit') result(bytes)
+            import :: c_int64_t
+            integer(c_int64_t) :: bytes
+        end function c_address_space_limit
+        function c_file_size_limit() bind(c, name='voiga_file_size_limit') result(bytes)
+            import :: c_int64_t
+            integer(c_int64_t) :: bytes
+        end function c_file_size_limit
         subroutine c_exit_now(status) bind(c, name='_exit')
             import :: c_int
             integer(c_int), value :: status
@@ -45,17 +37,12 @@ module voiga_platform_process
             integer(c_int), value :: overwrite
             integer(c_int) :: st
         end function c_setenv
-        function c_signal(signum, handler) bind(c, name='signal') result(previous)
-            import :: c_int, c_funptr
-            integer(c_int), value :: signum
-            type(c_funptr), value :: handler
-            type(c_funptr) :: previous
-        end function c_signal
-        function c_isatty(fd) bind(c, name='isatty') result(yes)
+        subroutine c_ignore_file_size_signal() bind(c, name='voiga_ignore_file_size_signal')
+        end subroutine c_ignore_file_size_signal
+        function c_stdout_is_terminal() bind(c, name='voiga_stdout_is_terminal') result(yes)
             import :: c_int
-            integer(c_int), value :: fd
             integer(c_int) :: yes
-        end function c_isatty
+        end function c_stdout_is_terminal
         function c_execv(path, argv) bind(c, name='execv') result(st)
             import :: c_char, c_ptr, c_int
             character(kind=c_char), intent(in) :: path(*)
@@ -72,20 +59,17 @@ contains
     !> (/proc/self/status VmSize); -1 when unknown or unlimited.
     subroutine memory_available(physical, address)
         integer(int64), intent(out) :: physical, address
-        type(rlimit_t) :: limit
+        integer(int64) :: limit
         physical = proc_value('/proc/meminfo', 'MemAvailable:')
         address = -1
-        if (c_getrlimit(rlimit_as, limit) == 0) then
-            if (limit%cur /= rlim_infinity .and. limit%cur > 0) &
-                address = max(limit%cur - max(proc_value('/proc/self/status', 'VmSize:'), 0_int64), 0_int64)
-        end if
+        limit = c_address_space_limit()
+        if (limit > 0) &
+            address = max(limit - max(proc_value('/proc/self/status', 'VmSize:'), 0_int64), 0_int64)
     end subroutine memory_available
 
     !> Is the address space of this process limited (`ulimit -v`)?
     logical function address_space_limited()
-        type(rlimit_t) :: limit
-        address_space_limited = .false.
-        if (c_getrlimit(rlimit_as, limit) == 0) address_space_limited = limit%cur /= rlim_infinity
+        address_space_limited = c_address_space_limit() >= 0
     end function address_space_limited
 
     !> The value in bytes of the line `key  <n> kB` of a /proc file; -1 if absent.
@@ -114,15 +98,14 @@ contains
     function write_failure_cause(path) result(text)
         character(len=*), intent(in) :: path
         character(len=:), allocatable :: text
-        type(rlimit_t) :: limit
-        integer(int64) :: size
+        integer(int64) :: limit, size
         character(len=24) :: buf
         text = ' (is the disk full?)'
-        if (c_getrlimit(rlimit_fsize, limit) /= 0) return
-        if (limit%cur == rlim_infinity) return
+        limit = c_file_size_limit()
+        if (limit < 0) return
         inquire (file=path, size=size)
-        if (size + 1048576_int64 < limit%cur) return
-        write (buf, '(i0)') limit%cur
+        if (size + 1048576_int64 < limit) return
+        write (buf, '(i0)') limit
         text = ' (the file-size limit, ulimit -f, of '//trim(buf)//' bytes is reached)'
     end function write_failure_cause
 
@@ -140,8 +123,7 @@ contains
     !> with EFBIG like one on a full disk, instead of killing the process with
     !> SIGXFSZ (whose default action the gfortran runtime also takes over).
     subroutine ignore_file_size_signal()
-        type(c_funptr) :: previous
-        previous = c_signal(sigxfsz, transfer(sig_ign, previous))
+        call c_ignore_file_size_signal()
     end subroutine ignore_file_size_signal
 
     !> Run this program again, from the start and with the same arguments, with
@@ -177,7 +159,7 @@ contains
     !> Whether the standard output is a terminal (`isatty(1)`): only there does a run
     !> show a live progress line (a pipe or a file gets whole lines only).
     logical function stdout_is_terminal() result(yes)
-        yes = c_isatty(1_c_int) == 1_c_int
+        yes = c_stdout_is_terminal() == 1_c_int
     end function stdout_is_terminal
 
 end module voiga_platform_process

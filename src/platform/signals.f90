@@ -3,75 +3,67 @@
 !> `caught_signal()` between Newton iterations and load steps and stops there,
 !> so a result file is never left in the middle of a write.
 !>
-!> The flag is the one mutable module variable of the library: a signal handler
-!> has no argument through which it could reach the caller's state. It is
-!> `volatile` (set asynchronously) and `protected` (only the handler and
-!> `clear_signal` change it).
+!> The handler and its flag are in libc.c: a handler has no argument through which
+!> it could reach the caller's state, so the flag lives beside it, a C
+!> `volatile sig_atomic_t` (the one type the C standard lets a handler write), and
+!> the signal numbers come from `<signal.h>`. No Fortran module variable changes.
 module voiga_platform_signals
-    use, intrinsic :: iso_c_binding, only: c_int, c_funptr, c_funloc, c_null_funptr
+    use, intrinsic :: iso_c_binding, only: c_int
     use voiga_text, only: str
     implicit none
     private
 
-    public :: catch_signals, caught_signal, clear_signal, signal_name, sigint, sigterm
-
-    !> Linux signal numbers.
-    integer(c_int), parameter :: sigint = 2_c_int, sigterm = 15_c_int
-
-    !> The last signal caught (0: none).
-    integer(c_int), volatile, protected :: caught = 0_c_int
+    public :: catch_signals, caught_signal, clear_signal, signal_name
 
     interface
-        !> libc `sighandler_t signal(int signum, sighandler_t handler)`.
-        function c_signal(signum, handler) bind(c, name='signal') result(previous)
-            import :: c_int, c_funptr
-            integer(c_int), value :: signum
-            type(c_funptr), value :: handler
-            type(c_funptr) :: previous
-        end function c_signal
+        subroutine c_catch_signals() bind(c, name='voiga_catch_signals')
+        end subroutine c_catch_signals
+        function c_caught_signal() bind(c, name='voiga_caught_signal') result(signum)
+            import :: c_int
+            integer(c_int) :: signum
+        end function c_caught_signal
+        subroutine c_clear_signal() bind(c, name='voiga_clear_signal')
+        end subroutine c_clear_signal
+        function c_sigint() bind(c, name='voiga_sigint') result(signum)
+            import :: c_int
+            integer(c_int) :: signum
+        end function c_sigint
+        function c_sigterm() bind(c, name='voiga_sigterm') result(signum)
+            import :: c_int
+            integer(c_int) :: signum
+        end function c_sigterm
     end interface
 
 contains
 
-    !> Route SIGINT and SIGTERM to the flag.
+    !> Route SIGINT and SIGTERM to the flag. The handler restores the default
+    !> action when it runs, so that a second Ctrl-C ends a run stuck in a long
+    !> factorization at once.
     subroutine catch_signals()
-        type(c_funptr) :: previous
-        previous = c_signal(sigint, c_funloc(on_signal))
-        previous = c_signal(sigterm, c_funloc(on_signal))
+        call c_catch_signals()
     end subroutine catch_signals
-
-    !> The handler: record the signal and restore the default action (SIG_DFL is
-    !> the null pointer), so that a second Ctrl-C ends a run stuck in a long
-    !> factorization at once. Both are async-signal safe.
-    subroutine on_signal(signum) bind(c)
-        integer(c_int), value :: signum
-        type(c_funptr) :: previous
-        caught = signum
-        previous = c_signal(signum, c_null_funptr)
-    end subroutine on_signal
 
     !> The signal caught since the start or the last `clear_signal` (0: none).
     integer function caught_signal()
-        caught_signal = int(caught)
+        caught_signal = int(c_caught_signal())
     end function caught_signal
 
     !> Forget a caught signal.
     subroutine clear_signal()
-        caught = 0_c_int
+        call c_clear_signal()
     end subroutine clear_signal
 
     !> 'SIGINT', 'SIGTERM' or 'signal <n>'.
-    pure function signal_name(signum) result(name)
+    function signal_name(signum) result(name)
         integer, intent(in) :: signum
         character(len=:), allocatable :: name
-        select case (signum)
-        case (sigint)
+        if (signum == c_sigint()) then
             name = 'SIGINT'
-        case (sigterm)
+        else if (signum == c_sigterm()) then
             name = 'SIGTERM'
-        case default
+        else
             name = 'signal '//str(signum)
-        end select
+        end if
     end function signal_name
 
 end module voiga_platform_signals
