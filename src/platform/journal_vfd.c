@@ -17,10 +17,19 @@
  *
  * Test hook: VOIGA_JOURNAL_KILL=n sends the process SIGKILL in the n-th flush that
  * writes anything, after the first write of its step 2 (test/python/test_journal.py;
- * never set otherwise). */
+ * never set otherwise).
+ *
+ * Built against the installed HDF5's own headers (`<hdf5.h>`, its folder from
+ * pkg-config through fpm's hdf5 metapackage) and written for HDF5 1.10; the driver
+ * class is filled by field name, so a field HDF5 renames or removes is a compile
+ * error, one it adds is left zero (NULL: not provided), and a callback whose
+ * signature changed is an error too (the pragma below). HDF5 1.13.2 and later also
+ * want the class's struct version and a driver value: set when
+ * H5FD_CLASS_VERSION says the struct has them. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -28,7 +37,20 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <hdf5/serial/hdf5.h>
+#include <zlib.h>
+#include <hdf5.h>
+#if defined(__has_include)
+#if __has_include(<H5FDdevelop.h>)
+#include <H5FDdevelop.h> /* H5FD_class_t and H5FD_t since HDF5 1.13 (1.10: H5FDpublic.h) */
+#endif
+#endif
+#if !H5_VERSION_GE(1, 10, 0)
+#error "voiga's journaled driver needs HDF5 1.10 or later"
+#endif
+
+/* A callback whose type does not match its field in the installed HDF5 is an
+ * error, not a warning: HDF5 would call it with other arguments. */
+#pragma GCC diagnostic error "-Wincompatible-pointer-types"
 
 #define JOURNAL_MAGIC "VOIGAJ01"
 #define FOOTER_BYTES 40
@@ -53,34 +75,20 @@ typedef struct {
 
 static hid_t driver_id = -1;
 
-/* CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) of `n` bytes, eight
- * bytes a step ("slicing-by-8": eight tables, the same remainder as the byte-wise
- * loop); a step's whole journal goes through it before every flush. */
+/* CRC-32 (IEEE 802.3, the polynomial of zlib's crc32 and Python's zlib.crc32, which
+ * post/journal.py checks) of `n` bytes, by zlib, whose length argument is 32 bits
+ * wide: a journal of 4 GiB or more goes through in pieces (crc32 continues from
+ * the value of the previous piece). */
 static uint64_t crc32_of(const unsigned char *p, size_t n)
 {
-    static uint32_t table[8][256];
-    static int ready = 0;
-    uint32_t c = 0xFFFFFFFFu;
-    if (!ready) {
-        for (uint32_t i = 0; i < 256; i++) {
-            uint32_t v = i;
-            for (int k = 0; k < 8; k++) v = (v & 1) ? 0xEDB88320u ^ (v >> 1) : v >> 1;
-            table[0][i] = v;
-        }
-        for (uint32_t i = 0; i < 256; i++)
-            for (int t = 1; t < 8; t++) table[t][i] = (table[t - 1][i] >> 8) ^ table[0][table[t - 1][i] & 0xFF];
-        ready = 1;
+    uLong c = crc32(0L, Z_NULL, 0);
+    while (n > 0) {
+        uInt piece = n > UINT_MAX ? UINT_MAX : (uInt)n;
+        c = crc32(c, p, piece);
+        p += piece;
+        n -= piece;
     }
-    while (n >= 8) {
-        uint32_t lo = c ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
-        uint32_t hi = (uint32_t)p[4] | (uint32_t)p[5] << 8 | (uint32_t)p[6] << 16 | (uint32_t)p[7] << 24;
-        c = table[7][lo & 0xFF] ^ table[6][(lo >> 8) & 0xFF] ^ table[5][(lo >> 16) & 0xFF] ^ table[4][lo >> 24] ^
-            table[3][hi & 0xFF] ^ table[2][(hi >> 8) & 0xFF] ^ table[1][(hi >> 16) & 0xFF] ^ table[0][hi >> 24];
-        p += 8;
-        n -= 8;
-    }
-    for (size_t i = 0; i < n; i++) c = table[0][(c ^ p[i]) & 0xFF] ^ (c >> 8);
-    return (uint64_t)(c ^ 0xFFFFFFFFu);
+    return (uint64_t)c;
 }
 
 static int write_all(int fd, const void *buf, size_t n, off_t at)
@@ -399,10 +407,34 @@ static herr_t j_truncate(H5FD_t *file, hid_t dxpl, hbool_t closing)
     return 0;
 }
 
+/* The driver value HDF5 1.13.2 and later ask for: one of the values 256-511 that
+ * HDF5 leaves to unregistered drivers. */
+#define JOURNAL_DRIVER_VALUE 479
+
+/* The driver: what it does not name is zero (no superblock or property-list
+ * extensions, HDF5's own allocation and locking). */
 static const H5FD_class_t journal_class = {
-    "voiga_journal", MAX_ADDR, H5F_CLOSE_WEAK, NULL, NULL, NULL, NULL, 0, NULL, NULL, NULL, 0, NULL, NULL,
-    j_open, j_close, j_cmp, j_query, NULL, NULL, NULL, j_get_eoa, j_set_eoa, j_get_eof, j_get_handle,
-    j_read, j_write, j_flush, j_truncate, NULL, NULL, H5FD_FLMAP_DICHOTOMY};
+#ifdef H5FD_CLASS_VERSION
+    .version = H5FD_CLASS_VERSION,
+    .value = (H5FD_class_value_t)JOURNAL_DRIVER_VALUE,
+#endif
+    .name = "voiga_journal",
+    .maxaddr = MAX_ADDR,
+    .fc_degree = H5F_CLOSE_WEAK,
+    .open = j_open,
+    .close = j_close,
+    .cmp = j_cmp,
+    .query = j_query,
+    .get_eoa = j_get_eoa,
+    .set_eoa = j_set_eoa,
+    .get_eof = j_get_eof,
+    .get_handle = j_get_handle,
+    .read = j_read,
+    .write = j_write,
+    .flush = j_flush,
+    .truncate = j_truncate,
+    .fl_map = H5FD_FLMAP_DICHOTOMY,
+};
 
 /* Make the file access property list `fapl` use the journaled driver, with a small
  * metadata cache (64 KiB): HDF5 1.10 scans every cached entry at each flush
