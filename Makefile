@@ -6,7 +6,7 @@ CASE    ?= cases/hertz/m3-NN2.2.nml
 PYTHON  ?= python3
 PREFIX  := build/install
 VOIGA   := $(PREFIX)/bin/voiga
-APT_PKGS := gfortran pkg-config libhdf5-dev libsuitesparse-dev liblapack-dev libblas-dev libopenblas-dev
+APT_PKGS := gfortran pkg-config libhdf5-dev zlib1g-dev libsuitesparse-dev liblapack-dev libblas-dev libopenblas-dev
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # One BLAS thread per run unless the caller sets it: on this 2-core machine the sweep
 # runs one case per core, and OpenBLAS threads that wait by spinning made hertz m3
@@ -38,6 +38,7 @@ deps:
 	pkg-config --exists lapack 2>/dev/null || missing="yes"; \
 	pkg-config --exists openblas 2>/dev/null || missing="yes"; \
 	[ -f /usr/include/suitesparse/umfpack.h ] || missing="yes"; \
+	pkg-config --exists zlib 2>/dev/null || missing="yes"; \
 	if [ -n "$$missing" ]; then \
 	  echo "deps: installing Debian packages: $(APT_PKGS)"; \
 	  $(SUDO) apt-get update -qq && \

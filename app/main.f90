@@ -1,27 +1,28 @@
 !> voiga command line: `voiga case.nml [--check] [--dump file.h5] [--quiet] ...`.
 !> Parses the arguments, reads the case, checks where the run writes and that it
 !> fits, builds the model and runs the solver. The run's progress goes to two
-!> observers side by side: the result file (`voiga_io_results`) and the terminal
+!> observers side by side: the result file (`voiga_io_output_results`) and the terminal
 !> (`voiga_app_console`).
 program voiga_main
     use voiga_error, only: error_t, error_code
     use voiga_version, only: voiga_version_string
-    use voiga_io_case, only: case_t, read_case, check_edges
-    use voiga_io_dump, only: write_dump
-    use voiga_io_bodies, only: discretize_bodies, read_rigid_curves
-    use voiga_io_outputs, only: check_outputs, resolve_restart, restart_file
-    use voiga_io_provenance, only: check_restart
-    use voiga_io_results, only: results_t, restart_case, read_restart
-    use voiga_io_process, only: leave, address_space_limited, reexec_with_environment, ignore_file_size_signal, &
-                                memory_available, stdout_is_terminal
-    use voiga_linalg_blas, only: warm_up_blas, default_library_threads, choose_blas_kernels
+    use voiga_io_input_case, only: case_t, read_case, check_edges
+    use voiga_io_output_dump, only: write_dump
+    use voiga_io_input_bodies, only: discretize_bodies, read_rigid_curves
+    use voiga_io_output_outputs, only: check_outputs, resolve_restart, restart_file
+    use voiga_io_output_provenance, only: check_restart
+    use voiga_io_output_results, only: results_t, restart_case, read_restart
+    use voiga_platform_process, only: leave, address_space_limited, reexec_with_environment, &
+                                      ignore_file_size_signal, memory_available, stdout_is_terminal
+    use voiga_linalg_blas, only: warm_up_blas
+    use voiga_platform_libraries, only: default_library_threads, choose_blas_kernels
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
     use voiga_model_checks, only: setup_warnings, warning_t, check_overlaps
     use voiga_solver_records, only: solver_stats_t, wall_seconds
     use voiga_solver_stepping, only: solve_steps, resume_t
-    use voiga_solver_signals, only: catch_signals, signal_name
-    use voiga_solver_heap, only: keep_freed_memory
+    use voiga_platform_signals, only: catch_signals, signal_name
+    use voiga_platform_heap, only: keep_freed_memory
     use voiga_solver_observers, only: observers_t
     use voiga_app_console, only: console_t
     use voiga_kinds, only: dp

@@ -1,6 +1,6 @@
 """Finish a flush that a killed voiga left half done (docs/hdf5.md, "Crash safety").
 
-voiga writes its result files through a journaled HDF5 driver (src/io/journal_vfd.c):
+voiga writes its result files through a journaled HDF5 driver (src/platform/journal_vfd.c):
 a flush first appends its writes to the end of the file as a journal with a footer,
 then writes them in place, then truncates the journal away. A file whose writer was
 killed between the footer and the truncation ends in a complete journal; applying it

@@ -19,6 +19,6 @@ NAMELISTS: dict[str, frozenset[str]] = {
                           "rigid_ux", "rigid_uy", "allow_overlap"}),
     "output": frozenset({"fields", "samples", "every", "steps"}),
 }
-"""Namelist group -> its variables, as the readers in ``src/io/case/`` declare them (a
+"""Namelist group -> its variables, as the readers in ``src/io/input/case/`` declare them (a
 test compares the two: ``post/tests/test_study.py``). A spec's case tables and a
 study's changes are checked against it."""

@@ -5,9 +5,9 @@ module voiga
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_version, only: voiga_version_string
-    use voiga_io_case, only: case_t, read_case, check_edges
-    use voiga_io_geometry, only: read_patch
-    use voiga_io_bodies, only: discretize_bodies
+    use voiga_io_input_case, only: case_t, read_case, check_edges
+    use voiga_io_input_geometry, only: read_patch
+    use voiga_io_input_bodies, only: discretize_bodies
     use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_eval
     use voiga_discretization_layout, only: layout_t
@@ -22,7 +22,7 @@ module voiga
     use voiga_solver_observers, only: observers_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
-    use voiga_io_results, only: results_t
+    use voiga_io_output_results, only: results_t
     implicit none
     public
 end module voiga

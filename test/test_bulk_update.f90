@@ -12,7 +12,7 @@ module test_bulk_update
     use voiga_nurbs_surface, only: nurbs_surface_t
     use voiga_contact_factory, only: contact_settings_t
     use voiga_model_loads, only: pressure_settings_t
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    use voiga_linalg_sparse, only: csc_matrix_t, new_csc_pattern
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_cholmod, only: cholmod_t, cholmod_runs_serial
     use voiga_solver_bulk_update, only: bulk_update_t, new_bulk_update

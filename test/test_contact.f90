@@ -10,7 +10,7 @@ module test_contact
     use voiga_contact_factory, only: contact_settings_t
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, &
                                     new_assembly_map
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_settings, only: solver_settings_t
     use voiga_solver_stepping, only: solve_steps

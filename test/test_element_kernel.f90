@@ -16,7 +16,7 @@ module test_element_kernel
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_model, only: model_t
     use voiga_model_assembly, only: assemble, assembly_stats_t, stiffness_pattern, assembly_map_t, new_assembly_map
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     implicit none
     private
 

@@ -5,11 +5,11 @@ module test_files
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_io_sha256, only: sha256_file, sha256_text
-    use voiga_io_namelist, only: nml_group_t, scan_groups
-    use voiga_io_os, only: canonical_path, path_exists, remove_file
-    use voiga_io_lock, only: lock_t, acquire_lock, release_lock
-    use voiga_io_process, only: memory_available
+    use voiga_platform_sha256, only: sha256_file, sha256_text
+    use voiga_io_input_namelist, only: nml_group_t, scan_groups
+    use voiga_platform_os, only: canonical_path, path_exists, remove_file, companion
+    use voiga_platform_lock, only: lock_t, acquire_lock, release_lock
+    use voiga_platform_process, only: memory_available
     implicit none
     private
 
@@ -25,6 +25,7 @@ contains
                     new_unittest('canonical_paths', test_canonical), &
                     new_unittest('lock_excludes_a_second_holder', test_lock), &
                     new_unittest('memory_available_is_known', test_memory), &
+                    new_unittest('companion_names_fit_a_file_name', test_companion), &
                     new_unittest('namelist_groups_wherever_they_start', test_scan), &
                     new_unittest('namelist_text_outside_groups_refused', test_scan_refused) &
                     ]
@@ -130,6 +131,24 @@ contains
         call memory_available(physical, address)
         call check(error, physical > 0_int64, 'MemAvailable read')
     end subroutine test_memory
+
+    !> A companion name ('.lock', '.part') is the file's name with the suffix while
+    !> that fits a file name (NAME_MAX, from the system's headers through libc.c:
+    !> 255 bytes on Linux), else shortened with a hash of the name; the folder is kept.
+    subroutine test_companion(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: name
+        name = companion('dir/'//repeat('a', 250), '.lock')
+        call check(error, name == 'dir/'//repeat('a', 250)//'.lock', '255 bytes: the name and suffix')
+        if (allocated(error)) return
+        name = companion('dir/'//repeat('a', 251), '.lock')
+        call check(error, len(name) == 4 + 200 + 1 + 16 + 5, '256 bytes: shortened')
+        if (allocated(error)) return
+        call check(error, name(1:205) == 'dir/'//repeat('a', 200)//'-' .and. name(222:) == '.lock', &
+                   'shortened: folder, 200 characters, hash, suffix')
+        if (allocated(error)) return
+        call check(error, name /= companion('dir/'//repeat('a', 252), '.lock'), 'two names, two companions')
+    end subroutine test_companion
 
     !> Write `lines` to a file.
     subroutine write_lines(path, lines)

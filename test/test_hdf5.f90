@@ -13,7 +13,7 @@ module test_hdf5
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check, test_failed
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_results, only: results_t
+    use voiga_io_output_results, only: results_t
     use voiga_solver_records, only: solver_stats_t, cut_record_t
     implicit none
     private

@@ -9,8 +9,8 @@ module test_multigrid
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_basis, only: find_span, basis_funs, n_basis
     use voiga_nurbs_refine, only: insertion_matrix
-    use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_csr, only: csr_t, csr_from_triplets, csr_transpose, csr_matmul, csr_to_csc, &
+    use voiga_linalg_sparse, only: csc_matrix_t
+    use voiga_linalg_csr, only: csr_t, csr_from_triplets, csr_transpose, csr_matmul, csr_to_csc, &
                                 csr_from_csc, csr_matvec
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_multigrid, only: multigrid_t

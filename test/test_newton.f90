@@ -8,7 +8,7 @@ module test_newton
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_model, only: model_t, set_prescribed
     use voiga_model_assembly, only: assemble, assembly_stats_t
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_context, only: context_t
     use voiga_solver_stepping, only: solve_steps

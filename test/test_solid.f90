@@ -15,7 +15,7 @@ module test_solid
     use voiga_model_assembly, only: body_element, body_dofs, assemble, assembly_stats_t
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: reference_gradients
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_records, only: solver_stats_t
     use voiga_solver_stepping, only: solve_steps
     use voiga_test_fixtures, only: paper_layout, lcg_t, annulus_sector, rectangle, quadratic, scene_t, scene_model

@@ -5,10 +5,11 @@ module test_sparse
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, error_code
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, consecutive_runs
+    use voiga_linalg_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, &
+                                   consecutive_runs
     use voiga_solver_umfpack, only: umfpack_t, dp_is_c_double
     use voiga_test_fixtures, only: lcg_t
-    use voiga_linalg_blas, only: kernels_for
+    use voiga_platform_libraries, only: kernels_for
     implicit none
     private
 

@@ -5,7 +5,7 @@ module test_supernodal
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, error_code
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern
+    use voiga_linalg_sparse, only: csc_matrix_t, new_csc_pattern
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_supernodal, only: supernodal_lu_t
     use voiga_test_fixtures, only: lcg_t

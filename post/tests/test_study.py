@@ -30,9 +30,9 @@ def write_study(folder: Path, text: str, name: str = "study.toml") -> Path:
 
 def test_namelists_are_those_of_the_solver() -> None:
     """The groups and variables a study may change are the ones the readers of
-    src/io/case/ (one per group) read."""
+    src/io/input/case/ (one per group) read."""
     found = {}
-    for path in sorted((REPO / "src" / "io").rglob("*.f90")):
+    for path in sorted((REPO / "src" / "io" / "input").rglob("*.f90")):
         for m in re.finditer(r"namelist\s*/(\w+)/\s*((?:[^\n]*&\s*\n)*[^\n]*)", path.read_text()):
             names = re.sub(r"&\s*\n", " ", m.group(2))
             found[m.group(1)] = frozenset(v.strip() for v in names.split(",") if v.strip())

@@ -1,5 +1,5 @@
 !> The contact methods by name (`&contact method`), the settings of one contact
-!> pair as a case gives them (`&contact`; read by `voiga_io_case_contact`), and the
+!> pair as a case gives them (`&contact`; read by `voiga_io_input_case_contact`), and the
 !> one place a pair is built: its method, law (with the automatic penalty),
 !> quadrature, history and reference state, from the settings and the bodies the
 !> model gives. A new method is a new extension of `contact_pair_t` plus one line
@@ -44,7 +44,7 @@ module voiga_contact_factory
         !> Rigid line: a point on it and its outward normal.
         real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
         !> Rigid obstacle bounded by a curve of the geometry file instead of the line:
-        !> its name ('' for the line) and the curve (read by `voiga_io_bodies`).
+        !> its name ('' for the line) and the curve (read by `voiga_io_input_bodies`).
         character(len=32) :: rigid_curve = ''
         type(nurbs_curve_t) :: curve
         !> The rigid master's translation at the end of each load phase, shape

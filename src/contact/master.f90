@@ -29,7 +29,7 @@ module voiga_contact_master
 
     !> What a master's kind adds to a pair's output at a step (docs/hdf5.md,
     !> `/steps/<k>/contact/<p>`): named vectors and, for a rigid curve, the curve
-    !> where it is. The result writer (`voiga_io_results`) stores it as it is, in
+    !> where it is. The result writer (`voiga_io_output_results`) stores it as it is, in
     !> this order, so the master decides what describes it and contact/ calls no
     !> HDF5.
     type :: master_output_t

@@ -47,7 +47,7 @@ module voiga_io_hdf5
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_hdf5_status, only: note, release, class_name, not_open, fits_integer
-    use voiga_io_os, only: file_info_t, file_status, kind_name, kind_missing, kind_regular
+    use voiga_platform_os, only: file_info_t, file_status, kind_name, kind_missing, kind_regular
     implicit none
     private
 
@@ -214,7 +214,7 @@ contains
     !> create a new file (refused when anything is at the name; never through a link).
     !> A file this object had open is closed first. HDF5's own file locking is off:
     !> a result file is guarded by the writer's lock file and its `flock` while a
-    !> step is written (`voiga_io_results`, docs/hdf5.md), whatever
+    !> step is written (`voiga_io_output_results`, docs/hdf5.md), whatever
     !> HDF5_USE_FILE_LOCKING says, and HDF5's lock would exclude that `flock`.
     subroutine file_open(self, path, mode, error)
         class(h5file_t), intent(inout) :: self

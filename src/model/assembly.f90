@@ -8,7 +8,7 @@ module voiga_model_assembly
     use voiga_kinds, only: dp, i8
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, set_contact_time
-    use voiga_solver_sparse, only: csc_matrix_t, position_cache_t
+    use voiga_linalg_sparse, only: csc_matrix_t, position_cache_t
     use voiga_model_assembly_pattern, only: body_dofs, stiffness_pattern, rebuild_pattern, &
                                             assembly_map_t, new_assembly_map
     use voiga_model_assembly_bulk, only: assembly_stats_t, body_element, assemble_bulk, &

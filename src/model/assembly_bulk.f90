@@ -11,7 +11,7 @@ module voiga_model_assembly_bulk
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element, solid_element_blocks, solid_element_force, element_work_t
-    use voiga_solver_sparse, only: csc_matrix_t, pattern_positions, consecutive_runs
+    use voiga_linalg_sparse, only: csc_matrix_t, pattern_positions, consecutive_runs
     use voiga_model_assembly_pattern, only: body_dofs, stiffness_pattern, assembly_map_t, &
                                             body_stiffness_t
     implicit none

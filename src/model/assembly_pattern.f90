@@ -7,7 +7,7 @@ module voiga_model_assembly_pattern
     use voiga_model, only: model_t
     use voiga_model_body, only: body_t
     use voiga_text, only: str
-    use voiga_solver_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, &
+    use voiga_linalg_sparse, only: csc_matrix_t, new_csc_pattern, pattern_positions, &
                                    consecutive_runs
     implicit none
     private

@@ -1,6 +1,6 @@
 !> A deformable body of the model: its discretization, material law, DOF offset
 !> and quadrature; and the settings a case gives for one (`&body`, read by
-!> `voiga_io_case_body`).
+!> `voiga_io_input_case_body`).
 module voiga_model_body
     use voiga_kinds, only: dp
     use voiga_error, only: error_t

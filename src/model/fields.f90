@@ -1,6 +1,6 @@
 !> Stress, strain and von Mises stress sampled in every element of a body, for the
-!> result file (`&output`; read by `voiga_io_case_output`, written by
-!> `voiga_io_results` at the steps the case asks for, and only then). The values
+!> result file (`&output`; read by `voiga_io_input_case_output`, written by
+!> `voiga_io_output_results` at the steps the case asks for, and only then). The values
 !> come from the body's material law (`material_t%fields`): the Cauchy stress and
 !> the law's strain measure at each sample point.
 !>

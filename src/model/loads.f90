@@ -1,7 +1,7 @@
 !> The loads of the model: prescribed displacements and pressures on named edges,
 !> each with a value at the end of every load phase (linear within a phase); and
 !> the settings a case gives for one (`&dirichlet`, `&pressure`, read by
-!> `voiga_io_case_dirichlet` and `voiga_io_case_pressure`).
+!> `voiga_io_input_case_dirichlet` and `voiga_io_input_case_pressure`).
 module voiga_model_loads
     use voiga_kinds, only: dp
     implicit none

@@ -24,7 +24,7 @@ module voiga_solver_bulk_update
     use voiga_text, only: str, real_str
     use voiga_linalg_lapack, only: lu_factor, lu_solve, triangular_inverse
     use voiga_linalg_blas, only: dgemm, triangular_solve
-    use voiga_solver_sparse, only: csc_matrix_t, pattern_positions
+    use voiga_linalg_sparse, only: csc_matrix_t, pattern_positions
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_cholmod, only: cholmod_t

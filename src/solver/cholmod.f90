@@ -15,7 +15,7 @@ module voiga_solver_cholmod
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t, solve_one_column
     implicit none
     private

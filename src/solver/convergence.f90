@@ -9,7 +9,7 @@
 !> rounding the coordinates alone moves the residual by more than tol ||r_0||).
 module voiga_solver_convergence
     use voiga_kinds, only: dp
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     implicit none
     private
 

@@ -12,7 +12,7 @@
 module voiga_solver_linear
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     implicit none
     private
 

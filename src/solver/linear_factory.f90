@@ -2,7 +2,7 @@
 module voiga_solver_linear_factory
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, contact_reach
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_supernodal, only: supernodal_lu_t

@@ -13,12 +13,12 @@
 module voiga_solver_multigrid
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_solver_sparse, only: csc_matrix_t
-    use voiga_solver_csr, only: csr_t, csr_from_csc, csr_from_triplets, csr_matmul, &
+    use voiga_linalg_sparse, only: csc_matrix_t
+    use voiga_linalg_csr, only: csr_t, csr_from_csc, csr_from_triplets, csr_matmul, &
                                 csr_to_csc, csr_matvec, csr_diagonal_positions, csr_matmul_numeric
     use voiga_solver_umfpack, only: umfpack_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
-    use voiga_solver_signals, only: caught_signal, signal_name
+    use voiga_platform_signals, only: caught_signal, signal_name
     use voiga_text, only: str, real_str
     use voiga_discretization_patch, only: discretization_t
     use voiga_solver_multigrid_levels, only: mg_level_t, build_levels

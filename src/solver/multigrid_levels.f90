@@ -10,7 +10,7 @@
 module voiga_solver_multigrid_levels
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
-    use voiga_solver_csr, only: csr_t, csr_from_triplets, csr_transpose
+    use voiga_linalg_csr, only: csr_t, csr_from_triplets, csr_transpose
     use voiga_solver_smoother, only: line_set_t, new_line_set
     use voiga_discretization_patch, only: discretization_t
     use voiga_discretization_hierarchy, only: coarse_space_t, cp_map_t, coarsen_discretization, &

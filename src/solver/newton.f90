@@ -6,7 +6,7 @@
 !> projection that does not converge, a singular matrix). The load stepping
 !> (`voiga_solver_stepping`) decides what a failure leads to; the step length of
 !> each iteration follows `voiga_solver_step_length`. SIGINT/SIGTERM
-!> (voiga_solver_signals) are polled between iterations.
+!> (voiga_platform_signals) are polled between iterations.
 module voiga_solver_newton
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
@@ -16,11 +16,11 @@ module voiga_solver_newton
                                     bulk_stiffness, assembly_stats_t
     use voiga_contact_law, only: state_stick, state_slip
     use voiga_contact_pair, only: pair_slot_t
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_linear_factory, only: new_linear_solver
     use voiga_solver_settings, only: solver_settings_t
-    use voiga_solver_signals, only: caught_signal, signal_name
+    use voiga_platform_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, wall_seconds
     use voiga_solver_progress, only: iteration_report_t
     use voiga_solver_context, only: context_t

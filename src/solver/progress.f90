@@ -1,6 +1,6 @@
 !> How a run's progress leaves the solver: the solver calls these hooks and never
 !> prints or writes a file itself. `progress_t` does nothing; the result file
-!> (`voiga_io_results`) and the terminal (`app/`) extend it with what they show.
+!> (`voiga_io_output_results`) and the terminal (`app/`) extend it with what they show.
 !> The hooks a run calls, in order: `set_up` once (a hierarchical linear solver's
 !> levels), then per attempt at a substep `substep`, per Newton iteration
 !> `iteration`, `factorized`, `linear_solved`;

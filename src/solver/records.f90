@@ -1,6 +1,6 @@
 !> What a run records: one record per converged step, one per cut of the load
 !> increment, and the run's counters. The solver fills them; the result file
-!> (`voiga_io_results`) and the terminal (`app/`) show them through
+!> (`voiga_io_output_results`) and the terminal (`app/`) show them through
 !> `voiga_solver_progress`.
 module voiga_solver_records
     use voiga_kinds, only: dp, i8

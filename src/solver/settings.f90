@@ -1,4 +1,4 @@
-!> The solver's settings (`&solver`; read and validated by `voiga_io_case_solver`,
+!> The solver's settings (`&solver`; read and validated by `voiga_io_input_case_solver`,
 !> reference in docs/formats.md): the load steps of each phase, Newton's tolerances,
 !> the adaptive load stepping, the linear solver and the step damping. The load
 !> "time" runs from 0 to the number of phases; phase k ends at time k.

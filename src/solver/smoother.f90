@@ -12,7 +12,7 @@ module voiga_solver_smoother
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: str
-    use voiga_solver_csr, only: csr_t
+    use voiga_linalg_csr, only: csr_t
     use voiga_linalg_lapack, only: band_factor
     implicit none
     private

@@ -22,7 +22,7 @@ module voiga_solver_stepping
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t, set_prescribed, set_contact_time
     use voiga_solver_settings, only: solver_settings_t
-    use voiga_solver_signals, only: caught_signal, signal_name
+    use voiga_platform_signals, only: caught_signal, signal_name
     use voiga_solver_records, only: solver_stats_t, step_record_t, cut_record_t, append_cut, wall_seconds
     use voiga_solver_progress, only: progress_t, step_report_t
     use voiga_solver_context, only: context_t

@@ -37,7 +37,7 @@ module voiga_solver_supernodal
     use, intrinsic :: iso_c_binding, only: c_int
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error
-    use voiga_solver_sparse, only: csc_matrix_t
+    use voiga_linalg_sparse, only: csc_matrix_t
     use voiga_solver_linear, only: linear_solver_t, solve_accuracy_t
     use voiga_solver_umfpack, only: umfpack_t
     implicit none

@@ -4,7 +4,7 @@
 !> block and adding its Schur complement to its parent's front; then the determinant
 !> and the reciprocal condition estimate from the pivots.
 submodule(voiga_solver_supernodal) voiga_solver_supernodal_factor
-    use voiga_solver_sparse, only: consecutive_runs
+    use voiga_linalg_sparse, only: consecutive_runs
     use voiga_linalg_blas, only: dgemm, dtrsm
     implicit none
 

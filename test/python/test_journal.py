@@ -1,4 +1,4 @@
-"""Crash safety of result files (docs/hdf5.md, "Crash safety"; src/io/journal_vfd.c):
+"""Crash safety of result files (docs/hdf5.md, "Crash safety"; src/platform/journal_vfd.c):
 a writer killed inside a flush, at a point chosen by the driver's test hook
 (VOIGA_JOURNAL_KILL=n: SIGKILL in the n-th flush, after the first of its in-place
 writes), leaves a complete journal at the end of the file; post's reader and voiga

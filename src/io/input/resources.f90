@@ -1,0 +1,95 @@
+!> Will the run fit? The size of every body's discretization (counted before it
+!> is built) against the 32-bit integers that number DOFs and matrix entries, and
+!> an estimate of the memory the run needs against what this process may use
+!> (/proc/meminfo and `ulimit -v`): refused with the numbers, before anything of
+!> that size is allocated.
+!>
+!> The estimate is fitted to the peak resident memory of runs on this code
+!> (docs/files.md, "Resources", has the table and the command): a base of
+!> 20 MiB (libraries, the program) plus, per entry of the element stiffness
+!> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
+!> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows
+!> like n log n) or 2.3 x log2(DOFs) with multigrid.
+module voiga_io_input_resources
+    use, intrinsic :: iso_fortran_env, only: int64
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t, fatal_error, error_code
+    use voiga_discretization_size, only: body_size_t
+    use voiga_platform_process, only: memory_available
+    implicit none
+    private
+
+    public :: memory_estimate, check_size
+
+    real(dp), parameter :: base_bytes = 20.0_dp*2.0_dp**20
+    real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp
+
+contains
+
+    !> Estimated peak memory (bytes) of a run with bodies of `sizes` and the
+    !> linear solver `linear_solver` ('direct' or 'multigrid').
+    pure real(dp) function memory_estimate(sizes, linear_solver)
+        type(body_size_t), intent(in) :: sizes(:)
+        character(len=*), intent(in) :: linear_solver
+        real(dp) :: ndof, entries
+        ndof = 2.0_dp*real(sum(sizes%ncp), dp)
+        entries = real(sum(sizes%entries), dp)
+        memory_estimate = base_bytes + entries*log(max(ndof, 2.0_dp))/log(2.0_dp)* &
+                          merge(per_entry_multigrid, per_entry_direct, trim(linear_solver) == 'multigrid')
+    end function memory_estimate
+
+    !> The counts fit the default integers, and (unless `memory_check` is false) the
+    !> estimate fits the memory available. `where` prefixes messages.
+    subroutine check_size(sizes, linear_solver, memory_check, where, error)
+        type(body_size_t), intent(in) :: sizes(:)
+        character(len=*), intent(in) :: linear_solver, where
+        logical, intent(in) :: memory_check
+        type(error_t), allocatable, intent(out) :: error
+        integer(int64) :: ndof, entries, limit
+        real(dp) :: need
+        integer(int64) :: physical, address
+        character(len=200) :: counts
+
+        ndof = 2*sum(sizes%ncp)
+        entries = sum(sizes%entries)
+        write (counts, '(i0,a,i0,a,i0,a)') ndof, ' DOFs, ', sum(sizes%nel), ' elements, ', entries, &
+            ' element matrix entries'
+        limit = huge(0)
+        if (ndof > limit .or. entries > limit) then
+            call fatal_error(error, where//'the discretization is too large: '//trim(counts)// &
+                             ' (DOFs and entries are counted in 32-bit integers, at most 2147483647)', &
+                             error_code%input)
+            return
+        end if
+        if (.not. memory_check) return
+        ! what the run adds to what the program uses now (libraries, the case)
+        need = memory_estimate(sizes, linear_solver) - base_bytes
+        call memory_available(physical, address)
+        if (physical >= 0 .and. need > real(physical, dp)) then
+            call fatal_error(error, where//'the run needs about '//gib(need)//' more memory ('//trim(counts)// &
+                             ', '//trim(linear_solver)//' solver) but '//gib(real(physical, dp))// &
+                             ' are available (MemAvailable); use fewer elements, or --no-memory-check', &
+                             error_code%input)
+        else if (address >= 0 .and. need > real(address, dp)) then
+            call fatal_error(error, where//'the run needs about '//gib(need)//' more memory ('//trim(counts)// &
+                             ', '//trim(linear_solver)//' solver) but the address-space limit (ulimit -v) '// &
+                             'leaves '//gib(real(address, dp))//'; raise it, use fewer elements, or '// &
+                             '--no-memory-check', error_code%input)
+        end if
+    end subroutine check_size
+
+    !> Bytes as '1.23 GB' (or MB).
+    pure function gib(bytes) result(text)
+        real(dp), intent(in) :: bytes
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        if (bytes >= 2.0_dp**30) then
+            write (buf, '(f0.2,a)') bytes/2.0_dp**30, ' GB'
+        else
+            write (buf, '(f0.1,a)') bytes/2.0_dp**20, ' MB'
+        end if
+        text = trim(buf)
+        if (text(1:1) == '.') text = '0'//text
+    end function gib
+
+end module voiga_io_input_resources
