@@ -226,6 +226,7 @@ def test_lock_removed_under_the_writer(voiga_bin: Path, tmp_path: Path) -> None:
     assert code == 1, err
     assert "converged" not in out
     assert "out.h5.lock' was removed or replaced" in err
+    assert "readable in" not in err and "are not in" in err    # out.h5 is the second's
     with h5py.File(tmp_path / "out.h5", "r") as f:     # the second run's result, whole
         assert f.attrs["status"] == b"converged" and f.attrs["n_steps_done"] == 400
 

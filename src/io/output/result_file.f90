@@ -154,18 +154,24 @@ contains
     !> The file's name still names it and the lock file is still ours; else the
     !> run must stop: a removed lock file lets a second run write the same file
     !> (nothing more is written: `broken`), a file moved, replaced or removed under
-    !> the writer is `lost` (its steps are no longer where its name says).
+    !> the writer is `lost` (its steps are no longer where its name says). The
+    !> file's name is looked at before the lock file: another run replaces the
+    !> file only after it took the lock, so a replaced file seen here comes with a
+    !> lock file seen gone or replaced, and the message names that cause, even when
+    !> this run was stopped between the two looks (SIGSTOP).
     subroutine check_names(self, error)
         class(result_file_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: error
+        logical :: here
         ! (a file opened by hand, without `claim`, `create` or `resume`, has neither)
         if (.not. self%is_open() .or. self%identity%kind == kind_missing) return
+        here = self%at_name()
         if (self%writer%fd >= 0 .and. .not. lock_intact(self%writer)) then
             self%broken = .true.
             call fatal_error(error, "the lock file '"//self%writer%path//"' was removed or replaced while "// &
                              "this run wrote '"//self%final_path//"': another run may be writing it now; "// &
                              'this run stopped writing it')
-        else if (self%lost .or. .not. self%at_name()) then
+        else if (self%lost .or. .not. here) then
             ! (once lost, always: nothing more is written to it)
             self%lost = .true.
             call fatal_error(error, "'"//self%path//"' is no longer the file this run writes: it was moved, "// &
@@ -290,6 +296,9 @@ contains
             text = "are in '"//self%part_path//"' ('"//self%final_path//"' was not replaced)"
         else if (.not. path_exists(self%final_path)) then
             text = "are not in '"//self%final_path//"': it does not exist"
+        else if (self%in_place .and. .not. self%at_name()) then
+            ! (a removed lock file let another run replace it: `broken`, not `lost`)
+            text = "are not in '"//self%final_path//"': another file took its name while this run wrote it"
         else
             text = 'are in '//self%final_path
         end if
