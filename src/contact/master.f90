@@ -36,7 +36,8 @@ module voiga_contact_master
         !> A curve written first as the group `curve_name` (empty: none).
         character(len=:), allocatable :: curve_name
         type(nurbs_curve_t) :: curve
-        !> Datasets of two values each: `names(j)` holds `vectors(:, j)`; shape [2, n].
+        !> Datasets of one value per spatial axis each: `names(j)` holds `vectors(:, j)`;
+        !> shape [nsd, n] (its first extent is the master's points', never a literal 2).
         character(len=16), allocatable :: names(:)
         real(dp), allocatable :: vectors(:, :)
     end type master_output_t

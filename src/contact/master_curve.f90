@@ -102,7 +102,7 @@ contains
         out%curve_name = 'rigid_curve'
         out%curve = nurbs_curve_t(self%surf%degree, self%surf%knots, self%surf%x0, self%surf%w)
         out%names = [character(len=16) :: 'rigid_offset']
-        out%vectors = reshape(self%offset, [2, 1])
+        out%vectors = reshape(self%offset, [size(self%offset), 1])
     end function curve_output
 
 end module voiga_contact_master_curve

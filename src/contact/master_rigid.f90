@@ -64,7 +64,7 @@ contains
         type(master_output_t) :: out
         out%curve_name = ''
         out%names = [character(len=16) :: 'rigid_point', 'rigid_normal', 'rigid_offset']
-        out%vectors = reshape([self%p0, self%n, self%p0 - self%p_ref], [2, 3])
+        out%vectors = reshape([self%p0, self%n, self%p0 - self%p_ref], [size(self%p0), 3])
     end function rigid_output
 
 end module voiga_contact_master_rigid

@@ -8,7 +8,14 @@ module voiga_model_loads
     private
 
     public :: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value
-    public :: obstacle_motion_t, phase_friction_t, phase_of
+    public :: obstacle_motion_t, phase_friction_t, phase_of, axis_names
+
+    !> The names of the spatial axes, in order; a model of dimension nsd uses the first
+    !> nsd (`axis_names(1:nsd)`). The one list of them: the result file's per-axis
+    !> attributes (`fix_x`, `fix_y` of a Dirichlet group) and the messages that name a
+    !> component (`ux`) take their letters from here, so that a third axis is a
+    !> change of nsd, not of every place that names one.
+    character(len=1), parameter :: axis_names(3) = ['x', 'y', 'z']
 
     !> A prescribed displacement on a named edge (docs/formats.md, `&dirichlet`).
     type :: dirichlet_settings_t

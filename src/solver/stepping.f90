@@ -502,9 +502,10 @@ contains
         associate (stats => sp%ctx%stats, rec => sp%ctx%record)
             stats%steps = rec%step
             rec%det_sign = sp%conv_det_sign
-            allocate (rec%reactions(2, size(model%dirichlet)))
+            ! one component per spatial axis (the result file's reactions, [nsd, n])
+            allocate (rec%reactions(model%nsd, size(model%dirichlet)))
             do j = 1, size(model%dirichlet)
-                do c = 1, 2
+                do c = 1, model%nsd
                     rec%reactions(c, j) = sum(sp%newton%r(model%dirichlet(j)%dofs(c, :)))
                 end do
             end do

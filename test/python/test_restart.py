@@ -152,6 +152,40 @@ def test_restart_after_stick_predictions(run, tmp_path: Path, keep: int) -> None
     compare(*restart_after(run, tmp_path, keep, "--quiet")[:2])
 
 
+def test_restart_checks_the_dimension(run, tmp_path: Path) -> None:
+    """Issue 37 item 5: a result records its spatial dimension (root attribute
+    ``dimension``, 2 here). A restart from a file whose dimension is not its case's
+    model's is refused, forced or not, naming both, and leaves the file as it was; a
+    file without the attribute (an older voiga's: 2D) is continued and reproduces the
+    run."""
+    res = run(setup(tmp_path, 2), "--quiet")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "run.h5") as f:
+        assert f.attrs["dimension"] == 2 and f.attrs["dimension"].dtype.kind == "i"
+        assert [f["dirichlet/1"].attrs[k] for k in ("fix_x", "fix_y")] == [1, 1]
+        assert "fix_z" not in f["dirichlet/1"].attrs and f["steps/000001/reactions"].shape == (1, 2)
+    full = tmp_path / "full.h5"
+    shutil.copy(tmp_path / "run.h5", full)
+    for name in ("three.h5", "older.h5"):
+        shutil.copy(full, tmp_path / name)
+        truncate(tmp_path / name, 2)
+    with h5py.File(tmp_path / "three.h5", "r+") as f:
+        f.attrs["dimension"] = np.int32(3)
+    before = (tmp_path / "three.h5").read_bytes()
+    for forced in ([], ["--force-restart"]):
+        res = run("--restart", tmp_path / "three.h5", "--quiet", *forced)
+        assert res.returncode == 2, res.stdout + res.stderr
+        assert "is of dimension 3" in res.stderr and "model is of dimension 2" in res.stderr, res.stderr
+        assert (tmp_path / "three.h5").read_bytes() == before
+    with h5py.File(tmp_path / "older.h5", "r+") as f:
+        del f.attrs["dimension"]
+    res = run("--restart", tmp_path / "older.h5", "--quiet")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "older.h5") as f:
+        assert f.attrs["status"] == b"converged" and f.attrs["n_steps_done"] == 5
+    compare(full, tmp_path / "older.h5")
+
+
 IRONING = """&case
   title = 'restart ironing', geometry = 'geometry.h5', output = 'run.h5', n_bodies = 2
 /

@@ -18,7 +18,7 @@ module voiga_io_input_case
     use voiga_io_input_case_output, only: read_output
     use voiga_model_fields, only: output_settings_t
     use voiga_model_body, only: body_settings_t
-    use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t
+    use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t, axis_names
     use voiga_contact_factory, only: contact_settings_t
     use voiga_solver_settings, only: solver_settings_t
     use voiga_discretization_patch, only: discretization_t, boundary_index
@@ -203,14 +203,13 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=128) :: msg
         integer :: i, j, c
-        character(len=1), parameter :: names(2) = ['x', 'y']
         do j = 2, size(dirichlet)
             do i = 1, j - 1
                 if (dirichlet(i)%body /= dirichlet(j)%body .or. dirichlet(i)%edge /= dirichlet(j)%edge) cycle
-                do c = 1, 2
+                do c = 1, size(dirichlet(j)%fix)
                     if (.not. (dirichlet(i)%fix(c) .and. dirichlet(j)%fix(c))) cycle
                     write (msg, '(a,i0,a,i0,a)') ': &dirichlet (', i, ') and (', j, ') both prescribe u'
-                    call fatal_error(error, path//trim(msg)//names(c)//" of edge '"//trim(dirichlet(j)%edge)// &
+                    call fatal_error(error, path//trim(msg)//axis_names(c)//" of edge '"//trim(dirichlet(j)%edge)// &
                                      "' of body '"//trim(dirichlet(j)%body)//"' (give each component of an "// &
                                      'edge once)', error_code%input)
                     return

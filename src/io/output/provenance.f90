@@ -15,7 +15,7 @@ module voiga_io_output_provenance
     use voiga_platform_sha256, only: sha256_file
     use voiga_platform_os, only: canonical_path
     use voiga_io_input_case, only: case_t
-    use voiga_model_loads, only: phase_of
+    use voiga_model_loads, only: phase_of, axis_names
     use voiga_platform_libraries, only: library_threads, blas_kernels
     implicit none
     private
@@ -133,7 +133,7 @@ contains
         character(len=:), allocatable, intent(out) :: text
         character(len=:), allocatable :: g, s
         type(error_t), allocatable :: error
-        integer :: i, n
+        integer :: i, n, c
         text = ''
         call compare_int(h5, '/', 'n_steps_planned', case%solver%total_steps(), '&solver n_steps (steps in all)', text)
         call compare_str(h5, '/', 'linear_solver', trim(case%solver%linear_solver), '&solver linear_solver', text)
@@ -157,8 +157,11 @@ contains
             s = '&dirichlet ('//str(i)//')'
             call compare_str(h5, g, 'body', trim(case%dirichlet(i)%body), s//' body', text)
             call compare_str(h5, g, 'edge', trim(case%dirichlet(i)%edge), s//' edge', text)
-            call compare_int(h5, g, 'fix_x', merge(1, 0, case%dirichlet(i)%fix(1)), s//' fix_x', text)
-            call compare_int(h5, g, 'fix_y', merge(1, 0, case%dirichlet(i)%fix(2)), s//' fix_y', text)
+            ! (the flags the writer writes: one per axis, `results.f90` write_dirichlet)
+            do c = 1, size(case%dirichlet(i)%fix)
+                call compare_int(h5, g, 'fix_'//axis_names(c), merge(1, 0, case%dirichlet(i)%fix(c)), &
+                                 s//' fix_'//axis_names(c), text)
+            end do
             call compare_values(h5, g//'/values', case%dirichlet(i)%values, s//' ux, uy', text)
         end do
         call h5%read_attr_int('/', 'n_steps_done', n, error)

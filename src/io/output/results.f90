@@ -21,6 +21,7 @@ module voiga_io_output_results
     use voiga_io_output_result_file, only: result_file_t
     use voiga_io_output_provenance, only: write_provenance
     use voiga_model, only: model_t
+    use voiga_model_loads, only: axis_names
     use voiga_model_fields, only: output_settings_t, field_samples_t
     use voiga_io_output_fields, only: write_fields, sample_bodies
     use voiga_contact_master, only: master_output_t
@@ -49,6 +50,10 @@ module voiga_io_output_results
         integer :: last_step = 0
         !> A step's fields could not be sampled (warned once; the steps are written).
         logical :: fields_failed = .false.
+        !> The spatial dimension of the file (its root attribute `dimension`): the
+        !> length of every spatial axis the writer shapes itself (the contact points'
+        !> positions); the model's at `open`, the file's at `reopen`.
+        integer :: nsd = 2
     contains
         !> Take the writer's lock of the file (before anything is built or read).
         procedure :: claim => results_claim
@@ -112,6 +117,7 @@ contains
 
         self%fields = case%field_output
         self%last_step = case%solver%total_steps()
+        self%nsd = model%nsd
         call self%h5%create(case%output, replace, error)
         if (allocated(error)) return
         ! (each write keeps its failure in the file: checked once, below)
@@ -123,6 +129,9 @@ contains
         call self%h5%write_attr('/', 'case_file', case%path)
         call self%h5%write_attr('/', 'status', 'running')
         call self%h5%write_attr('/', 'n_dofs', model%ndof)
+        ! the length of every spatial axis in the file (docs/hdf5.md); a restart
+        ! continues only a file of its model's dimension (`read_restart`)
+        call self%h5%write_attr('/', 'dimension', model%nsd)
         call self%h5%write_attr('/', 'linear_solver', trim(case%solver%linear_solver))
         call self%h5%write_attr('/', 'damping', trim(case%solver%damping))
         call self%h5%write_attr('/', 'n_steps_planned', case%solver%total_steps())
@@ -171,14 +180,17 @@ contains
         type(model_t), intent(in) :: model
         integer, intent(in) :: k
         character(len=:), allocatable :: g
+        integer :: c
 
         associate (d => model%dirichlet(k))
             g = '/dirichlet/'//str(k)
             call h5%create_group(g)
             call h5%write_attr(g, 'body', trim(model%bodies(d%body)%name))
             call h5%write_attr(g, 'edge', trim(d%edge))
-            call h5%write_attr(g, 'fix_x', merge(1, 0, d%fix(1)))
-            call h5%write_attr(g, 'fix_y', merge(1, 0, d%fix(2)))
+            ! one flag per axis of the model: fix_x, fix_y (, fix_z)
+            do c = 1, model%nsd
+                call h5%write_attr(g, 'fix_'//axis_names(c), merge(1, 0, d%fix(c)))
+            end do
             call h5%write(g//'/values', d%values)
         end associate
     end subroutine write_dirichlet
@@ -197,6 +209,11 @@ contains
         call self%h5%resume(path, error)
         if (allocated(error)) return
         call self%h5%read_attr_int('/', 'n_steps_done', self%n_written, error)
+        if (allocated(error)) return
+        ! (a file without it is of an older voiga: 2D; `read_restart` has compared it
+        ! with the model's)
+        self%nsd = 2
+        if (self%h5%has_attr('/', 'dimension')) call self%h5%read_attr_int('/', 'dimension', self%nsd, error)
         if (allocated(error)) return
         call self%h5%begin_write(65536_int64, error)
         if (allocated(error)) return
@@ -295,7 +312,7 @@ contains
         if (size(rec%reactions, 2) > 0) call self%h5%write(g//'/reactions', rec%reactions)
         call self%h5%write(g//'/displacement', u)
         do k = 1, size(pairs)
-            call write_contact(self%h5, g//'/contact/'//str(k), pairs(k)%pair)
+            call write_contact(self%h5, g//'/contact/'//str(k), pairs(k)%pair, self%nsd)
         end do
         if (present(model) .and. present(samples)) then
             if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples)
@@ -321,10 +338,12 @@ contains
     !> Per-slave-point contact output of `pair` as the group `c`: the pair's law,
     !> what its master's kind records (`contact_master_t%output`), the points'
     !> output of the last evaluation and the committed history.
-    subroutine write_contact(h5, c, pair)
+    subroutine write_contact(h5, c, pair, nsd)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: c
         class(contact_pair_t), intent(in) :: pair
+        !> The spatial dimension (the points' positions have `nsd` components).
+        integer, intent(in) :: nsd
         call h5%create_group(c)
         call h5%write_attr(c, 'slave', trim(pair%slave_name))
         call h5%write_attr(c, 'master', trim(pair%master_name))
@@ -334,7 +353,7 @@ contains
         call h5%write_attr(c, 'method', pair%method_name())
         call write_master(h5, c, pair%master%output())
         call h5%write(c//'/force', pair%force)
-        call write_points(h5, c, pair%out)
+        call write_points(h5, c, pair%out, nsd)
         call h5%write(c//'/xi_slave', pair%xi)
         ! committed friction history: what a restart needs
         call write_history(h5, c//'/history/', pair%history())
@@ -352,15 +371,17 @@ contains
         end do
     end subroutine write_master
 
-    !> Each slave point's output `out` as one dataset per quantity under `c`.
-    subroutine write_points(h5, c, out)
+    !> Each slave point's output `out` as one dataset per quantity under `c`; the
+    !> positions as [nsd, n] (h5py: (n, nsd)).
+    subroutine write_points(h5, c, out, nsd)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: c
         type(contact_point_out_t), intent(in) :: out(:)
+        integer, intent(in) :: nsd
         real(dp), allocatable :: a1(:)
         integer :: i
-        call h5%write(c//'/x_ref', reshape([(out(i)%x0, i=1, size(out))], [2, size(out)]))
-        call h5%write(c//'/x', reshape([(out(i)%x, i=1, size(out))], [2, size(out)]))
+        call h5%write(c//'/x_ref', reshape([(out(i)%x0(1:nsd), i=1, size(out))], [nsd, size(out)]))
+        call h5%write(c//'/x', reshape([(out(i)%x(1:nsd), i=1, size(out))], [nsd, size(out)]))
         a1 = out%gap
         ! no orthogonal projection onto the master: NaN
         where (a1 > 1.0e300_dp) a1 = ieee_value(1.0_dp, ieee_quiet_nan)

@@ -27,9 +27,30 @@ contains
         type(h5file_t) :: h5
         call h5%open(path, 'r', error)
         if (allocated(error)) return
-        call read_state(h5, model, state, error)
+        call check_dimension(h5, model%nsd, error)
+        if (.not. allocated(error)) call read_state(h5, model, state, error)
         call close_read(h5, error)
     end procedure read_restart
+
+    !> A restart continues only a file of its model's spatial dimension `nsd` (every
+    !> spatial axis of the file has that length; a 2D displacement read as 3D would
+    !> mix the components of different control points). A file without the root
+    !> attribute `dimension` was written before voiga wrote it, by a 2D voiga: 2.
+    !> Refused whatever `--force-restart` says.
+    subroutine check_dimension(h5, nsd, error)
+        type(h5file_t), intent(inout) :: h5
+        integer, intent(in) :: nsd
+        type(error_t), allocatable, intent(out) :: error
+        integer :: recorded
+        recorded = 2
+        if (h5%has_attr('/', 'dimension')) call h5%read_attr_int('/', 'dimension', recorded, error)
+        if (allocated(error)) return
+        if (recorded /= nsd) &
+            call fatal_error(error, h5%path//': --restart: the result file is of dimension '//str(recorded)// &
+                             ' (its root attribute dimension) but the case''s model is of dimension '// &
+                             str(nsd)//': a restart continues only a run of its own dimension', &
+                             error_code%input)
+    end subroutine check_dimension
 
     !> Close a file that was only read; `error` keeps the first error.
     subroutine close_read(h5, error)
