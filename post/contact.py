@@ -38,7 +38,7 @@ def _slave_edges(result: Result, st: Step, pair: int) -> tuple[Curve, Curve]:
     displaced by step ``st``."""
     body = result.bodies[st.contact[pair].slave]
     curve, ids = slave_edge_curve(body)
-    u = np.asarray(st.displacement[body.dofs]).reshape(-1, 2)
+    u = np.asarray(st.displacement[body.dofs]).reshape(-1, body.nsd)
     moved = Curve(degree=curve.degree, knots=curve.knots,
                   control_points=curve.control_points + u[ids], weights=curve.weights)
     return curve, moved

@@ -120,7 +120,7 @@ def displacement(body: Body, u_body: np.ndarray, xi: np.ndarray | float,
                  eta: np.ndarray | float) -> np.ndarray:
     """The displacement field ``u(xi, eta) = sum_a R_a u_a`` (same shapes as
     :func:`evaluate`)."""
-    return combine(body, np.asarray(u_body, dtype=float).reshape(body.ncp, 2), xi, eta)
+    return combine(body, np.asarray(u_body, dtype=float).reshape(body.ncp, body.nsd), xi, eta)
 
 
 def evaluate_grid(body: Body, u_body: np.ndarray | None, xi: np.ndarray,

@@ -25,19 +25,19 @@ def history_table(result: Result) -> tuple[list[str], np.ndarray]:
     points in contact, the largest pressure and the smallest gap."""
     names = ["step", "time", "iterations", "cuts"]
     for d in result.dirichlet:
-        names += [f"reaction_x {d.body}/{d.edge}", f"reaction_y {d.body}/{d.edge}"]
+        names += [f"reaction_{a} {d.body}/{d.edge}" for a in result.axes]
     pairs = result.steps[0].contact if result.steps else []
     for c in pairs:
         tag = f"{c.slave}->{c.master}"
-        names += [f"contact_x {tag}", f"contact_y {tag}", f"points_in_contact {tag}",
-                  f"max_p_n {tag}", f"min_gap {tag}"]
+        names += [f"contact_{a} {tag}" for a in result.axes]
+        names += [f"points_in_contact {tag}", f"max_p_n {tag}", f"min_gap {tag}"]
     rows = []
     for s in result.steps:
         row = [s.step, s.time, s.iterations, s.cuts]
         row += list(np.asarray(s.reactions, dtype=float).reshape(-1))
         for c in s.contact:
             gaps = c.gap[np.isfinite(c.gap)]
-            row += [*c.force[:2], int(np.count_nonzero(c.active)),
+            row += [*c.force[:result.dimension], int(np.count_nonzero(c.active)),
                     float(c.p_n.max()) if len(c.p_n) else 0.0,
                     float(gaps.min()) if len(gaps) else np.nan]
         rows.append(row)

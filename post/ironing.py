@@ -9,10 +9,10 @@ from .reader import Result
 
 
 def die_forces(result: Result, die: str = "die", edge: str = "inner") -> tuple[np.ndarray, np.ndarray]:
-    """Step numbers and the resultant reaction (Px, Py) on the die's driven edge, (n, 2)."""
+    """Step numbers and the resultant reaction (Px, Py) on the die's driven edge, (n, nsd)."""
     k = result.dirichlet_index(die, edge)
     steps = np.array([s.step for s in result.steps])
-    forces = np.array([s.reactions[k] for s in result.steps]).reshape(-1, 2)
+    forces = np.array([s.reactions[k] for s in result.steps]).reshape(-1, result.dimension)
     return steps, forces
 
 

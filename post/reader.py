@@ -4,8 +4,10 @@ This is the only module that opens result files. :func:`read_result` returns
 plain dataclasses holding numpy arrays in *natural* order, whatever h5py
 shows for the Fortran arrays:
 
-- control points ``(ncp, 2)``, reactions ``(n_dirichlet, 2)``, element ranges
-  ``(nel, 4)``, the bulk patch ``(n_eta, n_xi, 2)`` (``docs/formats.md``);
+- control points ``(ncp, nsd)``, reactions ``(n_dirichlet, nsd)``, element ranges
+  ``(nel, 4)``, the bulk patch ``(n_eta, n_xi, 2)`` (``docs/formats.md``), where nsd
+  is the file's spatial dimension (:attr:`Result.dimension`: the root attribute
+  ``dimension``, 2 in files written before voiga wrote it);
 - every id is **0-based**: element connectivity, element pointers, edge
   control point ids, :attr:`Body.dof_offset` (the index of the body's first
   DOF in a step's global displacement vector);
@@ -83,6 +85,26 @@ def _named(path: Path, err: BadResultError) -> BadResultError:
     return err if str(err).startswith(str(path)) else BadResultError(f"{path}: {err}")
 
 
+AXES: tuple[str, ...] = ("x", "y", "z")
+"""The names of the spatial axes; a file of dimension nsd uses ``AXES[:nsd]`` (as
+voiga's ``axis_names``)."""
+
+DIMENSIONS: tuple[int, ...] = (2, 3)
+"""The spatial dimensions a result file may have (root attribute ``dimension``)."""
+
+
+def dimension_of(path: Path, attrs: dict[str, Any]) -> int:
+    """The spatial dimension of a result file from its root attributes ``attrs``: the
+    attribute ``dimension``, 2 when the file has none (written before voiga wrote it,
+    always 2D); BadResultError naming the file when it is not one of
+    :data:`DIMENSIONS`."""
+    nsd = attrs.get("dimension", 2)
+    if not (isinstance(nsd, int) and nsd in DIMENSIONS):
+        raise BadResultError(f"{path}: root attribute dimension = {nsd!r}: not a spatial "
+                             f"dimension ({' or '.join(map(str, DIMENSIONS))})")
+    return nsd
+
+
 COUNTERS: tuple[str, ...] = ("n_steps_done", "n_steps_planned", "n_dofs", "n_cuts")
 """Root attributes that count something: never negative."""
 
@@ -137,7 +159,7 @@ class Body:
     dof_offset: int
     """0-based index of the body's first DOF in the global displacement vector."""
     control_points: np.ndarray
-    """(ncp, 2) reference control points, body-local numbering (0-based row = id)."""
+    """(ncp, nsd) reference control points, body-local numbering (0-based row = id)."""
     weights: np.ndarray
     """(ncp,)"""
     element_ptr: np.ndarray
@@ -156,6 +178,8 @@ class Body:
     """The VO layer curve, or None."""
     attrs: dict[str, Any] = field(default_factory=dict)
     """Every attribute of ``/bodies/<name>`` (decoded)."""
+    nsd: int = 2
+    """Spatial dimension: DOFs per control point (the file's ``dimension``)."""
 
     @property
     def ncp(self) -> int:
@@ -169,8 +193,8 @@ class Body:
 
     @property
     def dofs(self) -> slice:
-        """The body's DOFs in the global vector (x, y interleaved)."""
-        return slice(self.dof_offset, self.dof_offset + 2 * self.ncp)
+        """The body's DOFs in the global vector (the axes interleaved: x, y, x, y, ...)."""
+        return slice(self.dof_offset, self.dof_offset + self.nsd * self.ncp)
 
     def element(self, k: int) -> np.ndarray:
         """0-based control point ids of element ``k`` (0-based)."""
@@ -192,13 +216,13 @@ class ContactOutput:
     slave: str
     master: str
     force: np.ndarray
-    """(2,) resultant contact force on the slave."""
+    """(nsd,) resultant contact force on the slave."""
     xi_slave: np.ndarray
     """(n,) slave points' parameters along the slave's contact edge."""
     x_ref: np.ndarray
-    """(n, 2) reference position of each slave point."""
+    """(n, nsd) reference position of each slave point."""
     x: np.ndarray
-    """(n, 2) current position."""
+    """(n, nsd) current position."""
     gap: np.ndarray
     """(n,) normal gap (negative: penetration), NaN where there is no projection."""
     p_n: np.ndarray
@@ -253,7 +277,7 @@ class Step:
     step: int
     iterations: int
     reactions: np.ndarray
-    """(n_dirichlet, 2) resultant reaction (x, y) of each Dirichlet condition."""
+    """(n_dirichlet, nsd) resultant reaction (x, y, ...) of each Dirichlet condition."""
     seconds: dict[str, float]
     """stage (``STAGES``) -> wall-clock seconds."""
     cuts: int = 0
@@ -262,17 +286,17 @@ class Step:
     """Newton iterations of all substeps and failed attempts (None in older files)."""
     _data: dict[str, Any] = field(default_factory=dict, repr=False)
     """The lazy fields read so far."""
-    _source: tuple[Path, str, int] | None = field(default=None, repr=False)
-    """(file, step group name, n_dofs) to read the lazy fields from."""
+    _source: tuple[Path, str, int, int] | None = field(default=None, repr=False)
+    """(file, step group name, n_dofs, spatial dimension) to read the lazy fields from."""
 
     def _get(self, key: str) -> Any:
         if key not in self._data:
             if self._source is None:
                 raise AttributeError(f"step {self.step}: no {key} read and no file to read it from")
-            path, name, n_dofs = self._source
+            path, name, n_dofs, nsd = self._source
             with _open(path) as f:
                 try:
-                    self._data.update(_read_step_details(f["steps"][name], name))
+                    self._data.update(_read_step_details(f["steps"][name], name, nsd))
                 except BadResultError as err:
                     raise _named(path, err) from None
             if len(self._data["displacement"]) != n_dofs:
@@ -302,7 +326,8 @@ class Step:
 
     @property
     def displacement(self) -> np.ndarray:
-        """(n_dofs,) control point displacements, global numbering, x/y interleaved."""
+        """(n_dofs,) control point displacements, global numbering, the axes interleaved
+        (x, y, x, y, ... in 2D)."""
         return self._get("displacement")
 
     @property
@@ -374,6 +399,17 @@ class Result:
     @property
     def n_dofs(self) -> int:
         return int(self._attr("n_dofs", 0))
+
+    @property
+    def dimension(self) -> int:
+        """Spatial dimension (root attribute ``dimension``; 2 for files without it):
+        the length of every spatial axis of the file's arrays."""
+        return dimension_of(self.path, self.attrs)
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Names of the spatial axes, ``('x', 'y')`` in 2D."""
+        return AXES[:self.dimension]
 
     @property
     def n_steps_planned(self) -> int:
@@ -497,11 +533,11 @@ def _cause(err: BaseException) -> str:
 _open = open_result
 
 
-def _read_body(name: str, g: h5py.Group) -> Body:
+def _read_body(name: str, g: h5py.Group, nsd: int) -> Body:
     attrs = _attrs(g)
     cp = finite(np.asarray(g["control_points"][()], dtype=float), f"/bodies/{name}/control_points")
-    if cp.ndim != 2 or cp.shape[1] != 2:
-        raise ValueError(f"/bodies/{name}/control_points: shape {cp.shape}, expected (ncp, 2)")
+    if cp.ndim != 2 or cp.shape[1] != nsd:
+        raise ValueError(f"/bodies/{name}/control_points: shape {cp.shape}, expected (ncp, {nsd})")
     ncp = len(cp)
     e = g["elements"]
     ptr = np.asarray(e["ptr"][()], dtype=np.int64) - 1
@@ -526,7 +562,7 @@ def _read_body(name: str, g: h5py.Group) -> Body:
                 weights=finite(np.asarray(g["weights"][()], dtype=float).reshape(-1), f"/bodies/{name}/weights"),
                 element_ptr=ptr, element_conn=conn, element_ranges=ranges, element_vo=vo,
                 edges=edges, bulk=read_patch(g["bulk"]),
-                layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs)
+                layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs, nsd=nsd)
 
 
 _STEP_SCALARS: tuple[str, ...] = ("iterations", "iterations_total", "cuts") + \
@@ -572,15 +608,15 @@ def _read_array(gid: h5py.h5g.GroupID, name: str) -> np.ndarray | None:
 
 
 def _read_step(name: str, gid: h5py.h5g.GroupID, n_dirichlet: int, path: Path, n_dofs: int,
-               lazy: bool) -> Step | None:
+               nsd: int, lazy: bool) -> Step | None:
     if not gid.links.exists(b"displacement"):
         warnings.warn(f"step group /steps/{name} has no displacement (incomplete); skipped",
                       stacklevel=3)
         return None
     a = _scalar_attrs(gid, _STEP_SCALARS)
     reactions = _read_array(gid, "reactions")
-    reactions = np.zeros((0, 2)) if reactions is None else finite(reactions.reshape(-1, 2),
-                                                                    f"/steps/{name}/reactions")
+    reactions = np.zeros((0, nsd)) if reactions is None else finite(reactions.reshape(-1, nsd),
+                                                                      f"/steps/{name}/reactions")
     if len(reactions) != n_dirichlet:
         raise ValueError(f"/steps/{name}/reactions: {len(reactions)} rows for "
                          f"{n_dirichlet} Dirichlet conditions")
@@ -589,14 +625,15 @@ def _read_step(name: str, gid: h5py.h5g.GroupID, n_dirichlet: int, path: Path, n
                          if k.startswith("seconds_")},
                 cuts=int(a.get("cuts", 0)),
                 iterations_total=int(a["iterations_total"]) if "iterations_total" in a else None,
-                _source=(path, name, n_dofs))
+                _source=(path, name, n_dofs, nsd))
     if not lazy:
-        step._data = _read_step_details(h5py.Group(gid), name)
+        step._data = _read_step_details(h5py.Group(gid), name, nsd)
     return step
 
 
-def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
-    """The lazy fields of a step (``_LAZY_FIELDS``) from its group."""
+def _read_step_details(g: h5py.Group, name: str, nsd: int) -> dict[str, Any]:
+    """The lazy fields of a step (``_LAZY_FIELDS``) from its group (of a file of
+    dimension ``nsd``)."""
     gid = g.id
     a = _scalar_attrs(gid, ("time", "substeps"))
 
@@ -607,7 +644,7 @@ def _read_step_details(g: h5py.Group, name: str) -> dict[str, Any]:
     return {"time": float(a.get("time", np.nan)), "substeps": int(a.get("substeps", 1)),
             "residual_norms": vec("residual_norms"), "energy_norms": vec("energy_norms"),
             "displacement": finite(vec("displacement"), f"/steps/{name}/displacement"),
-            "contact": [_read_contact(g["contact"][k]) for k in sorted(g["contact"], key=int)]
+            "contact": [_read_contact(g["contact"][k], nsd) for k in sorted(g["contact"], key=int)]
             if gid.links.exists(b"contact") else [],
             "fields": {body: {k: _field_array(v) for k, v in fg.items()}
                        for body, fg in g["fields"].items()}
@@ -623,14 +660,14 @@ def _field_array(d: h5py.Dataset) -> np.ndarray:
     return np.asarray(d[()], dtype=float)
 
 
-def _read_contact(g: h5py.Group) -> ContactOutput:
+def _read_contact(g: h5py.Group, nsd: int) -> ContactOutput:
     a = _attrs(g)
 
     def vec(key: str) -> np.ndarray:
         return np.asarray(g[key][()], dtype=float).reshape(-1)
 
     def pts(key: str) -> np.ndarray:
-        return finite(np.asarray(g[key][()], dtype=float).reshape(-1, 2), f"{g.name}/{key}")
+        return finite(np.asarray(g[key][()], dtype=float).reshape(-1, nsd), f"{g.name}/{key}")
 
     # (the gap is NaN where a point has no projection onto its master: not checked)
     for key in ("force", "p_n", "p_t"):
@@ -682,9 +719,10 @@ def _read_result(path: Path, lazy: bool) -> Result:
         if "status" not in attrs:
             raise BadResultError(f"{path}: not a voiga result (no root attribute 'status')")
         check_counters(path, attrs)
-        bodies = [_read_body(name, g) for name, g in f["bodies"].items()] if "bodies" in f else []
+        nsd = dimension_of(path, attrs)
+        bodies = [_read_body(name, g, nsd) for name, g in f["bodies"].items()] if "bodies" in f else []
         bodies.sort(key=lambda b: b.dof_offset)
-        n_dofs = int(attrs.get("n_dofs", 0)) or sum(2 * b.ncp for b in bodies)
+        n_dofs = int(attrs.get("n_dofs", 0)) or sum(nsd * b.ncp for b in bodies)
         dirichlet = []
         if "dirichlet" in f:
             for key in sorted(f["dirichlet"], key=int):
@@ -701,7 +739,7 @@ def _read_result(path: Path, lazy: bool) -> Result:
                                   "(a step being or half written); skipped", stacklevel=3)
                     continue
                 s = _read_step(key, h5py.h5g.open(sid, key.encode()), len(dirichlet), path,
-                               n_dofs, lazy)
+                               n_dofs, nsd, lazy)
                 if s is not None:
                     steps.append(s)
         steps.sort(key=lambda s: s.step)
@@ -720,20 +758,20 @@ def _read_result(path: Path, lazy: bool) -> Result:
 
 
 def body_displacement(result: Result, body: str | Body, step: int = -1) -> np.ndarray:
-    """(ncp, 2) displacement of the control points of ``body`` at ``step``
+    """(ncp, nsd) displacement of the control points of ``body`` at ``step``
     (step selection as in :meth:`Result.select_step`; 0 gives zeros)."""
     b = result.body(body)
     s = result.select_step(step)
     if s is None:
-        return np.zeros((b.ncp, 2))
-    return s.displacement[b.dofs].reshape(b.ncp, 2).copy()
+        return np.zeros((b.ncp, b.nsd))
+    return s.displacement[b.dofs].reshape(b.ncp, b.nsd).copy()
 
 
 def reaction_history(result: Result, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(times (n_steps,), reactions (n_steps, 2))`` of Dirichlet condition
+    """``(times (n_steps,), reactions (n_steps, nsd))`` of Dirichlet condition
     ``k`` (0-based index into ``result.dirichlet``) over the converged steps."""
     if not -len(result.dirichlet) <= k < len(result.dirichlet):
         raise IndexError(f"Dirichlet index {k}: the file has {len(result.dirichlet)} condition(s)")
     times = np.array([s.time for s in result.steps], dtype=float)
-    forces = np.array([s.reactions[k] for s in result.steps], dtype=float).reshape(-1, 2)
+    forces = np.array([s.reactions[k] for s in result.steps], dtype=float).reshape(-1, result.dimension)
     return times, forces

@@ -61,7 +61,8 @@ def warnings_for(result: Result) -> list[str]:
 
 
 def _vec(v: np.ndarray) -> str:
-    return f"({v[0]:.6g}, {v[1]:.6g})"
+    """A vector's components, ``(1, -2.5)``: as many as it has (the file's dimension)."""
+    return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
 def summary_lines(result: Result) -> list[str]:
@@ -75,7 +76,7 @@ def summary_lines(result: Result) -> list[str]:
     iters = max(iters, int(result.attrs.get("newton_iterations", 0)))
     lines = [f"{result.title or result.path.name}: {result.status or 'no status'}, "
              f"{len(steps)} of {result.n_steps_planned} steps, {iters} Newton iterations, "
-             f"{int(result.attrs.get('n_cuts', 0))} cuts, {result.n_dofs} DOFs, "
+             f"{int(result.attrs.get('n_cuts', 0))} cuts, {result.n_dofs} DOFs ({result.dimension}D), "
              f"{result.wall_time:.3g} s"]
     if not u.known:
         lines.append(f"units: the file says {result.attrs.get('units', '')!r}: "

@@ -311,3 +311,25 @@ def test_impossible_counters_refused(two_h5: Path, tmp_path: Path, attr: str, va
     res = subprocess.run([sys.executable, "-m", "post", "summary", str(path)], capture_output=True, text=True,
                          timeout=120)
     assert res.returncode == 2 and words in res.stderr and res.stderr.count("\n") == 1, res.stderr
+
+
+def test_dimension_from_the_file(stretch_h5: Path, tmp_path: Path) -> None:
+    """Issue 37 item 5: a result carries its spatial dimension (root attribute
+    ``dimension``, 2 here); a file without it (an older voiga's) is read as 2D with the
+    same values; one that names no spatial dimension is refused naming it."""
+    with h5py.File(stretch_h5) as f:
+        assert f.attrs["dimension"] == 2 and f.attrs["dimension"].dtype.kind == "i"
+    r = read_result(stretch_h5)
+    assert r.dimension == 2 and r.axes == ("x", "y")
+    assert all(b.nsd == 2 for b in r.bodies.values())
+    older = read_result(_damaged(stretch_h5, tmp_path, lambda f: f.attrs.__delitem__("dimension")))
+    assert "dimension" not in older.attrs and older.dimension == 2
+    np.testing.assert_array_equal(body_displacement(older, "slab"), body_displacement(r, "slab"))
+    np.testing.assert_array_equal(older.steps[-1].reactions, r.steps[-1].reactions)
+    summary = subprocess.run([sys.executable, "-m", "post", "summary", str(stretch_h5)], capture_output=True,
+                             text=True, timeout=120)
+    assert summary.returncode == 0 and "112 DOFs (2D)" in summary.stdout, summary.stdout + summary.stderr
+    path = _damaged(stretch_h5, tmp_path, lambda f: f.attrs.__setitem__("dimension", np.int32(5)))
+    res = subprocess.run([sys.executable, "-m", "post", "summary", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 2 and "dimension = 5" in res.stderr and res.stderr.count("\n") == 1, res.stderr
