@@ -11,8 +11,9 @@ module voiga_discretization_patch
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_nurbs_basis, only: find_span, distinct_knots
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_elevate, curve_insert
-    use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval, surface_elevate, surface_insert, &
+    use voiga_nurbs_surface, only: nurbs_surface_t, surface_patch, surface_elevate, surface_insert, &
                                    surface_edge_curve, surface_reorient, edge_index
+    use voiga_nurbs_patch, only: nurbs_patch_t, patch_eval
     use voiga_discretization_layout, only: layout_t, validate_layout, basis_linear
     implicit none
     private
@@ -186,7 +187,9 @@ contains
         real(dp), intent(in) :: new_xi(:), new_eta(:)
         real(dp), allocatable :: bx(:), be(:)
         integer :: i, j
+        type(nurbs_patch_t) :: patch
 
+        patch = surface_patch(exact)
         bx = sorted([distinct_knots(exact%knots_xi), new_xi])
         be = sorted([distinct_knots(exact%knots_eta), new_eta])
         lin%degree = [1, 1]
@@ -197,7 +200,7 @@ contains
         lin%w = 1.0_dp
         do j = 1, size(be)
             do i = 1, size(bx)
-                call surface_eval(exact, bx(i), be(j), lin%cp(:, i, j))
+                call patch_eval(patch, [bx(i), be(j)], lin%cp(:, i, j))
             end do
         end do
     end subroutine build_linear

@@ -1,13 +1,15 @@
-!> NURBS curves in the plane: evaluation and refinement.
+!> NURBS curves in the plane: evaluation (the contact kernels' hot path); refinement is the
+!> general patch's (`voiga_nurbs_patch`).
 module voiga_nurbs_curve
     use voiga_kinds, only: dp
     use voiga_nurbs_basis, only: find_span, basis_ders
     use voiga_nurbs_rational, only: rationalize
-    use voiga_nurbs_refine, only: insert_knots, elevate_degree
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_elevate, patch_insert
     implicit none
     private
 
-    public :: nurbs_curve_t, curve_eval, curve_basis, curve_elevate, curve_insert, curve_from_homogeneous
+    public :: nurbs_curve_t, curve_eval, curve_basis, curve_elevate, curve_insert
+    public :: curve_patch, curve_from_patch
 
     !> A planar NURBS curve.
     type :: nurbs_curve_t
@@ -57,53 +59,43 @@ contains
         if (present(d2x)) d2x = matmul(curve%cp(:, span - p:span), d2r)
     end subroutine curve_eval
 
-    !> Homogeneous control points [w x, w y, w], shape [3, n].
-    pure function to_homogeneous(curve) result(pw)
+    !> The curve as a general patch (pdim 1): its refinement is the patch's.
+    pure function curve_patch(curve) result(patch)
         type(nurbs_curve_t), intent(in) :: curve
-        real(dp), allocatable :: pw(:, :)
-        allocate (pw(3, size(curve%w)))
-        pw(1, :) = curve%cp(1, :)*curve%w
-        pw(2, :) = curve%cp(2, :)*curve%w
-        pw(3, :) = curve%w
-    end function to_homogeneous
+        type(nurbs_patch_t) :: patch
+        patch = new_patch([curve%degree], [knots_t(curve%knots)], [size(curve%w)], curve%cp, curve%w)
+    end function curve_patch
 
-    !> Build a curve from degree, knots and homogeneous control points [3, n].
-    pure function curve_from_homogeneous(p, knots, pw) result(curve)
-        integer, intent(in) :: p
-        real(dp), intent(in) :: knots(:), pw(:, :)
+    !> The curve of a patch of parametric dimension 1 in the plane.
+    pure function curve_from_patch(patch) result(curve)
+        type(nurbs_patch_t), intent(in) :: patch
         type(nurbs_curve_t) :: curve
-        curve%degree = p
-        curve%knots = knots
-        curve%w = pw(3, :)
-        allocate (curve%cp(2, size(pw, 2)))
-        curve%cp(1, :) = pw(1, :)/pw(3, :)
-        curve%cp(2, :) = pw(2, :)/pw(3, :)
-    end function curve_from_homogeneous
+        curve%degree = patch%degree(1)
+        curve%knots = patch%knots(1)%u
+        curve%cp = patch%cp
+        curve%w = patch%w
+    end function curve_from_patch
 
     !> Raise the degree of `curve` by `t` (each distinct knot gains multiplicity t).
     pure subroutine curve_elevate(curve, t)
         type(nurbs_curve_t), intent(inout) :: curve
         integer, intent(in) :: t
-        real(dp), allocatable :: pw(:, :), knots(:)
-        integer :: p
+        type(nurbs_patch_t) :: patch
         if (t <= 0) return
-        pw = to_homogeneous(curve)
-        knots = curve%knots
-        p = curve%degree
-        call elevate_degree(p, knots, pw, t)
-        curve = curve_from_homogeneous(p, knots, pw)
+        patch = curve_patch(curve)
+        call patch_elevate(patch, 1, t)
+        curve = curve_from_patch(patch)
     end subroutine curve_elevate
 
     !> Insert each of `values` once into `curve`.
     pure subroutine curve_insert(curve, values)
         type(nurbs_curve_t), intent(inout) :: curve
         real(dp), intent(in) :: values(:)
-        real(dp), allocatable :: pw(:, :), knots(:)
+        type(nurbs_patch_t) :: patch
         if (size(values) == 0) return
-        pw = to_homogeneous(curve)
-        knots = curve%knots
-        call insert_knots(curve%degree, knots, pw, values)
-        curve = curve_from_homogeneous(curve%degree, knots, pw)
+        patch = curve_patch(curve)
+        call patch_insert(patch, 1, values)
+        curve = curve_from_patch(patch)
     end subroutine curve_insert
 
 end module voiga_nurbs_curve

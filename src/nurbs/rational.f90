@@ -15,9 +15,10 @@ contains
 
     !> NURBS values and parametric derivatives (first and second) from B-spline ones.
     !>
-    !> `npar` parametric directions (1 for curves, 2 for surfaces); second
-    !> derivatives are stored as the `npar*(npar+1)/2` entries of the symmetric
-    !> Hessian: [uu] for curves, [xixi, etaeta, xieta] for surfaces.
+    !> `npar` parametric directions (1 for curves, 2 for surfaces, 3 for volumes);
+    !> second derivatives are stored as the `npar*(npar+1)/2` entries of the
+    !> symmetric Hessian, the diagonal first: [uu] for curves, [xixi, etaeta,
+    !> xieta] for surfaces, [11, 22, 33, 12, 13, 23] for volumes.
     pure subroutine rationalize(w, b, db, d2b, r, dr, d2r)
         !> Weights, shape [nfun].
         real(dp), intent(in) :: w(:)
@@ -33,8 +34,8 @@ contains
         real(dp), intent(out) :: dr(:, :)
         !> NURBS second derivatives, shape [npar*(npar+1)/2, nfun].
         real(dp), intent(out) :: d2r(:, :)
-        ! fixed sizes (npar <= 2): no heap allocation per call
-        real(dp) :: ww, dw(2), d2w(3)
+        ! fixed sizes (npar <= 3): no heap allocation per call
+        real(dp) :: ww, dw(3), d2w(6)
         integer :: a, npar, i, j, k
 
         npar = size(db, 1)
@@ -61,18 +62,14 @@ contains
     pure subroutine hessian_pair(npar, k, i, j)
         integer, intent(in) :: npar, k
         integer, intent(out) :: i, j
-        if (npar == 1) then
-            i = 1
-            j = 1
+        ! the pairs after the diagonal: (1, 2) in 2D; (1, 2), (1, 3), (2, 3) in 3D
+        integer, parameter :: first(3) = [1, 1, 2], second(3) = [2, 3, 3]
+        if (k <= npar) then
+            i = k
+            j = k
         else
-            select case (k)
-            case (1)
-                i = 1; j = 1
-            case (2)
-                i = 2; j = 2
-            case default
-                i = 1; j = 2
-            end select
+            i = first(k - npar)
+            j = second(k - npar)
         end if
     end subroutine hessian_pair
 

@@ -1,16 +1,17 @@
-!> Tensor-product NURBS surfaces (one patch of a 2D body): evaluation,
-!> refinement along one direction, edge curves and re-orientation.
+!> Tensor-product NURBS surfaces (one patch of a 2D body): its named edges, edge
+!> curves and re-orientation. Evaluation and refinement are the general patch's
+!> (`voiga_nurbs_patch`, any dimension): `surface_patch` and `set_from_patch`
+!> convert, so there is one implementation of them.
 module voiga_nurbs_surface
     use voiga_kinds, only: dp
-    use voiga_nurbs_basis, only: find_span, basis_ders
-    use voiga_nurbs_rational, only: rationalize
-    use voiga_nurbs_refine, only: insert_knots, elevate_degree
-    use voiga_nurbs_curve, only: nurbs_curve_t
+    use voiga_nurbs_curve, only: nurbs_curve_t, curve_from_patch
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, &
+                                 patch_boundary
     implicit none
     private
 
     public :: nurbs_surface_t, surface_eval, surface_elevate, surface_insert, surface_edge_curve
-    public :: surface_reorient, edge_index, edge_labels
+    public :: surface_reorient, edge_index, edge_labels, surface_patch
 
     !> Labels of the four parametric edges, in the order of `edge_names`.
     character(len=4), parameter :: edge_labels(4) = ['xi0 ', 'xi1 ', 'eta0', 'eta1']
@@ -42,106 +43,47 @@ contains
         end do
     end function edge_index
 
+    !> The surface as a general patch (pdim 2, nsd 2), for evaluation (`patch_eval`)
+    !> in loops: convert once, evaluate many times.
+    pure function surface_patch(surf) result(patch)
+        type(nurbs_surface_t), intent(in) :: surf
+        type(nurbs_patch_t) :: patch
+        integer :: n(2)
+        n = shape(surf%w)
+        patch = new_patch(surf%degree, [knots_t(surf%knots_xi), knots_t(surf%knots_eta)], n, &
+                          reshape(surf%cp, [2, product(n)]), reshape(surf%w, [product(n)]))
+    end function surface_patch
+
+    !> The surface's knots, points and weights from the general patch `patch`.
+    pure subroutine set_from_patch(surf, patch)
+        type(nurbs_surface_t), intent(inout) :: surf
+        type(nurbs_patch_t), intent(in) :: patch
+        surf%degree = patch%degree
+        surf%knots_xi = patch%knots(1)%u
+        surf%knots_eta = patch%knots(2)%u
+        surf%cp = reshape(patch%cp, [2, patch%n(1), patch%n(2)])
+        surf%w = reshape(patch%w, [patch%n(1), patch%n(2)])
+    end subroutine set_from_patch
+
     !> Point `x` and Jacobian `dx` (shape [2, 2]: dx(:, 1) = dx/dxi, dx(:, 2) = dx/deta).
+    !> (Each call converts the surface: in a loop, evaluate `surface_patch` instead.)
     pure subroutine surface_eval(surf, xi, eta, x, dx)
         type(nurbs_surface_t), intent(in) :: surf
         real(dp), intent(in) :: xi, eta
         real(dp), intent(out) :: x(2)
         real(dp), intent(out), optional :: dx(2, 2)
-        integer :: p, q, sx, se, nf, i, j, a
-        real(dp), allocatable :: bx(:, :), be(:, :), w(:), b(:), db(:, :), d2b(:, :), &
-                                 r(:), dr(:, :), d2r(:, :), pts(:, :)
-
-        p = surf%degree(1)
-        q = surf%degree(2)
-        sx = find_span(surf%knots_xi, p, xi)
-        se = find_span(surf%knots_eta, q, eta)
-        bx = basis_ders(surf%knots_xi, p, sx, xi, 1)
-        be = basis_ders(surf%knots_eta, q, se, eta, 1)
-        nf = (p + 1)*(q + 1)
-        allocate (w(nf), b(nf), db(2, nf), d2b(3, nf), r(nf), dr(2, nf), d2r(3, nf), pts(2, nf))
-        d2b = 0.0_dp
-        a = 0
-        do j = 1, q + 1
-            do i = 1, p + 1
-                a = a + 1
-                w(a) = surf%w(sx - p + i - 1, se - q + j - 1)
-                pts(:, a) = surf%cp(:, sx - p + i - 1, se - q + j - 1)
-                b(a) = bx(1, i)*be(1, j)
-                db(1, a) = bx(2, i)*be(1, j)
-                db(2, a) = bx(1, i)*be(2, j)
-            end do
-        end do
-        call rationalize(w, b, db, d2b, r, dr, d2r)
-        x = matmul(pts, r)
-        if (present(dx)) dx = matmul(pts, transpose(dr))
+        call patch_eval(surface_patch(surf), [xi, eta], x, dx)
     end subroutine surface_eval
-
-    !> Homogeneous control points of the patch, shape [3, n_xi, n_eta].
-    pure function homogeneous(surf) result(pw)
-        type(nurbs_surface_t), intent(in) :: surf
-        real(dp), allocatable :: pw(:, :, :)
-        allocate (pw(3, size(surf%w, 1), size(surf%w, 2)))
-        pw(1, :, :) = surf%cp(1, :, :)*surf%w
-        pw(2, :, :) = surf%cp(2, :, :)*surf%w
-        pw(3, :, :) = surf%w
-    end function homogeneous
-
-    pure subroutine set_homogeneous(surf, pw)
-        type(nurbs_surface_t), intent(inout) :: surf
-        real(dp), intent(in) :: pw(:, :, :)
-        surf%w = pw(3, :, :)
-        if (allocated(surf%cp)) deallocate (surf%cp)
-        allocate (surf%cp(2, size(pw, 2), size(pw, 3)))
-        surf%cp(1, :, :) = pw(1, :, :)/pw(3, :, :)
-        surf%cp(2, :, :) = pw(2, :, :)/pw(3, :, :)
-    end subroutine set_homogeneous
-
-    !> Apply a curve refinement to every row (dir = 1) or column (dir = 2):
-    !> the other direction's control points are carried as extra coordinates.
-    pure subroutine refine_direction(surf, dir, t, values)
-        type(nurbs_surface_t), intent(inout) :: surf
-        integer, intent(in) :: dir
-        !> Degree elevation steps (0: none).
-        integer, intent(in) :: t
-        !> Knots to insert (after elevation).
-        real(dp), intent(in) :: values(:)
-        real(dp), allocatable :: pw3(:, :, :), flat(:, :), knots(:), out(:, :, :)
-        integer :: nx, ny, p
-
-        pw3 = homogeneous(surf)
-        nx = size(pw3, 2)
-        ny = size(pw3, 3)
-        if (dir == 1) then
-            ! rows: curve index is xi; carry [3*ny] coordinates per xi control point
-            flat = reshape(reshape(pw3, [3, ny, nx], order=[1, 3, 2]), [3*ny, nx])
-            knots = surf%knots_xi
-            p = surf%degree(1)
-        else
-            flat = reshape(pw3, [3*nx, ny])
-            knots = surf%knots_eta
-            p = surf%degree(2)
-        end if
-        if (t > 0) call elevate_degree(p, knots, flat, t)
-        if (size(values) > 0) call insert_knots(p, knots, flat, values)
-        if (dir == 1) then
-            out = reshape(reshape(flat, [3, ny, size(flat, 2)]), [3, size(flat, 2), ny], order=[1, 3, 2])
-            surf%knots_xi = knots
-            surf%degree(1) = p
-        else
-            out = reshape(flat, [3, nx, size(flat, 2)])
-            surf%knots_eta = knots
-            surf%degree(2) = p
-        end if
-        call set_homogeneous(surf, out)
-    end subroutine refine_direction
 
     !> Raise the degree along direction `dir` (1 = xi, 2 = eta) by `t`.
     pure subroutine surface_elevate(surf, dir, t)
         type(nurbs_surface_t), intent(inout) :: surf
         integer, intent(in) :: dir, t
-        real(dp) :: none(0)
-        if (t > 0) call refine_direction(surf, dir, t, none)
+        type(nurbs_patch_t) :: patch
+        if (t <= 0) return
+        patch = surface_patch(surf)
+        call patch_elevate(patch, dir, t)
+        call set_from_patch(surf, patch)
     end subroutine surface_elevate
 
     !> Insert each of `values` once along direction `dir`.
@@ -149,31 +91,21 @@ contains
         type(nurbs_surface_t), intent(inout) :: surf
         integer, intent(in) :: dir
         real(dp), intent(in) :: values(:)
-        if (size(values) > 0) call refine_direction(surf, dir, 0, values)
+        type(nurbs_patch_t) :: patch
+        if (size(values) == 0) return
+        patch = surface_patch(surf)
+        call patch_insert(patch, dir, values)
+        call set_from_patch(surf, patch)
     end subroutine surface_insert
 
     !> The boundary curve on edge `edge` (1..4 = xi0, xi1, eta0, eta1), running in
-    !> the direction of the parameter along that edge.
+    !> the direction of the parameter along that edge (`patch_boundary`).
     pure function surface_edge_curve(surf, edge) result(curve)
         type(nurbs_surface_t), intent(in) :: surf
         integer, intent(in) :: edge
         type(nurbs_curve_t) :: curve
-        integer :: nx, ny
-
-        nx = size(surf%w, 1)
-        ny = size(surf%w, 2)
-        select case (edge)
-        case (1, 2)
-            curve%degree = surf%degree(2)
-            curve%knots = surf%knots_eta
-            curve%cp = surf%cp(:, merge(1, nx, edge == 1), :)
-            curve%w = surf%w(merge(1, nx, edge == 1), :)
-        case default
-            curve%degree = surf%degree(1)
-            curve%knots = surf%knots_xi
-            curve%cp = surf%cp(:, :, merge(1, ny, edge == 3))
-            curve%w = surf%w(:, merge(1, ny, edge == 3))
-        end select
+        ! edges 1, 2 are the ends of direction 1 (xi), edges 3, 4 those of eta
+        curve = curve_from_patch(patch_boundary(surface_patch(surf), (edge + 1)/2, 1 - mod(edge, 2)))
     end function surface_edge_curve
 
     !> Re-parametrize the patch so that edge `edge` (1..4) becomes eta = 1, by a

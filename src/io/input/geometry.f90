@@ -9,7 +9,8 @@ module voiga_io_input_geometry
     use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
     use voiga_nurbs_basis, only: distinct_knots
-    use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels, surface_eval
+    use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels, surface_patch
+    use voiga_nurbs_patch, only: nurbs_patch_t, patch_eval
     use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
@@ -261,6 +262,8 @@ contains
         real(dp) :: x(2), dx(2, 2), xi, eta, scale, sgn
         integer :: i, j, a, b, n, k
         character(len=160) :: buf
+        type(nurbs_patch_t) :: patch
+        patch = surface_patch(surf)
         bx = distinct_knots(surf%knots_xi)
         be = distinct_knots(surf%knots_eta)
         n = (size(bx) - 1)*(size(be) - 1)*samples**2
@@ -272,7 +275,7 @@ contains
                     eta = be(j) + (be(j + 1) - be(j))*(real(b, dp) - 0.5_dp)/samples
                     do a = 1, samples
                         xi = bx(i) + (bx(i + 1) - bx(i))*(real(a, dp) - 0.5_dp)/samples
-                        call surface_eval(surf, xi, eta, x, dx)
+                        call patch_eval(patch, [xi, eta], x, dx)
                         k = k + 1
                         det(k) = dx(1, 1)*dx(2, 2) - dx(1, 2)*dx(2, 1)
                         at(:, k) = [xi, eta, x]

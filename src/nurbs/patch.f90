@@ -1,0 +1,234 @@
+!> Tensor-product NURBS patches of any parametric dimension (1 a curve, 2 a
+!> surface, 3 a volume) in any spatial dimension: evaluation, degree elevation and
+!> knot insertion along one direction, and the boundary patches (a face of a
+!> volume, an edge of a surface).
+!>
+!> This is the one implementation of the patch operations (docs/architecture.md,
+!> "Dimension as data"): the plane body's `nurbs_surface_t` refines and evaluates
+!> through it. Control points are stored flat, direction 1 fastest, so a patch has
+!> the same shape whatever its dimension: `cp(nsd, n(1) * ... * n(pdim))`.
+module voiga_nurbs_patch
+    use voiga_kinds, only: dp
+    use voiga_nurbs_basis, only: find_span, basis_ders
+    use voiga_nurbs_rational, only: rationalize
+    use voiga_nurbs_refine, only: insert_knots, elevate_degree
+    implicit none
+    private
+
+    public :: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, patch_boundary
+    public :: point_index
+
+    !> One knot vector (a patch has one per parametric direction).
+    type :: knots_t
+        real(dp), allocatable :: u(:)
+    end type knots_t
+
+    !> A NURBS patch.
+    type :: nurbs_patch_t
+        !> Parametric dimension (1, 2 or 3) and spatial dimension.
+        integer :: pdim = 0, nsd = 0
+        !> Degree and number of control points per direction [pdim].
+        integer, allocatable :: degree(:), n(:)
+        !> Knot vectors [pdim], each of length n(d) + degree(d) + 1.
+        type(knots_t), allocatable :: knots(:)
+        !> Cartesian control points [nsd, product(n)] and weights [product(n)],
+        !> direction 1 fastest (`point_index`).
+        real(dp), allocatable :: cp(:, :), w(:)
+    end type nurbs_patch_t
+
+contains
+
+    !> A patch from its degrees, knot vectors, control-point counts, control points
+    !> [nsd, product(n)] and weights.
+    pure function new_patch(degree, knots, n, cp, w) result(patch)
+        integer, intent(in) :: degree(:), n(:)
+        type(knots_t), intent(in) :: knots(:)
+        real(dp), intent(in) :: cp(:, :), w(:)
+        type(nurbs_patch_t) :: patch
+        patch%pdim = size(degree)
+        patch%nsd = size(cp, 1)
+        patch%degree = degree
+        patch%n = n
+        patch%knots = knots
+        patch%cp = cp
+        patch%w = w
+    end function new_patch
+
+    !> Flat index of the control point with indices `idx` [pdim] (1-based).
+    pure integer function point_index(patch, idx)
+        type(nurbs_patch_t), intent(in) :: patch
+        integer, intent(in) :: idx(:)
+        integer :: d, stride
+        point_index = 1
+        stride = 1
+        do d = 1, patch%pdim
+            point_index = point_index + (idx(d) - 1)*stride
+            stride = stride*patch%n(d)
+        end do
+    end function point_index
+
+    !> Point `x` [nsd] and Jacobian `dx` [nsd, pdim] (dx(:, d) = dx/du_d) at the
+    !> parameters `u` [pdim].
+    pure subroutine patch_eval(patch, u, x, dx)
+        type(nurbs_patch_t), intent(in) :: patch
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(out) :: x(:)
+        real(dp), intent(out), optional :: dx(:, :)
+        integer :: span(patch%pdim), local(patch%pdim), nf, a, d, e
+        real(dp), allocatable :: w(:), b(:), db(:, :), d2b(:, :), r(:), dr(:, :), d2r(:, :), pts(:, :)
+        ! B-spline values and first derivatives per direction [2, p + 1, pdim]
+        real(dp) :: values(2, maxval(patch%degree) + 1, patch%pdim)
+
+        do d = 1, patch%pdim
+            span(d) = find_span(patch%knots(d)%u, patch%degree(d), u(d))
+            values(:, 1:patch%degree(d) + 1, d) = basis_ders(patch%knots(d)%u, patch%degree(d), span(d), u(d), 1)
+        end do
+        nf = product(patch%degree + 1)
+        allocate (w(nf), b(nf), db(patch%pdim, nf), d2b(patch%pdim*(patch%pdim + 1)/2, nf), r(nf), &
+                  dr(patch%pdim, nf), d2r(patch%pdim*(patch%pdim + 1)/2, nf), pts(patch%nsd, nf))
+        d2b = 0.0_dp
+        local = 1
+        do a = 1, nf
+            w(a) = patch%w(point_index(patch, span - patch%degree + local - 1))
+            pts(:, a) = patch%cp(:, point_index(patch, span - patch%degree + local - 1))
+            b(a) = 1.0_dp
+            db(:, a) = 1.0_dp
+            do e = 1, patch%pdim
+                b(a) = b(a)*values(1, local(e), e)
+                do d = 1, patch%pdim
+                    db(d, a) = db(d, a)*values(merge(2, 1, d == e), local(e), e)
+                end do
+            end do
+            call next_local(local, patch%degree + 1)
+        end do
+        call rationalize(w, b, db, d2b, r, dr, d2r)
+        x = matmul(pts, r)
+        if (present(dx)) dx = matmul(pts, transpose(dr))
+    end subroutine patch_eval
+
+    !> The next multi-index after `local` in [1, counts], the first fastest.
+    pure subroutine next_local(local, counts)
+        integer, intent(inout) :: local(:)
+        integer, intent(in) :: counts(:)
+        integer :: d
+        do d = 1, size(local)
+            local(d) = local(d) + 1
+            if (local(d) <= counts(d)) return
+            local(d) = 1
+        end do
+    end subroutine next_local
+
+    !> Raise the degree along direction `dir` by `t` (each distinct knot gains
+    !> multiplicity `t`: the continuity is kept; the geometry is unchanged).
+    pure subroutine patch_elevate(patch, dir, t)
+        type(nurbs_patch_t), intent(inout) :: patch
+        integer, intent(in) :: dir, t
+        real(dp) :: none(0)
+        if (t > 0) call refine_direction(patch, dir, t, none)
+    end subroutine patch_elevate
+
+    !> Insert each of `values` once along direction `dir` (the geometry is unchanged).
+    pure subroutine patch_insert(patch, dir, values)
+        type(nurbs_patch_t), intent(inout) :: patch
+        integer, intent(in) :: dir
+        real(dp), intent(in) :: values(:)
+        if (size(values) > 0) call refine_direction(patch, dir, 0, values)
+    end subroutine patch_insert
+
+    !> Elevate by `t`, then insert `values`, along direction `dir`: every line of
+    !> control points along `dir` is one curve of the homogeneous points; the
+    !> other directions' points are carried as its extra coordinates.
+    pure subroutine refine_direction(patch, dir, t, values)
+        type(nurbs_patch_t), intent(inout) :: patch
+        integer, intent(in) :: dir, t
+        real(dp), intent(in) :: values(:)
+        real(dp), allocatable :: lines(:, :), knots(:)
+        integer :: p, before, after, nh
+
+        nh = patch%nsd + 1
+        before = product(patch%n(1:dir - 1))
+        after = product(patch%n(dir + 1:patch%pdim))
+        lines = gather_lines(patch, dir, before, after)
+        knots = patch%knots(dir)%u
+        p = patch%degree(dir)
+        if (t > 0) call elevate_degree(p, knots, lines, t)
+        if (size(values) > 0) call insert_knots(p, knots, lines, values)
+        patch%degree(dir) = p
+        patch%knots(dir)%u = knots
+        patch%n(dir) = size(lines, 2)
+        call scatter_lines(patch, lines, before, after)
+    end subroutine refine_direction
+
+    !> The homogeneous control points [w x, w] as lines along `dir`: shape
+    !> [(nsd + 1) before after, n(dir)], row (coordinate, point before, point after).
+    pure function gather_lines(patch, dir, before, after) result(lines)
+        type(nurbs_patch_t), intent(in) :: patch
+        integer, intent(in) :: dir, before, after
+        real(dp), allocatable :: lines(:, :)
+        integer :: nh, ib, ia, k, row, flat
+        nh = patch%nsd + 1
+        allocate (lines(nh*before*after, patch%n(dir)))
+        do ia = 1, after
+            do k = 1, patch%n(dir)
+                do ib = 1, before
+                    flat = ib + (k - 1)*before + (ia - 1)*before*patch%n(dir)
+                    row = nh*((ib - 1) + before*(ia - 1))
+                    lines(row + 1:row + patch%nsd, k) = patch%cp(:, flat)*patch%w(flat)
+                    lines(row + nh, k) = patch%w(flat)
+                end do
+            end do
+        end do
+    end function gather_lines
+
+    !> Cartesian points and weights back from `gather_lines`' layout (n(dir) is
+    !> the new count).
+    pure subroutine scatter_lines(patch, lines, before, after)
+        type(nurbs_patch_t), intent(inout) :: patch
+        real(dp), intent(in) :: lines(:, :)
+        integer, intent(in) :: before, after
+        integer :: nh, ib, ia, k, row, flat, nk
+        nh = patch%nsd + 1
+        nk = size(lines, 2)
+        deallocate (patch%cp, patch%w)
+        allocate (patch%cp(patch%nsd, before*nk*after), patch%w(before*nk*after))
+        do ia = 1, after
+            do k = 1, nk
+                do ib = 1, before
+                    flat = ib + (k - 1)*before + (ia - 1)*before*nk
+                    row = nh*((ib - 1) + before*(ia - 1))
+                    patch%w(flat) = lines(row + nh, k)
+                    patch%cp(:, flat) = lines(row + 1:row + patch%nsd, k)/lines(row + nh, k)
+                end do
+            end do
+        end do
+    end subroutine scatter_lines
+
+    !> The boundary patch (parametric dimension pdim - 1) where the parameter of
+    !> direction `dir` is at its start (`side` 0) or end (`side` 1); its directions
+    !> are the others, in order. A curve (pdim 1) has no boundary patch: `pdim` 0.
+    pure function patch_boundary(patch, dir, side) result(face)
+        type(nurbs_patch_t), intent(in) :: patch
+        integer, intent(in) :: dir, side
+        type(nurbs_patch_t) :: face
+        integer :: keep(patch%pdim - 1), before, after, ib, ia, k, i
+        if (patch%pdim < 2) return
+        keep = pack([(i, i=1, patch%pdim)], [(i /= dir, i=1, patch%pdim)])
+        face%pdim = patch%pdim - 1
+        face%nsd = patch%nsd
+        face%degree = patch%degree(keep)
+        face%n = patch%n(keep)
+        face%knots = patch%knots(keep)
+        before = product(patch%n(1:dir - 1))
+        after = product(patch%n(dir + 1:patch%pdim))
+        k = merge(1, patch%n(dir), side == 0)
+        allocate (face%cp(patch%nsd, before*after), face%w(before*after))
+        do ia = 1, after
+            do ib = 1, before
+                i = ib + (k - 1)*before + (ia - 1)*before*patch%n(dir)
+                face%cp(:, ib + (ia - 1)*before) = patch%cp(:, i)
+                face%w(ib + (ia - 1)*before) = patch%w(i)
+            end do
+        end do
+    end function patch_boundary
+
+end module voiga_nurbs_patch

@@ -1,0 +1,172 @@
+!> The general NURBS patch in three parametric directions: a quarter of a thick
+!> ring extruded along z (exact: radius 1 + u1, angle pi/2 u2, height u3) keeps its
+!> map exactly under degree elevation and knot insertion in each direction, its
+!> Jacobian matches finite differences, and its faces are the volume at the face.
+module test_patch
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t
+    use voiga_testdrive, only: unittest_t, new_unittest, check
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, &
+                                 patch_insert, patch_boundary, point_index
+    use voiga_test_fixtures, only: lcg_t
+    implicit none
+    private
+
+    public :: collect_patch
+
+    real(dp), parameter :: pi = acos(-1.0_dp)
+    !> The refinements are exact: round-off of a few steps on O(1) coordinates.
+    real(dp), parameter :: tol = 1.0e-12_dp
+
+contains
+
+    subroutine collect_patch(testsuite)
+        type(unittest_t), allocatable, intent(out) :: testsuite(:)
+        testsuite = [ &
+                    new_unittest('volume_is_exact', test_exact), &
+                    new_unittest('volume_refined_keeps_the_map', test_refined), &
+                    new_unittest('volume_jacobian_against_differences', test_jacobian), &
+                    new_unittest('face_is_the_volume_there', test_faces) &
+                    ]
+    end subroutine collect_patch
+
+    !> Quarter ring r in [1, 2], theta in [0, pi/2] (degree 1 x 2), extruded to
+    !> z in [0, 1] (degree 1): 2 x 3 x 2 control points.
+    function ring_block() result(patch)
+        type(nurbs_patch_t) :: patch
+        real(dp) :: cp(3, 12), w(12), arc(2, 3), warc(3)
+        integer :: i, j, k, a
+        arc = reshape([1.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 0.0_dp, 1.0_dp], [2, 3])
+        warc = [1.0_dp, 1.0_dp/sqrt(2.0_dp), 1.0_dp]
+        a = 0
+        do k = 1, 2
+            do j = 1, 3
+                do i = 1, 2
+                    a = a + 1
+                    cp(:, a) = [real(i, dp)*arc(:, j), real(k - 1, dp)]
+                    w(a) = warc(j)
+                end do
+            end do
+        end do
+        patch = new_patch([1, 2, 1], [knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]), &
+                                      knots_t([0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 1.0_dp]), &
+                                      knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp])], [2, 3, 2], cp, w)
+    end function ring_block
+
+    !> Largest distance of the patch's map from the exact ring block at 200 random
+    !> parameter points.
+    real(dp) function distance_from_exact(patch) result(dist)
+        type(nurbs_patch_t), intent(in) :: patch
+        type(lcg_t) :: rng
+        real(dp) :: u(3), x(3), r
+        integer :: k
+        dist = 0.0_dp
+        do k = 1, 200
+            u = [rng%uniform(), rng%uniform(), rng%uniform()]
+            call patch_eval(patch, u, x)
+            r = norm2(x(1:2))
+            ! the angle is not linear in u2 (rational arc): check radius and height,
+            ! and that the point lies in the quarter
+            dist = max(dist, abs(r - (1.0_dp + u(1))), abs(x(3) - u(3)), max(-x(1), -x(2), 0.0_dp))
+        end do
+    end function distance_from_exact
+
+    subroutine test_exact(error)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp) :: x(3)
+        call check(error, distance_from_exact(ring_block()) < tol, 'the ring block is not exact')
+        if (allocated(error)) return
+        call patch_eval(ring_block(), [0.5_dp, 0.5_dp, 0.25_dp], x)
+        call check(error, norm2(x - [1.5_dp/sqrt(2.0_dp), 1.5_dp/sqrt(2.0_dp), 0.25_dp]) < tol, &
+                   'the middle of the arc is not at 45 degrees')
+    end subroutine test_exact
+
+    !> Elevate and insert in every direction: the map is unchanged, the counts follow.
+    subroutine test_refined(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_patch_t) :: patch
+        patch = ring_block()
+        call patch_elevate(patch, 1, 2)
+        call patch_elevate(patch, 2, 1)
+        call patch_elevate(patch, 3, 1)
+        call patch_insert(patch, 1, [0.25_dp, 0.5_dp, 0.5_dp])
+        call patch_insert(patch, 2, [0.3_dp, 0.7_dp])
+        call patch_insert(patch, 3, [0.5_dp])
+        call check(error, all(patch%degree == [3, 3, 2]), 'degrees after elevation')
+        if (allocated(error)) return
+        ! elevation adds t per distinct knot span end; insertion one point per knot
+        call check(error, all(patch%n == [4 + 3, 4 + 2, 3 + 1]), 'control points per direction')
+        if (allocated(error)) return
+        call check(error, size(patch%w) == product(patch%n) .and. size(patch%cp, 2) == product(patch%n), &
+                   'flat storage')
+        if (allocated(error)) return
+        call check(error, distance_from_exact(patch) < tol, 'refinement changed the map')
+    end subroutine test_refined
+
+    !> dx(:, d) against central differences along each direction, on a refined patch.
+    subroutine test_jacobian(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_patch_t) :: patch
+        real(dp), parameter :: h = 1.0e-6_dp
+        real(dp) :: u(3), x(3), dx(3, 3), xp(3), xm(3), worst
+        integer :: d
+        patch = ring_block()
+        call patch_elevate(patch, 3, 2)
+        call patch_insert(patch, 2, [0.4_dp])
+        u = [0.3_dp, 0.55_dp, 0.7_dp]
+        call patch_eval(patch, u, x, dx)
+        worst = 0.0_dp
+        do d = 1, 3
+            call patch_eval(patch, u + h*unit(d), xp)
+            call patch_eval(patch, u - h*unit(d), xm)
+            worst = max(worst, norm2((xp - xm)/(2*h) - dx(:, d)))
+        end do
+        call check(error, worst < 1.0e-8_dp, 'the Jacobian differs from finite differences')
+    end subroutine test_jacobian
+
+    pure function unit(d) result(e)
+        integer, intent(in) :: d
+        real(dp) :: e(3)
+        e = 0.0_dp
+        e(d) = 1.0_dp
+    end function unit
+
+    !> Each of the six faces of a refined block is the volume there; the outer face
+    !> (u1 = 1) is the cylinder r = 2; a curve has no boundary patch.
+    subroutine test_faces(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_patch_t) :: patch, face, edge
+        real(dp) :: v(2), u(3), xf(3), xv(3), worst
+        integer :: dir, side, k, keep(2)
+        patch = ring_block()
+        call patch_elevate(patch, 1, 1)
+        call patch_insert(patch, 3, [0.6_dp])
+        worst = 0.0_dp
+        do dir = 1, 3
+            keep = pack([1, 2, 3], [1, 2, 3] /= dir)
+            do side = 0, 1
+                face = patch_boundary(patch, dir, side)
+                call check(error, face%pdim == 2 .and. face%nsd == 3 .and. all(face%n == patch%n(keep)), &
+                           'face shape')
+                if (allocated(error)) return
+                do k = 1, 5
+                    v = [0.1_dp*k, 1.0_dp - 0.13_dp*k]
+                    u(keep) = v
+                    u(dir) = real(side, dp)
+                    call patch_eval(face, v, xf)
+                    call patch_eval(patch, u, xv)
+                    worst = max(worst, norm2(xf - xv))
+                end do
+            end do
+        end do
+        call check(error, worst < tol, 'a face is not the volume at the face')
+        if (allocated(error)) return
+        face = patch_boundary(patch, 1, 1)
+        call patch_eval(face, [0.37_dp, 0.81_dp], xf)
+        call check(error, abs(norm2(xf(1:2)) - 2.0_dp) < tol, 'the outer face is not the cylinder r = 2')
+        if (allocated(error)) return
+        edge = patch_boundary(patch_boundary(face, 2, 0), 1, 0)
+        call check(error, edge%pdim == 0 .and. point_index(face, [1, 1]) == 1, 'a curve has no boundary patch')
+    end subroutine test_faces
+
+end module test_patch
