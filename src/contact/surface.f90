@@ -56,10 +56,11 @@ contains
             self%w = disc%layer%w
             self%cps = disc%layer_id
         else
-            ny = size(disc%bulk%w, 2)
+            ny = disc%bulk%n(2)
             self%degree = disc%bulk%degree(1)
-            self%knots = disc%bulk%knots_xi
-            self%w = disc%bulk%w(:, ny)
+            self%knots = disc%bulk%knots(1)%u
+            ! the last eta row of the flat weights (xi fastest)
+            self%w = disc%bulk%w((ny - 1)*disc%bulk%n(1) + 1:ny*disc%bulk%n(1))
             self%cps = disc%bulk_id(:, ny)
         end if
         allocate (self%dofs(disc%nsd, size(self%cps)))

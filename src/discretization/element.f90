@@ -88,7 +88,7 @@ contains
         associate (el => disc%elements(e))
             p = disc%bulk%degree(1)
             fx = 0.0_dp
-            fx(1:nd + 1, :p + 1) = basis_ders(disc%bulk%knots_xi, p, el%span_xi, xi, nd)
+            fx(1:nd + 1, :p + 1) = basis_ders(disc%bulk%knots(1)%u, p, el%span_xi, xi, nd)
             if (el%span_layer > 0) fx(1:nd + 1, p + 2:) = &
                 basis_ders(disc%layer%knots, disc%layer%degree, el%span_layer, xi, nd)
         end associate
@@ -101,7 +101,7 @@ contains
         real(dp), intent(in) :: eta
         real(dp), intent(out) :: fe(:, :)
         fe = 0.0_dp
-        fe(1:nd + 1, :) = basis_ders(disc%bulk%knots_eta, disc%bulk%degree(2), disc%elements(e)%span_eta, eta, nd)
+        fe(1:nd + 1, :) = basis_ders(disc%bulk%knots(2)%u, disc%bulk%degree(2), disc%elements(e)%span_eta, eta, nd)
     end subroutine eta_functions
 
     !> The NURBS functions of element `e` from its univariate ones: bulk tensor

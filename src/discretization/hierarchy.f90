@@ -66,9 +66,9 @@ contains
         real(dp), allocatable :: proj(:, :)
 
         fine%degree = disc%bulk%degree
-        fine%knots_xi = disc%bulk%knots_xi
-        fine%knots_eta = disc%bulk%knots_eta
-        fine%w = disc%bulk%w
+        fine%knots_xi = disc%bulk%knots(1)%u
+        fine%knots_eta = disc%bulk%knots(2)%u
+        fine%w = reshape(disc%bulk%w, [disc%bulk%n(1), disc%bulk%n(2)])
         if (disc%has_layer) then
             call layer_projection(disc, proj, error)
             if (allocated(error)) return
@@ -291,7 +291,7 @@ contains
         p = disc%bulk%degree(1)
         q = disc%layer%degree
         nl = n_basis(disc%layer%knots, q)
-        nb = n_basis(disc%bulk%knots_xi, p)
+        nb = n_basis(disc%bulk%knots(1)%u, p)
         allocate (m(nl, nl), proj(nl, nb), gp(q + 1), gw(q + 1))
         m = 0.0_dp
         proj = 0.0_dp
@@ -303,9 +303,9 @@ contains
                 u = 0.5_dp*(breaks(e) + breaks(e + 1)) + 0.5_dp*(breaks(e + 1) - breaks(e))*gp(g)
                 wt = 0.5_dp*(breaks(e + 1) - breaks(e))*gw(g)
                 sl = find_span(disc%layer%knots, q, u)
-                sb = find_span(disc%bulk%knots_xi, p, u)
+                sb = find_span(disc%bulk%knots(1)%u, p, u)
                 bl = basis_funs(disc%layer%knots, q, sl, u)
-                bb = basis_funs(disc%bulk%knots_xi, p, sb, u)
+                bb = basis_funs(disc%bulk%knots(1)%u, p, sb, u)
                 do k = 1, q + 1
                     do i = 1, q + 1
                         m(sl - q + i - 1, sl - q + k - 1) = m(sl - q + i - 1, sl - q + k - 1) + wt*bl(i)*bl(k)

@@ -11,9 +11,9 @@ module voiga_discretization_patch
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_nurbs_basis, only: find_span, distinct_knots
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_elevate, curve_insert
-    use voiga_nurbs_surface, only: nurbs_surface_t, surface_patch, surface_elevate, surface_insert, &
-                                   surface_edge_curve, surface_reorient, edge_index
-    use voiga_nurbs_patch, only: nurbs_patch_t, patch_eval
+    use voiga_nurbs_surface, only: nurbs_surface_t, surface_patch, surface_edge_curve, surface_reorient, &
+                                   edge_index
+    use voiga_nurbs_patch, only: nurbs_patch_t, patch_eval, patch_elevate, patch_insert, point_index
     use voiga_discretization_layout, only: layout_t, validate_layout, basis_linear
     implicit none
     private
@@ -52,8 +52,9 @@ module voiga_discretization_patch
         !> Spatial dimension (DOFs per control point) and parametric dimension of the
         !> patch (2 and 2: a plane body).
         integer :: nsd = 2, pdim = 2
-        !> Refined bulk patch (for L1: the degree-1 patch).
-        type(nurbs_surface_t) :: bulk
+        !> Refined bulk patch (for L1: the degree-1 patch), of parametric dimension
+        !> `pdim`.
+        type(nurbs_patch_t) :: bulk
         !> Is there a VO layer on the contact edge?
         logical :: has_layer = .false.
         !> The layer curve (degree q), valid when `has_layer`.
@@ -93,7 +94,7 @@ contains
         type(layout_t), intent(in) :: layout
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
-        type(nurbs_surface_t) :: oriented
+        type(nurbs_surface_t) :: oriented, linear
         real(dp), allocatable :: new_xi(:), new_eta(:)
         integer :: edge
 
@@ -115,19 +116,20 @@ contains
         new_eta = new_knots(oriented%knots_eta, layout%nel(2), layout%knots_eta)
 
         if (trim(layout%basis) == basis_linear) then
-            call build_linear(self%bulk, oriented, new_xi, new_eta)
+            call build_linear(linear, oriented, new_xi, new_eta)
+            self%bulk = surface_patch(linear)
         else
             if (layout%degree(1) < oriented%degree(1) .or. layout%degree(2) < oriented%degree(2)) then
                 call fatal_error(error, where//'degree_xi/degree_eta must be >= the degree of the '// &
                                  'exact geometry (along the contact edge first)', error_code%input)
                 return
             end if
-            self%bulk = oriented
+            self%bulk = surface_patch(oriented)
             ! k-refinement: elevate first, then insert the new knots once
-            call surface_elevate(self%bulk, 1, layout%degree(1) - oriented%degree(1))
-            call surface_elevate(self%bulk, 2, layout%degree(2) - oriented%degree(2))
-            call surface_insert(self%bulk, 1, new_xi)
-            call surface_insert(self%bulk, 2, new_eta)
+            call patch_elevate(self%bulk, 1, layout%degree(1) - oriented%degree(1))
+            call patch_elevate(self%bulk, 2, layout%degree(2) - oriented%degree(2))
+            call patch_insert(self%bulk, 1, new_xi)
+            call patch_insert(self%bulk, 2, new_eta)
             if (layout%layer_degree > 0) then
                 self%has_layer = .true.
                 self%layer = surface_edge_curve(oriented, 4)
@@ -138,7 +140,7 @@ contains
         end if
         call number_control_points(self)
         call build_elements(self)
-        call build_boundaries(self)
+        call build_boundaries(self, oriented%edge_names)
         self%total_dofs = self%nsd*self%ncp
         if (self%has_contact) self%interface_dofs = self%nsd*size(self%boundaries(contact_boundary(self))%cps)
         self%bulk_dofs = self%total_dofs - self%interface_dofs
@@ -229,8 +231,8 @@ contains
         type(discretization_t), intent(inout) :: self
         integer :: nx, ny, nrow, i, j, id, k
 
-        nx = size(self%bulk%w, 1)
-        ny = size(self%bulk%w, 2)
+        nx = self%bulk%n(1)
+        ny = self%bulk%n(2)
         nrow = merge(ny - 1, ny, self%has_layer)
         allocate (self%bulk_id(nx, ny))
         self%bulk_id = 0
@@ -254,8 +256,8 @@ contains
         allocate (self%x(2, id), self%w(id))
         do j = 1, nrow
             do i = 1, nx
-                self%x(:, self%bulk_id(i, j)) = self%bulk%cp(:, i, j)
-                self%w(self%bulk_id(i, j)) = self%bulk%w(i, j)
+                self%x(:, self%bulk_id(i, j)) = self%bulk%cp(:, point_index(self%bulk, [i, j]))
+                self%w(self%bulk_id(i, j)) = self%bulk%w(point_index(self%bulk, [i, j]))
             end do
         end do
         do k = 1, size(self%layer_id)
@@ -272,8 +274,8 @@ contains
         integer :: ix, ie, e, p, q, ql, i, j, a, sx, se, sl
         real(dp) :: xm, em
 
-        bx = distinct_knots(self%bulk%knots_xi)
-        be = distinct_knots(self%bulk%knots_eta)
+        bx = distinct_knots(self%bulk%knots(1)%u)
+        be = distinct_knots(self%bulk%knots(2)%u)
         self%nel_xi = size(bx) - 1
         self%nel_eta = size(be) - 1
         self%nel = self%nel_xi*self%nel_eta
@@ -287,8 +289,8 @@ contains
                 e = e + 1
                 xm = 0.5_dp*(bx(ix) + bx(ix + 1))
                 em = 0.5_dp*(be(ie) + be(ie + 1))
-                sx = find_span(self%bulk%knots_xi, p, xm)
-                se = find_span(self%bulk%knots_eta, q, em)
+                sx = find_span(self%bulk%knots(1)%u, p, xm)
+                se = find_span(self%bulk%knots(2)%u, q, em)
                 associate (el => self%elements(e))
                     el%ix = ix
                     el%ie = ie
@@ -325,15 +327,17 @@ contains
 
     !> The boundary entities of the plane patch, its four edges (names from the
     !> oriented patch), and their control points.
-    pure subroutine build_boundaries(self)
+    pure subroutine build_boundaries(self, names)
         type(discretization_t), intent(inout) :: self
+        !> The names of the oriented patch's edges, xi0, xi1, eta0, eta1.
+        character(len=*), intent(in) :: names(:)
         integer :: nx, ny, nl, k
 
         nx = size(self%bulk_id, 1)
         ny = size(self%bulk_id, 2)
         allocate (self%boundaries(2*self%pdim))
         do k = 1, size(self%boundaries)
-            self%boundaries(k)%name = self%bulk%edge_names(k)
+            self%boundaries(k)%name = names(k)
             self%boundaries(k)%direction = (k + 1)/2
             self%boundaries(k)%side = 1 - mod(k, 2)
         end do

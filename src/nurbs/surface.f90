@@ -1,16 +1,15 @@
-!> Tensor-product NURBS surfaces (one patch of a 2D body): its named edges, edge
-!> curves and re-orientation. Evaluation and refinement are the general patch's
-!> (`voiga_nurbs_patch`, any dimension): `surface_patch` and `set_from_patch`
-!> convert, so there is one implementation of them.
+!> The plane body's patch as the geometry file gives it: a NURBS surface with named
+!> edges, its edge curves and its re-orientation (the contact edge made eta = 1).
+!> The discretization refines and evaluates it as a general patch
+!> (`surface_patch`, `voiga_nurbs_patch`): one implementation of those operations.
 module voiga_nurbs_surface
     use voiga_kinds, only: dp
     use voiga_nurbs_curve, only: nurbs_curve_t, curve_from_patch
-    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, &
-                                 patch_boundary
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_boundary
     implicit none
     private
 
-    public :: nurbs_surface_t, surface_eval, surface_elevate, surface_insert, surface_edge_curve
+    public :: nurbs_surface_t, surface_eval, surface_edge_curve
     public :: surface_reorient, edge_index, edge_labels, surface_patch
 
     !> Labels of the four parametric edges, in the order of `edge_names`.
@@ -54,17 +53,6 @@ contains
                           reshape(surf%cp, [2, product(n)]), reshape(surf%w, [product(n)]))
     end function surface_patch
 
-    !> The surface's knots, points and weights from the general patch `patch`.
-    pure subroutine set_from_patch(surf, patch)
-        type(nurbs_surface_t), intent(inout) :: surf
-        type(nurbs_patch_t), intent(in) :: patch
-        surf%degree = patch%degree
-        surf%knots_xi = patch%knots(1)%u
-        surf%knots_eta = patch%knots(2)%u
-        surf%cp = reshape(patch%cp, [2, patch%n(1), patch%n(2)])
-        surf%w = reshape(patch%w, [patch%n(1), patch%n(2)])
-    end subroutine set_from_patch
-
     !> Point `x` and Jacobian `dx` (shape [2, 2]: dx(:, 1) = dx/dxi, dx(:, 2) = dx/deta).
     !> (Each call converts the surface: in a loop, evaluate `surface_patch` instead.)
     pure subroutine surface_eval(surf, xi, eta, x, dx)
@@ -74,29 +62,6 @@ contains
         real(dp), intent(out), optional :: dx(2, 2)
         call patch_eval(surface_patch(surf), [xi, eta], x, dx)
     end subroutine surface_eval
-
-    !> Raise the degree along direction `dir` (1 = xi, 2 = eta) by `t`.
-    pure subroutine surface_elevate(surf, dir, t)
-        type(nurbs_surface_t), intent(inout) :: surf
-        integer, intent(in) :: dir, t
-        type(nurbs_patch_t) :: patch
-        if (t <= 0) return
-        patch = surface_patch(surf)
-        call patch_elevate(patch, dir, t)
-        call set_from_patch(surf, patch)
-    end subroutine surface_elevate
-
-    !> Insert each of `values` once along direction `dir`.
-    pure subroutine surface_insert(surf, dir, values)
-        type(nurbs_surface_t), intent(inout) :: surf
-        integer, intent(in) :: dir
-        real(dp), intent(in) :: values(:)
-        type(nurbs_patch_t) :: patch
-        if (size(values) == 0) return
-        patch = surface_patch(surf)
-        call patch_insert(patch, dir, values)
-        call set_from_patch(surf, patch)
-    end subroutine surface_insert
 
     !> The boundary curve on edge `edge` (1..4 = xi0, xi1, eta0, eta1), running in
     !> the direction of the parameter along that edge (`patch_boundary`).

@@ -65,10 +65,11 @@ contains
         call h5%write_attr(group, 'total_dofs', disc%total_dofs)
         call h5%write_attr(group, 'n_elements', disc%nel)
         call h5%write(group//'/bulk/degree', disc%bulk%degree)
-        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots_xi)
-        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots_eta)
-        call h5%write(group//'/bulk/control_points', disc%bulk%cp)
-        call h5%write(group//'/bulk/weights', disc%bulk%w)
+        call h5%write(group//'/bulk/knots_xi', disc%bulk%knots(1)%u)
+        call h5%write(group//'/bulk/knots_eta', disc%bulk%knots(2)%u)
+        ! (the plane patch's arrays shaped [2, n_xi, n_eta] and [n_xi, n_eta], as before)
+        call h5%write(group//'/bulk/control_points', reshape(disc%bulk%cp, [disc%nsd, disc%bulk%n(1), disc%bulk%n(2)]))
+        call h5%write(group//'/bulk/weights', reshape(disc%bulk%w, [disc%bulk%n(1), disc%bulk%n(2)]))
         if (disc%has_layer) call write_curve(h5, group//'/layer', disc%layer)
     end subroutine write_discretization
 
