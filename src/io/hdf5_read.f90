@@ -29,6 +29,9 @@ contains
             allocate (array(dims(1), dims(2)))
         rank (3)
             allocate (array(dims(1), dims(2), dims(3)))
+        rank (4)
+            ! (a volume's control points)
+            allocate (array(dims(1), dims(2), dims(3), dims(4)))
         rank default
             call unsupported_rank(self, path, rank(array), error)
             return

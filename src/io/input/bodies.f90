@@ -3,12 +3,13 @@
 !> size counted first, `voiga_io_input_resources`), then build each with the case's layout;
 !> and read the curves of the rigid obstacles the contact pairs name.
 module voiga_io_input_bodies
-    use voiga_error, only: error_t
+    use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_input_case, only: case_t
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_input_geometry, only: read_patch, read_curve
+    use voiga_io_input_geometry, only: read_patch, read_volume, read_curve
     use voiga_io_input_resources, only: check_size
     use voiga_nurbs_surface, only: nurbs_surface_t
+    use voiga_nurbs_patch, only: nurbs_patch_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_size, only: body_size_t, body_size
     use voiga_discretization_layout, only: validate_layout
@@ -61,6 +62,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: geo
         type(error_t), allocatable :: close_error
+        integer, allocatable :: dims(:)
         integer :: i
 
         call geo%open(case%geometry, 'r', error)
@@ -70,7 +72,13 @@ contains
         end if
         allocate (coarse(size(case%bodies)))
         do i = 1, size(case%bodies)
-            call read_patch(geo, case%bodies(i)%name, coarse(i), error)
+            ! (three degrees: a volume)
+            dims = geo%shape('/bodies/'//trim(case%bodies(i)%name)//'/degree')
+            if (size(dims) == 1 .and. sum(dims) == 3) then
+                call refuse_volume(geo, case%bodies(i)%name, error)
+            else
+                call read_patch(geo, case%bodies(i)%name, coarse(i), error)
+            end if
             if (allocated(error)) then
                 error%message = case%path//": &body '"//trim(case%bodies(i)%name)//"': name: "// &
                                 error%message
@@ -80,6 +88,21 @@ contains
         call geo%close(close_error)
         if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine read_patches
+
+    !> A volume (a three-dimensional body): read and checked as any patch (a bad one
+    !> is refused for its fault), then refused, since the solver takes plane bodies
+    !> only so far.
+    subroutine refuse_volume(geo, name, error)
+        type(h5file_t), intent(inout) :: geo
+        character(len=*), intent(in) :: name
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_patch_t) :: volume
+        character(len=32) :: faces(6)
+        call read_volume(geo, name, volume, faces, error)
+        if (allocated(error)) return
+        call fatal_error(error, geo%path//": body '"//trim(name)//"' is a volume (a three-dimensional body, "// &
+                         'valid): voiga solves plane bodies only so far; docs/formats.md', error_code%input)
+    end subroutine refuse_volume
 
     !> Read the curve of every contact pair whose rigid master is one
     !> (`&contact rigid_curve`) from the geometry file into `case%contact(k)%curve`.

@@ -10,16 +10,20 @@ module voiga_io_input_geometry
     use voiga_io_hdf5, only: h5file_t
     use voiga_nurbs_basis, only: distinct_knots
     use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels, surface_patch
-    use voiga_nurbs_patch, only: nurbs_patch_t, patch_eval
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval
     use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
 
-    public :: read_patch, read_curve, validate_knots, geometry_units, check_jacobian
+    public :: read_patch, read_volume, read_curve, validate_knots, geometry_units, check_jacobian
 
     !> Sample points per knot span and direction for the sign of det J (a fold
     !> narrower than about 1/32 of a span of the exact geometry could hide between them).
     integer, parameter :: samples = 32
+    !> The same for a volume, per knot span and direction (8^3 = 512 per span: a
+    !> fold narrower than about 1/8 of a span could hide between them; `pre`'s
+    !> `check_volume` samples as many).
+    integer, parameter :: volume_samples = 8
 
     !> The largest geometry read (docs/formats.md): at most `max_side` control
     !> points of a patch along each direction (and of a curve), `max_points` in all;
@@ -37,10 +41,10 @@ contains
         character(len=*), intent(in) :: name
         type(nurbs_surface_t), intent(out) :: surf
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: g, where, label
+        character(len=:), allocatable :: g, where
         integer, allocatable :: degree(:)
         real(dp), allocatable :: cp(:, :, :), w(:, :)
-        integer :: i, j, k
+        integer :: j, k
 
         g = '/bodies/'//trim(name)
         call read_degree(h5, 'body', name, g, 2, degree, where, error)
@@ -89,32 +93,99 @@ contains
         surf%w = w
         call check_jacobian(surf, where, error)
         if (allocated(error)) return
-        do i = 1, 4
-            label = 'edge_'//trim(edge_labels(i))
-            if (h5%has_attr(g, label)) then
-                block
-                    character(len=:), allocatable :: value
-                    call h5%read_attr_str(g, label, value, error)
-                    if (allocated(error)) return
-                    if (len_trim(value) == 0 .or. len_trim(value) > len(surf%edge_names(i))) then
-                        call fatal_error(error, where//'attribute '//label// &
-                                         ' must be a name of 1 to 32 characters', error_code%input)
-                        return
-                    end if
-                    surf%edge_names(i) = value
-                end block
+        call read_names(h5, g, 'edge', edge_labels, where, surf%edge_names, error)
+    end subroutine read_patch
+
+    !> The names of a patch's boundary entities (`kind` 'edge' or 'face') from the
+    !> attributes `<kind>_<label>` of group `g`, where present (else `names` keeps
+    !> its defaults): 1 to 32 characters, all different.
+    subroutine read_names(h5, g, kind, labels, where, names, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: g, kind, labels(:), where
+        character(len=*), intent(inout) :: names(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: label, value
+        integer :: i, j
+        do i = 1, size(labels)
+            label = kind//'_'//trim(labels(i))
+            if (.not. h5%has_attr(g, label)) cycle
+            call h5%read_attr_str(g, label, value, error)
+            if (allocated(error)) return
+            if (len_trim(value) == 0 .or. len_trim(value) > len(names(i))) then
+                call fatal_error(error, where//'attribute '//label//' must be a name of 1 to 32 characters', &
+                                 error_code%input)
+                return
             end if
+            names(i) = value
         end do
-        do i = 1, 4
-            do j = i + 1, 4
-                if (surf%edge_names(i) == surf%edge_names(j)) then
-                    call fatal_error(error, where//"edge name '"//trim(surf%edge_names(i))// &
-                                     "' is used twice", error_code%input)
+        do i = 1, size(names)
+            do j = i + 1, size(names)
+                if (names(i) == names(j)) then
+                    call fatal_error(error, where//kind//" name '"//trim(names(i))//"' is used twice", &
+                                     error_code%input)
                     return
                 end if
             end do
         end do
-    end subroutine read_patch
+    end subroutine read_names
+
+    !> Read body `name`'s volume (a three-dimensional body: `degree` has three
+    !> entries; docs/formats.md) from the open geometry file `h5` into `patch`,
+    !> checked as a plane patch is (`volume_samples` det J samples per knot span and
+    !> direction); `faces` are its six faces' names (xi0, xi1, eta0, eta1, zeta0,
+    !> zeta1 unless the file names them).
+    subroutine read_volume(h5, name, patch, faces, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        type(nurbs_patch_t), intent(out) :: patch
+        character(len=32), intent(out) :: faces(6)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: directions(3) = ['xi  ', 'eta ', 'zeta']
+        character(len=:), allocatable :: g, where
+        integer, allocatable :: degree(:)
+        real(dp), allocatable :: cp(:, :, :, :), w(:, :, :)
+        type(knots_t) :: knots(3)
+        integer :: d
+
+        g = '/bodies/'//trim(name)
+        call read_degree(h5, 'body', name, g, 3, degree, where, error)
+        if (allocated(error)) return
+        do d = 1, 3
+            call h5%read(g//'/knots_'//trim(directions(d)), knots(d)%u, error, max_knots)
+            if (allocated(error)) return
+        end do
+        call h5%read(g//'/control_points', cp, error, 3_int64*max_points)
+        if (allocated(error)) return
+        call h5%read(g//'/weights', w, error, int(max_points, int64))
+        if (allocated(error)) return
+        if (size(cp, 1) /= 3 .or. any(shape(w) /= shape(cp(1, :, :, :)))) then
+            call fatal_error(error, where//'control_points must have shape (n_zeta, n_eta, n_xi, 3) and '// &
+                             'weights (n_zeta, n_eta, n_xi)', error_code%input)
+            return
+        end if
+        if (any(shape(w) > max_side)) then
+            call fatal_error(error, where//'control_points: at most '//str(max_side)// &
+                             ' points along each direction', error_code%input)
+            return
+        end if
+        do d = 1, 3
+            call validate_knots(knots(d)%u, degree(d), size(w, d), where//'knots_'//trim(directions(d)), error)
+            if (allocated(error)) return
+        end do
+        if (.not. all(ieee_is_finite(cp))) then
+            call fatal_error(error, where//'control_points must be finite', error_code%input)
+            return
+        end if
+        if (.not. all(w > 0.0_dp .and. ieee_is_finite(w))) then
+            call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
+            return
+        end if
+        patch = new_patch(degree, knots, shape(w), reshape(cp, [3, size(w)]), reshape(w, [size(w)]))
+        call check_map(patch, volume_samples, where, error)
+        if (allocated(error)) return
+        faces = ['xi0  ', 'xi1  ', 'eta0 ', 'eta1 ', 'zeta0', 'zeta1']
+        call read_names(h5, g, 'face', faces, where, faces, error)
+    end subroutine read_volume
 
     !> The root attribute `units` of the geometry file `path` ('<length>, <force>'
     !> when `pre` wrote it), or `default` when the file has none or cannot be read
@@ -186,7 +257,7 @@ contains
         call h5%read(g//'/degree', degree, error, 16_int64)
         if (allocated(error)) return
         if (size(degree) /= n) then
-            call fatal_error(error, where//'degree must have '//trim(merge('2 entries', '1 entry  ', n == 2)), &
+            call fatal_error(error, where//'degree must have '//str(n)//trim(merge(' entries', ' entry  ', n > 1)), &
                              error_code%input)
         else if (any(degree < 1) .or. any(degree > max_degree)) then
             call fatal_error(error, where//'degree must be between 1 and 20', error_code%input)
@@ -258,43 +329,103 @@ contains
         type(nurbs_surface_t), intent(in) :: surf
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: bx(:), be(:), det(:), at(:, :)
-        real(dp) :: x(2), dx(2, 2), xi, eta, scale, sgn
-        integer :: i, j, a, b, n, k
-        character(len=160) :: buf
-        type(nurbs_patch_t) :: patch
-        patch = surface_patch(surf)
-        bx = distinct_knots(surf%knots_xi)
-        be = distinct_knots(surf%knots_eta)
-        n = (size(bx) - 1)*(size(be) - 1)*samples**2
-        allocate (det(n), at(4, n))
+        call check_map(surface_patch(surf), samples, where, error)
+    end subroutine check_jacobian
+
+    !> The sign test of `check_jacobian` for a patch of any dimension (pdim = nsd),
+    !> with `per_span` sample points per knot span and direction.
+    subroutine check_map(patch, per_span, where, error)
+        type(nurbs_patch_t), intent(in) :: patch
+        integer, intent(in) :: per_span
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        type(knots_t) :: breaks(patch%pdim)
+        real(dp), allocatable :: det(:), at(:, :)
+        real(dp) :: u(patch%pdim), x(patch%nsd), dx(patch%nsd, patch%pdim), scale, sgn
+        integer :: span(patch%pdim), spans(patch%pdim), sample(patch%pdim), d, n, k, s, m
+        do d = 1, patch%pdim
+            breaks(d)%u = distinct_knots(patch%knots(d)%u)
+            spans(d) = size(breaks(d)%u) - 1
+        end do
+        n = product(spans)*per_span**patch%pdim
+        allocate (det(n), at(patch%pdim + patch%nsd, n))
         k = 0
-        do j = 1, size(be) - 1
-            do i = 1, size(bx) - 1
-                do b = 1, samples
-                    eta = be(j) + (be(j + 1) - be(j))*(real(b, dp) - 0.5_dp)/samples
-                    do a = 1, samples
-                        xi = bx(i) + (bx(i + 1) - bx(i))*(real(a, dp) - 0.5_dp)/samples
-                        call patch_eval(patch, [xi, eta], x, dx)
-                        k = k + 1
-                        det(k) = dx(1, 1)*dx(2, 2) - dx(1, 2)*dx(2, 1)
-                        at(:, k) = [xi, eta, x]
-                    end do
+        span = 1
+        do s = 1, product(spans)
+            sample = 1
+            do m = 1, per_span**patch%pdim
+                do d = 1, patch%pdim
+                    associate (b => breaks(d)%u)
+                        u(d) = b(span(d)) + (b(span(d) + 1) - b(span(d)))*(real(sample(d), dp) - 0.5_dp)/per_span
+                    end associate
                 end do
+                call patch_eval(patch, u, x, dx)
+                k = k + 1
+                det(k) = determinant(dx)
+                at(:, k) = [u, x]
+                call next_index(sample, spread(per_span, 1, patch%pdim))
             end do
+            call next_index(span, spans)
         end do
         scale = maxval(abs(det))
         sgn = sign(1.0_dp, det(maxloc(abs(det), 1)))
         k = findloc(sgn*det > 1.0e-10_dp*scale, .false., 1)
         if (.not. (scale > 0.0_dp) .or. k > 0) then
             k = max(k, 1)
-            write (buf, '(2(f0.4,a),2(es11.4,a),es10.3)') at(1, k), ', ', at(2, k), '), x = (', at(3, k), ', ', &
-                at(4, k), '): det J = ', det(k)
             call fatal_error(error, where//'the reference map folds over itself or degenerates (det J '// &
                              'changes sign or vanishes at '//str(count(.not. sgn*det > 1.0e-10_dp*scale))// &
-                             ' of '//str(n)//' sample points; first at (xi, eta) = ('//trim(buf)//')', &
+                             ' of '//str(n)//' sample points; first at '//sample_point(at(:, k), det(k), &
+                                                                                   patch%pdim)//')', &
                              error_code%input)
         end if
-    end subroutine check_jacobian
+    end subroutine check_map
+
+    !> '(xi, eta) = (0.0156, 0.5000), x = ( 1.0000E+00,  2.0000E-01): det J = -1.000E-02'
+    !> (with zeta and z in three dimensions) for a sample point [u, x].
+    function sample_point(at, det, pdim) result(text)
+        real(dp), intent(in) :: at(:), det
+        integer, intent(in) :: pdim
+        character(len=:), allocatable :: text
+        character(len=16) :: buf
+        integer :: d
+        text = '('//merge('xi, eta      ', 'xi, eta, zeta', pdim == 2)
+        text = trim(text)//') = ('
+        do d = 1, pdim
+            write (buf, '(f0.4)') at(d)
+            text = text//trim(buf)
+            if (d < pdim) text = text//', '
+        end do
+        text = text//'), x = ('
+        do d = pdim + 1, size(at)
+            write (buf, '(es11.4)') at(d)
+            text = text//buf(1:11)
+            if (d < size(at)) text = text//', '
+        end do
+        write (buf, '(es10.3)') det
+        text = text//'): det J = '//buf(1:10)
+    end function sample_point
+
+    !> The next multi-index after `idx` in [1, counts], the first fastest.
+    pure subroutine next_index(idx, counts)
+        integer, intent(inout) :: idx(:)
+        integer, intent(in) :: counts(:)
+        integer :: d
+        do d = 1, size(idx)
+            idx(d) = idx(d) + 1
+            if (idx(d) <= counts(d)) return
+            idx(d) = 1
+        end do
+    end subroutine next_index
+
+    !> The determinant of a 2 x 2 or 3 x 3 Jacobian.
+    pure real(dp) function determinant(a)
+        real(dp), intent(in) :: a(:, :)
+        if (size(a, 1) == 2) then
+            determinant = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+        else
+            determinant = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
+                          a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
+        end if
+    end function determinant
 
 end module voiga_io_input_geometry
