@@ -17,7 +17,8 @@ the control points themselves (the tests compare each with the same body built b
   the longitude, eta from the equator to the pole (the face ``eta = 1`` collapses onto
   the z axis), zeta from the inner to the outer sphere.
 - :func:`extrude`, :func:`revolve`: a 2D body (:class:`pre.nurbs.Patch`, z = 0) swept
-  along z or about an axis in its plane: xi along the sweep, ``(eta, zeta)`` the
+  along z or about an axis in its plane: xi along the sweep (backwards for a clockwise
+  patch, so that the volume is right-handed), ``(eta, zeta)`` the
   patch's ``(xi, eta)``, so its edges name the four side faces and its contact edge
   ``eta = 1`` becomes the contact face ``zeta = 1``.
 - :func:`solid` turns a splipy volume (``splipy.volume_factory``, :func:`read_g2_volumes`)
@@ -56,9 +57,10 @@ the plane x = x_c (longitude 90 degrees), ``equator`` the plane z = z_c, ``pole`
 face collapsed onto the axis x = x_c, y = y_c, ``inner``/``outer`` the spheres
 (``outer``: the contact face)."""
 
-SWEEP_ENDS = {"extrude": ("back", "front"), "revolve": ("start", "end")}
-"""Default labels of the faces ``xi = 0`` and ``xi = 1`` of a swept 2D body: where the
-sweep starts (the patch itself, z = z0 or the plane z = 0) and where it ends."""
+SWEEP_ENDS = {"extrude": ("back", "front"), "revolve": ("plane", "turned")}
+"""Default labels of the end faces of a swept 2D body: where the sweep starts (z = z0,
+or the patch itself in the plane z = 0) and where it ends (z = z1, or the patch turned
+by the angle); names other than the edges of the shapes of :mod:`pre.geometry`."""
 
 Point = Sequence[float]
 ONE = np.array([0.0, 0.0, 1.0, 1.0])
@@ -174,15 +176,22 @@ def shell_octant(r_in: float, r_out: float, centre: Point = (0.0, 0.0, 0.0),
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(SHELL_FACES, faces))
 
 
-def _counter_clockwise(patch: Patch, name: str) -> Patch:
-    """``patch`` checked, with xi reversed (its ``xi0`` and ``xi1`` edges swapped along)
-    when it runs clockwise (det J < 0): the swept volume is then right-handed."""
+def _clockwise(patch: Patch, name: str) -> bool:
+    """``patch`` checked (:func:`pre.geometry.check_patch`); whether it runs clockwise
+    (det J < 0, as the annular sectors, xi along the arcs and eta outwards)."""
     check_patch(name, patch)
-    if float(np.median(jacobian_signs(patch, 8))) > 0:
-        return patch
-    edges = {**patch.edges, "xi0": patch.edges["xi1"], "xi1": patch.edges["xi0"]}
-    return Patch(patch.degree, 1.0 - patch.knots_xi[::-1], patch.knots_eta,
-                 patch.control_points[:, ::-1].copy(), patch.weights[:, ::-1].copy(), edges)
+    return float(np.median(jacobian_signs(patch, 8))) < 0
+
+
+def _right_handed(vol: Volume, clockwise: bool) -> Volume:
+    """A volume swept from a patch, right-handed: for a clockwise patch its sweep
+    direction xi is reversed (the ends' names swapped along; the patch's own
+    parametrization, along eta and zeta, is kept)."""
+    if not clockwise:
+        return vol
+    faces = {**vol.faces, "xi0": vol.faces["xi1"], "xi1": vol.faces["xi0"]}
+    return Volume(vol.degree, 1.0 - vol.knots_xi[::-1], vol.knots_eta, vol.knots_zeta,
+                  vol.control_points[:, :, ::-1].copy(), vol.weights[:, :, ::-1].copy(), faces)
 
 
 def _sweep_faces(patch: Patch, ends: Sequence[str], what: str) -> dict[str, str]:
@@ -198,19 +207,21 @@ def extrude(patch: Patch, z: Sequence[float] = (0.0, 1.0),
             ends: Sequence[str] = SWEEP_ENDS["extrude"]) -> Volume:
     """The 2D body ``patch`` (in the plane z = 0, edges named) swept along z from
     ``z[0]`` to ``z[1]``. Degrees ``(1, p_xi, p_eta)``, ``2 x n_xi x n_eta`` control
-    points: xi along z, ``(eta, zeta)`` the patch's ``(xi, eta)`` (reversed in xi if the
-    patch runs clockwise). Faces: ``ends`` (default ``back``, z = z0, and ``front``,
-    z = z1) at xi = 0 and 1, the patch's edges ``xi0``, ``xi1``, ``eta0``, ``eta1`` at
-    eta = 0, eta = 1, zeta = 0, zeta = 1 (its contact edge becomes the contact face)."""
-    patch = _counter_clockwise(patch, "extruded patch")
+    points: xi along z, ``(eta, zeta)`` the patch's ``(xi, eta)``. Faces: ``ends``
+    (default ``back``, z = z0, and ``front``, z = z1) at xi = 0 and 1, the patch's edges
+    ``xi0``, ``xi1``, ``eta0``, ``eta1`` at eta = 0, eta = 1, zeta = 0, zeta = 1 (its
+    contact edge becomes the contact face). A clockwise patch (det J < 0, as an
+    :func:`pre.geometry.annular_sector`) is swept the other way, xi from z1 to z0
+    (``front`` at xi = 0), so that the volume is right-handed."""
+    clockwise = _clockwise(patch, "extruded patch")
     z0, z1 = _pair(z, "z")
     n_eta2, n_xi2 = patch.shape
     cp = np.zeros((n_eta2, n_xi2, 2, 3))
     cp[..., :2] = patch.control_points[:, :, None, :]
     cp[..., 2] = [z0, z1]
     w = np.repeat(patch.weights[:, :, None], 2, axis=2)
-    return Volume((1, *patch.degree), ONE, patch.knots_xi, patch.knots_eta, cp, w,
-                  _sweep_faces(patch, ends, "extrude"))
+    return _right_handed(Volume((1, *patch.degree), ONE, patch.knots_xi, patch.knots_eta, cp, w,
+                                _sweep_faces(patch, ends, "extrude")), clockwise)
 
 
 def revolve(patch: Patch, angle: float = 90.0, axis_point: Point = (0.0, 0.0),
@@ -220,11 +231,12 @@ def revolve(patch: Patch, angle: float = 90.0, axis_point: Point = (0.0, 0.0),
     ``axis_point`` along ``axis_direction`` (both in the plane z = 0), turning out of
     the plane towards +z. Degrees ``(2, p_xi, p_eta)``, ``3 x n_xi x n_eta`` control
     points: xi along the angle (exact rational quadratic arcs), ``(eta, zeta)`` the
-    patch's ``(xi, eta)`` (reversed in xi if the patch runs clockwise). Faces: ``ends``
-    (default ``start``, the patch itself, and ``end``, the patch turned) at xi = 0 and 1,
-    the patch's edges at eta = 0, 1 and zeta = 0, 1 as in :func:`extrude`. An edge on
-    the axis makes a face collapsed onto it (allowed); a patch across the axis is refused."""
-    patch = _counter_clockwise(patch, "revolved patch")
+    patch's ``(xi, eta)``. Faces: ``ends`` (default ``plane``, the patch itself, and
+    ``turned``, the patch turned) at xi = 0 and 1 (swapped for a clockwise patch, whose xi
+    runs from the end back to the start, as in :func:`extrude`), the patch's edges at
+    eta = 0, 1 and zeta = 0, 1 as in :func:`extrude`. An edge on the axis makes a face
+    collapsed onto it (allowed); a patch across the axis is refused."""
+    clockwise = _clockwise(patch, "revolved patch")
     sweep = _sweep(angle, "revolve")
     a = np.asarray(axis_direction, dtype=float)
     if a.shape != (2,) or not np.linalg.norm(a) > 0:
@@ -249,8 +261,8 @@ def revolve(patch: Patch, angle: float = 90.0, axis_point: Point = (0.0, 0.0),
         cp[:, :, i, :2] = c + along + in_plane
         cp[:, :, i, 2] = height
     w = patch.weights[:, :, None] * np.array([1.0, cw, 1.0])
-    return Volume((2, *patch.degree), ARC, patch.knots_xi, patch.knots_eta, cp, w,
-                  _sweep_faces(patch, ends, "revolve"))
+    return _right_handed(Volume((2, *patch.degree), ARC, patch.knots_xi, patch.knots_eta, cp, w,
+                                _sweep_faces(patch, ends, "revolve")), clockwise)
 
 
 def solid(spline: splipy.Volume, faces: dict[str, str]) -> Volume:
