@@ -2,6 +2,7 @@
 
 Subcommands:
   geometry     a geometry spec (TOML) -> geometry file and case file
+  geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
@@ -47,6 +48,26 @@ def _cmd_geometry(args: argparse.Namespace) -> int:
         print("replaced (case file or geometry -> spec):")
         for line in done.changes:
             print(f"  {line}")
+    return 0
+
+
+def _cmd_geometry3d(args: argparse.Namespace) -> int:
+    from .spec import SpecError
+    from .spec3d import write_from_spec3d
+
+    try:
+        done = write_from_spec3d(args.spec, args.out, args.force)
+    except (SpecError, FileNotFoundError, OSError) as err:
+        print(f"python -m pre geometry3d: {err}", file=sys.stderr)
+        return 2
+    except (ValueError, TypeError, KeyError, IndexError, ArithmeticError, RuntimeError) as err:
+        print(f"python -m pre geometry3d: {args.spec}: {type(err).__name__}: {err}", file=sys.stderr)
+        return 2
+    if done.stale:
+        print(f"python -m pre geometry3d: {done.geometry} differs from what {args.spec} gives now; "
+              "nothing written (--force replaces it)", file=sys.stderr)
+        return 2
+    print(f"wrote {done.geometry}" if done.written else f"kept {done.geometry} (up to date with {args.spec})")
     return 0
 
 
@@ -144,6 +165,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the geometry and case files although they exist and differ from the spec "
                         "(what is replaced is listed)")
     s.set_defaults(func=_cmd_geometry)
+
+    s = sub.add_parser("geometry3d", help="spec of 3D bodies (TOML) -> geometry file of volumes")
+    s.add_argument("spec", help="spec file (.toml; docs/pre.md, '3D bodies')")
+    s.add_argument("--out", default=None, help="output folder (default: the spec's folder)")
+    s.add_argument("--force", action="store_true", help="replace a geometry file that differs from the spec")
+    s.set_defaults(func=_cmd_geometry3d)
 
     s = sub.add_parser("cases", help="write geometry files and case namelists")
     s.add_argument("--out", default="cases",
