@@ -104,3 +104,20 @@ def test_volume_datasets_checked(voiga_bin: Path, tmp_path: Path) -> None:
 def test_face_names_checked(voiga_bin: Path, tmp_path: Path) -> None:
     res = check(voiga_bin, volume_case(tmp_path, faces={"face_xi0": "side", "face_zeta1": "side"}))
     assert res.returncode == 2 and "face name 'side' is used twice" in res.stderr, res.stderr
+
+
+def test_pre_volumes_are_valid_for_voiga(voiga_bin: Path, tmp_path: Path) -> None:
+    """Every body `pre` builds (box, cylinder sector, shell octant with its collapsed
+    pole) passes voiga's checks: refused only as a volume."""
+    from pre.solids import box, cylinder_sector, shell_octant, write_volumes
+
+    bodies = {"slab": box((0, 2), (0, 1), (0, 0.5)), "sector": cylinder_sector(1.0, 2.0, z=(0.0, 1.0)),
+              "shell": shell_octant(0.8, 1.0)}
+    for name, body in bodies.items():
+        sub = tmp_path / name
+        sub.mkdir()
+        case = block(sub)
+        write_volumes(sub / "geometry.h5", {"slab": body})
+        res = check(voiga_bin, case)
+        assert res.returncode == 2, (name, res.stderr)
+        assert "body 'slab' is a volume" in res.stderr and "folds" not in res.stderr, (name, res.stderr)
