@@ -8,6 +8,7 @@ module test_patch
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, &
                                  patch_insert, patch_boundary, point_index
+    use voiga_nurbs_rational, only: rationalize
     use voiga_test_fixtures, only: lcg_t
     implicit none
     private
@@ -26,7 +27,8 @@ contains
                     new_unittest('volume_is_exact', test_exact), &
                     new_unittest('volume_refined_keeps_the_map', test_refined), &
                     new_unittest('volume_jacobian_against_differences', test_jacobian), &
-                    new_unittest('face_is_the_volume_there', test_faces) &
+                    new_unittest('face_is_the_volume_there', test_faces), &
+                    new_unittest('rational_derivatives_in_three_directions', test_rational_3d) &
                     ]
     end subroutine collect_patch
 
@@ -168,5 +170,90 @@ contains
         edge = patch_boundary(patch_boundary(face, 2, 0), 1, 0)
         call check(error, edge%pdim == 0 .and. point_index(face, [1, 1]) == 1, 'a curve has no boundary patch')
     end subroutine test_faces
+
+    !> The trilinear Bernstein products (8 functions) at `u` with their first and
+    !> second derivatives, the Hessian stored diagonal first: 11, 22, 33, 12, 13, 23.
+    pure subroutine trilinear(u, b, db, d2b)
+        real(dp), intent(in) :: u(3)
+        real(dp), intent(out) :: b(8), db(3, 8), d2b(6, 8)
+        real(dp) :: v(2, 3), dv(2, 3)
+        integer :: i, j, k, a
+        integer, parameter :: first(3) = [1, 1, 2], second(3) = [2, 3, 3]
+        integer :: idx(3), d, m
+        v(1, :) = 1.0_dp - u
+        v(2, :) = u
+        dv(1, :) = -1.0_dp
+        dv(2, :) = 1.0_dp
+        a = 0
+        do k = 1, 2
+            do j = 1, 2
+                do i = 1, 2
+                    a = a + 1
+                    idx = [i, j, k]
+                    b(a) = v(i, 1)*v(j, 2)*v(k, 3)
+                    do d = 1, 3
+                        db(d, a) = term(v, dv, idx, [1, 2, 3] == d)
+                    end do
+                    ! linear in each direction: the diagonal vanishes
+                    d2b(1:3, a) = 0.0_dp
+                    do m = 1, 3
+                        d2b(3 + m, a) = term(v, dv, idx, [1, 2, 3] == first(m) .or. [1, 2, 3] == second(m))
+                    end do
+                end do
+            end do
+        end do
+    end subroutine trilinear
+
+    !> The product over the directions e of v(idx(e), e), its derivative where `derive(e)`.
+    pure real(dp) function term(v, dv, idx, derive)
+        real(dp), intent(in) :: v(2, 3), dv(2, 3)
+        integer, intent(in) :: idx(3)
+        logical, intent(in) :: derive(3)
+        integer :: e
+        term = 1.0_dp
+        do e = 1, 3
+            term = term*merge(dv(idx(e), e), v(idx(e), e), derive(e))
+        end do
+    end function term
+
+    !> `rationalize` in three directions: first and second derivatives of the NURBS
+    !> functions against central differences of the values and of the first
+    !> derivatives, for random weights.
+    subroutine test_rational_3d(error)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), parameter :: h = 1.0e-6_dp
+        integer, parameter :: first(3) = [1, 1, 2], second(3) = [2, 3, 3]
+        type(lcg_t) :: rng
+        real(dp) :: w(8), u(3), b(8), db(3, 8), d2b(6, 8), r(8), dr(3, 8), d2r(6, 8)
+        real(dp) :: rp(8), rm(8), drp(3, 8), drm(3, 8), d2p(6, 8), worst1, worst2
+        integer :: a, d, m
+        do a = 1, 8
+            w(a) = 0.4_dp + rng%uniform()
+        end do
+        u = [0.3_dp, 0.6_dp, 0.45_dp]
+        call trilinear(u, b, db, d2b)
+        call rationalize(w, b, db, d2b, r, dr, d2r)
+        worst1 = 0.0_dp
+        worst2 = 0.0_dp
+        do d = 1, 3
+            call trilinear(u + h*unit(d), b, db, d2b)
+            call rationalize(w, b, db, d2b, rp, drp, d2p)
+            call trilinear(u - h*unit(d), b, db, d2b)
+            call rationalize(w, b, db, d2b, rm, drm, d2p)
+            worst1 = max(worst1, maxval(abs((rp - rm)/(2*h) - dr(d, :))))
+            ! d/du_d of dr(d, :) is the diagonal entry d; of dr(e, :), e > d, the pair (d, e)
+            worst2 = max(worst2, maxval(abs((drp(d, :) - drm(d, :))/(2*h) - d2r(d, :))))
+            do m = 1, 3
+                if (first(m) == d) worst2 = max(worst2, maxval(abs((drp(second(m), :) - drm(second(m), :))/(2*h) &
+                                                                   - d2r(3 + m, :))))
+            end do
+        end do
+        call check(error, abs(sum(r) - 1.0_dp) < tol .and. maxval(abs(sum(dr, 2))) < tol .and. &
+                   maxval(abs(sum(d2r, 2))) < tol, 'the NURBS functions are not a partition of unity')
+        if (allocated(error)) return
+        call check(error, worst1 < 1.0e-8_dp, 'first derivatives differ from finite differences')
+        if (allocated(error)) return
+        call check(error, worst2 < 1.0e-7_dp, 'second derivatives differ from finite differences')
+    end subroutine test_rational_3d
 
 end module test_patch
