@@ -5,6 +5,7 @@ program voiga_tests
     use test_basis, only: collect_basis
     use test_refine, only: collect_refine
     use test_patch, only: collect_patch
+    use test_material, only: collect_material
     use test_discretization, only: collect_discretization
     use test_solid, only: collect_solid, lame_table
     use test_element_kernel, only: collect_element_kernel
@@ -34,6 +35,7 @@ program voiga_tests
              new_testsuite('basis', collect_basis), &
              new_testsuite('refine', collect_refine), &
              new_testsuite('patch', collect_patch), &
+             new_testsuite('material', collect_material), &
              new_testsuite('discretization', collect_discretization), &
              new_testsuite('solid', collect_solid), &
              new_testsuite('element_kernel', collect_element_kernel), &

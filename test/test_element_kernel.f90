@@ -27,8 +27,11 @@ module test_element_kernel
     !> tangent the symmetric shortcut would get wrong.
     type, extends(material_t) :: skew_law_t
         real(dp) :: c(2, 2, 2, 2) = 0.0_dp
+        !> The moduli on three-dimensional gradients (every law has both kernels).
+        real(dp) :: c3(3, 3, 3, 3) = 0.0_dp
     contains
         procedure :: stress => skew_stress
+        procedure :: stress3 => skew_stress3
         procedure :: fields => skew_fields
         procedure, nopass :: strain_name => skew_strain_name
     end type skew_law_t
@@ -56,6 +59,21 @@ contains
         c = self%c
         ok = .true.
     end subroutine skew_stress
+
+    pure subroutine skew_stress3(self, grad_u, s, c, ok)
+        class(skew_law_t), intent(in) :: self
+        real(dp), intent(in) :: grad_u(3, 3)
+        real(dp), intent(out) :: s(3, 3), c(3, 3, 3, 3)
+        logical, intent(out) :: ok
+        integer :: i, j
+        do j = 1, 3
+            do i = 1, 3
+                s(i, j) = sum(self%c3(i, j, :, :)*grad_u)
+            end do
+        end do
+        c = self%c3
+        ok = .true.
+    end subroutine skew_stress3
 
     pure subroutine skew_fields(self, grad_u, stress, strain, ok)
         class(skew_law_t), intent(in) :: self

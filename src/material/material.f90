@@ -31,6 +31,9 @@ module voiga_material
         logical :: finite_strain = .false.
     contains
         procedure(stress_interface), deferred :: stress
+        !> The same law on a three-dimensional body (3 x 3 gradients): the kernel
+        !> 3D elements call, beside the plane-strain one.
+        procedure(stress3_interface), deferred :: stress3
         procedure :: stress_points => material_stress_points
         procedure(fields_interface), deferred :: fields
         procedure(strain_name_interface), deferred, nopass :: strain_name
@@ -54,6 +57,15 @@ module voiga_material
         !> out-of-plane sigma_zz) and the law's strain measure (`strain_name`), each
         !> [xx, yy, zz, xy] (tensor components: eps_xy, not the engineering shear).
         !> `ok` is false when the state is inadmissible (J <= 0).
+        !> `stress` in three dimensions: grad_u, s [3, 3], c [3, 3, 3, 3].
+        pure subroutine stress3_interface(self, grad_u, s, c, ok)
+            import :: material_t, dp
+            class(material_t), intent(in) :: self
+            real(dp), intent(in) :: grad_u(3, 3)
+            real(dp), intent(out) :: s(3, 3), c(3, 3, 3, 3)
+            logical, intent(out) :: ok
+        end subroutine stress3_interface
+
         pure subroutine fields_interface(self, grad_u, stress, strain, ok)
             import :: material_t, dp
             class(material_t), intent(in) :: self

@@ -8,7 +8,7 @@
 module voiga_material_neohookean
     use, intrinsic :: iso_c_binding, only: c_double
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t
+    use voiga_material, only: material_t, delta
     implicit none
     private
 
@@ -31,6 +31,7 @@ module voiga_material_neohookean
     type, extends(material_t) :: neo_hookean_t
     contains
         procedure :: stress => neo_hookean_stress
+        procedure :: stress3 => neo_hookean_stress3
         procedure :: stress_points => neo_hookean_points
         procedure :: fields => neo_hookean_fields
         procedure, nopass :: strain_name => neo_hookean_strain_name
@@ -114,6 +115,54 @@ contains
             end do
         end do
     end subroutine neo_hookean_stress
+
+    !> tau and its spatial tangent in three dimensions, the formulas of the header
+    !> with b = F F^T of a 3 x 3 F (the plane-strain kernel is this one with F33 = 1);
+    !> `ok` false when J <= 0.
+    pure subroutine neo_hookean_stress3(self, grad_u, s, c, ok)
+        class(neo_hookean_t), intent(in) :: self
+        real(dp), intent(in) :: grad_u(3, 3)
+        real(dp), intent(out) :: s(3, 3), c(3, 3, 3, 3)
+        logical, intent(out) :: ok
+        real(dp) :: f(3, 3), bbar(3, 3), jac, trb, a1, b1
+        integer :: i, j, k, l
+        s = 0.0_dp
+        c = 0.0_dp
+        f = grad_u
+        do i = 1, 3
+            f(i, i) = f(i, i) + 1.0_dp
+        end do
+        jac = f(1, 1)*(f(2, 2)*f(3, 3) - f(2, 3)*f(3, 2)) - f(1, 2)*(f(2, 1)*f(3, 3) - f(2, 3)*f(3, 1)) + &
+              f(1, 3)*(f(2, 1)*f(3, 2) - f(2, 2)*f(3, 1))
+        ok = jac > 0.0_dp
+        if (.not. ok) return
+        bbar = matmul(f, transpose(f))/cbrt(jac)**2
+        trb = bbar(1, 1) + bbar(2, 2) + bbar(3, 3)
+        a1 = self%kappa*jac**2
+        b1 = self%kappa*(jac**2 - 1.0_dp)
+        do j = 1, 3
+            do i = 1, 3
+                s(i, j) = self%mu*(bbar(i, j) - trb/3.0_dp*delta(i, j)) + 0.5_dp*b1*delta(i, j)
+            end do
+        end do
+        do l = 1, 3
+            do k = 1, 3
+                do j = 1, 3
+                    do i = 1, 3
+                        c(i, j, k, l) = a1*delta(i, j)*delta(k, l) - b1*sym(i, j, k, l) + &
+                                        2.0_dp*self%mu/3.0_dp*(trb*(sym(i, j, k, l) + delta(i, j)*delta(k, l)/3.0_dp) - &
+                                                               bbar(i, j)*delta(k, l) - delta(i, j)*bbar(k, l))
+                    end do
+                end do
+            end do
+        end do
+    end subroutine neo_hookean_stress3
+
+    !> The symmetric fourth-order identity I_s.
+    pure real(dp) function sym(i, j, k, l)
+        integer, intent(in) :: i, j, k, l
+        sym = 0.5_dp*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+    end function sym
 
     !> tau and the Voigt tangent at `n` points (`material_t%stress_points`), a chunk
     !> of points at a time: the per-point latency chain (cbrt, two divisions) of
