@@ -149,9 +149,9 @@ contains
             do k = 1, 3
                 do j = 1, 3
                     do i = 1, 3
-                        c(i, j, k, l) = a1*delta(i, j)*delta(k, l) - b1*sym(i, j, k, l) + &
-                                        2.0_dp*self%mu/3.0_dp*(trb*(sym(i, j, k, l) + delta(i, j)*delta(k, l)/3.0_dp) - &
-                                                               bbar(i, j)*delta(k, l) - delta(i, j)*bbar(k, l))
+                        c(i, j, k, l) = a1*delta(i, j)*delta(k, l) - b1*sym(i, j, k, l) + 2.0_dp*self%mu/3.0_dp* &
+                                        (trb*(sym(i, j, k, l) + delta(i, j)*delta(k, l)/3.0_dp) - &
+                                         bbar(i, j)*delta(k, l) - delta(i, j)*bbar(k, l))
                     end do
                 end do
             end do
