@@ -16,7 +16,7 @@ module voiga_nurbs_patch
     private
 
     public :: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, patch_boundary
-    public :: point_index
+    public :: point_index, patch_basis
 
     !> One knot vector (a patch has one per parametric direction).
     type :: knots_t
@@ -74,8 +74,24 @@ contains
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: x(:)
         real(dp), intent(out), optional :: dx(:, :)
+        integer, allocatable :: ids(:)
+        real(dp), allocatable :: r(:), dr(:, :)
+        call patch_basis(patch, u, ids, r, dr)
+        x = matmul(patch%cp(:, ids), r)
+        if (present(dx)) dx = matmul(patch%cp(:, ids), transpose(dr))
+    end subroutine patch_eval
+
+    !> The NURBS functions nonzero at the parameters `u` [pdim]: their flat control
+    !> point indices `ids` [nf], values `r` [nf] and first derivatives `dr`
+    !> [pdim, nf], nf = product(degree + 1), direction 1 fastest: the tensor-product
+    !> loop a solid element of any dimension evaluates at its quadrature points.
+    pure subroutine patch_basis(patch, u, ids, r, dr)
+        type(nurbs_patch_t), intent(in) :: patch
+        real(dp), intent(in) :: u(:)
+        integer, allocatable, intent(out) :: ids(:)
+        real(dp), allocatable, intent(out) :: r(:), dr(:, :)
         integer :: span(patch%pdim), local(patch%pdim), nf, a, d, e
-        real(dp), allocatable :: w(:), b(:), db(:, :), d2b(:, :), r(:), dr(:, :), d2r(:, :), pts(:, :)
+        real(dp), allocatable :: w(:), b(:), db(:, :), d2b(:, :), d2r(:, :)
         ! B-spline values and first derivatives per direction [2, p + 1, pdim]
         real(dp) :: values(2, maxval(patch%degree) + 1, patch%pdim)
 
@@ -84,13 +100,13 @@ contains
             values(:, 1:patch%degree(d) + 1, d) = basis_ders(patch%knots(d)%u, patch%degree(d), span(d), u(d), 1)
         end do
         nf = product(patch%degree + 1)
-        allocate (w(nf), b(nf), db(patch%pdim, nf), d2b(patch%pdim*(patch%pdim + 1)/2, nf), r(nf), &
-                  dr(patch%pdim, nf), d2r(patch%pdim*(patch%pdim + 1)/2, nf), pts(patch%nsd, nf))
+        allocate (ids(nf), w(nf), b(nf), db(patch%pdim, nf), d2b(patch%pdim*(patch%pdim + 1)/2, nf), r(nf), &
+                  dr(patch%pdim, nf), d2r(patch%pdim*(patch%pdim + 1)/2, nf))
         d2b = 0.0_dp
         local = 1
         do a = 1, nf
-            w(a) = patch%w(point_index(patch, span - patch%degree + local - 1))
-            pts(:, a) = patch%cp(:, point_index(patch, span - patch%degree + local - 1))
+            ids(a) = point_index(patch, span - patch%degree + local - 1)
+            w(a) = patch%w(ids(a))
             b(a) = 1.0_dp
             db(:, a) = 1.0_dp
             do e = 1, patch%pdim
@@ -102,9 +118,7 @@ contains
             call next_local(local, patch%degree + 1)
         end do
         call rationalize(w, b, db, d2b, r, dr, d2r)
-        x = matmul(pts, r)
-        if (present(dx)) dx = matmul(pts, transpose(dr))
-    end subroutine patch_eval
+    end subroutine patch_basis
 
     !> The next multi-index after `local` in [1, counts], the first fastest.
     pure subroutine next_local(local, counts)
