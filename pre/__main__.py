@@ -15,21 +15,32 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 
-def _cmd_geometry(args: argparse.Namespace) -> int:
-    from .spec import SpecError, write_from_spec
+def _from_spec(command: str, write: Callable[[], Any], spec: str) -> Any:
+    """Run ``write`` (a spec's writer); a bad spec is one line on stderr naming
+    ``python -m pre COMMAND`` and None."""
+    from .spec import SpecError
 
     try:
-        done = write_from_spec(args.spec, args.out, args.force)
+        return write()
     except (SpecError, FileNotFoundError, OSError) as err:
-        print(f"python -m pre geometry: {err}", file=sys.stderr)
-        return 2
+        print(f"python -m pre {command}: {err}", file=sys.stderr)
     except (ValueError, TypeError, KeyError, IndexError, ArithmeticError, RuntimeError) as err:
         # what the checks of spec_check.py and the builders did not name (a spline
         # library's own refusal): still one line, still bad input
-        print(f"python -m pre geometry: {args.spec}: {type(err).__name__}: {err}", file=sys.stderr)
+        print(f"python -m pre {command}: {spec}: {type(err).__name__}: {err}", file=sys.stderr)
+    return None
+
+
+def _cmd_geometry(args: argparse.Namespace) -> int:
+    from .spec import write_from_spec
+
+    done = _from_spec("geometry", lambda: write_from_spec(args.spec, args.out, args.force), args.spec)
+    if done is None:
         return 2
     if done.stale:
         print(f"python -m pre geometry: {done.case} and {done.geometry.name} differ from what "
@@ -52,16 +63,10 @@ def _cmd_geometry(args: argparse.Namespace) -> int:
 
 
 def _cmd_geometry3d(args: argparse.Namespace) -> int:
-    from .spec import SpecError
     from .spec3d import write_from_spec3d
 
-    try:
-        done = write_from_spec3d(args.spec, args.out, args.force)
-    except (SpecError, FileNotFoundError, OSError) as err:
-        print(f"python -m pre geometry3d: {err}", file=sys.stderr)
-        return 2
-    except (ValueError, TypeError, KeyError, IndexError, ArithmeticError, RuntimeError) as err:
-        print(f"python -m pre geometry3d: {args.spec}: {type(err).__name__}: {err}", file=sys.stderr)
+    done = _from_spec("geometry3d", lambda: write_from_spec3d(args.spec, args.out, args.force), args.spec)
+    if done is None:
         return 2
     if done.stale:
         print(f"python -m pre geometry3d: {done.geometry} differs from what {args.spec} gives now; "

@@ -166,16 +166,27 @@ def check_case_tables(path: Path, group: str, value: Any) -> None:
                             "the [[body]] tables)")
 
 
-def _need(b: dict[str, Any], key: str, what: str = "body") -> Any:
+def need(b: dict[str, Any], key: str, what: str = "body") -> Any:
+    """The value of ``key`` in the spec table ``b`` of a ``what`` (a body, ...), or a
+    SpecError naming it."""
     if key not in b:
         raise SpecError(f"{what} {b.get('name', '?')!r}: missing {key!r}")
     return b[key]
 
 
+def pick(objs: list[Any], b: dict[str, Any], what: str) -> Any:
+    """The object ``index`` (default 0) of a .g2 file's ``objs`` for the body ``b``
+    (``what``: 'surface' or 'volume', for the message)."""
+    index = int(b.get("index", 0))
+    if not 0 <= index < len(objs):
+        raise SpecError(f"body {b.get('name', '?')!r}: the .g2 file has {len(objs)} {what}(s), no index {index}")
+    return objs[index]
+
+
 def build_patch(b: dict[str, Any], folder: Path) -> Patch:
     """The patch of one ``[[body]]`` table (``folder``: where relative files are)."""
-    name = _need(b, "name")
-    shape = _need(b, "shape")
+    name = need(b, "name")
+    shape = need(b, "shape")
     if not isinstance(name, str) or not isinstance(shape, str):
         raise SpecError(f"body {name!r}: name and shape must be strings")
     if shape not in SHAPE_KEYS:
@@ -190,24 +201,21 @@ def build_patch(b: dict[str, Any], folder: Path) -> Patch:
     edges = b.get("edges")
     try:
         if shape == "rectangle":
-            return rectangle(_need(b, "x"), _need(b, "y"), edges)
+            return rectangle(need(b, "x"), need(b, "y"), edges)
         if shape == "annular_sector":
-            return annular_sector(_need(b, "centre"), _need(b, "r_in"), _need(b, "r_out"),
-                                  _need(b, "angles"), edges)
+            return annular_sector(need(b, "centre"), need(b, "r_in"), need(b, "r_out"),
+                                  need(b, "angles"), edges)
         if shape == "arc":
-            r, t = float(_need(b, "radius")), float(_need(b, "thickness"))
-            return annular_sector(_need(b, "centre"), r - t / 2, r + t / 2, _need(b, "angles"), edges)
+            r, t = float(need(b, "radius")), float(need(b, "thickness"))
+            return annular_sector(need(b, "centre"), r - t / 2, r + t / 2, need(b, "angles"), edges)
         if shape == "ellipse":
-            return ellipse_sector(_need(b, "centre"), _need(b, "semi_axes"), _need(b, "angles"),
+            return ellipse_sector(need(b, "centre"), need(b, "semi_axes"), need(b, "angles"),
                                   float(b.get("inner", 0.0)), edges)
         if shape == "polygon":
             arcs = {int(a["segment"]): float(a["radius"]) for a in b.get("arcs", [])}
-            return polygon(_need(b, "points"), b.get("corners"), arcs, edges)
-        objs = [o for o in read_g2(folder / _need(b, "file")) if o.pardim == 2]
-        index = int(b.get("index", 0))
-        if not 0 <= index < len(objs):
-            raise SpecError(f"body {name!r}: the .g2 file has {len(objs)} surface(s), no index {index}")
-        return body(objs[index], dict(edges or {}))
+            return polygon(need(b, "points"), b.get("corners"), arcs, edges)
+        objs = [o for o in read_g2(folder / need(b, "file")) if o.pardim == 2]
+        return body(pick(objs, b, "surface"), dict(edges or {}))
     except (ValueError, KeyError, TypeError) as err:
         if isinstance(err, SpecError):
             raise
@@ -219,8 +227,8 @@ def build_curve(c: dict[str, Any], folder: Path) -> Curve:
     are): an ``arc`` or ``ellipse`` (``side`` "inside", the default: the disc is the
     obstacle, or "outside"), a ``polyline`` or the ``index``-th curve of a ``.g2``
     file (``side`` "left" or "right" of the direction of travel: required)."""
-    name = _need(c, "name", "curve")
-    shape = _need(c, "shape", "curve")
+    name = need(c, "name", "curve")
+    shape = need(c, "shape", "curve")
     if not isinstance(name, str) or not isinstance(shape, str):
         raise SpecError(f"curve {name!r}: name and shape must be strings")
     if shape not in CURVE_SHAPE_KEYS:
@@ -234,16 +242,16 @@ def build_curve(c: dict[str, Any], folder: Path) -> Curve:
         raise SpecError(str(err)) from None
     try:
         if shape == "arc":
-            return obstacle_arc(_need(c, "centre", "curve"), float(_need(c, "radius", "curve")),
-                                _need(c, "angles", "curve"), str(c.get("side", "inside")))
+            return obstacle_arc(need(c, "centre", "curve"), float(need(c, "radius", "curve")),
+                                need(c, "angles", "curve"), str(c.get("side", "inside")))
         if shape == "ellipse":
-            return obstacle_ellipse(_need(c, "centre", "curve"), _need(c, "semi_axes", "curve"),
-                                    _need(c, "angles", "curve"), str(c.get("side", "inside")))
-        side = str(_need(c, "side", "curve"))
+            return obstacle_ellipse(need(c, "centre", "curve"), need(c, "semi_axes", "curve"),
+                                    need(c, "angles", "curve"), str(c.get("side", "inside")))
+        side = str(need(c, "side", "curve"))
         if shape == "polyline":
             arcs = {int(a["segment"]): float(a["radius"]) for a in c.get("arcs", [])}
-            return obstacle_polyline(_need(c, "points", "curve"), side, arcs)
-        objs = [o for o in read_g2(folder / _need(c, "file", "curve")) if o.pardim == 1]
+            return obstacle_polyline(need(c, "points", "curve"), side, arcs)
+        objs = [o for o in read_g2(folder / need(c, "file", "curve")) if o.pardim == 1]
         index = int(c.get("index", 0))
         if not 0 <= index < len(objs):
             raise SpecError(f"curve {name!r}: the .g2 file has {len(objs)} curve(s), no index {index}")

@@ -32,7 +32,7 @@ from .solids import (
     solid,
     write_volumes,
 )
-from .spec import SpecError, build_patch
+from .spec import SpecError, build_patch, need, pick
 from .spec_check import SpecCheckError, integer, non_finite, number, numbers, text
 from .volume import Volume, check_volume
 
@@ -87,15 +87,9 @@ def _check(b: dict[str, Any], label: str) -> None:
             raise SpecCheckError(f"{where} must be a table (a 2D body: shape = \"rectangle\", ...)")
 
 
-def _need(b: dict[str, Any], key: str) -> Any:
-    if key not in b:
-        raise SpecError(f"body {b.get('name', '?')!r}: missing {key!r}")
-    return b[key]
-
-
 def build_volume(b: dict[str, Any], folder: Path) -> Volume:
     """The volume of one ``[[body]]`` table (``folder``: where relative files are)."""
-    name, shape = _need(b, "name"), _need(b, "shape")
+    name, shape = need(b, "name"), need(b, "shape")
     if not isinstance(name, str) or not name or not isinstance(shape, str):
         raise SpecError(f"body {name!r}: name and shape must be strings")
     if shape not in SHAPES:
@@ -111,26 +105,22 @@ def build_volume(b: dict[str, Any], folder: Path) -> Volume:
     faces = b.get("faces")
     try:
         if shape == "box":
-            return box(_need(b, "x"), _need(b, "y"), _need(b, "z"), faces)
+            return box(need(b, "x"), need(b, "y"), need(b, "z"), faces)
         if shape == "cylinder_sector":
-            return cylinder_sector(_need(b, "r_in"), _need(b, "r_out"), b.get("angles", [0.0, 90.0]),
-                                   _need(b, "z"), b.get("centre", [0.0, 0.0]), faces)
+            return cylinder_sector(need(b, "r_in"), need(b, "r_out"), b.get("angles", [0.0, 90.0]),
+                                   need(b, "z"), b.get("centre", [0.0, 0.0]), faces)
         if shape == "shell_octant":
-            return shell_octant(_need(b, "r_in"), _need(b, "r_out"), b.get("centre", [0.0, 0.0, 0.0]),
+            return shell_octant(need(b, "r_in"), need(b, "r_out"), b.get("centre", [0.0, 0.0, 0.0]),
                                 faces)
         if shape in ("extrude", "revolve"):
-            section = build_patch({"name": f"{name} section", **_need(b, "section")}, folder)
+            section = build_patch({"name": f"{name} section", **need(b, "section")}, folder)
             if shape == "extrude":
-                vol = extrude(section, _need(b, "z"), b.get("ends", ["back", "front"]))
+                vol = extrude(section, need(b, "z"), b.get("ends", ["back", "front"]))
             else:
-                vol = revolve(section, _need(b, "angle"), b.get("axis_point", [0.0, 0.0]),
+                vol = revolve(section, need(b, "angle"), b.get("axis_point", [0.0, 0.0]),
                               b.get("axis_direction", [0.0, 1.0]), b.get("ends", ["plane", "turned"]))
             return vol.renamed(faces)
-        objs = read_g2_volumes(folder / _need(b, "file"))
-        index = int(b.get("index", 0))
-        if not 0 <= index < len(objs):
-            raise SpecError(f"body {name!r}: the .g2 file has {len(objs)} volume(s), no index {index}")
-        return solid(objs[index], dict(faces or {}))
+        return solid(pick(read_g2_volumes(folder / need(b, "file")), b, "volume"), dict(faces or {}))
     except (ValueError, KeyError, TypeError) as err:
         if isinstance(err, SpecError):
             raise

@@ -7,7 +7,8 @@ module test_patch
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
     use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, &
-                                 patch_insert, patch_boundary, point_index, patch_basis
+                                 patch_insert, patch_boundary, point_index, patch_basis, &
+                                 next_index, jacobian_determinant
     use voiga_nurbs_basis, only: distinct_knots
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_nurbs_rational, only: rationalize
@@ -272,7 +273,7 @@ contains
         type(knots_t) :: breaks(3)
         integer, allocatable :: ids(:)
         real(dp), allocatable :: r(:), dr(:, :)
-        real(dp) :: gx(ng), gw(ng), u(3), jac(3, 3), volume, unity
+        real(dp) :: gx(ng), gw(ng), u(3), mid(3), half(3), jac(3, 3), volume, unity
         integer :: span(3), q(3), d, s, m
         patch = ring_block()
         call patch_elevate(patch, 1, 1)
@@ -287,42 +288,24 @@ contains
         unity = 0.0_dp
         span = 1
         do s = 1, product([(size(breaks(d)%u) - 1, d=1, 3)])
+            do d = 1, 3
+                mid(d) = 0.5_dp*(breaks(d)%u(span(d)) + breaks(d)%u(span(d) + 1))
+                half(d) = 0.5_dp*(breaks(d)%u(span(d) + 1) - breaks(d)%u(span(d)))
+            end do
             q = 1
             do m = 1, ng**3
-                do d = 1, 3
-                    associate (b => breaks(d)%u)
-                        u(d) = 0.5_dp*(b(span(d)) + b(span(d) + 1)) + 0.5_dp*(b(span(d) + 1) - b(span(d)))*gx(q(d))
-                    end associate
-                end do
+                u = mid + half*gx(q)
                 call patch_basis(patch, u, ids, r, dr)
                 jac = matmul(patch%cp(:, ids), transpose(dr))
-                volume = volume + det3(jac)*product(gw(q))*product([(0.5_dp*(breaks(d)%u(span(d) + 1) - &
-                                                                             breaks(d)%u(span(d))), d=1, 3)])
+                volume = volume + jacobian_determinant(jac)*product(gw(q))*product(half)
                 unity = max(unity, abs(sum(r) - 1.0_dp), maxval(abs(sum(dr, 2))))
-                call step(q, [ng, ng, ng])
+                call next_index(q, [ng, ng, ng])
             end do
-            call step(span, [(size(breaks(d)%u) - 1, d=1, 3)])
+            call next_index(span, [(size(breaks(d)%u) - 1, d=1, 3)])
         end do
         call check(error, unity < tol, 'the functions are not a partition of unity')
         if (allocated(error)) return
         call check(error, abs(volume - 0.75_dp*pi) < 1.0e-12_dp, 'the volume is not 3 pi / 4')
     end subroutine test_volume_quadrature
-
-    pure subroutine step(idx, counts)
-        integer, intent(inout) :: idx(:)
-        integer, intent(in) :: counts(:)
-        integer :: d
-        do d = 1, size(idx)
-            idx(d) = idx(d) + 1
-            if (idx(d) <= counts(d)) return
-            idx(d) = 1
-        end do
-    end subroutine step
-
-    pure real(dp) function det3(a)
-        real(dp), intent(in) :: a(3, 3)
-        det3 = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
-               a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
-    end function det3
 
 end module test_patch

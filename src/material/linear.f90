@@ -2,7 +2,7 @@
 !> sigma = lambda tr(eps) I + 2 mu eps, eps = sym(grad u).
 module voiga_material_linear
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, identity2, delta
+    use voiga_material, only: material_t, identity2, delta, symmetric_identity
     implicit none
     private
 
@@ -65,7 +65,7 @@ contains
                 do j = 1, 3
                     do i = 1, 3
                         c(i, j, k, l) = self%lambda*delta(i, j)*delta(k, l) + &
-                                        self%mu*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+                                        2.0_dp*self%mu*symmetric_identity(i, j, k, l)
                     end do
                 end do
             end do

@@ -12,7 +12,7 @@ module voiga_material
     implicit none
     private
 
-    public :: material_t, lame_from_young, delta, identity2, von_mises, voigt_i, voigt_j
+    public :: material_t, lame_from_young, delta, symmetric_identity, identity2, von_mises, voigt_i, voigt_j
 
     !> The 2 x 2 identity: delta(i, j) as a constant array, for the inner loops of
     !> the laws (a lookup instead of a call; same values as `delta`).
@@ -135,5 +135,11 @@ contains
         integer, intent(in) :: i, j
         delta = merge(1.0_dp, 0.0_dp, i == j)
     end function delta
+
+    !> The symmetric fourth-order identity I_s = (d_ik d_jl + d_il d_jk) / 2.
+    pure real(dp) function symmetric_identity(i, j, k, l)
+        integer, intent(in) :: i, j, k, l
+        symmetric_identity = 0.5_dp*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+    end function symmetric_identity
 
 end module voiga_material

@@ -8,7 +8,7 @@
 module voiga_material_neohookean
     use, intrinsic :: iso_c_binding, only: c_double
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, delta
+    use voiga_material, only: material_t, delta, symmetric_identity
     implicit none
     private
 
@@ -124,7 +124,7 @@ contains
         real(dp), intent(in) :: grad_u(3, 3)
         real(dp), intent(out) :: s(3, 3), c(3, 3, 3, 3)
         logical, intent(out) :: ok
-        real(dp) :: f(3, 3), bbar(3, 3), jac, trb, a1, b1
+        real(dp) :: f(3, 3), bbar(3, 3), jac, trb, a1, b1, dd, is
         integer :: i, j, k, l
         s = 0.0_dp
         c = 0.0_dp
@@ -149,20 +149,16 @@ contains
             do k = 1, 3
                 do j = 1, 3
                     do i = 1, 3
-                        c(i, j, k, l) = a1*delta(i, j)*delta(k, l) - b1*sym(i, j, k, l) + 2.0_dp*self%mu/3.0_dp* &
-                                        (trb*(sym(i, j, k, l) + delta(i, j)*delta(k, l)/3.0_dp) - &
-                                         bbar(i, j)*delta(k, l) - delta(i, j)*bbar(k, l))
+                        dd = delta(i, j)*delta(k, l)
+                        is = symmetric_identity(i, j, k, l)
+                        c(i, j, k, l) = a1*dd - b1*is + 2.0_dp*self%mu/3.0_dp*(trb*(is + dd/3.0_dp) - &
+                                                                               bbar(i, j)*delta(k, l) - &
+                                                                               delta(i, j)*bbar(k, l))
                     end do
                 end do
             end do
         end do
     end subroutine neo_hookean_stress3
-
-    !> The symmetric fourth-order identity I_s.
-    pure real(dp) function sym(i, j, k, l)
-        integer, intent(in) :: i, j, k, l
-        sym = 0.5_dp*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
-    end function sym
 
     !> tau and the Voigt tangent at `n` points (`material_t%stress_points`), a chunk
     !> of points at a time: the per-point latency chain (cbrt, two divisions) of

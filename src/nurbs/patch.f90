@@ -16,7 +16,7 @@ module voiga_nurbs_patch
     private
 
     public :: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, patch_boundary
-    public :: point_index, patch_basis
+    public :: point_index, patch_basis, next_index, jacobian_determinant
 
     !> One knot vector (a patch has one per parametric direction).
     type :: knots_t
@@ -115,22 +115,34 @@ contains
                     db(d, a) = db(d, a)*values(merge(2, 1, d == e), local(e), e)
                 end do
             end do
-            call next_local(local, patch%degree + 1)
+            call next_index(local, patch%degree + 1)
         end do
         call rationalize(w, b, db, d2b, r, dr, d2r)
     end subroutine patch_basis
 
-    !> The next multi-index after `local` in [1, counts], the first fastest.
-    pure subroutine next_local(local, counts)
-        integer, intent(inout) :: local(:)
+    !> The next multi-index after `idx` in [1, counts], the first fastest (the
+    !> order of a patch's control points, and of any loop over spans or points).
+    pure subroutine next_index(idx, counts)
+        integer, intent(inout) :: idx(:)
         integer, intent(in) :: counts(:)
         integer :: d
-        do d = 1, size(local)
-            local(d) = local(d) + 1
-            if (local(d) <= counts(d)) return
-            local(d) = 1
+        do d = 1, size(idx)
+            idx(d) = idx(d) + 1
+            if (idx(d) <= counts(d)) return
+            idx(d) = 1
         end do
-    end subroutine next_local
+    end subroutine next_index
+
+    !> The determinant of a 2 x 2 or 3 x 3 Jacobian (`patch_eval`'s `dx` when pdim = nsd).
+    pure real(dp) function jacobian_determinant(a) result(det)
+        real(dp), intent(in) :: a(:, :)
+        if (size(a, 1) == 2) then
+            det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+        else
+            det = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
+                  a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
+        end if
+    end function jacobian_determinant
 
     !> Raise the degree along direction `dir` by `t` (each distinct knot gains
     !> multiplicity `t`: the continuity is kept; the geometry is unchanged).

@@ -10,7 +10,7 @@ module voiga_io_input_geometry
     use voiga_io_hdf5, only: h5file_t
     use voiga_nurbs_basis, only: distinct_knots
     use voiga_nurbs_surface, only: nurbs_surface_t, edge_labels, surface_patch
-    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, patch_eval, next_index, jacobian_determinant
     use voiga_nurbs_curve, only: nurbs_curve_t
     implicit none
     private
@@ -361,7 +361,7 @@ contains
                 end do
                 call patch_eval(patch, u, x, dx)
                 k = k + 1
-                det(k) = determinant(dx)
+                det(k) = jacobian_determinant(dx)
                 at(:, k) = [u, x]
                 call next_index(sample, spread(per_span, 1, patch%pdim))
             end do
@@ -404,28 +404,5 @@ contains
         write (buf, '(es10.3)') det
         text = text//'): det J = '//buf(1:10)
     end function sample_point
-
-    !> The next multi-index after `idx` in [1, counts], the first fastest.
-    pure subroutine next_index(idx, counts)
-        integer, intent(inout) :: idx(:)
-        integer, intent(in) :: counts(:)
-        integer :: d
-        do d = 1, size(idx)
-            idx(d) = idx(d) + 1
-            if (idx(d) <= counts(d)) return
-            idx(d) = 1
-        end do
-    end subroutine next_index
-
-    !> The determinant of a 2 x 2 or 3 x 3 Jacobian.
-    pure real(dp) function determinant(a)
-        real(dp), intent(in) :: a(:, :)
-        if (size(a, 1) == 2) then
-            determinant = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
-        else
-            determinant = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
-                          a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
-        end if
-    end function determinant
 
 end module voiga_io_input_geometry
