@@ -9,6 +9,7 @@ program voiga_tests
     use test_discretization, only: collect_discretization
     use test_solid, only: collect_solid, lame_table
     use test_element_kernel, only: collect_element_kernel
+    use test_solid3, only: collect_solid3
     use voiga_error, only: error_t
     use voiga_kinds, only: dp
     use test_sparse, only: collect_sparse
@@ -39,6 +40,7 @@ program voiga_tests
              new_testsuite('discretization', collect_discretization), &
              new_testsuite('solid', collect_solid), &
              new_testsuite('element_kernel', collect_element_kernel), &
+             new_testsuite('solid3', collect_solid3), &
              new_testsuite('sparse', collect_sparse), &
              new_testsuite('contact', collect_contact), &
              new_testsuite('stepping', collect_stepping), &

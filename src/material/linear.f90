@@ -2,7 +2,7 @@
 !> sigma = lambda tr(eps) I + 2 mu eps, eps = sym(grad u).
 module voiga_material_linear
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, identity2, delta, symmetric_identity
+    use voiga_material, only: material_t, identity2, delta
     implicit none
     private
 
@@ -64,8 +64,9 @@ contains
             do k = 1, 3
                 do j = 1, 3
                     do i = 1, 3
+                        ! 2 mu I_s = mu (d_ik d_jl + d_il d_jk)
                         c(i, j, k, l) = self%lambda*delta(i, j)*delta(k, l) + &
-                                        2.0_dp*self%mu*symmetric_identity(i, j, k, l)
+                                        self%mu*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
                     end do
                 end do
             end do

@@ -8,7 +8,7 @@
 module voiga_material_neohookean
     use, intrinsic :: iso_c_binding, only: c_double
     use voiga_kinds, only: dp
-    use voiga_material, only: material_t, delta, symmetric_identity
+    use voiga_material, only: material_t, delta
     implicit none
     private
 
@@ -150,10 +150,13 @@ contains
                 do j = 1, 3
                     do i = 1, 3
                         dd = delta(i, j)*delta(k, l)
-                        is = symmetric_identity(i, j, k, l)
+                        ! the symmetric identity I_s
+                        is = 0.5_dp*(delta(i, k)*delta(j, l) + delta(i, l)*delta(j, k))
+                        ! the two bbar terms added first: c_ijkl = c_klij to the bit (the 3D
+                        ! element then forms six of the nine blocks of K, voiga_element_solid3)
                         c(i, j, k, l) = a1*dd - b1*is + 2.0_dp*self%mu/3.0_dp*(trb*(is + dd/3.0_dp) - &
-                                                                               bbar(i, j)*delta(k, l) - &
-                                                                               delta(i, j)*bbar(k, l))
+                                                                               (bbar(i, j)*delta(k, l) + &
+                                                                                delta(i, j)*bbar(k, l)))
                     end do
                 end do
             end do
