@@ -6,6 +6,7 @@ module voiga_test_fixtures
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_nurbs_surface, only: nurbs_surface_t
+    use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t
     use voiga_model, only: model_t, new_model
@@ -18,6 +19,7 @@ module voiga_test_fixtures
     private
 
     public :: mortar_history
+    public :: ring_block
     public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model, body_settings
 
     !> The settings of a test scene, as a case file would give them.
@@ -37,6 +39,29 @@ module voiga_test_fixtures
     end type lcg_t
 
 contains
+
+    !> Quarter ring r in [1, 2], theta in [0, pi/2] (degree 1 x 2), extruded to
+    !> z in [0, 1] (degree 1): 2 x 3 x 2 control points.
+    function ring_block() result(patch)
+        type(nurbs_patch_t) :: patch
+        real(dp) :: cp(3, 12), w(12), arc(2, 3), warc(3)
+        integer :: i, j, k, a
+        arc = reshape([1.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 0.0_dp, 1.0_dp], [2, 3])
+        warc = [1.0_dp, 1.0_dp/sqrt(2.0_dp), 1.0_dp]
+        a = 0
+        do k = 1, 2
+            do j = 1, 3
+                do i = 1, 2
+                    a = a + 1
+                    cp(:, a) = [real(i, dp)*arc(:, j), real(k - 1, dp)]
+                    w(a) = warc(j)
+                end do
+            end do
+        end do
+        patch = new_patch([1, 2, 1], [knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]), &
+                                      knots_t([0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 1.0_dp]), &
+                                      knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp])], [2, 3, 2], cp, w)
+    end function ring_block
 
     !> The model of scene `c` on the discretizations `discs` (one per body); the
     !> load and contact lists default to empty.
@@ -73,12 +98,12 @@ contains
         character(len=*), intent(in) :: contact
         type(layout_t) :: layout
         integer :: dot, ios
-        layout%nel = nel
+        layout%nel(:2) = nel
         layout%contact_edge = contact
         ios = 0
         if (name == 'L1') then
             layout%basis = 'linear'
-            layout%degree = [1, 1]
+            layout%degree(:2) = [1, 1]
         else if (name(1:min(2, len(name))) == 'NN') then
             dot = index(name, '.')
             if (dot == 0) then

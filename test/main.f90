@@ -7,9 +7,11 @@ program voiga_tests
     use test_patch, only: collect_patch
     use test_material, only: collect_material
     use test_discretization, only: collect_discretization
+    use test_discretization_3d, only: collect_discretization_3d
     use test_solid, only: collect_solid, lame_table
+    use test_solid_3d, only: collect_solid_3d
     use test_element_kernel, only: collect_element_kernel
-    use test_solid3, only: collect_solid3
+    use test_element_kernel_3d, only: collect_element_kernel_3d
     use voiga_error, only: error_t
     use voiga_kinds, only: dp
     use test_sparse, only: collect_sparse
@@ -38,9 +40,11 @@ program voiga_tests
              new_testsuite('patch', collect_patch), &
              new_testsuite('material', collect_material), &
              new_testsuite('discretization', collect_discretization), &
+             new_testsuite('discretization_3d', collect_discretization_3d), &
              new_testsuite('solid', collect_solid), &
+             new_testsuite('solid_3d', collect_solid_3d), &
              new_testsuite('element_kernel', collect_element_kernel), &
-             new_testsuite('solid3', collect_solid3), &
+             new_testsuite('element_kernel_3d', collect_element_kernel_3d), &
              new_testsuite('sparse', collect_sparse), &
              new_testsuite('contact', collect_contact), &
              new_testsuite('stepping', collect_stepping), &

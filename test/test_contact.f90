@@ -452,7 +452,7 @@ contains
         type(dirichlet_settings_t) :: d
         d%body = b
         d%edge = edge
-        d%fix = fix
+        d%fix(:2) = fix
         d%values = values
     end function bc
 

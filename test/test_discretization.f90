@@ -6,7 +6,7 @@ module test_discretization
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
-    use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval
+    use voiga_nurbs_surface, only: nurbs_surface_t, surface_eval, surface_patch
     use voiga_discretization_layout, only: layout_t
     use voiga_discretization_patch, only: discretization_t, new_discretization, contact_boundary
     use voiga_discretization_size, only: body_size_t, body_size
@@ -40,6 +40,14 @@ contains
         type(nurbs_surface_t) :: s
         s = annulus_sector([2.5_dp, 3.0_dp], 2.0_dp, 3.0_dp, pi, 2)
     end function die
+
+    !> The names of the die's edges.
+    function die_edges() result(names)
+        character(len=32) :: names(4)
+        type(nurbs_surface_t) :: s
+        s = die()
+        names = s%edge_names
+    end function die_edges
 
     function slab() result(s)
         type(nurbs_surface_t) :: s
@@ -93,7 +101,7 @@ contains
         integer :: n
         n = element_nfun(disc, e)
         allocate (r(n), dr(2, n), d2r(3, n))
-        call element_basis(disc, e, xi, eta, r, dr, d2r)
+        call element_basis(disc, e, [xi, eta], r, dr, d2r)
         x = matmul(disc%x(:, disc%elements(e)%conn), r)
         jac = matmul(disc%x(:, disc%elements(e)%conn), transpose(dr))
     end subroutine element_map
@@ -113,10 +121,10 @@ contains
         do k = 1, 1000
             e = 1 + int(rng%uniform()*disc%nel)
             associate (el => disc%elements(e))
-                xi = el%xi(1) + rng%uniform()*(el%xi(2) - el%xi(1))
-                eta = el%eta(1) + rng%uniform()*(el%eta(2) - el%eta(1))
+                xi = el%lo(1) + rng%uniform()*(el%hi(1) - el%lo(1))
+                eta = el%lo(2) + rng%uniform()*(el%hi(2) - el%lo(2))
                 ! every fifth point on the contact edge, where normals matter
-                if (mod(k, 5) == 0 .and. el%ie == disc%nel_eta) eta = el%eta(2)
+                if (mod(k, 5) == 0 .and. el%index(2) == disc%nels(2)) eta = el%hi(2)
             end associate
             call element_map(disc, e, xi, eta, x, jac)
             call surface_eval(exact, xi, eta, xe, jace)
@@ -189,11 +197,11 @@ contains
             ! every point of the oriented map lies in the slab, and the contact edge on its edge
             do i = 1, 200
                 e = 1 + int(rng%uniform()*b%nel)
-                xi = b%elements(e)%xi(1) + rng%uniform()*(b%elements(e)%xi(2) - b%elements(e)%xi(1))
+                xi = b%elements(e)%lo(1) + rng%uniform()*(b%elements(e)%hi(1) - b%elements(e)%lo(1))
                 eta = 1.0_dp
-                if (b%elements(e)%ie /= b%nel_eta) eta = b%elements(e)%eta(1)
+                if (b%elements(e)%index(2) /= b%nels(2)) eta = b%elements(e)%lo(2)
                 call element_map(b, e, xi, eta, x, jac)
-                if (b%elements(e)%ie == b%nel_eta) then
+                if (b%elements(e)%index(2) == b%nels(2)) then
                     select case (k)
                     case (1); xe = [0.0_dp, x(2)]
                     case (2); xe = [9.0_dp, x(2)]
@@ -226,11 +234,11 @@ contains
             if (allocated(error)) return
             do k = 1, 500
                 e = 1 + int(rng%uniform()*d%nel)
-                xi = d%elements(e)%xi(1) + rng%uniform()*(d%elements(e)%xi(2) - d%elements(e)%xi(1))
-                eta = d%elements(e)%eta(1) + rng%uniform()*(d%elements(e)%eta(2) - d%elements(e)%eta(1))
+                xi = d%elements(e)%lo(1) + rng%uniform()*(d%elements(e)%hi(1) - d%elements(e)%lo(1))
+                eta = d%elements(e)%lo(2) + rng%uniform()*(d%elements(e)%hi(2) - d%elements(e)%lo(2))
                 n = element_nfun(d, e)
                 allocate (r(n), dr(2, n), d2r(3, n))
-                call element_basis(d, e, xi, eta, r, dr, d2r)
+                call element_basis(d, e, [xi, eta], r, dr, d2r)
                 call check(error, sum(r), 1.0_dp, trim(names(il))//': partition of unity', abs=1.0e-14_dp)
                 if (allocated(error)) return
                 call check(error, all(r >= 0.0_dp), trim(names(il))//': non-negativity')
@@ -265,17 +273,17 @@ contains
         if (allocated(error)) return
         do k = 1, 200
             ! VO elements are the last row
-            e = d%nel - d%nel_xi + 1 + int(rng%uniform()*d%nel_xi)
-            xi = d%elements(e)%xi(1) + (0.05_dp + 0.9_dp*rng%uniform())*(d%elements(e)%xi(2) - d%elements(e)%xi(1))
-            eta = d%elements(e)%eta(1) + (0.05_dp + 0.9_dp*rng%uniform())*(d%elements(e)%eta(2) - d%elements(e)%eta(1))
+            e = d%nel - d%nels(1) + 1 + int(rng%uniform()*d%nels(1))
+            xi = d%elements(e)%lo(1) + (0.05_dp + 0.9_dp*rng%uniform())*(d%elements(e)%hi(1) - d%elements(e)%lo(1))
+            eta = d%elements(e)%lo(2) + (0.05_dp + 0.9_dp*rng%uniform())*(d%elements(e)%hi(2) - d%elements(e)%lo(2))
             n = element_nfun(d, e)
             allocate (r(n), dr(2, n), d2r(3, n), rp(n), drp(2, n), d2rp(3, n), rm(n), drm(2, n), d2rm(3, n))
-            call element_basis(d, e, xi, eta, r, dr, d2r)
+            call element_basis(d, e, [xi, eta], r, dr, d2r)
             do dir = 1, 2
                 off = 0.0_dp
                 off(dir) = h
-                call element_basis(d, e, xi + off(1), eta + off(2), rp, drp, d2rp)
-                call element_basis(d, e, xi - off(1), eta - off(2), rm, drm, d2rm)
+                call element_basis(d, e, [xi + off(1), eta + off(2)], rp, drp, d2rp)
+                call element_basis(d, e, [xi - off(1), eta - off(2)], rm, drm, d2rm)
                 ! O(h^2) truncation and eps/h round-off: 1e-6 relative to O(10) derivatives
                 call check(error, dr(dir, :), (rp - rm)/(2*h), 'dR vs FD', rel=1.0e-6_dp, abs=1.0e-6_dp)
                 if (allocated(error)) return
@@ -307,10 +315,10 @@ contains
             u(i) = rng%uniform()
         end do
         do k = 1, 100
-            e_top = d%nel - d%nel_xi + 1 + int(rng%uniform()*d%nel_xi)
-            e_low = e_top - d%nel_xi
-            xi = d%elements(e_top)%xi(1) + rng%uniform()*(d%elements(e_top)%xi(2) - d%elements(e_top)%xi(1))
-            eta = d%elements(e_top)%eta(1)
+            e_top = d%nel - d%nels(1) + 1 + int(rng%uniform()*d%nels(1))
+            e_low = e_top - d%nels(1)
+            xi = d%elements(e_top)%lo(1) + rng%uniform()*(d%elements(e_top)%hi(1) - d%elements(e_top)%lo(1))
+            eta = d%elements(e_top)%lo(2)
             call eval(e_top, above, dabove)
             call eval(e_low, below, dbelow)
             call check(error, above, below, 'field across the VO row boundary', abs=1.0e-13_dp)
@@ -325,7 +333,7 @@ contains
             integer :: n
             n = element_nfun(d, e)
             allocate (r(n), dr(2, n), d2r(3, n))
-            call element_basis(d, e, xi, eta, r, dr, d2r)
+            call element_basis(d, e, [xi, eta], r, dr, d2r)
             val = dot_product(u(d%elements(e)%conn), r)
             dval = dot_product(u(d%elements(e)%conn), dr(1, :))
             deallocate (r, dr, d2r)
@@ -349,7 +357,7 @@ contains
         call expect(err, "contact_edge = 'nowhere'")
         if (allocated(error)) return
         layout = paper_layout('N2', [6, 1], 'outer')
-        layout%degree = [1, 2]
+        layout%degree(:2) = [1, 2]
         call new_discretization(d, die(), layout, 'x: ', err)
         call expect(err, 'degree_xi')
         if (allocated(error)) return
@@ -399,7 +407,7 @@ contains
                     if (m == 3) layout%knots_xi = [0.2_dp, 0.5_dp, 0.7_dp]
                     call new_discretization(d, die(), layout, '', error)
                     if (allocated(error)) return
-                    counted = body_size(die(), layout)
+                    counted = body_size(surface_patch(die()), die_edges(), layout)
                     entries = 0
                     do el = 1, d%nel
                         entries = entries + (2_int64*size(d%elements(el)%conn))**2

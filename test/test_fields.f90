@@ -125,8 +125,8 @@ contains
                    maxval(abs(f%strain(4, :) - 0.5_dp*(g(1, 2) + g(2, 1)))), 0.0_dp, 'exact strain', abs=1.0e-14_dp)
         if (allocated(error)) return
         associate (e1 => model%bodies(1)%disc%elements(1))
-            call check(error, f%element(1) == 1 .and. f%element(10) == 2 .and. f%xi(1) == e1%xi(1) .and. &
-                       f%xi(2) == 0.5_dp*(e1%xi(1) + e1%xi(2)) .and. f%eta(4) == 0.5_dp*(e1%eta(1) + e1%eta(2)), &
+            call check(error, f%element(1) == 1 .and. f%element(10) == 2 .and. f%xi(1) == e1%lo(1) .and. &
+                       f%xi(2) == 0.5_dp*(e1%lo(1) + e1%hi(1)) .and. f%eta(4) == 0.5_dp*(e1%lo(2) + e1%hi(2)), &
                        'order: element by element, xi fastest, ends included')
         end associate
     end subroutine test_samples

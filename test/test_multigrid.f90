@@ -286,14 +286,14 @@ contains
         c%bodies(1)%material = 'linear'
         c%bodies(1)%youngs_modulus = 1.0_dp
         c%bodies(1)%poisson_ratio = 0.3_dp
-        layout%nel = [n, n]
-        layout%degree = [2, 2]
+        layout%nel(:2) = [n, n]
+        layout%degree(:2) = [2, 2]
         c%bodies(1)%layout = layout
         c%solver%n_steps = [1]
         allocate (c%pressure(0), c%contact(0))
-        c%dirichlet = [dirichlet_settings_t(body='square', edge='bottom', fix=[.true., .true.], &
+        c%dirichlet = [dirichlet_settings_t(body='square', edge='bottom', fix=[.true., .true., .false.], &
                                             values=reshape([0.0_dp, 0.0_dp], [2, 1])), &
-                       dirichlet_settings_t(body='square', edge='left', fix=[.true., .false.], &
+                       dirichlet_settings_t(body='square', edge='left', fix=[.true., .false., .false.], &
                                             values=reshape([0.0_dp, 0.0_dp], [2, 1]))]
         call new_discretization(discs(1), rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), layout, '', error)
         if (allocated(error)) return

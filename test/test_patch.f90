@@ -12,7 +12,7 @@ module test_patch
     use voiga_nurbs_basis, only: distinct_knots
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_nurbs_rational, only: rationalize
-    use voiga_test_fixtures, only: lcg_t
+    use voiga_test_fixtures, only: lcg_t, ring_block
     implicit none
     private
 
@@ -35,29 +35,6 @@ contains
                     new_unittest('volume_by_quadrature_of_the_basis', test_volume_quadrature) &
                     ]
     end subroutine collect_patch
-
-    !> Quarter ring r in [1, 2], theta in [0, pi/2] (degree 1 x 2), extruded to
-    !> z in [0, 1] (degree 1): 2 x 3 x 2 control points.
-    function ring_block() result(patch)
-        type(nurbs_patch_t) :: patch
-        real(dp) :: cp(3, 12), w(12), arc(2, 3), warc(3)
-        integer :: i, j, k, a
-        arc = reshape([1.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 0.0_dp, 1.0_dp], [2, 3])
-        warc = [1.0_dp, 1.0_dp/sqrt(2.0_dp), 1.0_dp]
-        a = 0
-        do k = 1, 2
-            do j = 1, 3
-                do i = 1, 2
-                    a = a + 1
-                    cp(:, a) = [real(i, dp)*arc(:, j), real(k - 1, dp)]
-                    w(a) = warc(j)
-                end do
-            end do
-        end do
-        patch = new_patch([1, 2, 1], [knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]), &
-                                      knots_t([0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 1.0_dp]), &
-                                      knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp])], [2, 3, 2], cp, w)
-    end function ring_block
 
     !> Largest distance of the patch's map from the exact ring block at 200 random
     !> parameter points.

@@ -210,7 +210,7 @@ contains
                                             penalty_normal=1000.0_dp)]
             c%contact(1)%curve = circle_arc([1.0_dp, 1.0_dp], 1.0_dp, pi, 2)
             allocate (c%dirichlet(1))
-            c%dirichlet(1) = dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true.])
+            c%dirichlet(1) = dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true., .false.])
             if (move) then
                 c%contact(1)%rigid_motion = reshape([0.0_dp, -d], [2, 1])
                 c%dirichlet(1)%values = reshape([0.0_dp, 0.0_dp], [2, 1])

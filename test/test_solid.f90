@@ -66,7 +66,7 @@ contains
         type(dirichlet_settings_t) :: d
         d%body = 'block'
         d%edge = edge
-        d%fix = fix
+        d%fix(:2) = fix
         d%values = values
         c%dirichlet = [c%dirichlet, d]
     end subroutine add_dirichlet
@@ -121,8 +121,8 @@ contains
                 do j = 1, 4
                     do i = 1, 4
                         associate (el => b%disc%elements(e))
-                            call element_basis(b%disc, e, el%xi(1) + (gx(i) + 1)/2*(el%xi(2) - el%xi(1)), &
-                                               el%eta(1) + (gx(j) + 1)/2*(el%eta(2) - el%eta(1)), r, dr, d2r)
+                            call element_basis(b%disc, e, [el%lo(1) + (gx(i) + 1)/2*(el%hi(1) - el%lo(1)), &
+                                               el%lo(2) + (gx(j) + 1)/2*(el%hi(2) - el%lo(2))], r, dr, d2r)
                         end associate
                         call reference_gradients(b%disc%x(:, b%disc%elements(e)%conn), dr, dndx, det)
                         f = matmul(ue, transpose(dndx))
@@ -351,8 +351,8 @@ contains
         integer :: e, i, j, n, ng
         integer, allocatable :: dofs(:)
 
-        layout%degree = [p, p]
-        layout%nel = [nel, nel]
+        layout%degree(:2) = [p, p]
+        layout%nel(:2) = [nel, nel]
         c = one_body_case('linear', layout, 1000.0_dp, 0.3_dp)
         c%solver%n_gauss = 6
         ! quarter annulus 1 <= r <= 2 in the first quadrant: xi from angle 0 to 90 deg
@@ -377,9 +377,9 @@ contains
                 associate (el => b%disc%elements(e))
                     do j = 1, ng
                         do i = 1, ng
-                            xi = el%xi(1) + (gx(i) + 1)/2*(el%xi(2) - el%xi(1))
-                            eta = el%eta(1) + (gx(j) + 1)/2*(el%eta(2) - el%eta(1))
-                            call element_basis(b%disc, e, xi, eta, r, dr, d2r)
+                            xi = el%lo(1) + (gx(i) + 1)/2*(el%hi(1) - el%lo(1))
+                            eta = el%lo(2) + (gx(j) + 1)/2*(el%hi(2) - el%lo(2))
+                            call element_basis(b%disc, e, [xi, eta], r, dr, d2r)
                             call reference_gradients(b%disc%x(:, el%conn), dr, dndx, det)
                             x = matmul(b%disc%x(:, el%conn), r)
                             uh = matmul(reshape(u(dofs), [2, n]), r)

@@ -62,17 +62,17 @@ contains
         c%bodies(1)%material = 'neo-hookean'
         c%bodies(1)%youngs_modulus = 1.0_dp
         c%bodies(1)%poisson_ratio = 0.3_dp
-        layout%nel = [4, 4]
-        layout%degree = [2, 2]
+        layout%nel(:2) = [4, 4]
+        layout%degree(:2) = [2, 2]
         layout%contact_edge = 'top'
         c%bodies(1)%layout = layout
         c%solver%n_steps = n
         allocate (c%pressure(0), c%contact(0), top(2, size(squeeze)))
         top(1, :) = 0.0_dp
         top(2, :) = -squeeze
-        c%dirichlet = [dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true.], &
+        c%dirichlet = [dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true., .false.], &
                                             values=0.0_dp*top), &
-                       dirichlet_settings_t(body='block', edge='top', fix=[.true., .true.], values=top)]
+                       dirichlet_settings_t(body='block', edge='top', fix=[.true., .true., .false.], values=top)]
         settings = c%solver
         call new_discretization(discs(1), rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp), layout, '', error)
         if (allocated(error)) return

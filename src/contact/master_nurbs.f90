@@ -55,11 +55,11 @@ contains
         real(dp), allocatable :: r(:), dr(:, :), d2r(:, :)
         real(dp) :: jac(2, 2)
         integer :: e, n
-        e = disc%nel - disc%nel_xi/2
+        e = disc%nel - disc%nels(1)/2
         n = element_nfun(disc, e)
         allocate (r(n), dr(2, n), d2r(3, n))
         associate (el => disc%elements(e))
-            call element_basis(disc, e, 0.5_dp*sum(el%xi), el%eta(2), r, dr, d2r)
+            call element_basis(disc, e, [0.5_dp*(el%lo(1) + el%hi(1)), el%hi(2)], r, dr, d2r)
             jac = matmul(disc%x(:, el%conn), transpose(dr))
         end associate
         ! dX/deta points outward at eta = 1

@@ -51,8 +51,8 @@ contains
         integer, intent(in) :: dof0
         integer :: ny, c
         if (disc%has_layer) then
-            self%degree = disc%layer%degree
-            self%knots = disc%layer%knots
+            self%degree = disc%layer%degree(1)
+            self%knots = disc%layer%knots(1)%u
             self%w = disc%layer%w
             self%cps = disc%layer_id
         else
@@ -61,7 +61,7 @@ contains
             self%knots = disc%bulk%knots(1)%u
             ! the last eta row of the flat weights (xi fastest)
             self%w = disc%bulk%w((ny - 1)*disc%bulk%n(1) + 1:ny*disc%bulk%n(1))
-            self%cps = disc%bulk_id(:, ny)
+            self%cps = disc%bulk_id((ny - 1)*disc%bulk%n(1) + 1:ny*disc%bulk%n(1))
         end if
         allocate (self%dofs(disc%nsd, size(self%cps)))
         do c = 1, disc%nsd

@@ -72,9 +72,10 @@ contains
         if (disc%has_layer) then
             call layer_projection(disc, proj, error)
             if (allocated(error)) return
-            call coarsen(fine, disc%bulk_id, space, map, changed, error, proj, disc%layer_id, disc%layer%w)
+            call coarsen(fine, reshape(disc%bulk_id, disc%bulk%n(1:2)), space, map, changed, error, proj, &
+                         disc%layer_id, disc%layer%w)
         else
-            call coarsen(fine, disc%bulk_id, space, map, changed, error)
+            call coarsen(fine, reshape(disc%bulk_id, disc%bulk%n(1:2)), space, map, changed, error)
         end if
         map%n_fine = disc%ncp
     end subroutine coarsen_discretization
@@ -289,22 +290,22 @@ contains
         real(dp) :: u, wt
 
         p = disc%bulk%degree(1)
-        q = disc%layer%degree
-        nl = n_basis(disc%layer%knots, q)
+        q = disc%layer%degree(1)
+        nl = n_basis(disc%layer%knots(1)%u, q)
         nb = n_basis(disc%bulk%knots(1)%u, p)
         allocate (m(nl, nl), proj(nl, nb), gp(q + 1), gw(q + 1))
         m = 0.0_dp
         proj = 0.0_dp
         call gauss_legendre(q + 1, gp, gw)
         ! the layer has the bulk breakpoints along xi (docs/theory.md)
-        breaks = distinct_knots(disc%layer%knots)
+        breaks = distinct_knots(disc%layer%knots(1)%u)
         do e = 1, size(breaks) - 1
             do g = 1, q + 1
                 u = 0.5_dp*(breaks(e) + breaks(e + 1)) + 0.5_dp*(breaks(e + 1) - breaks(e))*gp(g)
                 wt = 0.5_dp*(breaks(e + 1) - breaks(e))*gw(g)
-                sl = find_span(disc%layer%knots, q, u)
+                sl = find_span(disc%layer%knots(1)%u, q, u)
                 sb = find_span(disc%bulk%knots(1)%u, p, u)
-                bl = basis_funs(disc%layer%knots, q, sl, u)
+                bl = basis_funs(disc%layer%knots(1)%u, q, sl, u)
                 bb = basis_funs(disc%bulk%knots(1)%u, p, sb, u)
                 do k = 1, q + 1
                     do i = 1, q + 1

@@ -9,9 +9,9 @@ module voiga_discretization_size
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
     use voiga_nurbs_basis, only: distinct_knots, multiplicity
-    use voiga_nurbs_surface, only: nurbs_surface_t, surface_reorient, edge_index
-    use voiga_discretization_layout, only: layout_t, basis_linear
-    use voiga_discretization_patch, only: new_knots
+    use voiga_nurbs_patch, only: nurbs_patch_t
+    use voiga_discretization_layout, only: layout_t, basis_linear, knot_list
+    use voiga_discretization_patch, only: new_knots, orient_for_contact
     implicit none
     private
 
@@ -19,96 +19,110 @@ module voiga_discretization_size
 
     !> Counts of one discretized body.
     type :: body_size_t
-        !> Control points (2 DOFs each) and elements.
+        !> Control points (nsd DOFs each) and elements.
         integer(int64) :: ncp = 0, nel = 0
-        !> Sum over the elements of (2 x control points of the element)^2: the
+        !> Spatial dimension (DOFs per control point).
+        integer :: nsd = 2
+        !> Sum over the elements of (nsd x control points of the element)^2: the
         !> entries of all element stiffness matrices, the size of the assembly map.
         integer(int64) :: entries = 0
     end type body_size_t
 
 contains
 
-    !> The counts `new_discretization` would give `coarse` with `layout` (the
-    !> layout is assumed valid: `validate_layout`, and the contact edge an edge of
-    !> the patch; degrees below the geometry's count as the geometry's).
-    pure function body_size(coarse, layout) result(counts)
-        type(nurbs_surface_t), intent(in) :: coarse
+    !> The counts `new_discretization` would give `coarse` (boundaries `names`) with
+    !> `layout` (the layout is assumed valid: `validate_layout`; a contact name
+    !> that is not a boundary leaves the patch as it is; degrees below the
+    !> geometry's count as the geometry's).
+    pure function body_size(coarse, names, layout) result(counts)
+        type(nurbs_patch_t), intent(in) :: coarse
+        character(len=*), intent(in) :: names(:)
         type(layout_t), intent(in) :: layout
         type(body_size_t) :: counts
-        type(nurbs_surface_t) :: oriented
-        integer(int64) :: n(2), spans(2), n_layer, nen, nen_vo
-        integer :: p(2), d, edge
+        type(nurbs_patch_t) :: oriented
+        character(len=32) :: oriented_as(size(names))
+        integer(int64) :: n(coarse%pdim), spans(coarse%pdim), n_layer, nen, nen_vo, nface, nsd
+        real(dp), allocatable :: explicit(:)
+        integer :: p(coarse%pdim), d, nd
+        logical :: found
 
-        oriented = coarse
-        if (len_trim(layout%contact_edge) > 0) then
-            edge = edge_index(coarse, layout%contact_edge)
-            if (edge > 0) call surface_reorient(oriented, edge)
-        end if
-        do d = 1, 2
+        nd = coarse%pdim
+        nsd = coarse%nsd
+        call orient_for_contact(coarse, names, layout%contact_edge, oriented, oriented_as, found)
+        do d = 1, nd
             if (trim(layout%basis) == basis_linear) then
                 p(d) = 1
             else
                 p(d) = max(layout%degree(d), oriented%degree(d))
             end if
-            call direction(d, p(d), n(d), spans(d))
+            call knot_list(layout, d, explicit)
+            call direction(oriented%knots(d)%u, oriented%degree(d), p(d), layout%nel(d), explicit, &
+                           trim(layout%basis) == basis_linear, n(d), spans(d))
         end do
-        counts%ncp = n(1)*n(2)
-        counts%nel = spans(1)*spans(2)
-        nen = int(p(1) + 1, int64)*(p(2) + 1)
-        counts%entries = counts%nel*(2*nen)**2
+        counts%nsd = coarse%nsd
+        counts%ncp = product(n)
+        counts%nel = product(spans)
+        nen = product(int(p + 1, int64))
+        counts%entries = counts%nel*(nsd*nen)**2
         if (layout%layer_degree > 0 .and. trim(layout%basis) /= basis_linear) then
-            n_layer = layer_functions()
-            counts%ncp = counts%ncp - n(1) + n_layer
-            nen_vo = int(p(1) + 1, int64)*p(2) + layout%layer_degree + layout%layer_elevations + 1
-            counts%entries = counts%entries - spans(1)*(2*nen)**2 + spans(1)*(2*nen_vo)**2
+            ! the layer replaces the bulk's points on the contact boundary; its
+            ! elements (one layer of spans across) have the layer's functions instead
+            ! of the bulk's last row
+            nface = counts%ncp/n(nd)
+            n_layer = 1
+            do d = 1, nd - 1
+                call knot_list(layout, d, explicit)
+                n_layer = n_layer*layer_functions(oriented%knots(d)%u, oriented%degree(d), layout, d, explicit)
+            end do
+            counts%ncp = counts%ncp - nface + n_layer
+            nen_vo = nen/(p(nd) + 1)*p(nd) + int(layout%layer_degree + layout%layer_elevations + 1, int64)**(nd - 1)
+            counts%entries = counts%entries + counts%nel/spans(nd)*((nsd*nen_vo)**2 - (nsd*nen)**2)
         end if
-    contains
-        !> Functions `n_dir` and element spans along direction `dir` at degree `deg`.
-        pure subroutine direction(dir, deg, n_dir, spans_dir)
-            integer, intent(in) :: dir, deg
-            integer(int64), intent(out) :: n_dir, spans_dir
-            real(dp), allocatable :: knots(:), inserted(:), breaks(:), explicit(:)
-            integer :: pc, k
-            if (dir == 1) then
-                knots = oriented%knots_xi
-                if (allocated(layout%knots_xi)) explicit = layout%knots_xi
-            else
-                knots = oriented%knots_eta
-                if (allocated(layout%knots_eta)) explicit = layout%knots_eta
-            end if
-            pc = oriented%degree(dir)
-            inserted = new_knots(knots, layout%nel(dir), explicit)
-            breaks = distinct_knots(knots)
-            spans_dir = int(size(breaks) - 1, int64) + size(inserted)
-            if (trim(layout%basis) == basis_linear) then
-                n_dir = spans_dir + 1
-                return
-            end if
-            ! elevation raises every distinct knot's multiplicity by deg - pc; each
-            ! inserted knot adds one function
-            n_dir = deg + 1 + size(inserted)
-            do k = 2, size(breaks) - 1
-                n_dir = n_dir + multiplicity(knots, breaks(k)) + (deg - pc)
-            end do
-        end subroutine direction
-
-        !> Functions of the VO layer: the contact edge's curve elevated to the layer
-        !> degree, the new knots inserted, then `layer_elevations` more elevations.
-        pure integer(int64) function layer_functions()
-            real(dp), allocatable :: knots(:), inserted(:), breaks(:), explicit(:)
-            integer :: q, e, pc, k
-            knots = oriented%knots_xi
-            if (allocated(layout%knots_xi)) explicit = layout%knots_xi
-            pc = oriented%degree(1)
-            q = layout%layer_degree
-            e = layout%layer_elevations
-            inserted = new_knots(knots, layout%nel(1), explicit)
-            breaks = distinct_knots(knots)
-            layer_functions = q + e + 1 + int(size(inserted), int64)*(1 + e)
-            do k = 2, size(breaks) - 1
-                layer_functions = layer_functions + multiplicity(knots, breaks(k)) + (q - pc) + e
-            end do
-        end function layer_functions
     end function body_size
+
+    !> Functions `n_dir` and element spans along one direction of knots `knots`
+    !> (degree `pc`) at degree `deg`, `nel` uniform elements or the `explicit` knots.
+    pure subroutine direction(knots, pc, deg, nel, explicit, linear, n_dir, spans_dir)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: pc, deg, nel
+        real(dp), allocatable, intent(in) :: explicit(:)
+        logical, intent(in) :: linear
+        integer(int64), intent(out) :: n_dir, spans_dir
+        real(dp), allocatable :: inserted(:), breaks(:)
+        integer :: k
+        inserted = new_knots(knots, nel, explicit)
+        breaks = distinct_knots(knots)
+        spans_dir = int(size(breaks) - 1, int64) + size(inserted)
+        if (linear) then
+            n_dir = spans_dir + 1
+            return
+        end if
+        ! elevation raises every distinct knot's multiplicity by deg - pc; each
+        ! inserted knot adds one function
+        n_dir = deg + 1 + size(inserted)
+        do k = 2, size(breaks) - 1
+            n_dir = n_dir + multiplicity(knots, breaks(k)) + (deg - pc)
+        end do
+    end subroutine direction
+
+    !> Functions of the VO layer along direction `d` of the contact boundary: the
+    !> boundary's knots (degree `pc`) elevated to the layer degree, the new knots
+    !> inserted, then `layer_elevations` more elevations.
+    pure integer(int64) function layer_functions(knots, pc, layout, d, explicit)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: pc, d
+        type(layout_t), intent(in) :: layout
+        real(dp), allocatable, intent(in) :: explicit(:)
+        real(dp), allocatable :: inserted(:), breaks(:)
+        integer :: q, e, k
+        q = layout%layer_degree
+        e = layout%layer_elevations
+        inserted = new_knots(knots, layout%nel(d), explicit)
+        breaks = distinct_knots(knots)
+        layer_functions = q + e + 1 + int(size(inserted), int64)*(1 + e)
+        do k = 2, size(breaks) - 1
+            layer_functions = layer_functions + multiplicity(knots, breaks(k)) + (q - pc) + e
+        end do
+    end function layer_functions
 
 end module voiga_discretization_size

@@ -6,11 +6,10 @@ module voiga_model_assembly_bulk
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_model, only: model_t
     use voiga_model_body, only: body_t
-    use voiga_model_loads, only: phase_value
+    use voiga_model_pressure, only: external_forces
     use voiga_text, only: str
-    use voiga_discretization_element, only: element_basis, element_nfun
-    use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: solid_element, solid_element_blocks, solid_element_force, element_work_t
+    use voiga_element_solid3, only: solid3_element, solid3_force, solid3_work_t
     use voiga_linalg_sparse, only: csc_matrix_t, pattern_positions, consecutive_runs
     use voiga_model_assembly_pattern, only: body_dofs, stiffness_pattern, assembly_map_t, &
                                             body_stiffness_t
@@ -47,17 +46,19 @@ contains
         call solid_element(body%mat, body%points(e), ue, fe, ke, ok, work)
     end subroutine body_element
 
-    !> Displacements `ue` [2, nen] of the control points of element `e` of `body`.
+    !> Displacements `ue` [nsd, nen] of the control points of element `e` of `body`.
     pure subroutine gather_displacements(body, e, u, ue)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
         real(dp), intent(in) :: u(:)
         real(dp), intent(out) :: ue(:, :)
-        integer :: a
+        integer :: a, c, nsd
+        nsd = size(ue, 1)
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                ue(1, a) = u(body%dof0 + 2*conn(a) - 1)
-                ue(2, a) = u(body%dof0 + 2*conn(a))
+                do c = 1, nsd
+                    ue(c, a) = u(body%dof0 + nsd*(conn(a) - 1) + c)
+                end do
             end do
         end associate
     end subroutine gather_displacements
@@ -101,11 +102,8 @@ contains
         !> With `k`: element positions; the linear bodies' stiffness is kept in it.
         type(assembly_map_t), intent(inout), optional :: map
         logical, intent(in), optional :: forces_only
-        real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
-        integer, allocatable :: dofs(:), runs(:)
-        type(element_work_t) :: work
-        integer :: ib, e, n, npts, idx, nr
-        logical :: ok, keep, by_dofs, tangent
+        integer :: ib, npts, idx
+        logical :: keep, by_dofs, tangent
         integer(i8) :: c0, c1, rate
 
         call system_clock(c0, rate)
@@ -133,49 +131,20 @@ contains
                     end if
                 end if
                 npts = product(body%n_gauss)
-                do e = 1, body%disc%nel
-                    n = 2*size(body%disc%elements(e)%conn)
-                    if (allocated(fe)) then
-                        if (size(fe) /= n) deallocate (fe, ue, runs)
-                    end if
-                    if (.not. allocated(fe)) allocate (fe(n), ue(2, n/2), runs(n/2 + 1))
-                    if (by_dofs) then
-                        if (allocated(ke)) then
-                            if (size(ke, 1) /= n) deallocate (ke)
-                        end if
-                        if (.not. allocated(ke)) allocate (ke(n, n))
-                        call body_element(body, e, u, fe, ke, ok, work)
-                    else
-                        call gather_displacements(body, e, u, ue)
-                        if (tangent) then
-                            call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
-                        else
-                            call solid_element_force(body%mat, body%points(e), ue, fe, ok, work)
-                        end if
-                    end if
-                    if (.not. ok) then
-                        call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
-                                         ': the deformation is inverted (J <= 0 at a quadrature point)', &
-                                         error_code%numeric)
-                        return
-                    end if
-                    idx = idx + 1
-                    call add_force(body, e, fe, r)
-                    if (by_dofs) then
-                        dofs = body_dofs(body, e)
-                        call k%add_element(dofs, ke)
-                    else if (tangent) then
-                        call consecutive_runs(body%disc%elements(e)%conn, runs, nr)
-                        call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), &
-                                        n/2, work%k4, size(work%k4, 1), work%sym)
-                    end if
-                end do
+                ! the kernel of the body's dimension (plane strain or solid)
+                if (body%disc%nsd == 2) then
+                    call assemble_plane(body, u, r, tangent, by_dofs, idx, error, k, map)
+                else
+                    call assemble_solid(body, u, r, tangent, by_dofs, idx, error, k, map)
+                end if
+                if (allocated(error)) return
                 if (body%mat%finite_strain) then
                     stats%finite_strain_points = stats%finite_strain_points + int(npts, i8)*body%disc%nel
                 else
                     stats%small_strain_points = stats%small_strain_points + int(npts, i8)*body%disc%nel
                     if (keep .and. tangent) &
-                        call keep_linear_body(k, body%dof0 + 1, body%dof0 + 2*body%disc%ncp, map%linear(ib))
+                        call keep_linear_body(k, body%dof0 + 1, body%dof0 + body%disc%nsd*body%disc%ncp, &
+                                             map%linear(ib))
                 end if
             end associate
         end do
@@ -189,18 +158,145 @@ contains
         stats%seconds_bulk = stats%seconds_bulk + real(c1 - c0, dp)/real(rate, dp)
     end subroutine assemble_bulk
 
-    !> r(dofs of element e) += fe (the element's force, local order 2(a-1) + i).
+    !> The elements of the plane body `body` into `r` and, with `tangent`, `k` (by DOF
+    !> numbers when `by_dofs`, else through `map`); `idx` counts the elements of all
+    !> bodies so far (the map's index).
+    subroutine assemble_plane(body, u, r, tangent, by_dofs, idx, error, k, map)
+        type(body_t), intent(in) :: body
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        logical, intent(in) :: tangent, by_dofs
+        integer, intent(inout) :: idx
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout), optional :: k
+        type(assembly_map_t), intent(in), optional :: map
+        real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
+        integer, allocatable :: dofs(:), runs(:)
+        type(element_work_t) :: work
+        integer :: e, n, nr
+        logical :: ok
+        do e = 1, body%disc%nel
+            n = 2*size(body%disc%elements(e)%conn)
+            if (allocated(fe)) then
+                if (size(fe) /= n) deallocate (fe, ue, runs)
+            end if
+            if (.not. allocated(fe)) allocate (fe(n), ue(2, n/2), runs(n/2 + 1))
+            if (by_dofs) then
+                if (allocated(ke)) then
+                    if (size(ke, 1) /= n) deallocate (ke)
+                end if
+                if (.not. allocated(ke)) allocate (ke(n, n))
+                call body_element(body, e, u, fe, ke, ok, work)
+            else
+                call gather_displacements(body, e, u, ue)
+                if (tangent) then
+                    call solid_element_blocks(body%mat, body%points(e), ue, fe, ok, work)
+                else
+                    call solid_element_force(body%mat, body%points(e), ue, fe, ok, work)
+                end if
+            end if
+            if (.not. ok) then
+                call inverted(body, e, error)
+                return
+            end if
+            idx = idx + 1
+            call add_force(body, e, fe, r)
+            if (by_dofs) then
+                dofs = body_dofs(body, e)
+                call k%add_element(dofs, ke)
+            else if (tangent) then
+                call consecutive_runs(body%disc%elements(e)%conn, runs, nr)
+                call add_mapped(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), &
+                                n/2, work%k4, size(work%k4, 1), work%sym)
+            end if
+        end do
+    end subroutine assemble_plane
+
+    !> `assemble_plane` for a solid: the three-dimensional kernel, its element
+    !> matrices added by DOF numbers or through `map` (`add_mapped_full`).
+    subroutine assemble_solid(body, u, r, tangent, by_dofs, idx, error, k, map)
+        type(body_t), intent(in) :: body
+        real(dp), intent(in) :: u(:)
+        real(dp), intent(inout) :: r(:)
+        logical, intent(in) :: tangent, by_dofs
+        integer, intent(inout) :: idx
+        type(error_t), allocatable, intent(out) :: error
+        type(csc_matrix_t), intent(inout), optional :: k
+        type(assembly_map_t), intent(in), optional :: map
+        real(dp), allocatable :: fe(:), ue(:, :), ke(:, :)
+        integer, allocatable :: runs(:)
+        type(solid3_work_t) :: work
+        integer :: e, n, nr
+        logical :: ok
+        do e = 1, body%disc%nel
+            n = 3*size(body%disc%elements(e)%conn)
+            if (allocated(fe)) then
+                if (size(fe) /= n) deallocate (fe, ue, ke, runs)
+            end if
+            if (.not. allocated(fe)) allocate (fe(n), ue(3, n/3), ke(n, n), runs(n/3 + 1))
+            call gather_displacements(body, e, u, ue)
+            if (tangent) then
+                call solid3_element(body%mat, body%points(e), ue, fe, ke, ok, work)
+            else
+                call solid3_force(body%mat, body%points(e), ue, fe, ok, work)
+            end if
+            if (.not. ok) then
+                call inverted(body, e, error)
+                return
+            end if
+            idx = idx + 1
+            call add_force(body, e, fe, r)
+            if (by_dofs) then
+                call k%add_element(body_dofs(body, e), ke)
+            else if (tangent) then
+                call consecutive_runs(body%disc%elements(e)%conn, runs, nr)
+                call add_mapped_full(k%values, map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), runs(1:nr + 1), 3, ke)
+            end if
+        end do
+    end subroutine assemble_solid
+
+    !> The error of element `e` of `body` whose deformation is inverted.
+    subroutine inverted(body, e, error)
+        type(body_t), intent(in) :: body
+        integer, intent(in) :: e
+        type(error_t), allocatable, intent(out) :: error
+        call fatal_error(error, "body '"//trim(body%name)//"' element "//str(e)// &
+                         ': the deformation is inverted (J <= 0 at a quadrature point)', error_code%numeric)
+    end subroutine inverted
+
+    !> values += ke for an element matrix in local DOF order (nsd(a-1) + i) through
+    !> the positions of its runs' first rows `starts` (`new_assembly_map`): the rows
+    !> of a run are consecutive values in each column.
+    pure subroutine add_mapped_full(values, starts, runs, nsd, ke)
+        real(dp), intent(inout) :: values(:)
+        integer, intent(in) :: runs(:), nsd
+        real(dp), intent(in) :: ke(:, :)
+        integer, intent(in) :: starts(size(runs) - 1, size(ke, 2))
+        integer :: b, t, p, i0, i1
+        do b = 1, size(ke, 2)
+            do t = 1, size(runs) - 1
+                p = starts(t, b)
+                i0 = nsd*(runs(t) - 1) + 1
+                i1 = nsd*(runs(t + 1) - 1)
+                values(p:p + i1 - i0) = values(p:p + i1 - i0) + ke(i0:i1, b)
+            end do
+        end do
+    end subroutine add_mapped_full
+
+    !> r(dofs of element e) += fe (the element's force, local order nsd(a-1) + i).
     pure subroutine add_force(body, e, fe, r)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
         real(dp), intent(in) :: fe(:)
         real(dp), intent(inout) :: r(:)
-        integer :: a, i
+        integer :: a, c, i, nsd
+        nsd = body%disc%nsd
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                i = body%dof0 + 2*conn(a)
-                r(i - 1) = r(i - 1) + fe(2*a - 1)
-                r(i) = r(i) + fe(2*a)
+                i = body%dof0 + nsd*(conn(a) - 1)
+                do c = 1, nsd
+                    r(i + c) = r(i + c) + fe(nsd*(a - 1) + c)
+                end do
             end do
         end associate
     end subroutine add_force
@@ -270,69 +366,5 @@ contains
             end do
         end do
     end subroutine add_mapped
-
-    !> External forces of the pressures at load time `t`: f_a = int R_a (-p N) ds on the
-    !> reference edge, N the outward unit normal.
-    subroutine external_forces(model, t, f)
-        type(model_t), intent(in) :: model
-        real(dp), intent(in) :: t
-        real(dp), intent(out) :: f(:)
-        real(dp), allocatable :: gx(:), wx(:), r(:), dr(:, :), d2r(:, :), x0(:, :)
-        integer, allocatable :: dofs(:)
-        real(dp) :: p, s, tang(2), inward(2), normal(2), xi, eta, h, jac(2, 2)
-        integer :: k, e, i, a, nen, dir, ng
-        logical :: on_edge
-
-        f = 0.0_dp
-        do k = 1, size(model%pressure)
-            p = phase_value(model%pressure(k)%values, t)
-            if (p == 0.0_dp) cycle
-            associate (body => model%bodies(model%pressure(k)%body), edge => model%pressure(k)%edge)
-                ! along xi for the eta edges (3, 4), along eta for the xi edges (1, 2)
-                dir = merge(1, 2, edge >= 3)
-                ng = body%n_gauss(dir)
-                allocate (gx(ng), wx(ng))
-                call gauss_legendre(ng, gx, wx)
-                do e = 1, body%disc%nel
-                    associate (el => body%disc%elements(e))
-                        select case (edge)
-                        case (1); on_edge = el%ix == 1
-                        case (2); on_edge = el%ix == body%disc%nel_xi
-                        case (3); on_edge = el%ie == 1
-                        case default; on_edge = el%ie == body%disc%nel_eta
-                        end select
-                        if (.not. on_edge) cycle
-                        nen = element_nfun(body%disc, e)
-                        allocate (r(nen), dr(2, nen), d2r(3, nen))
-                        x0 = body%disc%x(:, el%conn)
-                        dofs = body_dofs(body, e)
-                        h = 0.5_dp*merge(el%xi(2) - el%xi(1), el%eta(2) - el%eta(1), dir == 1)
-                        do i = 1, ng
-                            s = merge(el%xi(1), el%eta(1), dir == 1) + h*(gx(i) + 1.0_dp)
-                            select case (edge)
-                            case (1); xi = el%xi(1); eta = s
-                            case (2); xi = el%xi(2); eta = s
-                            case (3); xi = s; eta = el%eta(1)
-                            case default; xi = s; eta = el%eta(2)
-                            end select
-                            call element_basis(body%disc, e, xi, eta, r, dr, d2r)
-                            jac = matmul(x0, transpose(dr))
-                            tang = jac(:, dir)
-                            ! the other parametric direction points inward at a 0-edge
-                            inward = jac(:, 3 - dir)*merge(1.0_dp, -1.0_dp, edge == 1 .or. edge == 3)
-                            normal = [tang(2), -tang(1)]/norm2(tang)
-                            if (dot_product(normal, inward) > 0.0_dp) normal = -normal
-                            do a = 1, nen
-                                f(dofs(2*a - 1:2*a)) = f(dofs(2*a - 1:2*a)) - &
-                                                       p*r(a)*normal*norm2(tang)*wx(i)*h
-                            end do
-                        end do
-                        deallocate (r, dr, d2r)
-                    end associate
-                end do
-                deallocate (gx, wx)
-            end associate
-        end do
-    end subroutine external_forces
 
 end module voiga_model_assembly_bulk

@@ -31,8 +31,8 @@ module voiga_model_assembly_pattern
         !> Start of each element's entries in `pos`, over all bodies in order [nel_total + 1].
         integer, allocatable :: ptr(:)
         !> Index into the matrix values, for each column of each element's matrix
-        !> (local order 2(a-1) + i), of the first row of each run of its control points
-        !> with consecutive numbers (`consecutive_runs`) [nruns, 2 nen per element]: the rows
+        !> (local order nsd(a-1) + i), of the first row of each run of its control points
+        !> with consecutive numbers (`consecutive_runs`) [nruns, nsd nen per element]: the rows
         !> of a run are consecutive DOFs, so their entries are consecutive in any CSC
         !> pattern that has them.
         integer, allocatable :: pos(:)
@@ -46,16 +46,18 @@ module voiga_model_assembly_pattern
 
 contains
 
-    !> Global DOFs of element `e` of `body`, local order 2(a-1)+i, shape [2 nen].
+    !> Global DOFs of element `e` of `body`, local order nsd(a-1)+i, shape [nsd nen].
     pure function body_dofs(body, e) result(dofs)
         type(body_t), intent(in) :: body
         integer, intent(in) :: e
-        integer :: dofs(2*size(body%disc%elements(e)%conn))
-        integer :: a
+        integer :: dofs(body%disc%nsd*size(body%disc%elements(e)%conn))
+        integer :: a, c, nsd
+        nsd = body%disc%nsd
         associate (conn => body%disc%elements(e)%conn)
             do a = 1, size(conn)
-                dofs(2*a - 1) = body%dof0 + 2*conn(a) - 1
-                dofs(2*a) = body%dof0 + 2*conn(a)
+                do c = 1, nsd
+                    dofs(nsd*(a - 1) + c) = body%dof0 + nsd*(conn(a) - 1) + c
+                end do
             end do
         end associate
     end function body_dofs
@@ -80,7 +82,7 @@ contains
                 associate (conn => model%bodies(ib)%disc%elements(e)%conn)
                     call reserve(runs, size(conn) + 1)
                     call consecutive_runs(conn, runs, nr)
-                    map%ptr(idx + 1) = map%ptr(idx) + 2*size(conn)*nr
+                    map%ptr(idx + 1) = map%ptr(idx) + model%bodies(ib)%disc%nsd*size(conn)*nr
                 end associate
             end do
         end do
@@ -102,7 +104,8 @@ contains
                 if (.not. allocated(pos)) allocate (pos(m, m))
                 call k%element_positions(dofs, pos)
                 call consecutive_runs(model%bodies(ib)%disc%elements(e)%conn, runs, nr)
-                call run_positions(pos, runs(1:nr + 1), map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ok)
+                call run_positions(pos, runs(1:nr + 1), model%bodies(ib)%disc%nsd, &
+                                   map%pos(map%ptr(idx):map%ptr(idx + 1) - 1), ok)
                 if (.not. ok) then
                     call fatal_error(error, 'new_assembly_map: the entries of a run of DOFs are not '// &
                                      'consecutive in the stiffness pattern')
@@ -123,20 +126,20 @@ contains
         allocate (a(n))
     end subroutine reserve
 
-    !> `starts` [nr, m]: the position of each run's first row (2 runs(t) - 1) in each
+    !> `starts` [nr, m]: the position of each run's first row (nsd (runs(t) - 1) + 1) in each
     !> column of the element positions `pos` [m, m]; false if a run's rows are not
     !> at consecutive positions (a pattern that lacks one of them).
-    pure subroutine run_positions(pos, runs, starts, ok)
-        integer, intent(in) :: pos(:, :), runs(:)
+    pure subroutine run_positions(pos, runs, nsd, starts, ok)
+        integer, intent(in) :: pos(:, :), runs(:), nsd
         integer, intent(out) :: starts(size(runs) - 1, size(pos, 2))
         logical, intent(out) :: ok
         integer :: c, t, r0, r
         ok = .true.
         do c = 1, size(pos, 2)
             do t = 1, size(runs) - 1
-                r0 = 2*runs(t) - 1
+                r0 = nsd*(runs(t) - 1) + 1
                 starts(t, c) = pos(r0, c)
-                do r = r0 + 1, 2*runs(t + 1) - 2
+                do r = r0 + 1, nsd*(runs(t + 1) - 1)
                     ok = ok .and. pos(r, c) == pos(r0, c) + (r - r0)
                 end do
             end do
@@ -163,7 +166,7 @@ contains
         do ib = 1, size(model%bodies)
             nel = nel + model%bodies(ib)%disc%nel
             do e = 1, model%bodies(ib)%disc%nel
-                n = n + 2*size(model%bodies(ib)%disc%elements(e)%conn)
+                n = n + model%bodies(ib)%disc%nsd*size(model%bodies(ib)%disc%elements(e)%conn)
             end do
         end do
         ! the contact pairs' nonempty blocks (contact_pair_t%block_dofs): with a deformable master
@@ -191,7 +194,7 @@ contains
         do ib = 1, size(model%bodies)
             do e = 1, model%bodies(ib)%disc%nel
                 pos = pos + 1
-                n = 2*size(model%bodies(ib)%disc%elements(e)%conn)
+                n = model%bodies(ib)%disc%nsd*size(model%bodies(ib)%disc%elements(e)%conn)
                 ptr(pos + 1) = ptr(pos) + n
                 dofs(ptr(pos):ptr(pos + 1) - 1) = body_dofs(model%bodies(ib), e)
             end do

@@ -97,18 +97,18 @@ contains
                 do a = 1, size(el%conn)
                     ue(:, a) = u(body%dof0 + 2*el%conn(a) - 1:body%dof0 + 2*el%conn(a))
                 end do
-                xc = 0.5_dp*(el%xi(1) + el%xi(2))
-                ec = 0.5_dp*(el%eta(1) + el%eta(2))
-                call element_basis(body%disc, e, xc, ec, r, dr)
+                xc = 0.5_dp*(el%lo(1) + el%hi(1))
+                ec = 0.5_dp*(el%lo(2) + el%hi(2))
+                call element_basis(body%disc, e, [xc, ec], r, dr)
                 det_centre = reference_det(body%disc%x(:, el%conn), dr)
                 do j = 1, samples
-                    eta = el%eta(1) + t(j)*(el%eta(2) - el%eta(1))
+                    eta = el%lo(2) + t(j)*(el%hi(2) - el%lo(2))
                     do i = 1, samples
-                        xi = el%xi(1) + t(i)*(el%xi(2) - el%xi(1))
+                        xi = el%lo(1) + t(i)*(el%hi(1) - el%lo(1))
                         q = q + 1
-                        call element_basis(body%disc, e, xi, eta, r, dr)
+                        call element_basis(body%disc, e, [xi, eta], r, dr)
                         if (abs(reference_det(body%disc%x(:, el%conn), dr)) <= degenerate*abs(det_centre)) &
-                            call element_basis(body%disc, e, xi + nudge*(xc - xi), eta + nudge*(ec - eta), r, dr)
+                            call element_basis(body%disc, e, [xi + nudge*(xc - xi), eta + nudge*(ec - eta)], r, dr)
                         call reference_gradients(body%disc%x(:, el%conn), dr, dndx, det)
                         grad_u = matmul(ue, transpose(dndx))
                         call body%mat%fields(grad_u, out%stress(:, q), out%strain(:, q), ok)

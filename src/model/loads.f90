@@ -17,12 +17,13 @@ module voiga_model_loads
     !> change of nsd, not of every place that names one.
     character(len=1), parameter :: axis_names(3) = ['x', 'y', 'z']
 
-    !> A prescribed displacement on a named edge (docs/formats.md, `&dirichlet`).
+    !> A prescribed displacement on a named edge or face (docs/formats.md, `&dirichlet`).
     type :: dirichlet_settings_t
+        !> The body, and the name of its edge or face.
         character(len=32) :: body = '', edge = ''
-        !> Which components are prescribed [x, y].
-        logical :: fix(2) = .false.
-        !> Value at the end of each phase, shape [2, n_phases] (linear within a phase).
+        !> Which components are prescribed [x, y, z] (a plane body has no z).
+        logical :: fix(3) = .false.
+        !> Value at the end of each phase, shape [3, n_phases] (linear within a phase).
         real(dp), allocatable :: values(:, :)
     end type dirichlet_settings_t
 
@@ -34,14 +35,15 @@ module voiga_model_loads
         real(dp), allocatable :: values(:)
     end type pressure_settings_t
 
-    !> Prescribed displacement on the control points of an edge.
+    !> Prescribed displacement on the control points of an edge or face.
     type :: dirichlet_t
         integer :: body = 0
         character(len=32) :: edge = ''
-        !> Global DOF numbers of the edge's x and y components, shape [2, ncp_edge].
+        !> Global DOF numbers of its points' components, shape [nsd, ncp_edge].
         integer, allocatable :: dofs(:, :)
-        logical :: fix(2) = .false.
-        !> Value at the end of each phase [2, n_phases].
+        !> Which components are prescribed [x, y, z] (the first nsd used).
+        logical :: fix(3) = .false.
+        !> Value at the end of each phase [3, n_phases] (the first nsd rows used).
         real(dp), allocatable :: values(:, :)
     end type dirichlet_t
 

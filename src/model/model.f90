@@ -117,6 +117,11 @@ contains
             error%message = 'dirichlet: '//error%message//" of body '"//trim(inp%body)//"'"
             return
         end if
+        if (any(inp%fix(self%nsd + 1:))) then
+            call fatal_error(error, "dirichlet: fix_z on the plane body '"//trim(inp%body)// &
+                             "' (a plane body has the components x and y only)", error_code%input)
+            return
+        end if
         d%body = ib
         d%edge = inp%edge
         d%fix = inp%fix
@@ -139,8 +144,8 @@ contains
         p%body = ib
         p%edge = boundary_index(self%bodies(ib)%disc, inp%edge)
         if (p%edge == 0) then
-            call fatal_error(error, "pressure: no edge named '"//trim(inp%edge)//"' on body '"// &
-                             trim(inp%body)//"'", error_code%input)
+            call fatal_error(error, 'pressure: no '//trim(merge('edge', 'face', self%nsd == 2))//" named '"// &
+                             trim(inp%edge)//"' on body '"//trim(inp%body)//"'", error_code%input)
             return
         end if
         p%values = inp%values

@@ -16,7 +16,7 @@ module voiga_nurbs_patch
     private
 
     public :: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, patch_boundary
-    public :: point_index, patch_basis, next_index, jacobian_determinant
+    public :: point_index, patch_basis, next_index, jacobian_determinant, patch_orient, oriented_names
 
     !> One knot vector (a patch has one per parametric direction).
     type :: knots_t
@@ -228,6 +228,70 @@ contains
             end do
         end do
     end subroutine scatter_lines
+
+    !> Re-parametrize `patch` so that its boundary (`dir`, `side`) becomes the end of
+    !> the last direction, keeping the orientation (the sign of det J): the other
+    !> directions come first, in cyclic order after `dir`, and one parameter is
+    !> reversed (u' = a + b - u) where the permutation and the reversal of the last
+    !> direction would otherwise turn the patch inside out. New direction d is old
+    !> direction `perm(d)`, reversed when `flip(d)`. The geometry is unchanged (the
+    !> control points are copied, not computed). For a plane patch these are the
+    !> quarter and half turns of the parameter square (a contact edge made eta = 1).
+    pure subroutine patch_orient(patch, dir, side, oriented, perm, flip)
+        type(nurbs_patch_t), intent(in) :: patch
+        integer, intent(in) :: dir, side
+        type(nurbs_patch_t), intent(out) :: oriented
+        integer, intent(out) :: perm(patch%pdim)
+        logical, intent(out) :: flip(patch%pdim)
+        integer :: d, nd, old(patch%pdim), new(patch%pdim), k
+        logical :: odd
+
+        nd = patch%pdim
+        perm = [(mod(dir + d - 1, nd) + 1, d=1, nd)]
+        flip = .false.
+        flip(nd) = side == 0
+        ! a cyclic shift of nd directions is an odd permutation when nd is even
+        odd = mod(nd, 2) == 0 .and. perm(1) /= 1
+        if (odd .neqv. flip(nd)) flip(1) = .true.
+        oriented%pdim = nd
+        oriented%nsd = patch%nsd
+        oriented%degree = patch%degree(perm)
+        oriented%n = patch%n(perm)
+        allocate (oriented%knots(nd), oriented%cp(patch%nsd, size(patch%w)), oriented%w(size(patch%w)))
+        do d = 1, nd
+            associate (u => patch%knots(perm(d))%u)
+                if (flip(d)) then
+                    oriented%knots(d)%u = u(1) + u(size(u)) - u(size(u):1:-1)
+                else
+                    oriented%knots(d)%u = u
+                end if
+            end associate
+        end do
+        new = 1
+        do k = 1, size(patch%w)
+            do d = 1, nd
+                old(perm(d)) = merge(oriented%n(d) + 1 - new(d), new(d), flip(d))
+            end do
+            oriented%cp(:, k) = patch%cp(:, point_index(patch, old))
+            oriented%w(k) = patch%w(point_index(patch, old))
+            call next_index(new, oriented%n)
+        end do
+    end subroutine patch_orient
+
+    !> The names of the boundaries [2 pdim] (direction by direction, start before
+    !> end) of the patch `patch_orient` made with `perm` and `flip`, from `names`.
+    pure function oriented_names(names, perm, flip) result(new)
+        character(len=*), intent(in) :: names(:)
+        integer, intent(in) :: perm(:)
+        logical, intent(in) :: flip(:)
+        character(len=len(names)) :: new(size(names))
+        integer :: d, s
+        do d = 1, size(perm)
+            do s = 0, 1
+                new(2*d - 1 + s) = names(2*perm(d) - 1 + merge(1 - s, s, flip(d)))
+            end do
+        end do
+    end function oriented_names
 
     !> The boundary patch (parametric dimension pdim - 1) where the parameter of
     !> direction `dir` is at its start (`side` 0) or end (`side` 1); its directions

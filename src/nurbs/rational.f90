@@ -9,7 +9,7 @@ module voiga_nurbs_rational
     implicit none
     private
 
-    public :: rationalize
+    public :: rationalize, hessian_pair
 
 contains
 

@@ -73,7 +73,7 @@ contains
         off_f = dof0
         do ib = 1, nb
             ncp(ib) = discs(ib)%ncp
-            grids(ib)%ids = discs(ib)%bulk_id
+            grids(ib)%ids = reshape(discs(ib)%bulk_id, discs(ib)%bulk%n(1:2))
             grids(ib)%extra = discs(ib)%layer_id
         end do
         allocate (levels(1))

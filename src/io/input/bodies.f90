@@ -5,10 +5,11 @@
 module voiga_io_input_bodies
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_io_input_case, only: case_t
+    use voiga_model_body, only: body_settings_t
     use voiga_io_hdf5, only: h5file_t
     use voiga_io_input_geometry, only: read_patch, read_volume, read_curve
     use voiga_io_input_resources, only: check_size
-    use voiga_nurbs_surface, only: nurbs_surface_t
+    use voiga_nurbs_surface, only: nurbs_surface_t, surface_patch
     use voiga_nurbs_patch, only: nurbs_patch_t
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_size, only: body_size_t, body_size
@@ -17,6 +18,12 @@ module voiga_io_input_bodies
     private
 
     public :: discretize_bodies, read_rigid_curves
+
+    !> A body's exact patch as the geometry file gives it, and its boundaries' names.
+    type :: coarse_body_t
+        type(nurbs_patch_t) :: patch
+        character(len=32), allocatable :: names(:)
+    end type coarse_body_t
 
 contains
 
@@ -28,7 +35,7 @@ contains
         type(discretization_t), allocatable, intent(out) :: discs(:)
         type(error_t), allocatable, intent(out) :: error
         logical, intent(in), optional :: memory_check
-        type(nurbs_surface_t), allocatable :: coarse(:)
+        type(coarse_body_t), allocatable :: coarse(:)
         type(body_size_t), allocatable :: sizes(:)
         logical :: check_memory
         integer :: i
@@ -37,31 +44,91 @@ contains
         if (present(memory_check)) check_memory = memory_check
         call read_patches(case, coarse, error)
         if (allocated(error)) return
+        call check_dimensions(case, coarse, error)
+        if (allocated(error)) return
         allocate (sizes(size(coarse)))
         do i = 1, size(coarse)
-            ! the counts are taken from a layout known to be valid
-            call validate_layout(case%bodies(i)%layout, case%path//": &body '"//trim(case%bodies(i)%name)// &
-                                 "': ", error)
+            call check_contact_key(case%bodies(i), coarse(i)%patch%pdim, case%path, error)
             if (allocated(error)) return
-            sizes(i) = body_size(coarse(i), case%bodies(i)%layout)
+            ! the counts are taken from a layout known to be valid
+            call validate_layout(case%bodies(i)%layout, coarse(i)%patch%pdim, case%path//": &body '"// &
+                                 trim(case%bodies(i)%name)//"': ", error)
+            if (allocated(error)) return
+            sizes(i) = body_size(coarse(i)%patch, coarse(i)%names, case%bodies(i)%layout)
         end do
         call check_size(sizes, case%solver%linear_solver, check_memory, case%path//': ', error)
         if (allocated(error)) return
         allocate (discs(size(case%bodies)))
         do i = 1, size(case%bodies)
-            call new_discretization(discs(i), coarse(i), case%bodies(i)%layout, &
+            call new_discretization(discs(i), coarse(i)%patch, coarse(i)%names, case%bodies(i)%layout, &
                                     case%path//": &body '"//trim(case%bodies(i)%name)//"': ", error)
             if (allocated(error)) return
         end do
     end subroutine discretize_bodies
 
+    !> The bodies of a case are all plane or all solid; a solid model has no contact
+    !> and no multigrid path yet (issues 42 and 41: docs/formats.md, "Solids").
+    subroutine check_dimensions(case, coarse, error)
+        type(case_t), intent(in) :: case
+        type(coarse_body_t), intent(in) :: coarse(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        do i = 2, size(coarse)
+            if (coarse(i)%patch%pdim /= coarse(1)%patch%pdim) then
+                call fatal_error(error, case%path//": &body '"//trim(case%bodies(i)%name)//"' is "// &
+                                 kind_of(coarse(i)%patch%pdim)//" but &body '"//trim(case%bodies(1)%name)// &
+                                 "' is "//kind_of(coarse(1)%patch%pdim)//': the bodies of a case must all be '// &
+                                 'plane or all be solids', error_code%input)
+                return
+            end if
+        end do
+        if (size(coarse) == 0) return
+        if (coarse(1)%patch%pdim /= 3) return
+        if (size(case%contact) > 0) then
+            call fatal_error(error, case%path//': &contact: contact between solids (volumes) is not '// &
+                             'implemented yet; a solid case has bodies, loads and no &contact (docs/formats.md, '// &
+                             '"Solids")', error_code%input)
+        else if (trim(case%solver%linear_solver) == 'multigrid') then
+            call fatal_error(error, case%path//": &solver linear_solver = 'multigrid' is not available for "// &
+                             "solids yet: use 'direct' (docs/formats.md, ""Solids"")", error_code%input)
+        end if
+    end subroutine check_dimensions
+
+    !> 'a plane body' or 'a solid'.
+    pure function kind_of(pdim) result(words)
+        integer, intent(in) :: pdim
+        character(len=:), allocatable :: words
+        words = 'a solid'
+        if (pdim == 2) words = 'a plane body'
+    end function kind_of
+
+    !> A plane body's contact boundary is an edge (`contact_edge`), a solid's a face
+    !> (`contact_face`): the key the case used must fit the body's geometry.
+    subroutine check_contact_key(body, pdim, path, error)
+        type(body_settings_t), intent(in) :: body
+        integer, intent(in) :: pdim
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
+        character(len=12) :: expected
+        character(len=:), allocatable :: what
+        if (len_trim(body%layout%contact_edge) == 0) return
+        expected = merge('contact_edge', 'contact_face', pdim == 2)
+        if (body%contact_key == expected) return
+        what = 'a volume (its boundaries are faces)'
+        if (pdim == 2) what = 'a plane patch (its boundaries are edges)'
+        call fatal_error(error, path//": &body '"//trim(body%name)//"': "//trim(body%contact_key)//" = '"// &
+                         trim(body%layout%contact_edge)//"': the body is "//what//': use '//trim(expected), &
+                         error_code%input)
+    end subroutine check_contact_key
+
     !> The coarse patch of every body of `case`, from its geometry file.
     subroutine read_patches(case, coarse, error)
         type(case_t), intent(in) :: case
-        type(nurbs_surface_t), allocatable, intent(out) :: coarse(:)
+        type(coarse_body_t), allocatable, intent(out) :: coarse(:)
         type(error_t), allocatable, intent(out) :: error
         type(h5file_t) :: geo
         type(error_t), allocatable :: close_error
+        type(nurbs_surface_t) :: plane
         integer, allocatable :: dims(:)
         integer :: i
 
@@ -75,9 +142,14 @@ contains
             ! (three degrees: a volume)
             dims = geo%shape('/bodies/'//trim(case%bodies(i)%name)//'/degree')
             if (size(dims) == 1 .and. sum(dims) == 3) then
-                call refuse_volume(geo, case%bodies(i)%name, error)
+                allocate (coarse(i)%names(6))
+                call read_volume(geo, case%bodies(i)%name, coarse(i)%patch, coarse(i)%names, error)
             else
-                call read_patch(geo, case%bodies(i)%name, coarse(i), error)
+                call read_patch(geo, case%bodies(i)%name, plane, error)
+                if (.not. allocated(error)) then
+                    coarse(i)%patch = surface_patch(plane)
+                    coarse(i)%names = plane%edge_names
+                end if
             end if
             if (allocated(error)) then
                 error%message = case%path//": &body '"//trim(case%bodies(i)%name)//"': name: "// &
@@ -88,21 +160,6 @@ contains
         call geo%close(close_error)
         if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
     end subroutine read_patches
-
-    !> A volume (a three-dimensional body): read and checked as any patch (a bad one
-    !> is refused for its fault), then refused, since the solver takes plane bodies
-    !> only so far.
-    subroutine refuse_volume(geo, name, error)
-        type(h5file_t), intent(inout) :: geo
-        character(len=*), intent(in) :: name
-        type(error_t), allocatable, intent(out) :: error
-        type(nurbs_patch_t) :: volume
-        character(len=32) :: faces(6)
-        call read_volume(geo, name, volume, faces, error)
-        if (allocated(error)) return
-        call fatal_error(error, geo%path//": body '"//trim(name)//"' is a volume (a three-dimensional body, "// &
-                         'valid): voiga solves plane bodies only so far; docs/formats.md', error_code%input)
-    end subroutine refuse_volume
 
     !> Read the curve of every contact pair whose rigid master is one
     !> (`&contact rigid_curve`) from the geometry file into `case%contact(k)%curve`.

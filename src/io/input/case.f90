@@ -249,21 +249,31 @@ contains
         do k = 1, size(self%dirichlet)
             ib = findloc(self%bodies%name, self%dirichlet(k)%body, dim=1)
             if (has_edge(discs(ib), self%dirichlet(k)%edge)) cycle
-            write (buf, '(a,i0,a)') ': &dirichlet (', k, '): edge: '
-            call fatal_error(error, self%path//trim(buf)//" no edge named '"//trim(self%dirichlet(k)%edge)// &
-                             "' of body '"//trim(self%dirichlet(k)%body)//"' (edges: "// &
-                             edge_names(discs(ib))//')', error_code%input)
+            write (buf, '(a,i0,a)') ': &dirichlet (', k, '): '
+            call missing(self%path//trim(buf), self%dirichlet(k)%edge, ' of body ', self%dirichlet(k)%body, &
+                         discs(ib), error)
             return
         end do
         do k = 1, size(self%pressure)
             ib = findloc(self%bodies%name, self%pressure(k)%body, dim=1)
             if (has_edge(discs(ib), self%pressure(k)%edge)) cycle
-            write (buf, '(a,i0,a)') ': &pressure (', k, '): edge: '
-            call fatal_error(error, self%path//trim(buf)//" no edge named '"//trim(self%pressure(k)%edge)// &
-                             "' on body '"//trim(self%pressure(k)%body)//"' (edges: "// &
-                             edge_names(discs(ib))//')', error_code%input)
+            write (buf, '(a,i0,a)') ': &pressure (', k, '): '
+            call missing(self%path//trim(buf), self%pressure(k)%edge, ' on body ', self%pressure(k)%body, &
+                         discs(ib), error)
             return
         end do
+    contains
+        !> The error of a load on `name`, which is no edge (a plane body) or face (a
+        !> solid) of `body`.
+        subroutine missing(where, name, link, body, disc, error)
+            character(len=*), intent(in) :: where, name, link, body
+            type(discretization_t), intent(in) :: disc
+            type(error_t), allocatable, intent(out) :: error
+            character(len=4) :: entity
+            entity = merge('edge', 'face', disc%pdim == 2)
+            call fatal_error(error, where//entity//': no '//entity//" named '"//trim(name)//"'"//link//"'"// &
+                             trim(body)//"' ("//entity//'s: '//edge_names(disc)//')', error_code%input)
+        end subroutine missing
     end subroutine check_edges
 
     pure logical function has_edge(disc, name)

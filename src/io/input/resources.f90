@@ -32,7 +32,7 @@ contains
         type(body_size_t), intent(in) :: sizes(:)
         character(len=*), intent(in) :: linear_solver
         real(dp) :: ndof, entries
-        ndof = 2.0_dp*real(sum(sizes%ncp), dp)
+        ndof = real(sum(sizes%nsd*sizes%ncp), dp)
         entries = real(sum(sizes%entries), dp)
         memory_estimate = base_bytes + entries*log(max(ndof, 2.0_dp))/log(2.0_dp)* &
                           merge(per_entry_multigrid, per_entry_direct, trim(linear_solver) == 'multigrid')
@@ -50,7 +50,7 @@ contains
         integer(int64) :: physical, address
         character(len=200) :: counts
 
-        ndof = 2*sum(sizes%ncp)
+        ndof = sum(sizes%nsd*sizes%ncp)
         entries = sum(sizes%entries)
         write (counts, '(i0,a,i0,a,i0,a)') ndof, ' DOFs, ', sum(sizes%nel), ' elements, ', entries, &
             ' element matrix entries'

@@ -133,8 +133,13 @@ contains
         character(len=:), allocatable, intent(out) :: text
         character(len=:), allocatable :: g, s
         type(error_t), allocatable :: error
-        integer :: i, n, c
+        integer :: i, n, c, nsd
         text = ''
+        ! the model's dimension (a file without the attribute is a plane model's)
+        nsd = 2
+        if (h5%has_attr('/', 'dimension')) call h5%read_attr_int('/', 'dimension', nsd, error)
+        if (allocated(error) .or. nsd < 2 .or. nsd > 3) nsd = 2
+        if (allocated(error)) deallocate (error)
         call compare_int(h5, '/', 'n_steps_planned', case%solver%total_steps(), '&solver n_steps (steps in all)', text)
         call compare_str(h5, '/', 'linear_solver', trim(case%solver%linear_solver), '&solver linear_solver', text)
         call compare_str(h5, '/', 'damping', trim(case%solver%damping), '&solver damping', text)
@@ -157,17 +162,30 @@ contains
             s = '&dirichlet ('//str(i)//')'
             call compare_str(h5, g, 'body', trim(case%dirichlet(i)%body), s//' body', text)
             call compare_str(h5, g, 'edge', trim(case%dirichlet(i)%edge), s//' edge', text)
-            ! (the flags the writer writes: one per axis, `results.f90` write_dirichlet)
-            do c = 1, size(case%dirichlet(i)%fix)
+            ! (the flags and values the writer writes: one per axis of the model,
+            ! `results.f90` write_dirichlet)
+            do c = 1, nsd
                 call compare_int(h5, g, 'fix_'//axis_names(c), merge(1, 0, case%dirichlet(i)%fix(c)), &
                                  s//' fix_'//axis_names(c), text)
             end do
-            call compare_values(h5, g//'/values', case%dirichlet(i)%values, s//' ux, uy', text)
+            call compare_values(h5, g//'/values', case%dirichlet(i)%values(1:nsd, :), s//' '//components(nsd), text)
         end do
         call h5%read_attr_int('/', 'n_steps_done', n, error)
         if (.not. allocated(error)) call compare_contact(h5, case, n, text)
         if (len(text) > 0) text = ' ('//text//')'
     end subroutine recorded_differences
+
+    !> The names of the displacement components of a model of dimension `nsd`:
+    !> 'ux, uy' or 'ux, uy, uz'.
+    pure function components(nsd) result(names)
+        integer, intent(in) :: nsd
+        character(len=:), allocatable :: names
+        integer :: c
+        names = 'u'//axis_names(1)
+        do c = 2, nsd
+            names = names//', u'//axis_names(c)
+        end do
+    end function components
 
     !> The contact laws recorded with the last written step.
     subroutine compare_contact(h5, case, step, text)

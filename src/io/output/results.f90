@@ -180,6 +180,8 @@ contains
         type(model_t), intent(in) :: model
         integer, intent(in) :: k
         character(len=:), allocatable :: g
+        ! (the model's axes of the [3, n_phases] values)
+        real(dp), allocatable :: values(:, :)
         integer :: c
 
         associate (d => model%dirichlet(k))
@@ -191,7 +193,8 @@ contains
             do c = 1, model%nsd
                 call h5%write_attr(g, 'fix_'//axis_names(c), merge(1, 0, d%fix(c)))
             end do
-            call h5%write(g//'/values', d%values)
+            values = d%values(1:model%nsd, :)
+            call h5%write(g//'/values', values)
         end associate
     end subroutine write_dirichlet
 

@@ -23,14 +23,15 @@ contains
         type(body_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         ! one character more than kept: a longer value is refused, not cut
-        character(len=33) :: name, material, basis, contact_edge
+        character(len=33) :: name, material, basis, contact_edge, contact_face
         real(dp) :: youngs_modulus, poisson_ratio
-        integer :: degree_xi, degree_eta, nel_xi, nel_eta, layer_degree, layer_elevations, ios
-        real(dp), allocatable :: knots_xi(:), knots_eta(:)
+        integer :: degree_xi, degree_eta, degree_zeta, nel_xi, nel_eta, nel_zeta, layer_degree, layer_elevations, ios
+        real(dp), allocatable :: knots_xi(:), knots_eta(:), knots_zeta(:)
         character(len=512) :: msg
         character(len=:), allocatable :: where
         namelist /body/ name, material, youngs_modulus, poisson_ratio, basis, degree_xi, degree_eta, &
-            nel_xi, nel_eta, knots_xi, knots_eta, contact_edge, layer_degree, layer_elevations
+            degree_zeta, nel_xi, nel_eta, nel_zeta, knots_xi, knots_eta, knots_zeta, contact_edge, contact_face, &
+            layer_degree, layer_elevations
 
         name = ''
         material = ''
@@ -39,12 +40,16 @@ contains
         basis = 'nurbs'
         degree_xi = 2
         degree_eta = 2
+        degree_zeta = 2
         nel_xi = 1
         nel_eta = 1
-        allocate (knots_xi(max_knots), knots_eta(max_knots))
+        nel_zeta = 1
+        allocate (knots_xi(max_knots), knots_eta(max_knots), knots_zeta(max_knots))
         knots_xi = unset()
         knots_eta = unset()
+        knots_zeta = unset()
         contact_edge = ''
+        contact_face = ''
         layer_degree = 0
         layer_elevations = 0
         read (text, nml=body, iostat=ios, iomsg=msg)
@@ -64,6 +69,7 @@ contains
         call check_length(material, 32, 'material', where//': ', error)
         call check_length(basis, 32, 'basis', where//': ', error)
         call check_length(contact_edge, 32, 'contact_edge', where//': ', error)
+        call check_length(contact_face, 32, 'contact_face', where//': ', error)
         if (allocated(error)) return
         if (len_trim(name) == 0) then
             call fatal_error(error, where//': name is required', error_code%input)
@@ -78,13 +84,22 @@ contains
         entry%poisson_ratio = poisson_ratio
 
         entry%layout%basis = basis
-        entry%layout%degree = [degree_xi, degree_eta]
-        entry%layout%nel = [nel_xi, nel_eta]
+        entry%layout%degree = [degree_xi, degree_eta, degree_zeta]
+        entry%layout%nel = [nel_xi, nel_eta, nel_zeta]
+        ! an edge of a plane body or a face of a solid: which one the geometry says
+        if (len_trim(contact_edge) > 0 .and. len_trim(contact_face) > 0) then
+            call fatal_error(error, where//'give contact_edge (a plane body) or contact_face (a solid), '// &
+                             'not both', error_code%input)
+            return
+        end if
         entry%layout%contact_edge = contact_edge
+        if (len_trim(contact_face) > 0) entry%layout%contact_edge = contact_face
+        entry%contact_key = merge('contact_face', 'contact_edge', len_trim(contact_face) > 0)
         entry%layout%layer_degree = layer_degree
         entry%layout%layer_elevations = layer_elevations
         ! each count in its range before any arithmetic on them (no overflow)
-        if (degree_xi > 20 .or. degree_eta > 20 .or. layer_degree > 20 .or. layer_elevations > 20) then
+        if (degree_xi > 20 .or. degree_eta > 20 .or. degree_zeta > 20 .or. layer_degree > 20 .or. &
+            layer_elevations > 20) then
             call fatal_error(error, where//'degrees above 20 are not supported', error_code%input)
             return
         end if
@@ -97,14 +112,24 @@ contains
             call fatal_error(error, where//'nel_xi and nel_eta must be between 1 and 100000', error_code%input)
             return
         end if
+        if (nel_zeta < 1 .or. nel_zeta > max_knots) then
+            call fatal_error(error, where//'nel_zeta must be between 1 and 100000', error_code%input)
+            return
+        end if
         if (degree_xi < 1 .or. degree_eta < 1 .or. layer_degree < 0 .or. layer_elevations < 0) then
             call fatal_error(error, where//'degree_xi and degree_eta must be >= 1, layer_degree and '// &
                              'layer_elevations >= 0', error_code%input)
             return
         end if
+        if (degree_zeta < 1) then
+            call fatal_error(error, where//'degree_zeta must be >= 1', error_code%input)
+            return
+        end if
         call take_knots(knots_xi, 'knots_xi', where, entry%layout%knots_xi, error)
         if (allocated(error)) return
         call take_knots(knots_eta, 'knots_eta', where, entry%layout%knots_eta, error)
+        if (allocated(error)) return
+        call take_knots(knots_zeta, 'knots_zeta', where, entry%layout%knots_zeta, error)
     contains
         !> Read one assignment into the &body group (for diagnosis).
         subroutine try_body(text, ios, msg)

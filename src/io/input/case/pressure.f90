@@ -1,10 +1,11 @@
-!> The `&pressure` group: a pressure on a named edge of a body.
+!> The `&pressure` group: a pressure on a named edge (a plane body) or face (a
+!> solid) of a body.
 module voiga_io_input_case_pressure
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_io_input_namelist, only: group_error
     use voiga_io_input_case_values, only: check_length, unset, max_phases, phase_values, &
-                                          check_body_edge
+                                          check_body_edge, edge_or_face
     use voiga_model_body, only: body_settings_t
     use voiga_model_loads, only: pressure_settings_t
     implicit none
@@ -25,15 +26,16 @@ contains
         type(pressure_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         ! one character more than kept: a longer value is refused, not cut
-        character(len=33) :: body, edge
+        character(len=33) :: body, edge, face
         real(dp) :: p(max_phases)
         integer :: ios
         character(len=512) :: msg
         character(len=:), allocatable :: where
-        namelist /pressure/ body, edge, p
+        namelist /pressure/ body, edge, face, p
 
         body = ''
         edge = ''
+        face = ''
         p = unset()
         read (text, nml=pressure, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -44,6 +46,9 @@ contains
         where = path//trim(msg)//' '
         call check_length(body, 32, 'body', where, error)
         call check_length(edge, 32, 'edge', where, error)
+        call check_length(face, 32, 'face', where, error)
+        if (allocated(error)) return
+        call edge_or_face(edge, face, where, error)
         if (allocated(error)) return
         call check_body_edge(bodies, body, edge, where, error)
         if (allocated(error)) return

@@ -11,7 +11,7 @@ module voiga_io_input_case_values
     private
 
     public :: check_length, unset, is_unset, max_phases, max_knots, max_value, phase_values, take_knots, body_index, &
-              check_body_edge, quoted, either
+              check_body_edge, edge_or_face, quoted, either
 
     !> The bits of `unset`: a quiet NaN with a payload no input can give (the
     !> namelist reader gives every NaN it reads, `NaN(...)` included, the default
@@ -145,6 +145,20 @@ contains
 
     !> A load group names a body of the case and an edge (checked against the
     !> body's edges once it is discretized, `voiga_io_input_case`).
+    !> A load names an edge (`edge`, a plane body) or a face (`face`, a solid): one
+    !> of them; `edge` holds the name given.
+    subroutine edge_or_face(edge, face, where, error)
+        character(len=*), intent(inout) :: edge
+        character(len=*), intent(in) :: face, where
+        type(error_t), allocatable, intent(out) :: error
+        if (len_trim(face) == 0) return
+        if (len_trim(edge) > 0) then
+            call fatal_error(error, where//'give edge (a plane body) or face (a solid), not both', error_code%input)
+            return
+        end if
+        edge = face
+    end subroutine edge_or_face
+
     subroutine check_body_edge(bodies, body, edge, where, error)
         type(body_settings_t), intent(in) :: bodies(:)
         character(len=*), intent(in) :: body, edge, where
@@ -154,7 +168,7 @@ contains
                              error_code%input)
             return
         end if
-        if (len_trim(edge) == 0) call fatal_error(error, where//'edge is required', error_code%input)
+        if (len_trim(edge) == 0) call fatal_error(error, where//'edge (or face) is required', error_code%input)
     end subroutine check_body_edge
 
 end module voiga_io_input_case_values

@@ -8,7 +8,7 @@
 !> integral); zero force under a rigid rotation; an inverted point rejected; the
 !> force alone bitwise the element's; symmetric tangents; and an extruded element
 !> in plane strain against the plane-strain kernel.
-module test_solid3
+module test_element_kernel_3d
     use voiga_kinds, only: dp
     use voiga_error, only: error_t
     use voiga_testdrive, only: unittest_t, new_unittest, check
@@ -22,7 +22,7 @@ module test_solid3
     implicit none
     private
 
-    public :: collect_solid3
+    public :: collect_element_kernel_3d
 
     real(dp), parameter :: youngs = 210.0_dp, poisson = 0.3_dp
 
@@ -48,7 +48,7 @@ module test_solid3
 
 contains
 
-    subroutine collect_solid3(testsuite)
+    subroutine collect_element_kernel_3d(testsuite)
         type(unittest_t), allocatable, intent(out) :: testsuite(:)
         testsuite = [ &
                     new_unittest('tangent_fd_linear', test_fd_linear), &
@@ -64,7 +64,7 @@ contains
                     new_unittest('symmetric_tangents', test_symmetric), &
                     new_unittest('extruded_plane_strain_is_2d_kernel', test_plane_strain) &
                     ]
-    end subroutine collect_solid3
+    end subroutine collect_element_kernel_3d
 
     ! ---------------------------------------------------------------- test laws
 
@@ -771,4 +771,4 @@ contains
                    abs=1.0e-12_dp)
     end subroutine test_plane_strain
 
-end module test_solid3
+end module test_element_kernel_3d
