@@ -27,7 +27,8 @@ contains
                     new_unittest('neo_hookean_3d_simple_shear', test_shear), &
                     new_unittest('neo_hookean_3d_is_plane_strain_at_f33_1', test_plane_strain), &
                     new_unittest('neo_hookean_3d_tangent_fd', test_tangent), &
-                    new_unittest('linear_3d_exact', test_linear) &
+                    new_unittest('linear_3d_exact', test_linear), &
+                    new_unittest('fields3_rotated_stretch', test_fields3) &
                     ]
     end subroutine collect_material
 
@@ -178,5 +179,69 @@ contains
                    all(abs(c - reshape(c, shape(c), order=[3, 4, 1, 2])) < 1.0e-14_dp*youngs), &
                    'the tensor is not symmetric')
     end subroutine test_linear
+
+    !> F = Q diag(l) (any rotation Q after the stretch): the result file's strain is
+    !> ln V = Q diag(ln l) Q^T, the stress tau/J rotated likewise; Hooke's fields are
+    !> sym(grad u) and its stress.
+    subroutine test_fields3(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(neo_hookean_t) :: m
+        type(linear_elastic_t) :: lin
+        real(dp) :: q(3, 3), l(3), f(3, 3), stress(6), strain(6), expect(3, 3), s(3, 3), c(3, 3, 3, 3), jac
+        real(dp) :: s0(3, 3), g(3, 3)
+        integer :: i
+        logical :: ok
+        m = neo()
+        ! (as the factory sets it: the law's kinematics are finite)
+        m%finite_strain = .true.
+        ! a rotation by 0.7 about the axis (1, 2, 2)/3 (Rodrigues)
+        q = rotation([1.0_dp, 2.0_dp, 2.0_dp]/3.0_dp, 0.7_dp)
+        l = [1.3_dp, 0.8_dp, 1.1_dp]
+        f = 0.0_dp
+        do i = 1, 3
+            f(:, i) = q(:, i)*l(i)
+        end do
+        ! F = Q diag(l) R^T with R = Q: V = Q diag(l) Q^T
+        f = matmul(f, transpose(q))
+        g = f
+        do i = 1, 3
+            g(i, i) = g(i, i) - 1.0_dp
+        end do
+        call m%fields3(g, stress, strain, ok)
+        expect = matmul(q, matmul(diag(log(l)), transpose(q)))
+        call check(error, ok .and. maxval(abs(strain - voigt6(expect))) < 1.0e-13_dp, 'ln V of a rotated stretch')
+        if (allocated(error)) return
+        call m%stress3(g, s, c, ok)
+        jac = product(l)
+        call check(error, maxval(abs(stress - voigt6(s/jac))) < 1.0e-12_dp*maxval(abs(s)), 'sigma = tau/J')
+        if (allocated(error)) return
+        call lame_from_young(lin, youngs, poisson)
+        g = 1.0e-3_dp*reshape([1.0_dp, 2.0_dp, -1.0_dp, 0.5_dp, -2.0_dp, 1.5_dp, 0.3_dp, 0.7_dp, 1.1_dp], [3, 3])
+        call lin%fields3(g, stress, strain, ok)
+        call lin%stress3(g, s0, c, ok)
+        call check(error, maxval(abs(strain - voigt6(0.5_dp*(g + transpose(g))))) == 0.0_dp .and. &
+                   maxval(abs(stress - voigt6(s0))) == 0.0_dp, 'Hooke: sym(grad u) and its stress')
+    contains
+        pure function diag(v) result(d)
+            real(dp), intent(in) :: v(3)
+            real(dp) :: d(3, 3)
+            integer :: k
+            d = 0.0_dp
+            do k = 1, 3
+                d(k, k) = v(k)
+            end do
+        end function diag
+        pure function voigt6(a) result(v)
+            real(dp), intent(in) :: a(3, 3)
+            real(dp) :: v(6)
+            v = [a(1, 1), a(2, 2), a(3, 3), a(1, 2), a(2, 3), a(1, 3)]
+        end function voigt6
+        pure function rotation(axis, angle) result(r)
+            real(dp), intent(in) :: axis(3), angle
+            real(dp) :: r(3, 3), k(3, 3)
+            k = reshape([0.0_dp, axis(3), -axis(2), -axis(3), 0.0_dp, axis(1), axis(2), -axis(1), 0.0_dp], [3, 3])
+            r = diag([1.0_dp, 1.0_dp, 1.0_dp]) + sin(angle)*k + (1.0_dp - cos(angle))*matmul(k, k)
+        end function rotation
+    end subroutine test_fields3
 
 end module test_material

@@ -44,6 +44,7 @@ module voiga_material
         !> 3D elements call, beside the plane-strain one.
         procedure(stress3_interface), deferred :: stress3
         procedure :: stress_points => material_stress_points
+        procedure :: fields3 => material_fields3
         procedure(fields_interface), deferred :: fields
         procedure(strain_name_interface), deferred, nopass :: strain_name
     end type material_t
@@ -132,11 +133,73 @@ contains
         self%kappa = youngs_modulus/(3.0_dp*(1.0_dp - 2.0_dp*poisson_ratio))
     end subroutine lame_from_young
 
-    !> The von Mises stress of the stress `s` [xx, yy, zz, xy] (plane strain: the
-    !> out-of-plane component counts).
+    !> The von Mises stress of the stress `s`: [xx, yy, zz, xy] (plane strain: the
+    !> out-of-plane component counts) or [xx, yy, zz, xy, yz, xz] (a solid).
     pure real(dp) function von_mises(s)
-        real(dp), intent(in) :: s(4)
-        von_mises = sqrt(0.5_dp*((s(1) - s(2))**2 + (s(2) - s(3))**2 + (s(3) - s(1))**2) + 3.0_dp*s(4)**2)
+        real(dp), intent(in) :: s(:)
+        von_mises = sqrt(0.5_dp*((s(1) - s(2))**2 + (s(2) - s(3))**2 + (s(3) - s(1))**2) + 3.0_dp*sum(s(4:)**2))
     end function von_mises
+
+    !> What a result file shows of a solid at a point with displacement gradient
+    !> `grad_u` (3 x 3): the Cauchy stress and the law's strain measure, each [xx, yy,
+    !> zz, xy, yz, xz] (tensor components). From the law's `stress3`: at small strain
+    !> its stress and sym(grad u); at finite strain sigma = tau / J and the logarithmic
+    !> strain ln V = ln(b)/2 (`strain_name`). `ok` is false when J <= 0.
+    pure subroutine material_fields3(self, grad_u, stress, strain, ok)
+        class(material_t), intent(in) :: self
+        real(dp), intent(in) :: grad_u(3, 3)
+        real(dp), intent(out) :: stress(6), strain(6)
+        logical, intent(out) :: ok
+        real(dp) :: s(3, 3), c(3, 3, 3, 3), f(3, 3), e(3, 3), jac
+        call self%stress3(grad_u, s, c, ok)
+        stress = 0.0_dp
+        strain = 0.0_dp
+        if (.not. ok) return
+        if (self%finite_strain) then
+            f = grad_u + delta
+            jac = f(1, 1)*(f(2, 2)*f(3, 3) - f(2, 3)*f(3, 2)) - f(1, 2)*(f(2, 1)*f(3, 3) - f(2, 3)*f(3, 1)) + &
+                  f(1, 3)*(f(2, 1)*f(3, 2) - f(2, 2)*f(3, 1))
+            s = s/jac
+            e = 0.5_dp*symmetric_log(matmul(f, transpose(f)))
+        else
+            e = 0.5_dp*(grad_u + transpose(grad_u))
+        end if
+        stress = [s(1, 1), s(2, 2), s(3, 3), s(1, 2), s(2, 3), s(1, 3)]
+        strain = [e(1, 1), e(2, 2), e(3, 3), e(1, 2), e(2, 3), e(1, 3)]
+    end subroutine material_fields3
+
+    !> The logarithm of a symmetric positive definite 3 x 3 matrix, from its
+    !> eigenpairs (cyclic Jacobi rotations until the off-diagonal part is below
+    !> round-off of the diagonal).
+    pure function symmetric_log(a) result(l)
+        real(dp), intent(in) :: a(3, 3)
+        real(dp) :: l(3, 3), d(3, 3), v(3, 3), t, c, sn, theta, r(3, 3)
+        integer :: sweep, p, q, k
+        d = a
+        v = delta
+        do sweep = 1, 50
+            if (sqrt(d(1, 2)**2 + d(1, 3)**2 + d(2, 3)**2) <= 1.0e-15_dp*sqrt(sum([(d(k, k)**2, k=1, 3)]))) exit
+            do p = 1, 2
+                do q = p + 1, 3
+                    if (d(p, q) == 0.0_dp) cycle
+                    theta = (d(q, q) - d(p, p))/(2.0_dp*d(p, q))
+                    t = sign(1.0_dp, theta)/(abs(theta) + sqrt(theta**2 + 1.0_dp))
+                    c = 1.0_dp/sqrt(t**2 + 1.0_dp)
+                    sn = t*c
+                    r = delta
+                    r(p, p) = c
+                    r(q, q) = c
+                    r(p, q) = sn
+                    r(q, p) = -sn
+                    d = matmul(transpose(r), matmul(d, r))
+                    v = matmul(v, r)
+                end do
+            end do
+        end do
+        l = 0.0_dp
+        do k = 1, 3
+            l = l + log(d(k, k))*spread(v(:, k), 2, 3)*spread(v(:, k), 1, 3)
+        end do
+    end function symmetric_log
 
 end module voiga_material

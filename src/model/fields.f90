@@ -14,6 +14,8 @@ module voiga_model_fields
     use voiga_material, only: von_mises
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_solid, only: reference_gradients
+    use voiga_element_solid3, only: reference_gradients3
+    use voiga_nurbs_patch, only: next_index
     use voiga_model_body, only: body_t
     implicit none
     private
@@ -44,10 +46,11 @@ module voiga_model_fields
 
     !> The fields of one body at its sample points (n of them).
     type :: field_samples_t
-        !> Parameters (oriented patch) and element of each point [n].
-        real(dp), allocatable :: xi(:), eta(:)
+        !> Parameters (oriented patch; zeta for a solid only) and element of each point [n].
+        real(dp), allocatable :: xi(:), eta(:), zeta(:)
         integer, allocatable :: element(:)
-        !> Cauchy stress and strain [4, n] ([xx, yy, zz, xy]), von Mises stress [n].
+        !> Cauchy stress and strain [4, n] ([xx, yy, zz, xy]; a solid's [6, n], [xx, yy,
+        !> zz, xy, yz, xz]), von Mises stress [n].
         real(dp), allocatable :: stress(:, :), strain(:, :), von_mises(:)
     end type field_samples_t
 
@@ -74,6 +77,20 @@ contains
     !> gradient is undefined: the point is sampled `nudge` of the way towards the
     !> element's centre instead (the field's limit there), and recorded where it is.
     subroutine sample_fields(body, u, samples, out, error)
+        type(body_t), intent(in) :: body
+        real(dp), intent(in) :: u(:)
+        integer, intent(in) :: samples
+        type(field_samples_t), intent(out) :: out
+        type(error_t), allocatable, intent(out) :: error
+        if (body%disc%pdim == 3) then
+            call sample_solid(body, u, samples, out, error)
+        else
+            call sample_plane(body, u, samples, out, error)
+        end if
+    end subroutine sample_fields
+
+    !> `sample_fields` of a plane body (samples x samples points per element).
+    subroutine sample_plane(body, u, samples, out, error)
         type(body_t), intent(in) :: body
         real(dp), intent(in) :: u(:)
         integer, intent(in) :: samples
@@ -131,7 +148,69 @@ contains
                 deallocate (r, dr, dndx, ue)
             end associate
         end do
-    end subroutine sample_fields
+    end subroutine sample_plane
+
+    !> `sample_fields` of a solid: samples^3 points per element (xi fastest), the law's
+    !> `fields3`.
+    subroutine sample_solid(body, u, samples, out, error)
+        type(body_t), intent(in) :: body
+        real(dp), intent(in) :: u(:)
+        integer, intent(in) :: samples
+        type(field_samples_t), intent(out) :: out
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: r(:), dr(:, :), dndx(:, :), ue(:, :)
+        real(dp) :: t(samples), det, det_centre, grad_u(3, 3), uc(3), us(3)
+        integer :: e, i, q, n, a, idx(3)
+        logical :: ok
+
+        n = body%disc%nel*samples**3
+        allocate (out%xi(n), out%eta(n), out%zeta(n), out%element(n), out%stress(6, n), out%strain(6, n), &
+                  out%von_mises(n))
+        t = 0.5_dp
+        if (samples > 1) t = [(real(i, dp)/real(samples - 1, dp), i=0, samples - 1)]
+        q = 0
+        do e = 1, body%disc%nel
+            associate (el => body%disc%elements(e), nen => element_nfun(body%disc, e))
+                allocate (r(nen), dr(3, nen), dndx(3, nen), ue(3, nen))
+                do a = 1, nen
+                    ue(:, a) = u(body%dof0 + 3*el%conn(a) - 2:body%dof0 + 3*el%conn(a))
+                end do
+                uc = 0.5_dp*(el%lo + el%hi)
+                call element_basis(body%disc, e, uc, r, dr)
+                call reference_gradients3(body%disc%x(:, el%conn), dr, dndx, det_centre)
+                idx = 1
+                do i = 1, samples**3
+                    q = q + 1
+                    us = el%lo + t(idx)*(el%hi - el%lo)
+                    call element_basis(body%disc, e, us, r, dr)
+                    call reference_gradients3(body%disc%x(:, el%conn), dr, dndx, det)
+                    if (abs(det) <= degenerate*abs(det_centre)) then
+                        us = us + nudge*(uc - us)
+                        call element_basis(body%disc, e, us, r, dr)
+                        call reference_gradients3(body%disc%x(:, el%conn), dr, dndx, det)
+                    end if
+                    grad_u = matmul(ue, transpose(dndx))
+                    call body%mat%fields3(grad_u, out%stress(:, q), out%strain(:, q), ok)
+                    if (.not. ok) then
+                        call fatal_error(error, "fields: body '"//trim(body%name)//"' element "//str(e)// &
+                                         ': the deformation is inverted (J <= 0) at the sample (xi, eta, zeta) '// &
+                                         '= ('//trim(adjustl(real_str(us(1), 'f8.5')))//', '// &
+                                         trim(adjustl(real_str(us(2), 'f8.5')))//', '// &
+                                         trim(adjustl(real_str(us(3), 'f8.5')))//'), between the quadrature '// &
+                                         'points: a finer mesh there, or &output samples = 1', error_code%numeric)
+                        return
+                    end if
+                    out%von_mises(q) = von_mises(out%stress(:, q))
+                    out%xi(q) = us(1)
+                    out%eta(q) = us(2)
+                    out%zeta(q) = us(3)
+                    out%element(q) = e
+                    call next_index(idx, [samples, samples, samples])
+                end do
+                deallocate (r, dr, dndx, ue)
+            end associate
+        end do
+    end subroutine sample_solid
 
     !> det dX/dxi of the reference map at a point (`x0` [2, nen], `dr` [2, nen]).
     pure real(dp) function reference_det(x0, dr) result(det)

@@ -75,6 +75,23 @@ def test_uniaxial_tension_is_exact(voiga_bin: Path, tmp_path: Path) -> None:
         assert abs(fx + SIGMA * 2.0 * 1.0) < 1e-12
 
 
+def test_fields_of_a_solid(voiga_bin: Path, tmp_path: Path) -> None:
+    """&output on a solid: six components per sample (xx yy zz xy yz xz), samples^3
+    per element with their (xi, eta, zeta); uniform uniaxial stress and strain."""
+    case = solid_case(tmp_path)
+    case.write_text(case.read_text() + "&output\n  samples = 2\n/\n")
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    with h5py.File(tmp_path / "box.h5") as f:
+        g = f["steps/000002/fields/block"]
+        assert g.attrs["components"] == b"xx yy zz xy yz xz"
+        stress, strain = g["stress"][()], g["strain"][()]
+        assert stress.shape == (12 * 8, 6) and g["zeta"].shape == (12 * 8,)
+        assert np.abs(stress - [SIGMA, 0, 0, 0, 0, 0]).max() < 1e-12
+        assert np.abs(strain - SIGMA / E * np.array([1, -NU, -NU, 0, 0, 0])).max() < 1e-12
+        assert np.abs(g["von_mises"][()] - SIGMA).max() < 1e-12
+
+
 def test_prescribed_uz_moves_the_face(voiga_bin: Path, tmp_path: Path) -> None:
     """uz on the bottom face: the whole box translates by it (a rigid motion on top
     of the tension)."""
