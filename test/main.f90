@@ -10,6 +10,7 @@ program voiga_tests
     use test_discretization_3d, only: collect_discretization_3d
     use test_solid, only: collect_solid, lame_table
     use test_solid_3d, only: collect_solid_3d
+    use test_lame_sphere, only: collect_lame_sphere, lame_sphere_table
     use test_element_kernel, only: collect_element_kernel
     use test_element_kernel_3d, only: collect_element_kernel_3d
     use voiga_error, only: error_t
@@ -43,6 +44,7 @@ program voiga_tests
              new_testsuite('discretization_3d', collect_discretization_3d), &
              new_testsuite('solid', collect_solid), &
              new_testsuite('solid_3d', collect_solid_3d), &
+             new_testsuite('lame_sphere', collect_lame_sphere), &
              new_testsuite('element_kernel', collect_element_kernel), &
              new_testsuite('element_kernel_3d', collect_element_kernel_3d), &
              new_testsuite('sparse', collect_sparse), &
@@ -62,6 +64,16 @@ program voiga_tests
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)
+    if (trim(filter) == '--lame-sphere-table') then
+        ! the spherical shell's table of docs/verification.md
+        block
+            real(dp) :: rates(3, 2, 4)
+            type(error_t), allocatable :: error
+            call lame_sphere_table(rates, error, .true.)
+            if (allocated(error)) error stop 1
+        end block
+        stop
+    end if
     if (trim(filter) == '--lame-table') then
         ! the convergence table of docs/verification.md
         block

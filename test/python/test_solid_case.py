@@ -104,6 +104,33 @@ def test_prescribed_uz_moves_the_face(voiga_bin: Path, tmp_path: Path) -> None:
         assert np.abs(u - exact).max() < 1e-12
 
 
+def test_restart_of_a_solid(voiga_bin: Path, tmp_path: Path) -> None:
+    """A Neo-Hookean box pulled by 30 % of E in 6 steps, cut after step 3 and continued
+    with --restart: the same displacements as the run that was not cut."""
+    import shutil
+
+    case = solid_case(tmp_path, material="neo-hookean", p="-0.6")
+    case.write_text(case.read_text().replace("n_steps = 2", "n_steps = 6"))
+    assert run(voiga_bin, case).returncode == 0
+    full, partial = tmp_path / "full.h5", tmp_path / "box.h5"
+    shutil.copy(partial, full)
+    with h5py.File(partial, "r+") as f:
+        for k in list(f["steps"]):
+            if int(k) > 3:
+                del f["steps"][k]
+        f.attrs["n_steps_done"] = np.int32(3)
+        f.attrs["status"] = np.bytes_("interrupted")
+    res = run(voiga_bin, case, "--restart", str(partial))
+    assert res.returncode == 0, res.stderr
+    with h5py.File(full) as a, h5py.File(partial) as b:
+        assert b.attrs["status"] == b"converged" and int(b.attrs["n_steps_done"]) == 6
+        for k in a["steps"]:
+            np.testing.assert_allclose(b["steps"][k]["displacement"][()], a["steps"][k]["displacement"][()],
+                                       rtol=0, atol=1e-12, err_msg=k)
+        # a large stretch: the last step's axial displacement at x = 3 is well beyond small strain
+        assert a["steps/000006/displacement"][()].reshape(-1, 3)[:, 0].max() > 0.3
+
+
 def refused(res: subprocess.CompletedProcess, *words: str) -> None:
     assert res.returncode == 2, (res.returncode, res.stderr)
     for word in words:
