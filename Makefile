@@ -117,7 +117,7 @@ attack: build
 	  --markdown build/attack/table.md $(ATTACK_ARGS)
 
 ## bench: performance figures of one run (stages, NNp vs Np, accuracy, scaling, CalculiX,
-## Kratos)
+## Kratos, CalculiX on the thick sphere of issue 41)
 bench: build
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m bench $(BENCH_ARGS)
 

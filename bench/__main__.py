@@ -9,6 +9,8 @@ Sections (``--only 1,2,...``):
      offers it
   6  Kratos Multiphysics (Q4, 2D mortar penalty / augmented Lagrangian) on the same Hertz
      problem, installed by pip into build/kratos-venv (skipped if that fails)
+  7  CalculiX (C3D20R) on the thick spherical shell under internal pressure, errors against
+     Lame's solution over a refinement sequence (issue 41's 3D reference; needs no voiga)
 
 Runs go to a scratch directory (default build/bench); every ratio compares runs made
 here, interleaved and best of --repeat, never against figures from another run.
@@ -190,7 +192,7 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", default="1,2,3,4,5,6", help="comma-separated sections")
+    ap.add_argument("--only", default="1,2,3,4,5,6,7", help="comma-separated sections")
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
@@ -215,12 +217,21 @@ def main(argv: list[str] | None = None) -> int:
                          "timed on the matched run")
     ap.add_argument("--kratos-match", default="penalty:m5:2",
                     help="section 6: the Kratos run timed against voiga hertz m4 NN2.2")
+    ap.add_argument("--sphere-meshes", default=None,
+                    help="section 7: n or nxm per mesh, n x n x m C3D20R per block of the "
+                         "three-block octant (n over the angles, m radially; default "
+                         "bench.ccx_sphere.MESHES)")
+    ap.add_argument("--sphere-threads", type=int, default=2,
+                    help="section 7: ccx's threads (OMP_NUM_THREADS and CCX_NPROC_*)")
+    ap.add_argument("--sphere-solvers", default=None,
+                    help="section 7: ccx solvers, default (its own choice: SPOOLES) or *STATIC "
+                         "SOLVER= values (default bench.ccx_sphere.SOLVERS)")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
-    if not VOIGA.exists():
+    only = {s.strip() for s in args.only.split(",")}
+    if not VOIGA.exists() and only - {"7"}:
         print(f"bench: {VOIGA} missing; run make build", file=sys.stderr)
         return 1
-    only = {s.strip() for s in args.only.split(",")}
     w = Workdir(args.work)
     t0 = time.perf_counter()
     print(f"bench: voiga {VOIGA}, work dir {w.path}, best of {args.repeat} "
@@ -244,6 +255,10 @@ def main(argv: list[str] | None = None) -> int:
         from .kratos import section_kratos
         figures["kratos"] = section_kratos(w, args.kratos_runs, args.kratos_match, args.repeat,
                                           args.kratos_solvers)
+    if "7" in only:
+        from .ccx_sphere import MESHES, SOLVERS, section_sphere
+        figures["sphere_calculix"] = section_sphere(w, args.sphere_meshes or MESHES, args.sphere_threads,
+                                                      args.sphere_solvers or SOLVERS)
     total = time.perf_counter() - t0
     print(f"\nbench: done in {total:.0f} s")
     path = args.json or (w.path / "bench.json")
