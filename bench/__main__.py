@@ -11,6 +11,9 @@ Sections (``--only 1,2,...``):
      problem, installed by pip into build/kratos-venv (skipped if that fails)
   7  CalculiX (C3D20R) on the thick spherical shell under internal pressure, errors against
      Lame's solution over a refinement sequence (issue 41's 3D reference; needs no voiga)
+  8  voiga on the same shell (exact NURBS octant, degrees 2-4), and with section 7 in the
+     same run: each CalculiX run against the fastest voiga run at its stress error or
+     below, the pair re-timed interleaved
 
 Runs go to a scratch directory (default build/bench); every ratio compares runs made
 here, interleaved and best of --repeat, never against figures from another run.
@@ -192,7 +195,7 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", default="1,2,3,4,5,6,7", help="comma-separated sections")
+    ap.add_argument("--only", default="1,2,3,4,5,6,7,8", help="comma-separated sections")
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
@@ -226,6 +229,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sphere-solvers", default=None,
                     help="section 7: ccx solvers, default (its own choice: SPOOLES) or *STATIC "
                          "SOLVER= values (default bench.ccx_sphere.SOLVERS)")
+    ap.add_argument("--sphere-voiga-meshes", default=None,
+                    help="section 8: p:n per run, degree p and n elements per direction "
+                         "(default bench.voiga_sphere.MESHES)")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
     only = {s.strip() for s in args.only.split(",")}
@@ -259,6 +265,11 @@ def main(argv: list[str] | None = None) -> int:
         from .ccx_sphere import MESHES, SOLVERS, section_sphere
         figures["sphere_calculix"] = section_sphere(w, args.sphere_meshes or MESHES, args.sphere_threads,
                                                       args.sphere_solvers or SOLVERS)
+    if "8" in only:
+        from .voiga_sphere import MESHES as VOIGA_MESHES
+        from .voiga_sphere import section_voiga_sphere
+        figures["sphere_voiga"] = section_voiga_sphere(w, args.sphere_voiga_meshes or VOIGA_MESHES,
+                                                       figures.get("sphere_calculix"), args.repeat)
     total = time.perf_counter() - t0
     print(f"\nbench: done in {total:.0f} s")
     path = args.json or (w.path / "bench.json")

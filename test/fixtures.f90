@@ -19,7 +19,7 @@ module voiga_test_fixtures
     private
 
     public :: mortar_history
-    public :: ring_block
+    public :: ring_block, layout3
     public :: annulus_sector, rectangle, lcg_t, quadratic, paper_layout, scene_t, scene_model, body_settings
 
     !> The settings of a test scene, as a case file would give them.
@@ -39,6 +39,19 @@ module voiga_test_fixtures
     end type lcg_t
 
 contains
+
+    !> A solid's layout: bulk degree `p` in each direction, `nel` elements per direction,
+    !> layer degree `q` with `k` elevations (q = 0: none) on `face`.
+    function layout3(p, nel, q, k, face) result(layout)
+        integer, intent(in) :: p, nel(3), q, k
+        character(len=*), intent(in) :: face
+        type(layout_t) :: layout
+        layout%degree = p
+        layout%nel = nel
+        layout%layer_degree = q
+        layout%layer_elevations = k
+        layout%contact_edge = face
+    end function layout3
 
     !> Quarter ring r in [1, 2], theta in [0, pi/2] (degree 1 x 2), extruded to
     !> z in [0, 1] (degree 1): 2 x 3 x 2 control points.

@@ -14,7 +14,7 @@ module test_discretization_3d
     use voiga_discretization_size, only: body_size_t, body_size
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_test_fixtures, only: lcg_t, ring_block
+    use voiga_test_fixtures, only: lcg_t, ring_block, layout3
     implicit none
     private
 
@@ -39,19 +39,6 @@ contains
                     new_unittest('bad_layouts_refused', test_bad) &
                     ]
     end subroutine collect_discretization_3d
-
-    !> A layout: bulk degree `p` in each direction, `nel` elements per direction,
-    !> layer degree `q` with `k` elevations (q = 0: none) on `face`.
-    function layout3(p, nel, q, k, face) result(layout)
-        integer, intent(in) :: p, nel(3), q, k
-        character(len=*), intent(in) :: face
-        type(layout_t) :: layout
-        layout%degree = p
-        layout%nel = nel
-        layout%layer_degree = q
-        layout%layer_elevations = k
-        layout%contact_edge = face
-    end function layout3
 
     !> Build the ring block's discretization or stop the test.
     subroutine build(d, layout, error)

@@ -18,7 +18,7 @@ module test_element_kernel_3d
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_element_solid, only: element_points_t, reference_gradients, solid_element
     use voiga_element_solid3, only: solid3_element, solid3_force, reference_gradients3, solid3_work_t
-    use voiga_test_fixtures, only: lcg_t
+    use voiga_test_fixtures, only: lcg_t, ring_block
     implicit none
     private
 
@@ -176,23 +176,8 @@ contains
         integer, intent(in) :: p
         type(nurbs_patch_t) :: patch
         type(lcg_t) :: rng
-        real(dp) :: cp(3, 12), w(12), arc(2, 3), warc(3)
-        integer :: i, j, k, a
-        arc = reshape([1.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 0.0_dp, 1.0_dp], [2, 3])
-        warc = [1.0_dp, 1.0_dp/sqrt(2.0_dp), 1.0_dp]
-        a = 0
-        do k = 1, 2
-            do j = 1, 3
-                do i = 1, 2
-                    a = a + 1
-                    cp(:, a) = [real(i, dp)*arc(:, j), real(k - 1, dp)]
-                    w(a) = warc(j)
-                end do
-            end do
-        end do
-        patch = new_patch([1, 2, 1], [knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp]), &
-                                      knots_t([0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 1.0_dp]), &
-                                      knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp])], [2, 3, 2], cp, w)
+        integer :: a
+        patch = ring_block()
         call patch_elevate(patch, 1, p - 1)
         call patch_elevate(patch, 2, p - 2)
         call patch_elevate(patch, 3, p - 1)

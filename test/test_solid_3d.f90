@@ -17,7 +17,7 @@ module test_solid_3d
     use voiga_solver_stepping, only: solve_steps
     use voiga_material_neohookean, only: neo_hookean_t
     use voiga_material, only: lame_from_young
-    use voiga_test_fixtures, only: lcg_t, quadratic, scene_t, scene_model, body_settings
+    use voiga_test_fixtures, only: lcg_t, quadratic, scene_t, scene_model, body_settings, layout3
     implicit none
     private
 
@@ -65,19 +65,6 @@ contains
         end do
         patch = new_patch([2, 2, 2], knots, [3, 3, 3], cp, w)
     end function distorted_box
-
-    !> A layout: bulk degree `p`, `nel` elements per direction, a layer of degree q
-    !> (0: none) with k elevations on `face`.
-    function layout3(p, nel, q, k, face) result(layout)
-        integer, intent(in) :: p, nel(3), q, k
-        character(len=*), intent(in) :: face
-        type(layout_t) :: layout
-        layout%degree = p
-        layout%nel = nel
-        layout%layer_degree = q
-        layout%layer_elevations = k
-        layout%contact_edge = face
-    end function layout3
 
     !> A Dirichlet condition on `face`: components `fix` [3] at `value` (one phase).
     function on_face(face, fix, value) result(d)
