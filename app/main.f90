@@ -17,6 +17,8 @@ program voiga_main
     use voiga_linalg_blas, only: warm_up_blas
     use voiga_platform_libraries, only: default_library_threads, choose_blas_kernels
     use voiga_discretization_patch, only: discretization_t
+    use voiga_discretization_size, only: discretization_size
+    use voiga_io_input_resources, only: memory_estimate, gib
     use voiga_model, only: model_t, new_model
     use voiga_model_checks, only: setup_warnings, warning_t, check_overlaps
     use voiga_solver_records, only: solver_stats_t, wall_seconds
@@ -144,6 +146,9 @@ contains
             total = total + discs(i)%total_dofs
         end do
         write (*, '(a,i0)') 'dofs all total=', total
+        write (*, '(a)') 'memory estimate '//gib(memory_estimate([(discretization_size(discs(i)), i=1, &
+                                                                   size(discs))], case%solver%linear_solver))// &
+            ' ('//trim(case%solver%linear_solver)//' solver; docs/files.md, "Resources")'
     end subroutine print_dofs
 
     !> The run ended (interrupted, failed or converged): the result file's final

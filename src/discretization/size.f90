@@ -11,11 +11,11 @@ module voiga_discretization_size
     use voiga_nurbs_basis, only: distinct_knots, multiplicity
     use voiga_nurbs_patch, only: nurbs_patch_t
     use voiga_discretization_layout, only: layout_t, basis_linear, knot_list
-    use voiga_discretization_patch, only: new_knots, orient_for_contact
+    use voiga_discretization_patch, only: discretization_t, new_knots, orient_for_contact
     implicit none
     private
 
-    public :: body_size_t, body_size
+    public :: body_size_t, body_size, discretization_size
 
     !> Counts of one discretized body.
     type :: body_size_t
@@ -79,6 +79,20 @@ contains
             counts%entries = counts%entries + counts%nel/spans(nd)*((nsd*nen_vo)**2 - (nsd*nen)**2)
         end if
     end function body_size
+
+    !> The counts of a built discretization (the same as `body_size` gave before it
+    !> was built).
+    pure function discretization_size(disc) result(counts)
+        type(discretization_t), intent(in) :: disc
+        type(body_size_t) :: counts
+        integer :: e
+        counts%nsd = disc%nsd
+        counts%ncp = disc%ncp
+        counts%nel = disc%nel
+        do e = 1, disc%nel
+            counts%entries = counts%entries + (int(disc%nsd, int64)*size(disc%elements(e)%conn))**2
+        end do
+    end function discretization_size
 
     !> Functions `n_dir` and element spans along one direction of knots `knots`
     !> (degree `pc`) at degree `deg`, `nel` uniform elements or the `explicit` knots.
