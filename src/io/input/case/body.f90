@@ -6,6 +6,7 @@ module voiga_io_input_case_body
     use voiga_io_input_case_values, only: check_length, unset, is_unset, max_knots, max_value, &
                                           take_knots, quoted, either
     use voiga_model_body, only: body_settings_t
+    use voiga_discretization_layout, only: layout_t
     use voiga_material_factory, only: material_names
     implicit none
     private
@@ -97,34 +98,8 @@ contains
         entry%contact_key = merge('contact_face', 'contact_edge', len_trim(contact_face) > 0)
         entry%layout%layer_degree = layer_degree
         entry%layout%layer_elevations = layer_elevations
-        ! each count in its range before any arithmetic on them (no overflow)
-        if (degree_xi > 20 .or. degree_eta > 20 .or. degree_zeta > 20 .or. layer_degree > 20 .or. &
-            layer_elevations > 20) then
-            call fatal_error(error, where//'degrees above 20 are not supported', error_code%input)
-            return
-        end if
-        if (layer_degree + layer_elevations > 20) then
-            call fatal_error(error, where//'layer_degree + layer_elevations above 20 is not supported', &
-                             error_code%input)
-            return
-        end if
-        if (nel_xi < 1 .or. nel_eta < 1 .or. nel_xi > max_knots .or. nel_eta > max_knots) then
-            call fatal_error(error, where//'nel_xi and nel_eta must be between 1 and 100000', error_code%input)
-            return
-        end if
-        if (nel_zeta < 1 .or. nel_zeta > max_knots) then
-            call fatal_error(error, where//'nel_zeta must be between 1 and 100000', error_code%input)
-            return
-        end if
-        if (degree_xi < 1 .or. degree_eta < 1 .or. layer_degree < 0 .or. layer_elevations < 0) then
-            call fatal_error(error, where//'degree_xi and degree_eta must be >= 1, layer_degree and '// &
-                             'layer_elevations >= 0', error_code%input)
-            return
-        end if
-        if (degree_zeta < 1) then
-            call fatal_error(error, where//'degree_zeta must be >= 1', error_code%input)
-            return
-        end if
+        call check_counts(entry%layout, where, error)
+        if (allocated(error)) return
         call take_knots(knots_xi, 'knots_xi', where, entry%layout%knots_xi, error)
         if (allocated(error)) return
         call take_knots(knots_eta, 'knots_eta', where, entry%layout%knots_eta, error)
@@ -140,6 +115,40 @@ contains
             read (text, nml=body, iostat=ios, iomsg=msg)
         end subroutine try_body
     end subroutine read_body
+
+    !> Each count of `l` in its range before any arithmetic on them (no overflow).
+    subroutine check_counts(l, where, error)
+        type(layout_t), intent(in) :: l
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        if (l%degree(1) > 20 .or. l%degree(2) > 20 .or. l%degree(3) > 20 .or. l%layer_degree > 20 .or. &
+            l%layer_elevations > 20) then
+            call fatal_error(error, where//'degrees above 20 are not supported', error_code%input)
+            return
+        end if
+        if (l%layer_degree + l%layer_elevations > 20) then
+            call fatal_error(error, where//'layer_degree + layer_elevations above 20 is not supported', &
+                             error_code%input)
+            return
+        end if
+        if (l%nel(1) < 1 .or. l%nel(2) < 1 .or. l%nel(1) > max_knots .or. l%nel(2) > max_knots) then
+            call fatal_error(error, where//'nel_xi and nel_eta must be between 1 and 100000', error_code%input)
+            return
+        end if
+        if (l%nel(3) < 1 .or. l%nel(3) > max_knots) then
+            call fatal_error(error, where//'nel_zeta must be between 1 and 100000', error_code%input)
+            return
+        end if
+        if (l%degree(1) < 1 .or. l%degree(2) < 1 .or. l%layer_degree < 0 .or. l%layer_elevations < 0) then
+            call fatal_error(error, where//'degree_xi and degree_eta must be >= 1, layer_degree and '// &
+                             'layer_elevations >= 0', error_code%input)
+            return
+        end if
+        if (l%degree(3) < 1) then
+            call fatal_error(error, where//'degree_zeta must be >= 1', error_code%input)
+            return
+        end if
+    end subroutine check_counts
 
     !> The material is one of `material_names`, E finite and positive, nu in (-1, 0.5).
     subroutine check_material(material, youngs_modulus, poisson_ratio, where, error)
