@@ -3,14 +3,16 @@ dimension 3): a perspective-free 3D view (matplotlib's mplot3d) of every body's
 boundary in its current configuration ``X + scale * u``.
 
 Each of a body's six faces is sampled on a parametric grid that contains every element
-boundary (at least :data:`MIN_SAMPLES` samples per direction), evaluated with the exact
+boundary (at least :data:`MIN_SAMPLES` samples per direction, the same number in every
+element), evaluated with the exact
 map of :mod:`post.field` and coloured by the quantity of :mod:`post.quantity` (``|u|``,
 a component, or a sampled stress or strain, interpolated within the elements), flat
-per facet. Only the facets turned towards the viewer are drawn (back-face culling:
-exact for a convex body, and the rest is left to mplot3d's depth sort), with the
-element boundaries of those faces as thin black lines; ``reference=True`` adds the
-undeformed body's twelve edges, dashed. The view is from elevation :data:`ELEVATION`
-and azimuth :data:`AZIMUTH` degrees, with equal scales on the three axes. Why a 3D view
+per facet. Only the facets turned towards the viewer are drawn (back-face culling;
+mplot3d's depth sort of the facets does the rest: right for a convex body, close for
+others), with the element boundaries on them as thin black lines in the same sort;
+``reference=True`` adds the undeformed body's twelve edges (grey, in the same sort).
+The view is from elevation :data:`ELEVATION` and azimuth :data:`AZIMUTH` degrees, with
+equal scales on the three axes. Why a 3D view
 rather than sections: it shows the whole outer surface (where a solid's stresses
 are largest and its boundary conditions act) in one picture, at the cost of
 the interior; ParaView (``python -m post vtk``) cuts and clips it.
@@ -24,18 +26,26 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.cm import ScalarMappable  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from .field import displacement, evaluate  # noqa: E402
-from .plot import CMAP, _title, auto_scale, breakpoints, colour_norms, sample_parameters  # noqa: E402
+from .paraview import element_samples  # noqa: E402
+from .plot import CMAP, _title, auto_scale, breakpoints, colour_norms  # noqa: E402
 from .quantity import DISPLACEMENT, displacement_quantity, label, sampled_quantity  # noqa: E402
 from .reader import Body, Result, Step, body_displacement  # noqa: E402
 
 MIN_SAMPLES = 40
-"""At least this many samples along each parametric direction of a face."""
+"""At least this many samples along each parametric direction of a face (and one per
+element: a fine mesh is drawn with flat facets per element, which keeps mplot3d's
+polygons to about the faces' elements)."""
 
 ELEVATION, AZIMUTH = 25.0, -55.0
 """The view direction (degrees, mplot3d's ``view_init``)."""
+
+LIFT = 0.02
+"""The element boundaries are drawn this fraction of the scene's size towards the viewer
+(about a facet's size): in mplot3d's depth order (by the mean depth of each polygon)
+they come after the facets around them, and before anything farther in front."""
 
 FACES: tuple[tuple[int, float], ...] = ((0, 0.0), (0, 1.0), (1, 0.0), (1, 1.0), (2, 0.0), (2, 1.0))
 """The six faces of the parameter cube: (fixed direction, its value): xi0, xi1, eta0,
@@ -49,7 +59,7 @@ def face_parameters(body: Body, face: tuple[int, float],
     fixed, value = face
     breaks = breakpoints(body)
     free = [d for d in range(3) if d != fixed]
-    u, v = (sample_parameters(breaks[d], minimum) for d in free)
+    u, v = (element_samples(breaks[d], 1, minimum) for d in free)
     uu, vv = np.meshgrid(u, v)
     params = [None, None, None]
     params[free[0]], params[free[1]] = uu, vv
@@ -73,36 +83,35 @@ def view_direction(elevation: float = ELEVATION, azimuth: float = AZIMUTH) -> np
     return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
 
 
-def _facets(points: np.ndarray, values: np.ndarray, inward: np.ndarray,
-            towards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The facets ``(n, 4, 3)`` of a face grid ``points (n_v, n_u, 3)`` turned towards
-    the viewer (``towards``; ``inward`` (3,): a direction into the body from the face),
-    and the mean value of each."""
+def _face_grid_lines(params: tuple[np.ndarray, np.ndarray, np.ndarray], fixed: int,
+                     breaks: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Which columns (constant first free parameter) and rows (constant second) of a
+    face's sampling grid lie on element boundaries: boolean ``(n_u,)``, ``(n_v,)``."""
+    free = [d for d in range(3) if d != fixed]
+    u, v = params[free[0]][0, :], params[free[1]][:, 0]
+    return np.isin(u, breaks[free[0]]), np.isin(v, breaks[free[1]])
+
+
+def _facets(points: np.ndarray, values: np.ndarray, inward: np.ndarray, towards: np.ndarray,
+            columns: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Of a face's sampling grid ``points (n_v, n_u, 3)``: the facets ``(n, 4, 3)`` turned
+    towards the viewer (``towards``; ``inward`` (3,): a direction into the body from the
+    face), the mean value of each, and the element boundaries on them (the grid lines
+    ``columns`` and ``rows`` say are boundaries) as segments ``(m, 2, 3)`` beside at
+    least one front facet."""
     quads = np.stack([points[:-1, :-1], points[:-1, 1:], points[1:, 1:], points[1:, :-1]], axis=2)
     normal = np.cross(quads[..., 1, :] - quads[..., 0, :], quads[..., 3, :] - quads[..., 0, :])
     if np.sum(normal @ inward) > 0:  # point the normals out of the body
         normal = -normal
     mean = 0.25 * (values[:-1, :-1] + values[:-1, 1:] + values[1:, 1:] + values[1:, :-1])
     front = np.sum(normal * towards, axis=-1) > 0
-    return quads[front], mean[front]
-
-
-def _element_lines(body: Body, u_body: np.ndarray, scale: float, face: tuple[int, float],
-                   n: int = 60) -> list[np.ndarray]:
-    """The deformed element boundaries on a face: lines of constant parameter at every
-    breakpoint of its two free directions."""
-    fixed, value = face
-    breaks = breakpoints(body)
-    free = [d for d in range(3) if d != fixed]
-    t = np.linspace(0.0, 1.0, n)
-    lines = []
-    for k, d in enumerate(free):
-        other = free[1 - k]
-        for b in breaks[d]:
-            params = [None, None, None]
-            params[fixed], params[d], params[other] = np.full(n, value), np.full(n, b), t
-            lines.append(evaluate(body, scale * u_body, *params))
-    return lines
+    # a grid line's segment is seen when a facet on either side of it is
+    pad = np.pad(front, 1)
+    seen_col = pad[1:-1, :-1] | pad[1:-1, 1:]  # (n_v - 1, n_u): segments along v
+    seen_row = pad[:-1, 1:-1] | pad[1:, 1:-1]  # (n_v, n_u - 1): segments along u
+    along_v = np.stack([points[:-1], points[1:]], axis=2)[seen_col & columns[None, :]]
+    along_u = np.stack([points[:, :-1], points[:, 1:]], axis=2)[seen_row & rows[:, None]]
+    return quads[front], mean[front], np.concatenate([along_v, along_u])
 
 
 def _reference_edges(body: Body, n: int = 60) -> list[np.ndarray]:
@@ -122,11 +131,12 @@ def solid_figure(result: Result, step: int = -1, scale: float | str = "auto",
                  length_unit: str | None = None, reference: bool = False, field: str = "u",
                  colour_scale: str | None = None) -> tuple[plt.Figure, dict]:
     """The figure of every solid of ``result`` deformed at ``step`` (selection as in
-    :meth:`post.reader.Result.select_step`) and each body's facet collection.
+    :meth:`post.reader.Result.select_step`), and for each body the collection of
+    facets and lines (one for all: mplot3d sorts within a collection).
 
     ``scale`` (``'auto'``: :func:`post.plot.auto_scale`), ``length_unit``, ``field``
     and ``colour_scale`` as in :func:`post.plot.deformed_figure`; ``reference=True``
-    adds the undeformed edges (dashed).
+    adds the undeformed edges (grey).
     """
     if colour_scale is None:
         colour_scale = "body" if field in DISPLACEMENT else "shared"
@@ -136,7 +146,7 @@ def solid_figure(result: Result, step: int = -1, scale: float | str = "auto",
     number = 0 if s is None else s.step
     unit = length_unit or result.units.length
 
-    faces = {}  # body -> [(face, reference points, displacement, values)]
+    faces = {}  # body -> [(face, reference points, displacement, inward, values, parameters)]
     for name, body in result.bodies.items():
         u = body_displacement(result, name, number)
         faces[name] = []
@@ -146,7 +156,7 @@ def solid_figure(result: Result, step: int = -1, scale: float | str = "auto",
             inner = list(params)
             inner[face[0]] = np.full_like(params[0], 0.5)
             inward = (evaluate(body, None, *inner) - ref).reshape(-1, 3).mean(axis=0)
-            faces[name].append((face, ref, uf, inward, face_quantity(body, s, uf, field, params)))
+            faces[name].append((face, ref, uf, inward, face_quantity(body, s, uf, field, params), params))
     norms = colour_norms({n: np.concatenate([f[4].ravel() for f in fs]) for n, fs in faces.items()},
                          field, colour_scale == "body")
     allpts = np.concatenate([(f[1] + f[2]).reshape(-1, 3) for fs in faces.values() for f in fs])
@@ -159,30 +169,39 @@ def solid_figure(result: Result, step: int = -1, scale: float | str = "auto",
     fig = plt.figure(figsize=(9.0, 7.5), layout="constrained")
     ax = fig.add_subplot(projection="3d")
     ax.view_init(ELEVATION, AZIMUTH)
-    ax.computed_zorder = False  # facets first, then the lines on them
     towards = view_direction()
-    collections, lines = {}, []
+    lift = LIFT * size * towards
+    # one collection for every body's facets and the lines on them, so that mplot3d's
+    # depth sort (per polygon) hides what is behind: the lines are closed two-point
+    # polygons; the facets' edges in their own colour (no seams between them)
+    polygons, faces_rgba, edges_rgba = [], [], []
+
+    def add_lines(segments: np.ndarray, colour: tuple[float, ...]) -> None:
+        polygons.append(segments[:, [0, 1, 1, 0]] + lift)
+        faces_rgba.append(np.zeros((len(segments), 4)))
+        edges_rgba.append(np.tile(colour, (len(segments), 1)))
+
+    drawn = []
     for name, fs in faces.items():
-        body = result.bodies[name]
-        u = body_displacement(result, name, number)
-        facets, colours = [], []
-        for face, ref, uf, inward, values in fs:
-            quads, mean = _facets(ref + scale * uf, values, inward, towards)
-            facets.append(quads)
-            colours.append(mean)
-            if len(quads):
-                lines += _element_lines(body, u, scale, face)
-        rgba = plt.get_cmap(CMAP)(norms[name](np.concatenate(colours)))
-        # edges in the facet's colour: no seams between the facets
-        poly = Poly3DCollection(np.concatenate(facets), facecolors=rgba, edgecolors=rgba, linewidths=0.3)
-        ax.add_collection3d(poly)
-        collections[name] = poly
-    ax.add_collection3d(Line3DCollection(lines, colors="k", linewidths=0.35, alpha=0.7))
-    drawn = [(f[1] + scale * f[2]).reshape(-1, 3) for fs in faces.values() for f in fs]
+        breaks = breakpoints(result.bodies[name])
+        for face, ref, uf, inward, values, params in fs:
+            columns, rows = _face_grid_lines(params, face[0], breaks)
+            points = ref + scale * uf
+            quads, mean, segments = _facets(points, values, inward, towards, columns, rows)
+            rgba = plt.get_cmap(CMAP)(norms[name](mean))
+            polygons.append(quads)
+            faces_rgba.append(rgba)
+            edges_rgba.append(rgba)
+            add_lines(segments, matplotlib.colors.to_rgba("k", 0.75))
+            drawn.append(points.reshape(-1, 3))
     if reference:
-        edges = [e for body in result.bodies.values() for e in _reference_edges(body)]
-        ax.add_collection3d(Line3DCollection(edges, colors="0.45", linewidths=0.8, linestyles="--"))
-        drawn += edges
+        for body in result.bodies.values():
+            for edge in _reference_edges(body):
+                add_lines(np.stack([edge[:-1], edge[1:]], axis=1), matplotlib.colors.to_rgba("0.35"))
+                drawn.append(edge)
+    poly = Poly3DCollection(np.concatenate(polygons), facecolors=np.concatenate(faces_rgba),
+                            edgecolors=np.concatenate(edges_rgba), linewidths=0.4)
+    ax.add_collection3d(poly)
     lo, hi = np.concatenate(drawn).min(axis=0), np.concatenate(drawn).max(axis=0)
     span = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1.0))
     ax.set_xlim(lo[0], lo[0] + span[0])
@@ -193,13 +212,13 @@ def solid_figure(result: Result, step: int = -1, scale: float | str = "auto",
         setter(f"{axis} [{unit}]")
     ax.set_title(_title(result, number, None if s is None else s.time, scale), fontsize=10)
     text = label(field, result.units)
-    if colour_scale == "shared" or len(collections) == 1:
+    if colour_scale == "shared" or len(faces) == 1:
         first = next(iter(faces))
-        cbar = fig.colorbar(ScalarMappable(norm=norms[first], cmap=CMAP), ax=ax, shrink=0.7, pad=0.02)
+        cbar = fig.colorbar(ScalarMappable(norm=norms[first], cmap=CMAP), ax=ax, shrink=0.7, pad=0.08)
         cbar.set_label(text)
     else:
-        for name in collections:
+        for name in faces:
             cbar = fig.colorbar(ScalarMappable(norm=norms[name], cmap=CMAP), ax=ax, shrink=0.7,
-                                pad=0.01, fraction=0.04)
+                                pad=0.08, fraction=0.04)
             cbar.set_label(f"{name}: {text}", fontsize=8)
-    return fig, collections
+    return fig, {name: poly for name in faces}
