@@ -3,7 +3,8 @@
 Subcommands:
   run            solve a case with voiga, print what it found, write figures and ParaView files
   summary        what a result file says, in a few lines
-  plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG)
+  plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG;
+                 a solid: a 3D view of its boundary)
   plot-contact   p_N and p_T along the contact (PNG)
   history        reactions and contact forces against the load time (CSV and PNG)
   vtk            ParaView time series (.pvd + .vtu)
@@ -464,7 +465,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default=None, help="folder (default: next to the result)")
     s.add_argument("--samples", type=int, default=2,
                    help="least subdivisions of each element per direction (default 2; at "
-                        "least 48 per body and direction)")
+                        "least 48 per body and direction, 16 for a solid)")
     s.set_defaults(func=_cmd_vtk)
 
     s = sub.add_parser("plot-deformed", help="bodies in the current configuration, coloured by |u|, "
@@ -485,7 +486,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--field", default="u", metavar="NAME",
                    help="the colouring: u (|u|, default), ux, uy, von_mises, stress_xx, stress_yy, "
                         "stress_zz, stress_xy, strain_xx, ... (stress and strain: steps with &output "
-                        "fields); files <result>-<NAME>-<step>.png (u: -deformed-)")
+                        "fields; a solid's also uz and the yz, xz components); files "
+                        "<result>-<NAME>-<step>.png (u: -deformed-)")
     s.add_argument("--colour-scale", choices=("body", "shared"), default=None,
                    help="a colour scale per body or one shared by all bodies (default: per body "
                         "for u, ux, uy; shared for a stress or strain)")

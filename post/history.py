@@ -2,7 +2,8 @@
 Dirichlet condition and the resultant force of every contact pair against the load
 time, as a CSV table and a PNG figure.
 
-Forces are per unit thickness (plane strain): force/length in the file's units.
+Forces are per unit thickness in 2D (plane strain): force/length in the file's units;
+a solid's (3D) are forces, with a z component.
 """
 
 from __future__ import annotations
@@ -21,8 +22,8 @@ from .reader import Result
 def history_table(result: Result) -> tuple[list[str], np.ndarray]:
     """``(column names, rows (n_steps, n_columns))`` of the converged steps:
     step, load time, Newton iterations, cuts; per Dirichlet condition its reaction
-    (x, y); per contact pair its resultant force on the slave (x, y), the number of
-    points in contact, the largest pressure and the smallest gap."""
+    (x, y, and z for a solid); per contact pair its resultant force on the slave (x,
+    y), the number of points in contact, the largest pressure and the smallest gap."""
     names = ["step", "time", "iterations", "cuts"]
     for d in result.dirichlet:
         names += [f"reaction_{a} {d.body}/{d.edge}" for a in result.axes]
@@ -74,14 +75,14 @@ def plot_history(result: Result, output: str | Path | None = None,
     has_contact = any(n.startswith("contact_x") for n in names)
     fig, axes = plt.subplots(2 if has_contact else 1, 1, figsize=(7.5, 7.0 if has_contact else 4.2),
                              sharex=True, layout="constrained", squeeze=False)
-    unit = result.units.line_force
+    unit = result.units.resultant(result.dimension)
     t = rows[:, col["time"]]
     forces = [k for n, k in col.items() if n.startswith(("reaction_", "contact_"))]
     # components that are zero up to round-off of the largest force are left out
     noise = 1e-9 * (float(np.abs(rows[:, forces]).max()) if forces and len(rows) else 0.0)
     ax = axes[0, 0]
     for d in result.dirichlet:
-        for comp, style in (("x", "-"), ("y", "--")):
+        for comp, style in zip(result.axes, ("-", "--", ":")[:result.dimension], strict=True):
             y = rows[:, col[f"reaction_{comp} {d.body}/{d.edge}"]]
             if np.abs(y).max(initial=0.0) > noise:
                 ax.plot(t, y, style, marker=".", ms=3, label=f"$R_{comp}$ {d.body}/{d.edge}")

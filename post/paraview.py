@@ -12,11 +12,13 @@ blocks):
 
 - ``bodies``: every body finely sampled: each element split into at least
   ``samples x samples`` bilinear quads (more on coarse meshes: at least
-  ``MIN_SAMPLES`` along each direction of a body) whose corners are the exact VO map at reference
-  coordinates; point data ``displacement`` (3 components, z = 0: use *Warp By
-  Vector* for the deformed shape); cell data ``body`` (index into the field data
-  ``body_names``) and ``element`` (0-based element of that body). Linear
-  interpolation between the samples is the only approximation.
+  ``MIN_SAMPLES`` along each direction of a body), of a solid into ``samples^3``
+  trilinear hexahedra (at least ``MIN_SAMPLES_3D`` along each direction), whose
+  corners are the exact VO map at reference coordinates; point data
+  ``displacement`` (3 components, z = 0 in 2D: use *Warp By Vector* for the deformed
+  shape); cell data ``body`` (index into the field data ``body_names``) and
+  ``element`` (0-based element of that body). Linear interpolation between the
+  samples is the only approximation.
 - ``contact``: the slave points of every contact pair at their reference
   positions, one polyline per pair in slave-parameter order; point data
   ``displacement`` (current minus reference position), ``p_n``, ``p_t``, ``gap``
@@ -30,10 +32,10 @@ blocks):
 - ``fields``: stress, strain and von Mises at the steps the result file has them
   (``/steps/<k>/fields/<body>``, written by voiga as ``&output`` asks; docs/hdf5.md):
   the sample points at their reference positions with ``displacement``, joined
-  into quads within each element (one vertex per point with one sample per
-  element), with ``stress`` and ``strain`` as symmetric tensors (``XX YY ZZ XY YZ
-  XZ``, z out of plane), ``von_mises``, ``element`` and ``body``; the stress and
-  strain measures as field data.
+  into quads (a solid's: hexahedra) within each element (one vertex per point with
+  one sample per element), with ``stress`` and ``strain`` as symmetric tensors
+  (``XX YY ZZ XY YZ XZ``; in 2D z out of plane, YZ = XZ = 0), ``von_mises``,
+  ``element`` and ``body``; the stress and strain measures as field data.
 
 Field data of every file: ``units``, ``title``, ``case_file``, ``voiga_version``,
 ``status``, ``source`` (the result file), ``writer``, ``step``, ``time``.
@@ -55,6 +57,7 @@ from pre.nurbs import curve_to_splipy
 from .field import combine, displacement, evaluate
 from .naming import output_path
 from .plot import breakpoints
+from .quantity import element_of
 from .reader import Body, ContactOutput, Result, Step, body_displacement
 
 SAMPLES = 2
@@ -62,6 +65,16 @@ SAMPLES = 2
 
 MIN_SAMPLES = 48
 """Least subdivisions of a body in each parametric direction (coarse meshes)."""
+
+MIN_SAMPLES_3D = 16
+"""The same for a solid (16^3 = 4096 hexahedra at least; 48^3 would be 110 592)."""
+
+HEXAHEDRON = (0, 1, 3, 2, 4, 5, 7, 6)
+"""VTK's vertex order of a hexahedron from the corners of a cell numbered (zeta, eta,
+xi) as bits (xi fastest): (0,0,0), (1,0,0), (1,1,0), (0,1,0), then the same at zeta 1."""
+
+LEFT_HANDED_HEXAHEDRON = (0, 2, 3, 1, 4, 6, 7, 5)
+"""The same with the eta and xi edges swapped: positive volume for a left-handed map."""
 
 
 def element_samples(breaks: np.ndarray, samples: int, minimum: int = MIN_SAMPLES) -> np.ndarray:
@@ -92,12 +105,16 @@ def _array(name: str, values: np.ndarray) -> vtk.vtkDataArray:
 
 
 def _vec3(v: np.ndarray) -> np.ndarray:
-    v = np.asarray(v, dtype=float).reshape(-1, 2)
+    """Vectors ``(n, 2)`` with z = 0, or ``(n, 3)``, as ``(n, 3)``."""
+    v = np.asarray(v, dtype=float)
+    if v.ndim == 2 and v.shape[1] == 3:
+        return v
+    v = v.reshape(-1, 2)
     return np.column_stack([v, np.zeros(len(v))])
 
 
 def _grid(points: np.ndarray, cells: list[np.ndarray], cell_type: int) -> vtk.vtkUnstructuredGrid:
-    """An unstructured grid of ``points (n, 2)`` and cells of one type."""
+    """An unstructured grid of ``points (n, 2 or 3)`` and cells of one type."""
     grid = vtk.vtkUnstructuredGrid()
     pts = vtk.vtkPoints()
     pts.SetData(numpy_to_vtk(_vec3(points), deep=True))
@@ -123,46 +140,61 @@ def _field_data(grid: vtk.vtkDataSet, result: Result, step: Step | None) -> None
     fd.AddArray(_string_array("body_names", list(result.bodies)))
 
 
-def body_samples(body: Body, samples: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Sampling of one body: ``(xi grid, eta grid)`` (n_eta, n_xi) and the 0-based
-    element of every quad ``(n_eta - 1, n_xi - 1)``."""
-    bx, be = breakpoints(body)
-    xi, eta = element_samples(bx, samples), element_samples(be, samples)
-    xm, em = 0.5 * (xi[1:] + xi[:-1]), 0.5 * (eta[1:] + eta[:-1])
-    r = body.element_ranges
-    ix = np.searchsorted(bx, xm) - 1
-    ie = np.searchsorted(be, em) - 1
-    lookup = {}
-    for k, (xa, xb, ea, eb) in enumerate(r):
-        lookup[(int(np.searchsorted(bx, 0.5 * (xa + xb)) - 1),
-                int(np.searchsorted(be, 0.5 * (ea + eb)) - 1))] = k
-    elem = np.array([[lookup.get((int(i), int(j)), -1) for i in ix] for j in ie], dtype=np.int64)
-    xx, ee = np.meshgrid(xi, eta)
-    return xx, ee, elem
+def body_samples(body: Body, samples: int) -> tuple[np.ndarray, ...]:
+    """Sampling of one body: the parameter grids ``(xi grid, eta grid)`` (n_eta, n_xi)
+    and the 0-based element of every quad ``(n_eta - 1, n_xi - 1)``; of a solid ``(xi,
+    eta, zeta grids)`` (n_zeta, n_eta, n_xi) and the element of every hexahedron."""
+    minimum = MIN_SAMPLES if body.nsd == 2 else MIN_SAMPLES_3D
+    t = [element_samples(b, samples, minimum) for b in breakpoints(body)]
+    mid = [0.5 * (a[1:] + a[:-1]) for a in t]
+    grids = np.meshgrid(*t[::-1], indexing="ij")[::-1]  # xi varies along the last axis
+    centres = np.meshgrid(*mid[::-1], indexing="ij")[::-1]
+    elem = element_of(body, *(c.ravel() for c in centres))[0].reshape(centres[0].shape)
+    return (*grids, elem.astype(np.int64))
+
+
+def _cells(ids: np.ndarray, positive: bool) -> np.ndarray:
+    """The cells of a structured block of point ids ``(n_eta, n_xi)`` (quads) or
+    ``(n_zeta, n_eta, n_xi)`` (hexahedra) -> ``(n_cells, 4 or 8)``; ``positive``: the
+    block's map is right-handed (else the vertex order is mirrored so that every cell
+    keeps a positive area or volume)."""
+    if ids.ndim == 2:
+        quads = np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:], ids[1:, :-1]], axis=-1)
+        return (quads if positive else quads[..., ::-1]).reshape(-1, 4)
+    corners = [ids[k:ids.shape[0] - 1 + k, j:ids.shape[1] - 1 + j, i:ids.shape[2] - 1 + i]
+               for k in (0, 1) for j in (0, 1) for i in (0, 1)]  # bits (zeta, eta, xi)
+    order = HEXAHEDRON if positive else LEFT_HANDED_HEXAHEDRON
+    return np.stack([corners[c] for c in order], axis=-1).reshape(-1, 8)
+
+
+def right_handed(x: np.ndarray) -> bool:
+    """Whether the map sampled on a grid ``x`` ``(n_eta, n_xi, 2)`` or ``(n_zeta, n_eta,
+    n_xi, 3)`` is right-handed (orientation-preserving), judged at its first cell."""
+    if x.ndim == 3:
+        e1, e2 = x[0, 1] - x[0, 0], x[1, 0] - x[0, 0]
+        return bool(e1[0] * e2[1] - e1[1] * e2[0] >= 0)
+    e1, e2, e3 = x[0, 0, 1] - x[0, 0, 0], x[0, 1, 0] - x[0, 0, 0], x[1, 0, 0] - x[0, 0, 0]
+    return bool(np.dot(np.cross(e1, e2), e3) >= 0)
 
 
 def bodies_grid(result: Result, step: Step | None, samples: int = SAMPLES) -> vtk.vtkUnstructuredGrid:
     """Every body sampled (see the module docstring)."""
     points, disp, cells, body_id, elem_id = [], [], [], [], []
     offset = 0
+    nsd = result.dimension
     for b, (name, body) in enumerate(result.bodies.items()):
         u = body_displacement(result, name, 0 if step is None else step.step)
-        xx, ee, elem = body_samples(body, samples)
-        x = evaluate(body, None, xx, ee)
-        n_eta, n_xi = xx.shape
-        ids = offset + np.arange(n_eta * n_xi).reshape(n_eta, n_xi)
-        quads = np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:], ids[1:, :-1]], axis=-1)
-        # keep the quads counter-clockwise (the arc scenes' patches are left-handed)
-        e1, e2 = x[0, 1] - x[0, 0], x[1, 0] - x[0, 0]
-        if e1[0] * e2[1] - e1[1] * e2[0] < 0:
-            quads = quads[..., ::-1]
-        points.append(x.reshape(-1, 2))
-        disp.append(displacement(body, u, xx, ee).reshape(-1, 2))
-        cells += list(quads.reshape(-1, 4))
+        *params, elem = body_samples(body, samples)
+        x = evaluate(body, None, *params)
+        ids = offset + np.arange(params[0].size).reshape(params[0].shape)
+        # keep the cells positively oriented (the arc scenes' patches are left-handed)
+        cells += list(_cells(ids, right_handed(x)))
+        points.append(x.reshape(-1, nsd))
+        disp.append(displacement(body, u, *params).reshape(-1, nsd))
         body_id.append(np.full(elem.size, b))
         elem_id.append(elem.reshape(-1))
-        offset += n_eta * n_xi
-    grid = _grid(np.concatenate(points), cells, vtk.VTK_QUAD)
+        offset += params[0].size
+    grid = _grid(np.concatenate(points), cells, vtk.VTK_QUAD if nsd == 2 else vtk.VTK_HEXAHEDRON)
     grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
     grid.GetCellData().AddArray(_array("body", np.concatenate(body_id)))
     grid.GetCellData().AddArray(_array("element", np.concatenate(elem_id)))
@@ -269,58 +301,77 @@ TENSOR_COMPONENTS = ("XX", "YY", "ZZ", "XY", "YZ", "XZ")
 """ParaView's order of a symmetric tensor's six components."""
 
 
+FILE_COMPONENTS = {"xx yy zz xy": 4, "xx yy zz xy yz xz": 6}
+"""The result file's stress and strain components (attribute ``components``) that
+:func:`symmetric_tensor` turns into ParaView's order, and their number."""
+
+
 def symmetric_tensor(values: np.ndarray) -> np.ndarray:
     """(n, 4) [xx, yy, zz, xy] (the result file's plane-strain components) as (n, 6) in
-    ParaView's symmetric-tensor order (yz = xz = 0)."""
-    v = np.asarray(values, dtype=float).reshape(-1, 4)
+    ParaView's symmetric-tensor order (yz = xz = 0); a solid's (n, 6) [xx, yy, zz, xy, yz,
+    xz] are in that order already."""
+    v = np.asarray(values, dtype=float)
+    if v.ndim == 2 and v.shape[1] == 6:
+        return v
+    v = v.reshape(-1, 4)
     return np.column_stack([v[:, 0], v[:, 1], v[:, 2], v[:, 3], np.zeros(len(v)), np.zeros(len(v))])
 
 
-def _sample_cells(fields: dict[str, np.ndarray], samples: int, offset: int) -> list[np.ndarray]:
-    """Quads joining each element's ``samples x samples`` grid of points (xi fastest),
-    or one vertex per point (one sample, or no element numbers)."""
+def _sample_cells(fields: dict[str, np.ndarray], samples: int, offset: int, nsd: int = 2,
+                  positive: bool = True) -> list[np.ndarray]:
+    """Quads (a solid's: hexahedra) joining each element's grid of ``samples`` points
+    per direction (xi fastest), or one vertex per point (one sample, or no element
+    numbers); ``positive``: the body's map is right-handed (hexahedra: see
+    :func:`_cells`; quads are counter-clockwise in the patch's parameters, and
+    left-handed patches are fine for VTK)."""
     n = len(fields["xi"])
-    if samples < 2 or "element" not in fields or n % samples**2:
+    per = samples**nsd
+    if samples < 2 or "element" not in fields or n % per:
         return [np.array([offset + i]) for i in range(n)]
-    k = samples
-    grid = np.arange(k * k).reshape(k, k)
-    quad = np.stack([grid[:-1, :-1], grid[:-1, 1:], grid[1:, 1:], grid[1:, :-1]], axis=-1).reshape(-1, 4)
-    # counter-clockwise in the patch's parameters; left-handed patches are fine for VTK
-    return [offset + e * k * k + q for e in range(n // (k * k)) for q in quad]
+    block = _cells(np.arange(per).reshape([samples] * nsd), positive or nsd == 2)
+    return [offset + e * per + c for e in range(n // per) for c in block]
 
 
 def fields_grid(result: Result, step: Step) -> vtk.vtkUnstructuredGrid | None:
     """Sampled solver fields (stress, strain, von Mises) of the step, None when the
     file has none: the sample points at their reference positions with
     ``displacement``, joined into quads per element when the solver sampled a grid
-    (``&output samples >= 2``); ``stress`` and ``strain`` as symmetric tensors
-    (``XX YY ZZ XY YZ XZ``) when the file gives their plane-strain components."""
+    (``&output samples >= 2``; a solid's: hexahedra); ``stress`` and ``strain`` as
+    symmetric tensors (``XX YY ZZ XY YZ XZ``) when the file gives their plane-strain
+    components or a solid's six."""
     if not step.fields:
         return None
     pts, disp, values, body_id, cells = [], [], {}, [], []
     tensors = set()
     names = list(result.bodies)
+    nsd = result.dimension
+    params = ("xi", "eta", "zeta")[:nsd]
     offset = 0
     for name, fields in step.fields.items():
         body = result.body(name)
         info = step.field_info.get(name, {})
-        xi, eta = fields["xi"], fields["eta"]
+        at = [fields[p] for p in params]
+        n = len(at[0])
         u = body_displacement(result, name, step.step)
-        pts.append(evaluate(body, None, xi, eta).reshape(-1, 2))
-        disp.append(combine(body, u, xi, eta).reshape(-1, 2))
-        body_id.append(np.full(len(xi), names.index(name)))
-        cells += _sample_cells(fields, int(info.get("samples", 1)), offset)
-        offset += len(xi)
-        plane = info.get("components") == "xx yy zz xy"
+        x = evaluate(body, None, *at).reshape(-1, nsd)
+        pts.append(x)
+        disp.append(combine(body, u, *at).reshape(-1, nsd))
+        body_id.append(np.full(n, names.index(name)))
+        samples = int(info.get("samples", 1))
+        positive = nsd == 2 or samples < 2 or n < samples**3 or \
+            right_handed(x[:samples**3].reshape(samples, samples, samples, 3))
+        cells += _sample_cells(fields, samples, offset, nsd, positive)
+        offset += n
+        components = FILE_COMPONENTS.get(str(info.get("components", "")))
         for key, v in fields.items():
-            if key in ("xi", "eta"):
+            if key in params:
                 continue
-            if plane and key in ("stress", "strain"):
-                v = symmetric_tensor(v)
+            if components and key in ("stress", "strain"):
+                v = symmetric_tensor(np.asarray(v).reshape(n, components))
                 tensors.add(key)
-            values.setdefault(key, []).append(np.asarray(v).reshape(len(xi), -1))
+            values.setdefault(key, []).append(np.asarray(v).reshape(n, -1))
     points = np.concatenate(pts)
-    kind = vtk.VTK_QUAD if cells and len(cells[0]) == 4 else vtk.VTK_VERTEX
+    kind = {4: vtk.VTK_QUAD, 8: vtk.VTK_HEXAHEDRON}.get(len(cells[0]) if cells else 1, vtk.VTK_VERTEX)
     grid = _grid(points, cells, kind)
     grid.GetPointData().AddArray(_array("displacement", _vec3(np.concatenate(disp))))
     grid.GetPointData().AddArray(_array("body", np.concatenate(body_id)))

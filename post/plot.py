@@ -10,7 +10,8 @@ chosen automatically when the displacements are small (:func:`auto_scale`; the
 title says the factor); rigid masters (lines and curves) are drawn moved by their
 prescribed motion times the same factor, so that they sit on the bodies they
 touch; when bodies are in contact a second panel shows the contact zone at true
-scale.
+scale. A result of solids (dimension 3) is drawn by :mod:`post.plot3d` instead: a 3D
+view of the bodies' boundaries.
 """
 
 from __future__ import annotations
@@ -48,10 +49,11 @@ TARGET = 0.1
 """The auto scale magnifies the largest displacement to about this fraction of the size."""
 
 
-def breakpoints(body: Body) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct element boundaries ``(xi values, eta values)`` of a body."""
+def breakpoints(body: Body) -> tuple[np.ndarray, ...]:
+    """Distinct element boundaries of a body in each parametric direction: ``(xi
+    values, eta values)``, of a solid ``(xi values, eta values, zeta values)``."""
     r = body.element_ranges
-    return np.unique(r[:, :2]), np.unique(r[:, 2:])
+    return tuple(np.unique(r[:, 2 * d:2 * d + 2]) for d in range(r.shape[1] // 2))
 
 
 def sample_parameters(breaks: np.ndarray, minimum: int = MIN_SAMPLES) -> np.ndarray:
@@ -296,7 +298,11 @@ def deformed_figure(result: Result, step: int = -1, scale: float | str = "auto",
     """
     if not result.bodies:
         raise ValueError(f"{result.path}: no bodies")
-    check_name(field)
+    check_name(field, result.dimension)
+    if result.dimension == 3:  # solids: a 3D view of the boundary (post/plot3d.py)
+        from .plot3d import solid_figure
+
+        return solid_figure(result, step, scale, length_unit, reference, field, colour_scale)
     if colour_scale is None:
         colour_scale = "body" if field in DISPLACEMENT else "shared"
     if colour_scale not in ("body", "shared"):

@@ -5,10 +5,12 @@ plain dataclasses holding numpy arrays in *natural* order, whatever h5py
 shows for the Fortran arrays:
 
 - control points ``(ncp, nsd)``, reactions ``(n_dirichlet, nsd)``, element ranges
-  ``(nel, 4)``, the bulk patch ``(n_eta, n_xi, 2)`` (``docs/formats.md``), where nsd
-  is the file's spatial dimension (:attr:`Result.dimension`: the root attribute
-  ``dimension``, 2 in files written before voiga wrote it);
-- every id is **0-based**: element connectivity, element pointers, edge
+  ``(nel, 2 nsd)``, the bulk patch ``(n_eta, n_xi, 2)`` or volume ``(n_zeta, n_eta,
+  n_xi, 3)`` (``docs/formats.md``), where nsd is the file's spatial dimension
+  (:attr:`Result.dimension`: the root attribute ``dimension``, 2 in files written
+  before voiga wrote it); a plane body's boundaries are its ``edges``, a solid's
+  its ``faces`` (both read into :attr:`Body.edges`);
+- every id is **0-based**: element connectivity, element pointers, edge or face
   control point ids, :attr:`Body.dof_offset` (the index of the body's first
   DOF in a step's global displacement vector);
 - byte-string attributes are decoded to ``str`` (trailing blanks and NULs of
@@ -51,8 +53,9 @@ from typing import Any
 import h5py
 import numpy as np
 
-from pre.h5io import read_curve, read_patch
+from pre.h5io import read_curve, read_patch, read_volume
 from pre.nurbs import Curve, Patch
+from pre.volume import Volume
 
 from .journal import recover
 from .units import Units
@@ -149,8 +152,45 @@ def _attrs(obj: h5py.HLObject) -> dict[str, Any]:
 
 
 @dataclass
+class Surface:
+    """A NURBS surface in space: the VO layer of a solid (``/bodies/<name>/layer`` of a
+    file of dimension 3), over the bulk's first two directions (xi, eta)."""
+
+    degree: tuple[int, int]
+    knots_xi: np.ndarray
+    knots_eta: np.ndarray
+    control_points: np.ndarray
+    """(n_eta n_xi, 3), xi fastest (the body's numbering of its layer points)."""
+    weights: np.ndarray
+    """(n_eta n_xi,)"""
+
+    def __post_init__(self) -> None:
+        self.degree = (int(self.degree[0]), int(self.degree[1]))
+        self.knots_xi = np.asarray(self.knots_xi, dtype=float).reshape(-1)
+        self.knots_eta = np.asarray(self.knots_eta, dtype=float).reshape(-1)
+        self.control_points = np.asarray(self.control_points, dtype=float)
+        self.weights = np.asarray(self.weights, dtype=float).reshape(-1)
+        n_eta, n_xi = self.shape
+        if n_xi < 1 or n_eta < 1 or self.control_points.shape != (n_xi * n_eta, 3) \
+                or len(self.weights) != n_xi * n_eta:
+            raise ValueError(f"layer surface: control_points {self.control_points.shape}, weights "
+                             f"{self.weights.shape}, knots for {n_xi} x {n_eta} points")
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(n_eta, n_xi)`` from the knot vectors."""
+        return (len(self.knots_eta) - self.degree[1] - 1, len(self.knots_xi) - self.degree[0] - 1)
+
+
+def _read_surface(g: h5py.Group) -> Surface:
+    return Surface(degree=tuple(np.asarray(g["degree"][()]).reshape(-1)),  # type: ignore[arg-type]
+                   knots_xi=g["knots_xi"][()], knots_eta=g["knots_eta"][()],
+                   control_points=g["control_points"][()], weights=g["weights"][()])
+
+
+@dataclass
 class Body:
-    """One body: its material, numbering, elements, edges and discretization."""
+    """One body: its material, numbering, elements, edges (or faces) and discretization."""
 
     name: str
     material: str
@@ -167,15 +207,17 @@ class Body:
     element_conn: np.ndarray
     """0-based control point ids; per element: bulk tensor products (xi fastest), then layer."""
     element_ranges: np.ndarray
-    """(nel, 4): xi_a, xi_b, eta_a, eta_b of each element."""
+    """(nel, 2 nsd): xi_a, xi_b, eta_a, eta_b (, zeta_a, zeta_b) of each element."""
     element_vo: np.ndarray
-    """(nel,) bool: True for a varying-order (contact row) element."""
+    """(nel,) bool: True for a varying-order (contact row or layer) element."""
     edges: dict[str, np.ndarray]
-    """edge name -> 0-based control point ids on the edge."""
-    bulk: Patch
-    """The refined bulk patch (contact edge at eta = 1)."""
-    layer: Curve | None
-    """The VO layer curve, or None."""
+    """Boundary name -> 0-based control point ids on it: the edges of a plane body,
+    the faces of a solid (also :attr:`faces`)."""
+    bulk: Patch | Volume
+    """The refined bulk patch (contact edge at eta = 1), or of a solid the refined
+    volume (contact face at zeta = 1)."""
+    layer: Curve | Surface | None
+    """The VO layer: a curve (plane body), a surface (solid), or None."""
     attrs: dict[str, Any] = field(default_factory=dict)
     """Every attribute of ``/bodies/<name>`` (decoded)."""
     nsd: int = 2
@@ -187,13 +229,23 @@ class Body:
         return len(self.weights)
 
     @property
+    def faces(self) -> dict[str, np.ndarray]:
+        """A solid's faces (face name -> 0-based control point ids): :attr:`edges`."""
+        return self.edges
+
+    @property
+    def boundary(self) -> str:
+        """What a boundary of the body is called: ``'edge'`` or ``'face'``."""
+        return "edge" if self.nsd == 2 else "face"
+
+    @property
     def n_elements(self) -> int:
         """Number of elements."""
         return len(self.element_ptr) - 1
 
     @property
     def dofs(self) -> slice:
-        """The body's DOFs in the global vector (the axes interleaved: x, y, x, y, ...)."""
+        """The body's DOFs in the global vector (the axes interleaved: x, y, (z,) x, y, ...)."""
         return slice(self.dof_offset, self.dof_offset + self.nsd * self.ncp)
 
     def element(self, k: int) -> np.ndarray:
@@ -207,6 +259,8 @@ class Dirichlet:
 
     body: str
     edge: str
+    """The boundary it holds: an edge of a plane body, a face of a solid (voiga writes
+    the face's name in the attribute ``edge`` too)."""
 
 
 @dataclass
@@ -337,10 +391,11 @@ class Step:
 
     @property
     def fields(self) -> dict[str, dict[str, np.ndarray]]:
-        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (n,),
-        ``element`` (n,) 0-based, ``stress`` and ``strain`` (n, 4) as [xx, yy, zz, xy],
-        ``von_mises`` (n,)), from ``/steps/<k>/fields/<body>``; empty at the steps
-        without (``&output``; docs/hdf5.md)."""
+        """Sampled solver fields: body -> dataset name -> array (``xi``, ``eta`` (and a
+        solid's ``zeta``) (n,), ``element`` (n,) 0-based, ``stress`` and ``strain`` (n, 4)
+        as [xx, yy, zz, xy], of a solid (n, 6) as [xx, yy, zz, xy, yz, xz], ``von_mises``
+        (n,)), from ``/steps/<k>/fields/<body>``; empty at the steps without
+        (``&output``; docs/hdf5.md)."""
         return self._get("fields")
 
     @property
@@ -542,7 +597,7 @@ def _read_body(name: str, g: h5py.Group, nsd: int) -> Body:
     e = g["elements"]
     ptr = np.asarray(e["ptr"][()], dtype=np.int64) - 1
     conn = np.asarray(e["conn"][()], dtype=np.int64) - 1
-    ranges = np.asarray(e["range"][()], dtype=float).reshape(-1, 4)
+    ranges = np.asarray(e["range"][()], dtype=float).reshape(-1, 2 * nsd)
     vo = np.asarray(e["vo"][()]).astype(bool)
     nel = len(ptr) - 1
     if ptr[0] != 0 or ptr[-1] != len(conn) or np.any(np.diff(ptr) <= 0):
@@ -552,8 +607,15 @@ def _read_body(name: str, g: h5py.Group, nsd: int) -> Body:
                          f"{len(ranges)}, vo {len(vo)}")
     if len(conn) and (conn.min() < 0 or conn.max() >= ncp):
         raise ValueError(f"/bodies/{name}/elements/conn: ids outside 1..{ncp}")
-    edges = {k: np.asarray(v[()], dtype=np.int64).reshape(-1) - 1 for k, v in g["edges"].items()} \
-        if "edges" in g else {}
+    where = "edges" if nsd == 2 else "faces"  # a plane body's boundaries, a solid's
+    edges = {k: np.asarray(v[()], dtype=np.int64).reshape(-1) - 1 for k, v in g[where].items()} \
+        if where in g else {}
+    if nsd == 2:
+        bulk: Patch | Volume = read_patch(g["bulk"])
+        layer: Curve | Surface | None = read_curve(g["layer"]) if "layer" in g else None
+    else:
+        bulk = read_volume(g["bulk"])
+        layer = _read_surface(g["layer"]) if "layer" in g else None
     return Body(name=name, material=str(attrs.get("material", "")),
                 youngs_modulus=float(attrs.get("youngs_modulus", np.nan)),
                 poisson_ratio=float(attrs.get("poisson_ratio", np.nan)),
@@ -561,8 +623,7 @@ def _read_body(name: str, g: h5py.Group, nsd: int) -> Body:
                 control_points=cp,
                 weights=finite(np.asarray(g["weights"][()], dtype=float).reshape(-1), f"/bodies/{name}/weights"),
                 element_ptr=ptr, element_conn=conn, element_ranges=ranges, element_vo=vo,
-                edges=edges, bulk=read_patch(g["bulk"]),
-                layer=read_curve(g["layer"]) if "layer" in g else None, attrs=attrs, nsd=nsd)
+                edges=edges, bulk=bulk, layer=layer, attrs=attrs, nsd=nsd)
 
 
 _STEP_SCALARS: tuple[str, ...] = ("iterations", "iterations_total", "cuts") + \

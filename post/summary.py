@@ -86,11 +86,11 @@ def summary_lines(result: Result) -> list[str]:
     last = steps[-1]
     lines.append(f"last converged step {last.step}, load time {last.time:g}:")
     for d, r in zip(result.dirichlet, last.reactions, strict=True):
-        lines.append(f"  reaction on {d.body}/{d.edge}: {_vec(r)} {u.line_force}")
+        lines.append(f"  reaction on {d.body}/{d.edge}: {_vec(r)} {u.resultant(result.dimension)}")
     for c in last.contact:
         active = c.active
         line = (f"  contact {c.slave} -> {c.master}: force on {c.slave} {_vec(c.force)} "
-                f"{u.line_force}, {int(active.sum())} of {len(active)} points in contact")
+                f"{u.resultant(result.dimension)}, {int(active.sum())} of {len(active)} points in contact")
         if active.any():
             gap = c.gap[active]
             x = c.x[active]

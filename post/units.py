@@ -5,7 +5,7 @@ voiga works in any consistent units; the result file's root attribute ``units``
 the labels use them; otherwise (e.g. ``"consistent (...)"``, free text) they read
 ``length`` and ``force``. In 2D plane strain every force is per unit thickness:
 reactions and contact forces are force/length, contact pressure, tractions and
-stresses force/length^2.
+stresses force/length^2; a solid's (3D) reactions are forces.
 """
 
 from __future__ import annotations
@@ -39,6 +39,11 @@ class Units:
     def line_force(self) -> str:
         """Force per unit thickness (reactions, contact forces, P)."""
         return f"{self.force}/{self.length}"
+
+    def resultant(self, dimension: int) -> str:
+        """The unit of a resultant force (a reaction) of a result file of spatial
+        ``dimension``: force per unit thickness in 2D, force in 3D."""
+        return self.line_force if dimension == 2 else self.force
 
     @property
     def pressure(self) -> str:

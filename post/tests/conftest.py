@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
 
 import h5py
@@ -153,12 +154,17 @@ def _skip_or_fail(msg: str) -> None:
     pytest.skip(msg)
 
 
-def run_case(voiga: Path, folder: Path, text: str, output: str, expect: int = 0) -> Path:
-    """Write ``case.nml`` (and the ironing geometry) into ``folder``, run
-    ``voiga case.nml --quiet`` there, check the exit code; returns the result
-    file. A binary built before the solver existed skips (fails under CI)."""
+def run_case(voiga: Path, folder: Path, text: str, output: str, expect: int = 0,
+             geometry: Callable[[Path], object] | None = None) -> Path:
+    """Write ``case.nml`` and the geometry (the ironing scene's, or what ``geometry``
+    writes at the path it is given) into ``folder``, run ``voiga case.nml --quiet``
+    there, check the exit code; returns the result file. A binary built before the
+    solver existed skips (fails under CI)."""
     folder.mkdir(parents=True, exist_ok=True)
-    shutil.copy(CASES / "ironing" / "geometry.h5", folder / "geometry.h5")
+    if geometry is None:
+        shutil.copy(CASES / "ironing" / "geometry.h5", folder / "geometry.h5")
+    else:
+        geometry(folder / "geometry.h5")
     (folder / "case.nml").write_text(text)
     run = subprocess.run([str(voiga), "case.nml", "--quiet"], cwd=folder, capture_output=True,
                          text=True, timeout=TIMEOUT, stdin=subprocess.DEVNULL)
@@ -300,3 +306,100 @@ def hertz_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     if run.returncode != 0:
         pytest.fail(f"hertz m1 NN2.2: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}")
     return folder / "m1-NN2.2.h5"
+
+
+# Solids (dimension 3). The box [0, 3] x [0, 2] x [0, 1] pulled by a traction SIGMA on
+# x = 3 and held by its symmetry planes (test/python/test_solid_case.py's case): the
+# exact field u = t SIGMA/E (x, -nu y, -nu z) lies in the NURBS space, stress
+# (SIGMA t, 0, 0, 0, 0, 0). NN3.1 layer on the contact face.
+SIGMA, E_SOLID = 0.02, 2.0
+
+SOLID = """&case
+  title = 'box', geometry = 'geometry.h5', output = '{output}', n_bodies = 1
+/
+&body
+  name = 'block', material = 'linear', youngs_modulus = 2.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, degree_zeta = 2, nel_xi = 3, nel_eta = 2, nel_zeta = 2,
+  contact_face = '{contact}', layer_degree = 3, layer_elevations = 1
+/
+&solver
+  n_steps = 2
+/
+&dirichlet
+  body = 'block', face = 'left', fix_x = .true.
+/
+&dirichlet
+  body = 'block', face = 'front', fix_y = .true.
+/
+&dirichlet
+  body = 'block', face = 'bottom', fix_z = .true.
+/
+&pressure
+  body = 'block', face = 'right', p = -0.02
+/
+&output
+  samples = {samples}
+/
+"""
+
+# A thick quarter cylinder (rational, r from 1 to 2, z from 0 to 1) with a layer on its
+# outer face, held at its bottom and pressed on its outer face.
+CYLINDER = """&case
+  title = 'quarter cylinder', geometry = 'geometry.h5', output = 'cylinder.h5', n_bodies = 1
+/
+&body
+  name = 'tube', material = 'linear', youngs_modulus = 10.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, degree_zeta = 2, nel_xi = 2, nel_eta = 2, nel_zeta = 2,
+  contact_face = 'outer', layer_degree = 3, layer_elevations = 0
+/
+&solver
+  n_steps = 1
+/
+&dirichlet
+  body = 'tube', face = 'bottom', fix_x = .true., fix_y = .true., fix_z = .true.
+/
+&pressure
+  body = 'tube', face = 'outer', p = 0.01
+/
+"""
+
+
+def exact_box(x: np.ndarray, time: float) -> np.ndarray:
+    """The exact displacement of the box case at ``x`` (..., 3) and load time ``time``."""
+    return time * SIGMA / E_SOLID * np.asarray(x, dtype=float) * np.array([1.0, -NU, -NU])
+
+
+def _box_geometry(path: Path) -> None:
+    from pre.solids import box, write_volumes
+
+    write_volumes(path, {"block": box((0.0, 3.0), (0.0, 2.0), (0.0, 1.0))})
+
+
+def _cylinder_geometry(path: Path) -> None:
+    from pre.solids import cylinder_sector, write_volumes
+
+    write_volumes(path, {"tube": cylinder_sector(1.0, 2.0)})
+
+
+@pytest.fixture(scope="session")
+def box_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The box case (contact face 'top', fields at 2 x 2 x 2 points per element)."""
+    return run_case(voiga, tmp_path_factory.mktemp("box"),
+                    SOLID.format(output="box.h5", contact="top", samples=2), "box.h5",
+                    geometry=_box_geometry)
+
+
+@pytest.fixture(scope="session")
+def turned_box_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The box case with the contact face 'back' (y = 2): the solver turns the patch so
+    that it is zeta = 1; fields at 3 x 3 x 3 points per element."""
+    return run_case(voiga, tmp_path_factory.mktemp("turned"),
+                    SOLID.format(output="turned.h5", contact="back", samples=3), "turned.h5",
+                    geometry=_box_geometry)
+
+
+@pytest.fixture(scope="session")
+def cylinder_h5(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The quarter cylinder (rational map, layer on the outer face)."""
+    return run_case(voiga, tmp_path_factory.mktemp("cylinder"), CYLINDER, "cylinder.h5",
+                    geometry=_cylinder_geometry)
