@@ -2,7 +2,7 @@
 
 Subcommands:
   geometry     a geometry spec (TOML) -> geometry file and case file
-  geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes
+  geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
@@ -36,22 +36,19 @@ def _from_spec(command: str, write: Callable[[], Any], spec: str) -> Any:
     return None
 
 
-def _cmd_geometry(args: argparse.Namespace) -> int:
-    from .spec import write_from_spec
-
-    done = _from_spec("geometry", lambda: write_from_spec(args.spec, args.out, args.force), args.spec)
-    if done is None:
-        return 2
+def _report(command: str, spec: str, done: Any) -> int:
+    """What a spec's writer did (a :class:`pre.spec.SpecOutcome`), as ``python -m pre
+    COMMAND`` prints it: the files written, kept, or the differences (exit 2)."""
     if done.stale:
-        print(f"python -m pre geometry: {done.case} and {done.geometry.name} differ from what "
-              f"{args.spec} gives now:", file=sys.stderr)
+        print(f"python -m pre {command}: {done.case} and {done.geometry.name} differ from what "
+              f"{spec} gives now:", file=sys.stderr)
         for line in done.changes:
             print(f"  {line}", file=sys.stderr)
         print("nothing written; --force writes both from the spec (the case file's own values "
               "listed above are then replaced)", file=sys.stderr)
         return 2
     if not done.written:
-        print(f"kept {done.geometry} and {done.case} (up to date with {args.spec})")
+        print(f"kept {done.geometry} and {done.case} (up to date with {spec})")
         return 0
     print(f"wrote {done.geometry}")
     print(f"wrote {done.case}")
@@ -62,18 +59,18 @@ def _cmd_geometry(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_geometry(args: argparse.Namespace) -> int:
+    from .spec import write_from_spec
+
+    done = _from_spec("geometry", lambda: write_from_spec(args.spec, args.out, args.force), args.spec)
+    return 2 if done is None else _report("geometry", args.spec, done)
+
+
 def _cmd_geometry3d(args: argparse.Namespace) -> int:
     from .spec3d import write_from_spec3d
 
     done = _from_spec("geometry3d", lambda: write_from_spec3d(args.spec, args.out, args.force), args.spec)
-    if done is None:
-        return 2
-    if done.stale:
-        print(f"python -m pre geometry3d: {done.geometry} differs from what {args.spec} gives now; "
-              "nothing written (--force replaces it)", file=sys.stderr)
-        return 2
-    print(f"wrote {done.geometry}" if done.written else f"kept {done.geometry} (up to date with {args.spec})")
-    return 0
+    return 2 if done is None else _report("geometry3d", args.spec, done)
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
@@ -171,10 +168,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "(what is replaced is listed)")
     s.set_defaults(func=_cmd_geometry)
 
-    s = sub.add_parser("geometry3d", help="spec of 3D bodies (TOML) -> geometry file of volumes")
+    s = sub.add_parser("geometry3d", help="spec of 3D bodies (TOML) -> geometry file of volumes and case file")
     s.add_argument("spec", help="spec file (.toml; docs/pre.md, '3D bodies')")
     s.add_argument("--out", default=None, help="output folder (default: the spec's folder)")
-    s.add_argument("--force", action="store_true", help="replace a geometry file that differs from the spec")
+    s.add_argument("--force", action="store_true",
+                   help="write the geometry and case files although they exist and differ from the spec "
+                        "(what is replaced is listed)")
     s.set_defaults(func=_cmd_geometry3d)
 
     s = sub.add_parser("cases", help="write geometry files and case namelists")

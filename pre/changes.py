@@ -1,6 +1,6 @@
 """What differs between the files a spec wrote earlier and what it gives now
-(``python -m pre geometry``): the case file's groups and variables, and the
-geometry file's bodies and curves. A spec edited since (a new ``n_steps``) and a case
+(``python -m pre geometry``, ``geometry3d``): the case file's groups and variables, and
+the geometry file's bodies (patches or volumes) and curves. A spec edited since (a new ``n_steps``) and a case
 edited by hand (an added ``&output``) both show up here, one line each, so that
 nothing is replaced without saying what."""
 
@@ -10,10 +10,12 @@ from pathlib import Path
 from typing import Any
 
 import f90nml
+import h5py
 import numpy as np
 
-from .h5io import read_curves, read_geometry
+from .h5io import attrs_dict, read_body, read_curves
 from .nurbs import Curve, Patch
+from .volume import Volume
 
 LABEL_KEYS = ("name", "slave", "body")
 """The variable that names a repeated group in a message (``&body 'block'``)."""
@@ -77,14 +79,18 @@ def namelist_changes(old_text: str, new_text: str) -> list[str]:
     return out
 
 
-def _same_patch(a: Patch | Curve, b: Patch | Curve) -> bool:
-    if isinstance(a, Patch) != isinstance(b, Patch):
+def _same_patch(a: Patch | Volume | Curve, b: Patch | Volume | Curve) -> bool:
+    if type(a) is not type(b):
         return False
-    if isinstance(a, Patch):
+    if isinstance(a, Volume) and isinstance(b, Volume):
+        pairs = list(zip(a.knots, b.knots, strict=True))
+        if a.degree != b.degree or a.faces != b.faces:
+            return False
+    elif isinstance(a, Patch) and isinstance(b, Patch):
         pairs = [(a.knots_xi, b.knots_xi), (a.knots_eta, b.knots_eta)]
         if a.degree != b.degree or a.edges != b.edges:
             return False
-    else:
+    elif isinstance(a, Curve) and isinstance(b, Curve):
         pairs = [(a.knots, b.knots)]
         if a.degree != b.degree:
             return False
@@ -92,19 +98,26 @@ def _same_patch(a: Patch | Curve, b: Patch | Curve) -> bool:
     return all(np.shape(x) == np.shape(y) and np.array_equal(x, y) for x, y in pairs)
 
 
+def _read_bodies(path: Path) -> tuple[dict[str, Any], dict[str, Patch | Volume]]:
+    """``(root attrs, {name: patch or volume})`` of a geometry file of either dimension."""
+    with h5py.File(path, "r") as f:
+        return attrs_dict(f), {name: read_body(g) for name, g in f["bodies"].items()}
+
+
 def geometry_changes(old: Path, new: Path) -> list[str]:
     """The differences of two geometry files: bodies and curves added, removed or
-    changed (shape, mesh of the coarse patch, edge names), the scene and units."""
+    changed (shape, mesh of the coarse patch or volume, edge or face names), the scene
+    and units."""
     if not old.is_file():
         return []
     if old.read_bytes() == new.read_bytes():
         return []
     try:
-        old_attrs, old_bodies = read_geometry(old)
+        old_attrs, old_bodies = _read_bodies(old)
         old_curves = read_curves(old)
     except Exception as err:  # h5py raises several kinds on a file that is not ours
         return [f"{old.name} is not a readable geometry file ({err})"]
-    new_attrs, new_bodies = read_geometry(new)
+    new_attrs, new_bodies = _read_bodies(new)
     new_curves = read_curves(new)
     out = []
     for what, a, b in (("body", old_bodies, new_bodies), ("curve", old_curves, new_curves)):
@@ -114,10 +127,11 @@ def geometry_changes(old: Path, new: Path) -> list[str]:
             elif name not in b:
                 out.append(f"{old.name}: {what} {name!r}: only in the geometry file")
             elif not _same_patch(a[name], b[name]):
-                out.append(f"{old.name}: {what} {name!r}: its shape or edges differ")
+                sides = "faces" if isinstance(b[name], Volume) else "edges"
+                out.append(f"{old.name}: {what} {name!r}: its shape or {sides} differ")
         if list(a) != list(b) and set(a) == set(b):
             out.append(f"{old.name}: the {what} order differs")
-    for key in ("scene", "units"):
+    for key in ("scene", "units", "dimension"):
         if str(old_attrs.get(key, "")) != str(new_attrs.get(key, "")):
             out.append(f"{old.name}: {key} {old_attrs.get(key, '')!r} -> {new_attrs.get(key, '')!r} (spec)")
     return out or [f"{old.name}: differs (its metadata)"]

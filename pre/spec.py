@@ -8,12 +8,17 @@ A spec lists bodies (``[[body]]``, one patch each: ``shape = "rectangle"``,
 (``[defaults]``), and the other groups of the case file (``[case]``, ``[solver]``,
 ``[[dirichlet]]``, ``[[pressure]]``, ``[[contact]]``, ``[output]``), written to the
 case as they are after their variables are checked against those voiga reads
-(:data:`pre.namelists.NAMELISTS`): the spec holds the whole case. From ``name.toml``
+(:data:`pre.namelists.PLANE`): the spec holds the whole case. From ``name.toml``
 it writes ``name-geometry.h5`` and the case ``name.nml`` next to it (or into
 ``--out``). When they exist and differ from what the spec gives now (the spec was
 edited, or the case by hand), nothing is written: the differences are listed, and
 ``force`` writes both anew, listing what it replaced. A case written without load
 groups is a template: its comments show the groups to add (``docs/formats.md``).
+
+The spec of 3D bodies (:mod:`pre.spec3d`) shares the parts that do not depend on the
+dimension: :func:`load_toml`, :func:`check_groups` (the case tables against the
+variables voiga reads), :func:`assemble_case` (the case file's groups) and
+:func:`write_case_files` (the two files, kept, listed or replaced).
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from __future__ import annotations
 import math
 import os
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,7 +51,7 @@ from .geometry import (
     write_bodies,
 )
 from .layouts import parse_layout
-from .namelists import NAMELISTS
+from .namelists import PLANE
 from .nurbs import Curve, Patch
 from .spec_check import MAX_ELEMENTS, SpecCheckError, check_spec, check_table
 
@@ -117,28 +123,42 @@ class Spec:
         return {**DEFAULTS, **self.data.get("defaults", {})}
 
 
-def read_spec(path: str | Path) -> Spec:
-    """Parse a TOML spec (tomllib); SpecError names the problem."""
-    path = Path(path)
+def load_toml(path: Path) -> dict[str, Any]:
+    """The tables of a TOML spec (tomllib); SpecError when there is no such file or it
+    is not TOML."""
     if not path.is_file():
         raise SpecError(f"no spec file {path}")
     try:
-        data = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise SpecError(f"{path}: not valid TOML ({err})") from None
+
+
+def check_groups(path: Path, data: dict[str, Any], groups: tuple[str, ...],
+                 variables: dict[str, frozenset[str]]) -> None:
+    """Every value of a spec checked (:func:`pre.spec_check.check_spec`), then its
+    ``[case]`` and the case tables of ``groups`` against the ``variables`` of their
+    namelist groups (:data:`pre.namelists.PLANE` or ``SOLID``)."""
+    try:
+        check_spec(data)
+    except SpecCheckError as err:
+        raise SpecError(f"{path}: {err}") from None
+    for group in ("case", *groups):
+        if group in data:
+            check_case_tables(path, group, data[group], variables)
+
+
+def read_spec(path: str | Path) -> Spec:
+    """Parse a TOML spec (tomllib); SpecError names the problem."""
+    path = Path(path)
+    data = load_toml(path)
     unknown = set(data) - {"units", "scene", "defaults", "body", "curve", "case", *CASE_GROUPS}
     if unknown:
         raise SpecError(f"{path}: unknown table(s) {sorted(unknown)} (known: units, scene, [defaults], "
                         f"[[body]], [[curve]], [case], {', '.join(_table_name(g) for g in CASE_GROUPS)})")
     if not data.get("body"):
         raise SpecError(f"{path}: no [[body]]")
-    try:
-        check_spec(data)
-    except SpecCheckError as err:
-        raise SpecError(f"{path}: {err}") from None
-    for group in ("case", *CASE_GROUPS):
-        if group in data:
-            check_case_tables(path, group, data[group])
+    check_groups(path, data, CASE_GROUPS, PLANE)
     return Spec(path, data)
 
 
@@ -146,9 +166,11 @@ def _table_name(group: str) -> str:
     return f"[{group}]" if group in SINGLE_GROUPS else f"[[{group}]]"
 
 
-def check_case_tables(path: Path, group: str, value: Any) -> None:
+def check_case_tables(path: Path, group: str, value: Any,
+                      variables: dict[str, frozenset[str]] = PLANE) -> None:
     """A case group of the spec: one table for ``[case]``, ``[solver]``, ``[output]``
-    (any number for the others), each key a variable voiga reads in that group."""
+    (any number for the others), each key one of the ``variables`` of that group
+    (those voiga reads in a plane case, by default)."""
     tables = [value] if isinstance(value, dict) else value
     if group in SINGLE_GROUPS and not isinstance(value, dict):
         raise SpecError(f"{path}: [{group}] is one table (the case has one &{group}), not [[{group}]]")
@@ -156,10 +178,10 @@ def check_case_tables(path: Path, group: str, value: Any) -> None:
         raise SpecError(f"{path}: {_table_name(group)} must be a table")
     for k, table in enumerate(tables, start=1):
         where = f"[{group}]" if isinstance(value, dict) else f"[[{group}]] ({k})"
-        unknown = sorted(set(table) - NAMELISTS[group])
+        unknown = sorted(set(table) - variables[group])
         if unknown:
             raise SpecError(f"{path}: {where}: {unknown} not variable(s) of &{group} (known: "
-                            f"{', '.join(sorted(NAMELISTS[group]))}; docs/formats.md)")
+                            f"{', '.join(sorted(variables[group]))}; docs/formats.md)")
         own = sorted(set(table) & set(CASE_BY_PRE)) if group == "case" else []
         if own:
             raise SpecError(f"{path}: [case]: {own} written by pre itself (the geometry file it writes, "
@@ -336,21 +358,27 @@ TEMPLATE_HELP = """
 """
 
 
+def assemble_case(data: dict[str, Any], bodies: list[dict[str, Any]], geometry: str, stem: str,
+                  groups: tuple[str, ...] = CASE_GROUPS) -> dict[str, Any]:
+    """The case file's groups: ``&case`` (pre's values, then the spec's ``[case]``), the
+    ``&body`` groups ``bodies``, then the spec's tables of ``groups`` as given."""
+    case = {"title": data.get("scene", stem), "scene": data.get("scene", stem),
+            "geometry": geometry, "output": f"{stem}.h5", "n_bodies": len(bodies)}
+    case.update(data.get("case", {}))
+    out: dict[str, Any] = {"case": case, "body": bodies}
+    for g in groups:
+        if g in data:
+            value = data[g]
+            out[g] = value if isinstance(value, dict) else list(value)
+    return out
+
+
 def case_groups(spec: Spec, patches: dict[str, Patch], geometry: str, stem: str) -> dict[str, Any]:
     """The case file's groups: ``&case`` (pre's values, then the spec's ``[case]``), one
     ``&body`` per body, then the spec's ``[solver]``, ``[[dirichlet]]``,
     ``[[pressure]]``, ``[[contact]]``, ``[output]`` as given."""
-    case = {"title": spec.data.get("scene", stem), "scene": spec.data.get("scene", stem),
-            "geometry": geometry, "output": f"{stem}.h5", "n_bodies": len(patches)}
-    case.update(spec.data.get("case", {}))
-    groups: dict[str, Any] = {"case": case,
-                              "body": [body_group(b, patches[b["name"]], spec.defaults)
-                                       for b in spec.bodies]}
-    for g in CASE_GROUPS:
-        if g in spec.data:
-            value = spec.data[g]
-            groups[g] = value if isinstance(value, dict) else list(value)
-    return groups
+    return assemble_case(spec.data, [body_group(b, patches[b["name"]], spec.defaults) for b in spec.bodies],
+                         geometry, stem)
 
 
 @dataclass
@@ -401,16 +429,31 @@ def case_text(spec: Spec, patches: dict[str, Patch], stem: str) -> str:
 def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
                     force: bool = False) -> SpecOutcome:
     """Build every body of the spec and write ``<stem>-geometry.h5`` and the case
-    ``<stem>.nml`` (into ``out``, default the spec's folder). When the case file
-    exists, nothing is written without ``force``: its values and the geometry are
-    the spec's (the file keeps its comments; a missing geometry file is written), or
-    they differ (the spec or the case was edited) and the outcome lists how. With
-    ``force`` both are written anew, the outcome listing what was replaced."""
+    ``<stem>.nml`` (into ``out``, default the spec's folder), as
+    :func:`write_case_files` does: kept when up to date, the differences listed and
+    nothing written without ``force``."""
     spec = read_spec(spec_path)
-    folder = Path(out) if out is not None else spec.path.parent
-    stem = spec.path.stem
     patches, curves = build_all(spec)
-    text = case_text(spec, patches, stem)
+    text = case_text(spec, patches, spec.path.stem)
+
+    def geometry(path: Path) -> None:
+        write_bodies(path, patches, scene=str(spec.data.get("scene", spec.path.stem)),
+                     units=str(spec.data.get("units", "mm, N")), curves=curves)
+
+    return write_case_files(spec.path, out, text, geometry, force)
+
+
+def write_case_files(spec_path: Path, out: str | Path | None, text: str,
+                     write_geometry: Callable[[Path], None], force: bool = False) -> SpecOutcome:
+    """Write the geometry file (``write_geometry(path)`` writes it) and the case
+    ``text`` as ``<stem>-geometry.h5`` and ``<stem>.nml`` of the spec ``spec_path``
+    (into ``out``, default the spec's folder). When the case file exists, nothing is
+    written without ``force``: its values and the geometry are the spec's (the file
+    keeps its comments; a missing geometry file is written), or they differ (the spec
+    or the case was edited) and the outcome lists how. With ``force`` both are
+    written anew, the outcome listing what was replaced."""
+    folder = Path(out) if out is not None else spec_path.parent
+    stem = spec_path.stem
     folder.mkdir(parents=True, exist_ok=True)
     geometry, case = folder / f"{stem}-geometry.h5", folder / f"{stem}.nml"
     # nothing is written through a link or over a special file (pre/files.py)
@@ -418,8 +461,7 @@ def write_from_spec(spec_path: str | Path, out: str | Path | None = None,
     check_output(case)
     fresh = folder / f".{stem}-geometry.h5.new"
     try:
-        write_bodies(fresh, patches, scene=str(spec.data.get("scene", stem)),
-                     units=str(spec.data.get("units", "mm, N")), curves=curves)
+        write_geometry(fresh)
         changes: list[str] = []
         if case.exists():
             changes = [f"{case.name}: {c}" for c in namelist_changes(case.read_text(), text)]

@@ -1,27 +1,30 @@
-"""A geometry spec of 3D bodies (TOML) -> a geometry file of volumes
-(``python -m pre geometry3d SPEC.toml``; reference in ``docs/pre.md``).
+"""A spec of 3D bodies (TOML) -> geometry file of volumes and case file
+(``python -m pre geometry3d SPEC.toml``; reference in ``docs/pre.md``, "3D bodies").
 
-The 2D spec (:mod:`pre.spec`) holds a whole case, and its body tables carry the
-case file's 2D ``&body`` settings (``nel = [n_xi, n_eta]``, a contact edge, the layout
-of a contact curve); voiga's case file has no 3D bodies yet. So volumes have their own,
-geometry-only spec: ``units``, ``scene`` and ``[[body]]`` tables with ``name``,
-``shape`` (:data:`SHAPES`), the shape's keys and ``faces`` (renames, ``{label = "new
-name"}``; for ``g2`` the names of all six faces by key). ``extrude`` and ``revolve``
-take a ``section``: a 2D body table of the 2D spec (``shape = "rectangle"``, ... with
-its ``edges``), built by :func:`pre.spec.build_patch`. From ``name.toml`` it writes
-``name-geometry.h5`` (into ``--out`` or the spec's folder); a file there that differs
-is replaced only with ``force``.
+The 3D counterpart of :mod:`pre.spec`: ``units``, ``scene``, ``[defaults]`` and
+``[[body]]`` tables with ``name``, ``shape`` (:data:`SHAPES`), the shape's keys,
+``faces`` (renames, ``{label = "new name"}``; for ``g2`` the names of all six faces by
+key) and the ``&body`` settings of a solid (``layout``, ``elements``,
+``element_size`` or ``nel = [n_xi, n_eta, n_zeta]``, ``contact_face``, the material;
+:mod:`pre.solid_case`). ``extrude`` and ``revolve`` take a ``section``: a 2D body
+table of the 2D spec (``shape = "rectangle"``, ... with its ``edges``), built by
+:func:`pre.spec.build_patch`. The case groups ``[case]``, ``[solver]``,
+``[[dirichlet]]`` and ``[[pressure]]`` (on faces: ``face``, ``fix_z``, ``uz``) and
+``[output]`` are checked against the variables of a solid case
+(:data:`pre.namelists.SOLID`) and copied; ``[[contact]]`` is refused (contact between
+solids is not implemented yet: issue 42). From ``name.toml`` it writes
+``name-geometry.h5`` and the case ``name.nml`` (into ``--out`` or the spec's folder),
+kept, listed or replaced as the 2D spec's (:func:`pre.spec.write_case_files`).
 """
 
 from __future__ import annotations
 
-import os
-import tomllib
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .files import check_output
+from .cases import to_namelist_text
+from .namelists import SOLID
+from .solid_case import DEFAULT_KEYS, MESH_KEYS, check_loads, solid_body_group
 from .solids import (
     box,
     cylinder_sector,
@@ -32,8 +35,18 @@ from .solids import (
     solid,
     write_volumes,
 )
-from .spec import SpecError, build_patch, need, pick
-from .spec_check import SpecCheckError, integer, non_finite, number, numbers, text
+from .spec import (
+    SpecError,
+    SpecOutcome,
+    assemble_case,
+    build_patch,
+    check_groups,
+    load_toml,
+    need,
+    pick,
+    write_case_files,
+)
+from .spec_check import KEY_CHECKS, MAX_ELEMENTS, SpecCheckError, integer, number, numbers, text
 from .volume import Volume, check_volume
 
 SHAPES: dict[str, set[str]] = {
@@ -44,9 +57,21 @@ SHAPES: dict[str, set[str]] = {
     "revolve": {"section", "angle", "axis_point", "axis_direction", "ends"},
     "g2": {"file", "index"},
 }
-"""The shapes of a ``[[body]]`` table and their keys (besides ``name``, ``shape``, ``faces``)."""
+"""The shapes of a ``[[body]]`` table and their keys (besides :data:`BODY_KEYS`)."""
 
-BODY_KEYS = {"name", "shape", "faces"}
+BODY_KEYS = {"name", "shape", "faces"} | MESH_KEYS
+"""Keys of every ``[[body]]``: its name, shape, face names and ``&body`` settings."""
+
+CASE_GROUPS = ("solver", "dirichlet", "pressure", "output")
+"""Spec tables copied into a solid case file, in this order (``[case]`` goes into
+``&case``; no ``[[contact]]`` yet)."""
+
+TABLES = ("units", "scene", "defaults", "body", "case", *CASE_GROUPS)
+"""What a 3D spec may hold (``[[contact]]`` is named apart: not implemented yet)."""
+
+def _fail(message: str) -> None:
+    raise SpecCheckError(message)
+
 
 CHECKS: dict[str, Any] = {
     "x": lambda v, w: numbers(v, w, 2), "y": lambda v, w: numbers(v, w, 2),
@@ -55,9 +80,14 @@ CHECKS: dict[str, Any] = {
     "angle": lambda v, w: number(v, w, 0.0, 90.0),
     "axis_point": lambda v, w: numbers(v, w, 2), "axis_direction": lambda v, w: numbers(v, w, 2),
     "file": text, "index": lambda v, w: integer(v, w, 0, 10**6),
+    "contact_face": lambda v, w: None if v == "" else text(v, w),
+    "nel": lambda v, w: [integer(n, f"{w}[{k}]", 1, MAX_ELEMENTS) for k, n in enumerate(v)]
+    if isinstance(v, list) and len(v) == 3 else _fail(f"{w} must be three integers [n_xi, n_eta, n_zeta], "
+                                                       f"not {v!r}"),
+    **{k: KEY_CHECKS[k] for k in DEFAULT_KEYS},
 }
-"""How each shape key is checked before anything is built (``centre``, ``ends``,
-``faces`` and ``section`` by :func:`_check`)."""
+"""How each key of a ``[[body]]`` is checked before anything is built (``centre``,
+``ends``, ``faces`` and ``section`` by :func:`_check`)."""
 
 
 def _strings(value: Any, where: str, count: int | None = None) -> None:
@@ -128,51 +158,34 @@ def build_volume(b: dict[str, Any], folder: Path) -> Volume:
 
 
 def read_spec3d(path: str | Path) -> dict[str, Any]:
-    """Parse a 3D spec (tomllib); SpecError names the problem."""
+    """Parse a 3D spec (tomllib) and check its tables; SpecError names the problem."""
     path = Path(path)
-    if not path.is_file():
-        raise SpecError(f"no spec file {path}")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise SpecError(f"{path}: not valid TOML ({err})") from None
-    unknown = set(data) - {"units", "scene", "body"}
+    data = load_toml(path)
+    if "contact" in data:
+        raise SpecError(f"{path}: [[contact]]: contact between solids is not implemented yet (issue 42); "
+                        "a solid case has bodies and loads (docs/formats.md, \"Solids\")")
+    unknown = set(data) - set(TABLES)
     if unknown:
         raise SpecError(f"{path}: unknown key(s) or table(s) {sorted(unknown)} (known: units, scene, "
-                        "[[body]]; a 3D spec writes the geometry file only)")
+                        "[defaults], [[body]], [case], [solver], [[dirichlet]], [[pressure]], [output])")
     body = data.get("body")
     if not body or not isinstance(body, list) or not all(isinstance(t, dict) for t in body):
         raise SpecError(f"{path}: no [[body]] tables")
-    try:
-        non_finite(data, "")
-        for key in ("units", "scene"):
-            if key in data:
-                text(data[key], key)
-    except SpecCheckError as err:
-        raise SpecError(f"{path}: {err}") from None
+    defaults = data.get("defaults", {})
+    if isinstance(defaults, dict) and set(defaults) - DEFAULT_KEYS:
+        raise SpecError(f"{path}: [defaults]: unknown key(s) {sorted(set(defaults) - DEFAULT_KEYS)} "
+                        f"(known: {', '.join(sorted(DEFAULT_KEYS))})")
+    if isinstance(defaults, dict) and {"elements", "element_size"} <= set(defaults):
+        raise SpecError(f"{path}: [defaults]: give elements or element_size, not both")
+    check_groups(path, data, CASE_GROUPS, SOLID)
     return data
 
 
-@dataclass
-class Outcome3d:
-    """What :func:`write_from_spec3d` did: the file, whether it was written, and
-    whether it was left alone because it differs (``force`` replaces it)."""
-
-    geometry: Path
-    written: bool
-    stale: bool
-
-
-def write_from_spec3d(spec_path: str | Path, out: str | Path | None = None,
-                      force: bool = False) -> Outcome3d:
-    """Build and check every volume of the spec and write ``<stem>-geometry.h5`` (into
-    ``out``, default the spec's folder). A file already there with the same bytes is
-    kept; one that differs is replaced only with ``force`` (else ``stale``)."""
-    spec_path = Path(spec_path)
-    data = read_spec3d(spec_path)
+def build_volumes(data: dict[str, Any], folder: Path) -> dict[str, Volume]:
+    """Every body's volume, checked (``folder``: where relative files are)."""
     volumes: dict[str, Volume] = {}
     for b in data["body"]:
-        vol = build_volume(b, spec_path.parent)
+        vol = build_volume(b, folder)
         if b["name"] in volumes:
             raise SpecError(f"two bodies are named {b['name']!r}")
         try:
@@ -180,19 +193,49 @@ def write_from_spec3d(spec_path: str | Path, out: str | Path | None = None,
         except ValueError as err:
             raise SpecError(str(err)) from None
         volumes[b["name"]] = vol
-    folder = Path(out) if out is not None else spec_path.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    geometry = check_output(folder / f"{spec_path.stem}-geometry.h5")
-    fresh = folder / f".{spec_path.stem}-geometry.h5.new"
-    try:
-        write_volumes(fresh, volumes, scene=str(data.get("scene", spec_path.stem)),
+    return volumes
+
+
+TEMPLATE_HELP = """
+! This case has no loads yet: add the groups you need (docs/formats.md, "Solids"), e.g.
+!
+! &solver
+!   n_steps = 1
+! /
+! &dirichlet
+!   body = '{body}', face = '{fixed}', fix_x = .true., fix_y = .true., fix_z = .true.
+! /
+! &pressure
+!   body = '{body}', face = '{loaded}', p = 0.01
+! /
+"""
+
+
+def case_text3d(data: dict[str, Any], volumes: dict[str, Volume], stem: str) -> str:
+    """The case file of a 3D spec (a template with comments when it has no load groups)."""
+    bodies = [solid_body_group(b, volumes[b["name"]], data.get("defaults", {})) for b in data["body"]]
+    text = to_namelist_text(assemble_case(data, bodies, f"{stem}-geometry.h5", stem, CASE_GROUPS))
+    if not any(g in data for g in CASE_GROUPS if g != "output"):
+        first = data["body"][0]["name"]
+        faces = volumes[first].faces
+        text += TEMPLATE_HELP.format(body=first, fixed=faces["zeta0"], loaded=faces["zeta1"])
+    return text
+
+
+def write_from_spec3d(spec_path: str | Path, out: str | Path | None = None,
+                      force: bool = False) -> SpecOutcome:
+    """Build and check every volume of the spec, its loads against them, and write
+    ``<stem>-geometry.h5`` and the case ``<stem>.nml`` (into ``out``, default the
+    spec's folder) as :func:`pre.spec.write_case_files` does: kept when up to date, the
+    differences listed and nothing written without ``force``."""
+    spec_path = Path(spec_path)
+    data = read_spec3d(spec_path)
+    volumes = build_volumes(data, spec_path.parent)
+    check_loads(data, volumes)
+    text = case_text3d(data, volumes, spec_path.stem)
+
+    def geometry(path: Path) -> None:
+        write_volumes(path, volumes, scene=str(data.get("scene", spec_path.stem)),
                       units=str(data.get("units", "mm, N")))
-        if geometry.exists():
-            if geometry.read_bytes() == fresh.read_bytes():
-                return Outcome3d(geometry, False, False)
-            if not force:
-                return Outcome3d(geometry, False, True)
-        os.replace(fresh, check_output(geometry))
-        return Outcome3d(geometry, True, False)
-    finally:
-        fresh.unlink(missing_ok=True)
+
+    return write_case_files(spec_path, out, text, geometry, force)

@@ -1,7 +1,8 @@
-"""Shared fixtures: the repo root and a freshly generated cases/ tree."""
+"""Shared fixtures: the repo root, a freshly generated cases/ tree and the built voiga."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -23,3 +24,15 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("cases")
     write_cases(out)
     return out
+
+
+@pytest.fixture(scope="session")
+def voiga_bin() -> Path:
+    """The built ``voiga`` (``$VOIGA_BIN``, else ``build/install/bin/voiga``); the test
+    is skipped without it (failed on CI, where it must be there)."""
+    path = Path(os.environ.get("VOIGA_BIN", REPO / "build" / "install" / "bin" / "voiga"))
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        if os.environ.get("CI"):
+            pytest.fail(f"voiga binary not found at {path}; run `make build` first")
+        pytest.skip(f"voiga binary not found at {path}; run `make build` first")
+    return path
