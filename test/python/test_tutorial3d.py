@@ -4,6 +4,7 @@ one shell in a temporary folder (with the built voiga on the PATH and this check
 checked."""
 from __future__ import annotations
 
+import math
 import os
 import re
 import subprocess
@@ -62,5 +63,13 @@ def test_the_3d_tutorial_runs_as_written(voiga_bin: Path, tmp_path: Path) -> Non
     assert [len(q) for q in quotes] == [2, 1, 2], quotes
     for line in sum(quotes, []):
         assert line in out, (line, out)
+    # post summary's reactions: the pressure on each quarter disc, p pi a^2 / 4, normal
+    # to each plane (the quoted lines; their round-off components are not compared)
+    for plane in ("start", "end", "equator"):
+        line = next(x for x in out if f"reaction on shell/{plane}:" in x)
+        values = [float(v) for v in line.split("(")[1].split(")")[0].split(",")]
+        normal = {"start": 1, "end": 0, "equator": 2}[plane]
+        assert abs(values[normal] + math.pi / 4) < 1e-5, line
+    assert (folder / "shell.pvd").is_file()
     assert "contact_face = 'inner'" in (folder / "shell-vo.nml").read_text()
     assert "layer_degree = 3" in (folder / "shell-vo.nml").read_text()
