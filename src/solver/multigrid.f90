@@ -33,8 +33,8 @@ module voiga_solver_multigrid
     type, extends(linear_solver_t) :: multigrid_t
         !> Largest coarse problem solved directly.
         integer :: coarse_dofs = 2000
-        !> Line Gauss-Seidel sweeps (each: xi lines, then eta lines) before and
-        !> after each coarse correction.
+        !> Line Gauss-Seidel sweeps (each: xi lines, then eta lines, then zeta lines)
+        !> before and after each coarse correction (in reverse order after).
         integer :: sweeps = 1
         !> GMRES restart length and iteration cap per solve.
         integer :: restart = 50, max_iterations = 500
@@ -68,8 +68,8 @@ module voiga_solver_multigrid
 
 contains
 
-    !> Build the hierarchy for bodies `discs` whose DOFs start at `dof0` (2 per
-    !> control point: 2(a-1)+c), `ndof` in all, with the Dirichlet DOFs `fixed`.
+    !> Build the hierarchy for bodies `discs` whose DOFs start at `dof0` (nsd per
+    !> control point: nsd(a-1)+c), `ndof` in all, with the Dirichlet DOFs `fixed`.
     subroutine mg_build(self, discs, dof0, ndof, fixed, error)
         class(multigrid_t), intent(inout) :: self
         type(discretization_t), intent(in) :: discs(:)
@@ -117,7 +117,7 @@ contains
         class(multigrid_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
-        integer :: l, nl
+        integer :: l, nl, d
         logical :: same
 
         if (.not. allocated(self%levels)) then
@@ -148,8 +148,9 @@ contains
                 call unit_diagonal(self%levels(l + 1)%a, self%levels(l + 1)%fixed)
             end do
             do l = 1, nl - 1
-                call self%levels(l)%lines(1)%analyse(self%levels(l)%a)
-                call self%levels(l)%lines(2)%analyse(self%levels(l)%a)
+                do d = 1, size(self%levels(l)%lines)
+                    call self%levels(l)%lines(d)%analyse(self%levels(l)%a)
+                end do
             end do
             do l = 1, nl
                 self%levels(l)%diag = csr_diagonal_positions(self%levels(l)%a)
@@ -168,10 +169,10 @@ contains
             end if
         end do
         do l = 1, nl - 1
-            call self%levels(l)%lines(1)%factor(self%levels(l)%a, error)
-            if (allocated(error)) return
-            call self%levels(l)%lines(2)%factor(self%levels(l)%a, error)
-            if (allocated(error)) return
+            do d = 1, size(self%levels(l)%lines)
+                call self%levels(l)%lines(d)%factor(self%levels(l)%a, error)
+                if (allocated(error)) return
+            end do
         end do
         if (same) then
             self%coarse%values = 0.0_dp
@@ -264,7 +265,7 @@ contains
         class(multigrid_t), intent(inout) :: self
         integer, intent(in) :: l
         type(error_t), allocatable, intent(out) :: error
-        integer :: s
+        integer :: s, d
 
         associate (lv => self%levels(l))
             if (l == size(self%levels)) then
@@ -273,8 +274,9 @@ contains
             end if
             lv%x = 0.0_dp
             do s = 1, self%sweeps
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
+                do d = 1, size(lv%lines)
+                    call lv%lines(d)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
+                end do
             end do
             call csr_matvec(lv%a, lv%x, lv%res)
             lv%res = lv%b - lv%res
@@ -284,8 +286,9 @@ contains
             call csr_matvec(lv%p, self%levels(l + 1)%x, lv%res)
             lv%x = lv%x + lv%res
             do s = 1, self%sweeps
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
+                do d = size(lv%lines), 1, -1
+                    call lv%lines(d)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
+                end do
             end do
         end associate
     end subroutine vcycle
