@@ -193,7 +193,8 @@ contains
     !> A linear-elastic box [0, 3] x [0, 2] x [0, 1] (elements 3 : 2 : 1), n^3
     !> quadratic elements, bottom face clamped: GMRES + multigrid (coarsest at most
     !> 100 DOFs) solves K x = b to 1e-10, agrees with UMFPACK, and needs fewer than 15
-    !> iterations at n = 4, 8 and 16 (3, 4 and 5 levels; 9 at each when written).
+    !> iterations at n = 4, 8 and 16 (3, 4 and 5 levels; 9 at each when written); a
+    !> second `factor` of the same tangent reuses the set-up.
     subroutine test_solve(error)
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: sizes(3) = [4, 8, 16]
@@ -247,6 +248,15 @@ contains
             call check(error, maxval(abs(x - xd)) <= 1.0e-8_dp*maxval(abs(xd)), trim(label)//': = UMFPACK')
             if (allocated(error)) return
             call check(error, its(i) < 15, trim(label)//': fewer than 15 GMRES iterations')
+            if (allocated(error)) return
+            ! the same tangent again (a linear body's next Newton iteration): no new set-up
+            call mg%factor(k, error)
+            if (allocated(error)) return
+            call check(error, mg%n_setups == 1 .and. mg%n_reused == 1, trim(label)//': set-up reused')
+            if (allocated(error)) return
+            call mg%solve(k, b, xd, error, solve_accuracy_t(rtol=1.0e-10_dp))
+            if (allocated(error)) return
+            call check(error, all(xd == x), trim(label)//': the same solution')
         end subroutine solve_one
     end subroutine test_solve
 

@@ -5,7 +5,8 @@
 !> The hierarchy (`build`) is made once per run (`voiga_solver_multigrid_levels`).
 !> Every Newton iteration (`factor`) computes the Galerkin coarse operators
 !> A_(l+1) = P_l^T A_l P_l from the assembled tangent, contact included, and
-!> factorizes the coarsest with UMFPACK. A V-cycle smooths with `sweeps` forward
+!> factorizes the coarsest with UMFPACK; unless the tangent equals the last one
+!> entry by entry (a linear body without contact), then all of it stands. A V-cycle smooths with `sweeps` forward
 !> Gauss-Seidel sweeps before the coarse correction and as many backward sweeps
 !> after it (symmetric for a symmetric tangent). GMRES (right preconditioned,
 !> restarted every `restart` iterations) stops at a relative residual `rtol`.
@@ -38,8 +39,9 @@ module voiga_solver_multigrid
         integer :: sweeps = 1
         !> GMRES restart length and iteration cap per solve.
         integer :: restart = 50, max_iterations = 500
-        !> Counters (read only): setups, solves, GMRES iterations in all and in the last solve.
-        integer :: n_setups = 0, n_solves = 0, n_iterations = 0, iterations_last = 0
+        !> Counters (read only): setups, setups skipped (the tangent of the last one
+        !> again), solves, GMRES iterations in all and in the last solve.
+        integer :: n_setups = 0, n_reused = 0, n_solves = 0, n_iterations = 0, iterations_last = 0
         !> Relative residual reached by the last solve (read only).
         real(dp) :: residual_last = 0.0_dp
         type(mg_level_t), allocatable :: levels(:)
@@ -131,6 +133,12 @@ contains
                 same = all(self%colptr == a%colptr) .and. all(self%rowind == a%rowind)
         end if
         if (same) then
+            ! the tangent of the last set-up (a linear body without contact, whose
+            ! tangent does not change): its operators and factors stand
+            if (all(self%levels(1)%a%val == a%values(self%perm))) then
+                self%n_reused = self%n_reused + 1
+                return
+            end if
             ! the patterns are those of the last set-up: values only
             self%levels(1)%a%val = a%values(self%perm)
             do l = 1, nl - 1
