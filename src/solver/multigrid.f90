@@ -135,7 +135,7 @@ contains
         if (same) then
             ! the tangent of the last set-up (a linear body without contact, whose
             ! tangent does not change): its operators and factors stand
-            if (all(self%levels(1)%a%val == a%values(self%perm))) then
+            if (same_values(self%levels(1)%a%val, a%values, self%perm)) then
                 self%n_reused = self%n_reused + 1
                 return
             end if
@@ -196,23 +196,26 @@ contains
         self%n_setups = self%n_setups + 1
     end subroutine mg_setup
 
+    !> Is val(q) = values(perm(q)) for every q? (A loop that stops at the first
+    !> difference: no temporary of the tangent's size.)
+    pure logical function same_values(val, values, perm) result(same)
+        real(dp), intent(in) :: val(:), values(:)
+        integer, intent(in) :: perm(:)
+        integer :: q
+        same = .false.
+        do q = 1, size(perm)
+            if (val(q) /= values(perm(q))) return
+        end do
+        same = .true.
+    end function same_values
+
     !> The fine operator in CSR, and the map from its entries to the tangent's
     !> values (kept for later set-ups with the same pattern).
     subroutine fine_operator(self, k)
         class(multigrid_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: k
-        type(csc_matrix_t) :: index
-        type(csr_t) :: t
-        integer :: q
 
-        ! the transpose of the entry numbers gives each CSR entry's CSC position
-        index%n = k%n
-        index%colptr = k%colptr
-        index%rowind = k%rowind
-        index%values = [(real(q, dp), q=1, size(k%values))]
-        call csr_from_csc(index, t)
-        self%perm = nint(t%val)
-        call csr_from_csc(k, self%levels(1)%a)
+        call csr_from_csc(k, self%levels(1)%a, self%perm)
         self%colptr = k%colptr
         self%rowind = k%rowind
     end subroutine fine_operator
