@@ -9,7 +9,10 @@
 !> 20 MiB (libraries, the program) plus, per entry of the element stiffness
 !> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
 !> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows
-!> like n log n) or 2.3 x log2(DOFs) with multigrid.
+!> like n log n) or 2.3 x log2(DOFs) with multigrid; 1.0 x log2(DOFs) for a solid's
+!> entries with multigrid (its element matrices, 81^2 entries for quadratic elements,
+!> count many more entries per matrix nonzero than a plane body's: 13-16 bytes per
+!> entry measured, docs/files.md).
 module voiga_io_input_resources
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
@@ -22,7 +25,8 @@ module voiga_io_input_resources
     public :: memory_estimate, check_size
 
     real(dp), parameter :: base_bytes = 20.0_dp*2.0_dp**20
-    real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp
+    real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp, &
+                           per_entry_multigrid_solid = 1.0_dp
 
 contains
 
@@ -31,11 +35,21 @@ contains
     pure real(dp) function memory_estimate(sizes, linear_solver)
         type(body_size_t), intent(in) :: sizes(:)
         character(len=*), intent(in) :: linear_solver
-        real(dp) :: ndof, entries
+        real(dp) :: ndof, entries, solid
+        logical :: multigrid
+        integer :: i
         ndof = real(sum(sizes%nsd*sizes%ncp), dp)
-        entries = real(sum(sizes%entries), dp)
+        multigrid = trim(linear_solver) == 'multigrid'
+        ! a solid's entries with multigrid apart (their own rate), the rest at the plane rate
+        solid = 0.0_dp
+        do i = 1, size(sizes)
+            if (multigrid .and. sizes(i)%nsd == 3) solid = solid + real(sizes(i)%entries, dp)
+        end do
+        entries = real(sum(sizes%entries), dp) - solid
         memory_estimate = base_bytes + entries*log(max(ndof, 2.0_dp))/log(2.0_dp)* &
-                          merge(per_entry_multigrid, per_entry_direct, trim(linear_solver) == 'multigrid')
+                          merge(per_entry_multigrid, per_entry_direct, multigrid)
+        if (solid > 0.0_dp) memory_estimate = memory_estimate + &
+                                              solid*log(max(ndof, 2.0_dp))/log(2.0_dp)*per_entry_multigrid_solid
     end function memory_estimate
 
     !> The counts fit the default integers, and (unless `memory_check` is false) the
