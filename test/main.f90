@@ -19,6 +19,7 @@ program voiga_tests
     use test_contact, only: collect_contact
     use test_stepping, only: collect_stepping
     use test_multigrid, only: collect_multigrid
+    use test_multigrid_3d, only: collect_multigrid_3d
     use test_hdf5, only: collect_hdf5
     use test_alm, only: collect_alm
     use test_rigid, only: collect_rigid
@@ -51,6 +52,7 @@ program voiga_tests
              new_testsuite('contact', collect_contact), &
              new_testsuite('stepping', collect_stepping), &
              new_testsuite('multigrid', collect_multigrid), &
+             new_testsuite('multigrid_3d', collect_multigrid_3d), &
              new_testsuite('hdf5', collect_hdf5), &
              new_testsuite('alm', collect_alm), &
              new_testsuite('rigid', collect_rigid), &

@@ -27,23 +27,41 @@ module voiga_linalg_csr
 
 contains
 
-    !> CSR copy of a CSC matrix (same matrix, not its transpose).
-    pure subroutine csr_from_csc(a, b)
+    !> CSR copy of a CSC matrix (same matrix, not its transpose), in one pass over its
+    !> entries (no copy of the CSC arrays: the tangent of a solid is the largest array).
+    pure subroutine csr_from_csc(a, b, perm)
         type(csc_matrix_t), intent(in) :: a
         type(csr_t), intent(out) :: b
-        type(csr_t) :: t
-        integer :: j
+        !> Optional: the position in `a%values` of each entry of `b` [nnz].
+        integer, allocatable, intent(out), optional :: perm(:)
+        integer, allocatable :: next(:)
+        integer :: i, j, q, k, nnz
 
-        ! the CSC arrays read as CSR are the transpose; transposing sorts and flips back
-        t%nrow = a%n
-        t%ncol = a%n
-        allocate (t%ptr(a%n + 1))
-        do j = 1, a%n + 1
-            t%ptr(j) = int(a%colptr(j)) + 1
+        ! a counting-sort transpose of the CSC arrays: columns ascend within each row
+        b%nrow = a%n
+        b%ncol = a%n
+        nnz = int(a%colptr(a%n + 1))
+        allocate (b%ptr(a%n + 1), b%col(nnz), b%val(nnz))
+        if (present(perm)) allocate (perm(nnz))
+        b%ptr = 0
+        do q = 1, nnz
+            b%ptr(a%rowind(q) + 2) = b%ptr(a%rowind(q) + 2) + 1
         end do
-        t%col = int(a%rowind) + 1
-        t%val = a%values
-        call csr_transpose(t, b)
+        b%ptr(1) = 1
+        do i = 1, a%n
+            b%ptr(i + 1) = b%ptr(i + 1) + b%ptr(i)
+        end do
+        next = b%ptr(1:a%n)
+        do j = 1, a%n
+            do q = int(a%colptr(j)) + 1, int(a%colptr(j + 1))
+                i = a%rowind(q) + 1
+                k = next(i)
+                b%col(k) = j
+                b%val(k) = a%values(q)
+                if (present(perm)) perm(k) = q
+                next(i) = k + 1
+            end do
+        end do
     end subroutine csr_from_csc
 
     !> CSC copy (0-based, rows sorted within columns) of a square CSR matrix.

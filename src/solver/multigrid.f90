@@ -5,7 +5,8 @@
 !> The hierarchy (`build`) is made once per run (`voiga_solver_multigrid_levels`).
 !> Every Newton iteration (`factor`) computes the Galerkin coarse operators
 !> A_(l+1) = P_l^T A_l P_l from the assembled tangent, contact included, and
-!> factorizes the coarsest with UMFPACK. A V-cycle smooths with `sweeps` forward
+!> factorizes the coarsest with UMFPACK; unless the tangent equals the last one
+!> entry by entry (a linear body without contact), then all of it stands. A V-cycle smooths with `sweeps` forward
 !> Gauss-Seidel sweeps before the coarse correction and as many backward sweeps
 !> after it (symmetric for a symmetric tangent). GMRES (right preconditioned,
 !> restarted every `restart` iterations) stops at a relative residual `rtol`.
@@ -33,13 +34,14 @@ module voiga_solver_multigrid
     type, extends(linear_solver_t) :: multigrid_t
         !> Largest coarse problem solved directly.
         integer :: coarse_dofs = 2000
-        !> Line Gauss-Seidel sweeps (each: xi lines, then eta lines) before and
-        !> after each coarse correction.
+        !> Line Gauss-Seidel sweeps (each: xi lines, then eta lines, then zeta lines)
+        !> before and after each coarse correction (in reverse order after).
         integer :: sweeps = 1
         !> GMRES restart length and iteration cap per solve.
         integer :: restart = 50, max_iterations = 500
-        !> Counters (read only): setups, solves, GMRES iterations in all and in the last solve.
-        integer :: n_setups = 0, n_solves = 0, n_iterations = 0, iterations_last = 0
+        !> Counters (read only): setups, setups skipped (the tangent of the last one
+        !> again), solves, GMRES iterations in all and in the last solve.
+        integer :: n_setups = 0, n_reused = 0, n_solves = 0, n_iterations = 0, iterations_last = 0
         !> Relative residual reached by the last solve (read only).
         real(dp) :: residual_last = 0.0_dp
         type(mg_level_t), allocatable :: levels(:)
@@ -68,8 +70,8 @@ module voiga_solver_multigrid
 
 contains
 
-    !> Build the hierarchy for bodies `discs` whose DOFs start at `dof0` (2 per
-    !> control point: 2(a-1)+c), `ndof` in all, with the Dirichlet DOFs `fixed`.
+    !> Build the hierarchy for bodies `discs` whose DOFs start at `dof0` (nsd per
+    !> control point: nsd(a-1)+c), `ndof` in all, with the Dirichlet DOFs `fixed`.
     subroutine mg_build(self, discs, dof0, ndof, fixed, error)
         class(multigrid_t), intent(inout) :: self
         type(discretization_t), intent(in) :: discs(:)
@@ -117,7 +119,7 @@ contains
         class(multigrid_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: a
         type(error_t), allocatable, intent(out) :: error
-        integer :: l, nl
+        integer :: l, nl, d
         logical :: same
 
         if (.not. allocated(self%levels)) then
@@ -131,6 +133,12 @@ contains
                 same = all(self%colptr == a%colptr) .and. all(self%rowind == a%rowind)
         end if
         if (same) then
+            ! the tangent of the last set-up (a linear body without contact, whose
+            ! tangent does not change): its operators and factors stand
+            if (same_values(self%levels(1)%a%val, a%values, self%perm)) then
+                self%n_reused = self%n_reused + 1
+                return
+            end if
             ! the patterns are those of the last set-up: values only
             self%levels(1)%a%val = a%values(self%perm)
             do l = 1, nl - 1
@@ -148,8 +156,9 @@ contains
                 call unit_diagonal(self%levels(l + 1)%a, self%levels(l + 1)%fixed)
             end do
             do l = 1, nl - 1
-                call self%levels(l)%lines(1)%analyse(self%levels(l)%a)
-                call self%levels(l)%lines(2)%analyse(self%levels(l)%a)
+                do d = 1, size(self%levels(l)%lines)
+                    call self%levels(l)%lines(d)%analyse(self%levels(l)%a)
+                end do
             end do
             do l = 1, nl
                 self%levels(l)%diag = csr_diagonal_positions(self%levels(l)%a)
@@ -168,10 +177,10 @@ contains
             end if
         end do
         do l = 1, nl - 1
-            call self%levels(l)%lines(1)%factor(self%levels(l)%a, error)
-            if (allocated(error)) return
-            call self%levels(l)%lines(2)%factor(self%levels(l)%a, error)
-            if (allocated(error)) return
+            do d = 1, size(self%levels(l)%lines)
+                call self%levels(l)%lines(d)%factor(self%levels(l)%a, error)
+                if (allocated(error)) return
+            end do
         end do
         if (same) then
             self%coarse%values = 0.0_dp
@@ -187,23 +196,26 @@ contains
         self%n_setups = self%n_setups + 1
     end subroutine mg_setup
 
+    !> Is val(q) = values(perm(q)) for every q? (A loop that stops at the first
+    !> difference: no temporary of the tangent's size.)
+    pure logical function same_values(val, values, perm) result(same)
+        real(dp), intent(in) :: val(:), values(:)
+        integer, intent(in) :: perm(:)
+        integer :: q
+        same = .false.
+        do q = 1, size(perm)
+            if (val(q) /= values(perm(q))) return
+        end do
+        same = .true.
+    end function same_values
+
     !> The fine operator in CSR, and the map from its entries to the tangent's
     !> values (kept for later set-ups with the same pattern).
     subroutine fine_operator(self, k)
         class(multigrid_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: k
-        type(csc_matrix_t) :: index
-        type(csr_t) :: t
-        integer :: q
 
-        ! the transpose of the entry numbers gives each CSR entry's CSC position
-        index%n = k%n
-        index%colptr = k%colptr
-        index%rowind = k%rowind
-        index%values = [(real(q, dp), q=1, size(k%values))]
-        call csr_from_csc(index, t)
-        self%perm = nint(t%val)
-        call csr_from_csc(k, self%levels(1)%a)
+        call csr_from_csc(k, self%levels(1)%a, self%perm)
         self%colptr = k%colptr
         self%rowind = k%rowind
     end subroutine fine_operator
@@ -264,7 +276,7 @@ contains
         class(multigrid_t), intent(inout) :: self
         integer, intent(in) :: l
         type(error_t), allocatable, intent(out) :: error
-        integer :: s
+        integer :: s, d
 
         associate (lv => self%levels(l))
             if (l == size(self%levels)) then
@@ -273,8 +285,9 @@ contains
             end if
             lv%x = 0.0_dp
             do s = 1, self%sweeps
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
+                do d = 1, size(lv%lines)
+                    call lv%lines(d)%sweep(lv%a, lv%b, lv%x, .true., lv%work)
+                end do
             end do
             call csr_matvec(lv%a, lv%x, lv%res)
             lv%res = lv%b - lv%res
@@ -284,8 +297,9 @@ contains
             call csr_matvec(lv%p, self%levels(l + 1)%x, lv%res)
             lv%x = lv%x + lv%res
             do s = 1, self%sweeps
-                call lv%lines(2)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
-                call lv%lines(1)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
+                do d = size(lv%lines), 1, -1
+                    call lv%lines(d)%sweep(lv%a, lv%b, lv%x, .false., lv%work)
+                end do
             end do
         end associate
     end subroutine vcycle

@@ -67,7 +67,7 @@ contains
     end subroutine discretize_bodies
 
     !> The bodies of a case are all plane or all solid; a solid model has no contact
-    !> and no multigrid path yet (issues 42 and 41: docs/formats.md, "Solids").
+    !> yet (issues 42 and 41: docs/formats.md, "Solids").
     subroutine check_dimensions(case, coarse, error)
         type(case_t), intent(in) :: case
         type(coarse_body_t), intent(in) :: coarse(:)
@@ -88,9 +88,6 @@ contains
             call fatal_error(error, case%path//': &contact: contact between solids (volumes) is not '// &
                              'implemented yet; a solid case has bodies, loads and no &contact (docs/formats.md, '// &
                              '"Solids")', error_code%input)
-        else if (trim(case%solver%linear_solver) == 'multigrid') then
-            call fatal_error(error, case%path//": &solver linear_solver = 'multigrid' is not available for "// &
-                             "solids yet: use 'direct' (docs/formats.md, ""Solids"")", error_code%input)
         end if
     end subroutine check_dimensions
 

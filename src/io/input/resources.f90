@@ -9,7 +9,10 @@
 !> 20 MiB (libraries, the program) plus, per entry of the element stiffness
 !> matrices (`body_size_t%entries`), 3.3 x log2(DOFs) bytes with the direct
 !> solver (the assembly map, the matrix, and UMFPACK's factors, whose fill grows
-!> like n log n) or 2.3 x log2(DOFs) with multigrid.
+!> like n log n) or 2.3 x log2(DOFs) with multigrid; 1.0 x log2(DOFs) for a solid's
+!> entries with multigrid (its element matrices, 81^2 entries for quadratic elements,
+!> count many more entries per matrix nonzero than a plane body's: 13-16 bytes per
+!> entry measured, docs/files.md).
 module voiga_io_input_resources
     use, intrinsic :: iso_fortran_env, only: int64
     use voiga_kinds, only: dp
@@ -23,10 +26,10 @@ module voiga_io_input_resources
 
     real(dp), parameter :: base_bytes = 20.0_dp*2.0_dp**20
     real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp
-    !> A solid's direct factors hold fewer bytes per element-matrix entry: its elements
-    !> couple more DOFs each (81 to 375 rows against 18 to 50), so the entries grow faster
-    !> than the fill.
-    real(dp), parameter :: per_entry_direct_solid = 2.4_dp
+    !> A solid's rates are lower: its elements couple more DOFs each (81 to 375 rows
+    !> against 18 to 50), so the element-matrix entries grow faster than the factors'
+    !> fill (direct) or the operators and hierarchy (multigrid).
+    real(dp), parameter :: per_entry_direct_solid = 2.4_dp, per_entry_multigrid_solid = 1.0_dp
 
 contains
 
@@ -36,11 +39,17 @@ contains
         type(body_size_t), intent(in) :: sizes(:)
         character(len=*), intent(in) :: linear_solver
         real(dp) :: ndof, entries, per_entry
+        logical :: multigrid, solid
         ndof = real(sum(sizes%nsd*sizes%ncp), dp)
         entries = real(sum(sizes%entries), dp)
-        per_entry = per_entry_direct
-        if (any(sizes%nsd == 3)) per_entry = per_entry_direct_solid
-        if (trim(linear_solver) == 'multigrid') per_entry = per_entry_multigrid
+        multigrid = trim(linear_solver) == 'multigrid'
+        ! a case's bodies are all plane or all solids (`voiga_io_input_bodies`)
+        solid = any(sizes%nsd == 3)
+        if (solid) then
+            per_entry = merge(per_entry_multigrid_solid, per_entry_direct_solid, multigrid)
+        else
+            per_entry = merge(per_entry_multigrid, per_entry_direct, multigrid)
+        end if
         memory_estimate = base_bytes + entries*log(max(ndof, 2.0_dp))/log(2.0_dp)*per_entry
     end function memory_estimate
 
