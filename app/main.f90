@@ -18,7 +18,7 @@ program voiga_main
     use voiga_platform_libraries, only: default_library_threads, choose_blas_kernels
     use voiga_discretization_patch, only: discretization_t
     use voiga_discretization_size, only: discretization_size
-    use voiga_io_input_resources, only: memory_estimate, gib
+    use voiga_io_input_resources, only: memory_estimate, gib, solid_time_estimate
     use voiga_model, only: model_t, new_model
     use voiga_model_checks, only: setup_warnings, warning_t, check_overlaps
     use voiga_solver_records, only: solver_stats_t, wall_seconds
@@ -149,7 +149,24 @@ contains
         write (*, '(a)') 'memory estimate '//gib(memory_estimate([(discretization_size(discs(i)), i=1, &
                                                                    size(discs))], case%solver%linear_solver))// &
             ' ('//trim(case%solver%linear_solver)//' solver; docs/files.md, "Resources")'
+        if (discs(1)%nsd == 3) call print_time_estimate()
     end subroutine print_dofs
+
+    !> A solid's time estimate (`solid_time_estimate`): 3D factors grow fast.
+    subroutine print_time_estimate()
+        real(dp) :: seconds
+        integer :: i
+        seconds = solid_time_estimate([(discretization_size(discs(i)), i=1, size(discs))], &
+                                      case%solver%linear_solver)
+        if (trim(case%solver%linear_solver) == 'multigrid') then
+            write (*, '(a)') 'time estimate '//trim(fixed_str(seconds, 1))//' s per Newton iteration '// &
+                '(multigrid; docs/performance-solids.md)'
+        else
+            write (*, '(a)') 'time estimate '//trim(fixed_str(seconds, 1))//' s per factorization (direct: '// &
+                "once for linear bodies, every Newton iteration at finite strain; linear_solver = 'multigrid' "// &
+                'grows slower; docs/performance-solids.md)'
+        end if
+    end subroutine print_time_estimate
 
     !> The run ended (interrupted, failed or converged): the result file's final
     !> status, the last lines and the exit code.

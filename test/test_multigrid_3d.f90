@@ -23,7 +23,7 @@ module test_multigrid_3d
     use voiga_linalg_lapack, only: solve_spd
     use voiga_test_fixtures, only: lcg_t, ring_block, scene_t, scene_model, body_settings
     use voiga_discretization_size, only: body_size_t
-    use voiga_io_input_resources, only: memory_estimate
+    use voiga_io_input_resources, only: memory_estimate, solid_time_estimate
     use, intrinsic :: iso_fortran_env, only: int64
     implicit none
     private
@@ -316,6 +316,13 @@ contains
         lg = log(2.0e4_dp)/log(2.0_dp)
         call check(error, memory_estimate(plane, 'multigrid'), base + real(plane(1)%entries, dp)*lg*2.3_dp, &
                    'plane, multigrid', rel=1.0e-12_dp)
+        if (allocated(error)) return
+        ! the time estimate against the table it was fitted to: 53^3 with multigrid 37.1 s
+        ! per Newton iteration, 39^3 direct 181.6 s for the run (its factorization)
+        call check(error, solid_time_estimate(box, 'multigrid'), 37.1_dp, 'time, multigrid', rel=0.3_dp)
+        if (allocated(error)) return
+        box(1) = body_size_t(ncp=41_int64**3, nel=39_int64**3, nsd=3, entries=39_int64**3*81_int64**2)
+        call check(error, solid_time_estimate(box, 'direct'), 181.6_dp, 'time, direct', rel=0.3_dp)
     end subroutine test_memory
 
 end module test_multigrid_3d

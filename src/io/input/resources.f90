@@ -22,7 +22,7 @@ module voiga_io_input_resources
     implicit none
     private
 
-    public :: memory_estimate, check_size, gib
+    public :: memory_estimate, check_size, gib, solid_time_estimate
 
     real(dp), parameter :: base_bytes = 20.0_dp*2.0_dp**20
     real(dp), parameter :: per_entry_direct = 3.3_dp, per_entry_multigrid = 2.3_dp
@@ -52,6 +52,27 @@ contains
         end if
         memory_estimate = base_bytes + entries*log(max(ndof, 2.0_dp))/log(2.0_dp)*per_entry
     end function memory_estimate
+
+    !> A solid's expected seconds on the 2-core reference machine: with the direct
+    !> solver for one factorization of the stiffness (once per run for linear bodies,
+    !> every Newton iteration at finite strain), with multigrid for one Newton
+    !> iteration. Fitted to the quadratic box of docs/performance-solids.md (1e4 to
+    !> 5e5 DOFs: direct 1.3 to 182 s, DOFs^1.64; multigrid 0.6 to 37 s per iteration,
+    !> DOFs^1.055) and taken in element-matrix entries (2187 per DOF there), so that a
+    !> higher degree, which couples more DOFs per element, costs more: an order of
+    !> magnitude to plan a run by, not a measurement (contact adds to it).
+    pure real(dp) function solid_time_estimate(sizes, linear_solver) result(seconds)
+        type(body_size_t), intent(in) :: sizes(:)
+        character(len=*), intent(in) :: linear_solver
+        real(dp), parameter :: per_dof = 2187.0_dp
+        real(dp) :: n
+        n = real(sum(sizes%entries), dp)/per_dof
+        if (trim(linear_solver) == 'multigrid') then
+            seconds = 3.6e-5_dp*n**1.055_dp
+        else
+            seconds = 3.5e-7_dp*n**1.64_dp
+        end if
+    end function solid_time_estimate
 
     !> The counts fit the default integers, and (unless `memory_check` is false) the
     !> estimate fits the memory available. `where` prefixes messages.
