@@ -27,7 +27,7 @@ module voiga_discretization_hierarchy
     use voiga_error, only: error_t, fatal_error
     use voiga_nurbs_basis, only: find_span, basis_funs, distinct_knots, n_basis
     use voiga_nurbs_refine, only: insertion_matrix
-    use voiga_nurbs_patch, only: knots_t
+    use voiga_nurbs_patch, only: knots_t, next_index
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_linalg_lapack, only: solve_spd
     use voiga_discretization_patch, only: discretization_t
@@ -165,7 +165,7 @@ contains
         real(dp), intent(in), optional :: layer_w(:)
         type(dense_t) :: t(3), lt(2)
         logical :: cd
-        integer :: nd, d, cidx(3), b, n, cap
+        integer :: nd, d, cidx(3), b, n
 
         nd = fine%pdim
         space%pdim = nd
@@ -191,124 +191,118 @@ contains
                 call column_ranges(lt(d)%a, lt(d)%lo, lt(d)%hi)
             end do
         end if
-        cap = 16
-        allocate (map%fine(cap), map%coarse(cap), map%val(cap))
+        allocate (map%fine(16), map%coarse(16), map%val(16))
         n = 0
         cidx = 1
         do b = 1, product(space%n)
-            call bulk_column(b, cidx)
-            if (present(proj)) call layer_column(b, cidx)
-            call next_in(cidx, space%n)
+            call bulk_column(t, fine, space, ids, b, cidx, map, n)
+            if (present(proj)) call layer_column(t, lt, fine, space, layer_ids, layer_w, b, cidx, map, n)
+            call next_index(cidx, space%n)
         end do
         map%n_coarse = product(space%n)
         map%fine = map%fine(1:n)
         map%coarse = map%coarse(1:n)
         map%val = map%val(1:n)
-    contains
-        !> The fine bulk points of coarse point b (indices cidx): fine index i along
-        !> direction 1 innermost, the others as a multi-index, direction 2 fastest.
-        subroutine bulk_column(b, cidx)
-            integer, intent(in) :: b, cidx(3)
-            integer :: jdx(3), lo(3), hi(3), i, o, a0, d
-            real(dp) :: v
-            lo = 1
-            hi = 1
-            do d = 1, nd
-                lo(d) = t(d)%lo(cidx(d))
-                hi(d) = t(d)%hi(cidx(d))
-            end do
-            if (any(hi < lo)) return
-            jdx = lo
-            outer: do o = 1, product(hi(2:) - lo(2:) + 1)
-                if (o > 1) call advance(jdx, lo, hi, 2)
-                do d = 2, nd
-                    if (abs(t(d)%a(jdx(d), cidx(d))) <= drop_tol) cycle outer
-                end do
-                a0 = flat([1, jdx(2), jdx(3)], fine%n) - 1
-                do i = lo(1), hi(1)
-                    if (abs(t(1)%a(i, cidx(1))) <= drop_tol) cycle
-                    if (ids(a0 + i) == 0) cycle
-                    v = t(1)%a(i, cidx(1))
-                    do d = 2, nd
-                        v = v*t(d)%a(jdx(d), cidx(d))
-                    end do
-                    call push(ids(a0 + i), b, v*space%w(b)/fine%w(a0 + i))
-                end do
-            end do outer
-        end subroutine bulk_column
-
-        !> The layer points of coarse point b: through the last bulk layer
-        !> (i_pdim = n(pdim)), the tensor product of the projected 1D maps.
-        subroutine layer_column(b, cidx)
-            integer, intent(in) :: b, cidx(3)
-            integer :: kdx(3), lo(3), hi(3), nl(3), o, d
-            real(dp) :: v, across
-            if (t(nd)%hi(cidx(nd)) /= fine%n(nd)) return
-            across = t(nd)%a(fine%n(nd), cidx(nd))
-            if (abs(across) <= drop_tol) return
-            lo = 1
-            hi = 1
-            nl = 1
-            do d = 1, nd - 1
-                lo(d) = lt(d)%lo(cidx(d))
-                hi(d) = lt(d)%hi(cidx(d))
-                nl(d) = size(lt(d)%a, 1)
-            end do
-            if (any(hi < lo)) return
-            kdx = lo
-            outer: do o = 1, product(hi - lo + 1)
-                if (o > 1) call advance(kdx, lo, hi, 1)
-                do d = 1, nd - 1
-                    if (abs(lt(d)%a(kdx(d), cidx(d))) <= drop_tol) cycle outer
-                end do
-                v = lt(1)%a(kdx(1), cidx(1))
-                do d = 2, nd - 1
-                    v = v*lt(d)%a(kdx(d), cidx(d))
-                end do
-                call push(layer_ids(flat(kdx, nl)), b, v*across*space%w(b)/layer_w(flat(kdx, nl)))
-            end do outer
-        end subroutine layer_column
-
-        subroutine push(a, b, v)
-            integer, intent(in) :: a, b
-            real(dp), intent(in) :: v
-            if (n == cap) then
-                cap = 2*cap
-                call grow_int(map%fine, cap)
-                call grow_int(map%coarse, cap)
-                call grow_real(map%val, cap)
-            end if
-            n = n + 1
-            map%fine(n) = a
-            map%coarse(n) = b
-            map%val(n) = v
-        end subroutine push
     end subroutine coarsen
 
-    !> The next multi-index in [1, n], the first fastest.
-    pure subroutine next_in(idx, n)
-        integer, intent(inout) :: idx(3)
-        integer, intent(in) :: n(3)
-        integer :: d
-        do d = 1, 3
-            idx(d) = idx(d) + 1
-            if (idx(d) <= n(d)) return
-            idx(d) = 1
+    !> Push the fine bulk points of coarse point b (indices cidx) onto the first n
+    !> entries of `map`: fine index i along direction 1 innermost, the others as a
+    !> multi-index, direction 2 fastest; t: the 1D insertion matrices.
+    pure subroutine bulk_column(t, fine, space, ids, b, cidx, map, n)
+        type(dense_t), intent(in) :: t(:)
+        type(coarse_space_t), intent(in) :: fine, space
+        integer, intent(in) :: ids(:), b, cidx(3)
+        type(cp_map_t), intent(inout) :: map
+        integer, intent(inout) :: n
+        integer :: jdx(3), lo(3), hi(3), kk(3), cnt(3), i, o, a0, d, nd
+        real(dp) :: v
+        nd = fine%pdim
+        lo = 1
+        hi = 1
+        do d = 1, nd
+            lo(d) = t(d)%lo(cidx(d))
+            hi(d) = t(d)%hi(cidx(d))
         end do
-    end subroutine next_in
+        if (any(hi < lo)) return
+        cnt = hi - lo + 1
+        cnt(1) = 1
+        kk = 1
+        outer: do o = 1, product(cnt)
+            if (o > 1) call next_index(kk, cnt)
+            jdx = lo + kk - 1
+            do d = 2, nd
+                if (abs(t(d)%a(jdx(d), cidx(d))) <= drop_tol) cycle outer
+            end do
+            a0 = flat([1, jdx(2), jdx(3)], fine%n) - 1
+            do i = lo(1), hi(1)
+                if (abs(t(1)%a(i, cidx(1))) <= drop_tol) cycle
+                if (ids(a0 + i) == 0) cycle
+                v = t(1)%a(i, cidx(1))
+                do d = 2, nd
+                    v = v*t(d)%a(jdx(d), cidx(d))
+                end do
+                call push(map, n, ids(a0 + i), b, v*space%w(b)/fine%w(a0 + i))
+            end do
+        end do outer
+    end subroutine bulk_column
 
-    !> The next multi-index in the box [lo, hi] over the directions from `first`
-    !> on (the first of them fastest).
-    pure subroutine advance(idx, lo, hi, first)
-        integer, intent(inout) :: idx(3)
-        integer, intent(in) :: lo(3), hi(3), first
-        integer :: d
-        do d = first, 3
-            idx(d) = idx(d) + 1
-            if (idx(d) <= hi(d)) return
-            idx(d) = lo(d)
+    !> Push the layer points of coarse point b: through the last bulk layer
+    !> (i_pdim = n(pdim)), the tensor product of the projected 1D maps lt.
+    pure subroutine layer_column(t, lt, fine, space, layer_ids, layer_w, b, cidx, map, n)
+        type(dense_t), intent(in) :: t(:), lt(:)
+        type(coarse_space_t), intent(in) :: fine, space
+        integer, intent(in) :: layer_ids(:), b, cidx(3)
+        real(dp), intent(in) :: layer_w(:)
+        type(cp_map_t), intent(inout) :: map
+        integer, intent(inout) :: n
+        integer :: kdx(3), lo(3), hi(3), nl(3), kk(3), cnt(3), o, d, nd
+        real(dp) :: v, across
+        nd = fine%pdim
+        if (t(nd)%hi(cidx(nd)) /= fine%n(nd)) return
+        across = t(nd)%a(fine%n(nd), cidx(nd))
+        if (abs(across) <= drop_tol) return
+        lo = 1
+        hi = 1
+        nl = 1
+        do d = 1, nd - 1
+            lo(d) = lt(d)%lo(cidx(d))
+            hi(d) = lt(d)%hi(cidx(d))
+            nl(d) = size(lt(d)%a, 1)
         end do
-    end subroutine advance
+        if (any(hi < lo)) return
+        cnt = hi - lo + 1
+        kk = 1
+        outer: do o = 1, product(cnt)
+            if (o > 1) call next_index(kk, cnt)
+            kdx = lo + kk - 1
+            do d = 1, nd - 1
+                if (abs(lt(d)%a(kdx(d), cidx(d))) <= drop_tol) cycle outer
+            end do
+            v = lt(1)%a(kdx(1), cidx(1))
+            do d = 2, nd - 1
+                v = v*lt(d)%a(kdx(d), cidx(d))
+            end do
+            call push(map, n, layer_ids(flat(kdx, nl)), b, v*across*space%w(b)/layer_w(flat(kdx, nl)))
+        end do outer
+    end subroutine layer_column
+
+    !> Append the triplet (a, b, v) as entry n + 1 of `map` (doubling its arrays
+    !> when full).
+    pure subroutine push(map, n, a, b, v)
+        type(cp_map_t), intent(inout) :: map
+        integer, intent(inout) :: n
+        integer, intent(in) :: a, b
+        real(dp), intent(in) :: v
+        if (n == size(map%fine)) then
+            call grow_int(map%fine, 2*n)
+            call grow_int(map%coarse, 2*n)
+            call grow_real(map%val, 2*n)
+        end if
+        n = n + 1
+        map%fine(n) = a
+        map%coarse(n) = b
+        map%val(n) = v
+    end subroutine push
 
     !> Flat index of idx in a grid of n points per direction (the first fastest).
     pure integer function flat(idx, n)
