@@ -30,6 +30,7 @@ program voiga_tests
     use test_newton, only: collect_newton
     use test_segment, only: collect_segment
     use test_method, only: collect_method
+    use test_projection, only: collect_projection, projection_timing
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -62,7 +63,8 @@ program voiga_tests
              new_testsuite('supernodal', collect_supernodal), &
              new_testsuite('newton', collect_newton), &
              new_testsuite('segment', collect_segment), &
-             new_testsuite('method', collect_method) &
+             new_testsuite('method', collect_method), &
+             new_testsuite('projection', collect_projection) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)
@@ -74,6 +76,11 @@ program voiga_tests
             call lame_sphere_table(rates, error, .true.)
             if (allocated(error)) error stop 1
         end block
+        stop
+    end if
+    if (trim(filter) == '--projection-timing') then
+        ! queries per second of the surface projection (not a test)
+        call projection_timing()
         stop
     end if
     if (trim(filter) == '--lame-table') then

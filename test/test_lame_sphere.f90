@@ -21,7 +21,7 @@ module test_lame_sphere
     implicit none
     private
 
-    public :: collect_lame_sphere, lame_sphere_table
+    public :: collect_lame_sphere, lame_sphere_table, shell_octant
 
     !> Inner and outer radius, pressure, E, nu.
     real(dp), parameter :: ra = 1.0_dp, rb = 2.0_dp, pressure = 1.0_dp, young = 1000.0_dp, nu = 0.3_dp
