@@ -42,9 +42,13 @@ module voiga_nurbs_projection
         real(dp), allocatable :: breaks_u(:), breaks_v(:)
         !> Knot-span index of each cell column and row [ncell_u], [ncell_v].
         integer, allocatable :: span_u(:), span_v(:)
-        !> Control-point box of each cell [xmin, ymin, zmin, xmax, ymax, zmax]
-        !> [6, ncell], cell c = i + (j - 1) ncell_u.
-        real(dp), allocatable :: boxes(:, :)
+        !> Each cell's box of its control points [xmin, ymin, zmin, xmax, ymax, zmax]
+        !> [6, ncell] (cell c = i + (j - 1) ncell_u); the cell's own orthonormal frame
+        !> (rows: the unit tangent along u, the in-plane normal to it, the normal at
+        !> the cell's centre) [3, 3, ncell] and the box in that frame [6, ncell]: the
+        !> first is cheap to test against every cell, the second sharp for the few
+        !> that pass.
+        real(dp), allocatable :: boxes(:, :), frames(:, :, :), oboxes(:, :)
         !> Start samples [3, n_start**2, ncell], at the cell-centred parameters of
         !> `sample_parameters`.
         real(dp), allocatable :: samples(:, :, :)
@@ -83,7 +87,8 @@ contains
         search%breaks_v = distinct_knots(patch%knots(2)%u)
         nu = size(search%breaks_u) - 1
         nv = size(search%breaks_v) - 1
-        allocate (search%span_u(nu), search%span_v(nv), search%boxes(6, nu*nv), search%samples(3, n_start**2, nu*nv))
+        allocate (search%span_u(nu), search%span_v(nv), search%boxes(6, nu*nv), search%frames(3, 3, nu*nv), &
+                  search%oboxes(6, nu*nv), search%samples(3, n_start**2, nu*nv))
         do i = 1, nu
             search%span_u(i) = find_span(patch%knots(1)%u, patch%degree(1), &
                                          0.5_dp*(search%breaks_u(i) + search%breaks_u(i + 1)))
@@ -107,6 +112,10 @@ contains
                 end do
                 search%boxes(1:3, c) = minval(pts(:, 1:np), dim=2)
                 search%boxes(4:6, c) = maxval(pts(:, 1:np), dim=2)
+                search%frames(:, :, c) = cell_frame(search, c, span)
+                pts(:, 1:np) = matmul(search%frames(:, :, c), pts(:, 1:np))
+                search%oboxes(1:3, c) = minval(pts(:, 1:np), dim=2)
+                search%oboxes(4:6, c) = maxval(pts(:, 1:np), dim=2)
                 do k = 1, n_start**2
                     call surface_derivatives(patch, sample_parameters(search, c, k), span, &
                                              search%samples(:, k, c), d1, d2)
@@ -114,6 +123,32 @@ contains
             end do
         end do
     end subroutine new_surface_search
+
+    !> The orthonormal frame [3, 3] (rows) of cell `c` at its centre: a1, then the
+    !> part of a2 normal to it, then their normal. Any frame gives a valid box; this
+    !> one makes a nearly flat cell's box a thin slab, so that a point above one cell
+    !> is not within its neighbours' boxes (the search's pruning is then sharp). A
+    !> degenerate centre (no tangent) falls back to the axes.
+    pure function cell_frame(search, c, span) result(q)
+        type(surface_search_t), intent(in) :: search
+        integer, intent(in) :: c, span(2)
+        real(dp) :: q(3, 3), x(3), d1(3, 2), d2(3, 3), e(3, 3)
+        integer :: i, j
+        i = mod(c - 1, size(search%span_u)) + 1
+        j = (c - 1)/size(search%span_u) + 1
+        call surface_derivatives(search%patch, 0.5_dp*[search%breaks_u(i) + search%breaks_u(i + 1), &
+                                                       search%breaks_v(j) + search%breaks_v(j + 1)], span, x, d1, d2)
+        e(:, 1) = d1(:, 1)
+        e(:, 3) = cross(d1(:, 1), d1(:, 2))
+        if (norm2(e(:, 1)) == 0.0_dp .or. norm2(e(:, 3)) <= 1.0e-12_dp*norm2(d1(:, 1))*norm2(d1(:, 2))) then
+            q = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
+            return
+        end if
+        e(:, 1) = e(:, 1)/norm2(e(:, 1))
+        e(:, 3) = e(:, 3)/norm2(e(:, 3))
+        e(:, 2) = cross(e(:, 3), e(:, 1))
+        q = transpose(e)
+    end function cell_frame
 
     !> Parameters of start sample k (1 .. n_start**2, u fastest) of cell `c`.
     pure function sample_parameters(search, c, k) result(u)
@@ -230,6 +265,7 @@ contains
             if (c == 0) exit
             if (lb(c) >= best2) exit
             visited(c) = .true.
+            if (box_distance2(search%oboxes(:, c), matmul(search%frames(:, :, c), x)) >= best2) cycle
             kbest = 1
             best_sample: block
                 real(dp) :: ds
