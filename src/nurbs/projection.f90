@@ -5,20 +5,25 @@
 !> will build a `surface_search_t` from its displaced face and call this).
 !>
 !> Search (built once per configuration by `new_surface_search`): per knot-span cell,
-!> the box of its (p + 1)(q + 1) control points. With positive weights a NURBS cell
-!> lies in the convex hull of its control points, so the box's distance is a rigorous
-!> lower bound of the cell's distance: no chord-error estimate of a sampled box is
-!> needed, and no cell holding the closest point can be pruned by mistake.
+!> the box of its (p + 1)(q + 1) control points, axis-aligned and in the cell's own
+!> tangent frame. With positive weights a NURBS cell lies in the convex hull of its
+!> control points, so either box's distance is a rigorous lower bound of the cell's
+!> distance: no chord-error estimate of a sampled box is needed, and no cell holding
+!> the closest point can be pruned by mistake.
 !>
-!> Query (`project_on_surface`): cells in increasing order of their box's distance,
-!> stopping at the first whose box is no closer than the best point found; in each,
+!> Query (`project_on_surface`): an upper bound from the nearest start sample of the
+!> nearest box; the cells whose boxes are closer than that, nearest first, stopping at
+!> the first whose box is no closer than the best point found; in each,
 !> a projected Newton iteration on f(u) = |x - S(u)|^2 / 2 over the cell's parameter
 !> box from the nearest of a few stored samples: the full Hessian
 !> H = a_a . a_b - (x - S) . a_ab when it is positive definite, else the first
 !> fundamental form (Gauss-Newton, regularized where a tangent vanishes: a collapsed
 !> edge), with a backtracking search on f along the projected path. Directions at a
 !> bound with the gradient pushing outward are held (the active set), which makes
-!> the iteration end on cell edges and corners, and a collapsed edge, cleanly.
+!> the iteration end on cell edges and corners, and a collapsed edge, cleanly. A
+!> point whose minimum is on the patch's boundary (beyond the patch) is minimized
+!> again along the boundary edges, since a cell's Newton may have stopped at a local
+!> minimum of the edge it reached first.
 module voiga_nurbs_projection
     use voiga_kinds, only: dp
     use voiga_nurbs_patch, only: nurbs_patch_t
@@ -239,17 +244,18 @@ contains
         logical, intent(out) :: found, converged
         real(dp), intent(in), optional :: start(2)
         type(surface_projection_t) :: cand
-        real(dp) :: lb(size(search%boxes, 2)), best2, d2
-        logical :: visited(size(search%boxes, 2)), ok
-        integer :: c, k, nu, kbest
+        real(dp) :: lb(size(search%boxes, 2)), key(size(search%boxes, 2)), best2, bound, d2
+        integer :: list(size(search%boxes, 2))
+        logical :: done(size(search%boxes, 2)), ok
+        integer :: c, c0, k, nu, nc, kbest, warm
 
         nu = size(search%span_u)
         do c = 1, size(lb)
             lb(c) = box_distance2(search%boxes(:, c), x)
         end do
-        visited = .false.
         best2 = huge(1.0_dp)
         converged = .false.
+        warm = 0
         if (present(start)) then
             c = locate(search%breaks_u, start(1)) + (locate(search%breaks_v, start(2)) - 1)*nu
             call cell_newton(search, x, c, start, cand, ok)
@@ -257,27 +263,36 @@ contains
                 res = cand
                 best2 = cand%distance**2
                 converged = .true.
-                visited(c) = .true.
+                warm = c
             end if
         end if
+        ! an upper bound of the distance (squared): the nearest sample of the nearest
+        ! box; the candidates are the cells whose boxes, the axis-aligned and then the
+        ! cell-oriented one, are closer, visited nearest first
+        ! (the nearest box itself always: its sample may be as far as the box, or a
+        ! rounding farther in the rotated frame)
+        c0 = minloc(lb, dim=1)
+        call nearest_sample(search, x, c0, kbest, d2)
+        bound = min(best2, d2)
+        nc = 0
+        do c = 1, size(lb)
+            if (c == warm) cycle
+            if (c /= c0 .and. lb(c) >= bound) cycle
+            d2 = max(lb(c), box_distance2(search%oboxes(:, c), matmul(search%frames(:, :, c), x)))
+            if (c == c0) d2 = lb(c)
+            if (c /= c0 .and. d2 >= bound) cycle
+            nc = nc + 1
+            list(nc) = c
+            key(nc) = d2
+        end do
+        done(1:nc) = .false.
         do
-            c = minloc(lb, dim=1, mask=.not. visited)
-            if (c == 0) exit
-            if (lb(c) >= best2) exit
-            visited(c) = .true.
-            if (box_distance2(search%oboxes(:, c), matmul(search%frames(:, :, c), x)) >= best2) cycle
-            kbest = 1
-            best_sample: block
-                real(dp) :: ds
-                d2 = huge(1.0_dp)
-                do k = 1, n_start**2
-                    ds = sum((x - search%samples(:, k, c))**2)
-                    if (ds < d2) then
-                        d2 = ds
-                        kbest = k
-                    end if
-                end do
-            end block best_sample
+            k = minloc(key(1:nc), dim=1, mask=.not. done(1:nc))
+            if (k == 0) exit
+            if (key(k) >= best2) exit
+            done(k) = .true.
+            c = list(k)
+            call nearest_sample(search, x, c, kbest, d2)
             call cell_newton(search, x, c, sample_parameters(search, c, kbest), cand, ok)
             if (cand%distance**2 < best2) then
                 res = cand
@@ -362,6 +377,26 @@ contains
             end do
         end do
     end subroutine boundary_search
+
+    !> The start sample `k` of cell `c` nearest to `x`, and its squared distance `d2`.
+    pure subroutine nearest_sample(search, x, c, k, d2)
+        type(surface_search_t), intent(in) :: search
+        real(dp), intent(in) :: x(3)
+        integer, intent(in) :: c
+        integer, intent(out) :: k
+        real(dp), intent(out) :: d2
+        real(dp) :: ds
+        integer :: j
+        d2 = huge(1.0_dp)
+        k = 1
+        do j = 1, n_start**2
+            ds = sum((x - search%samples(:, j, c))**2)
+            if (ds < d2) then
+                d2 = ds
+                k = j
+            end if
+        end do
+    end subroutine nearest_sample
 
     !> a1 x a2 / |a1 x a2|; where a tangent vanishes (a collapsed edge: a sphere's
     !> pole) the limit from inside: a1 ~ (v - v_e) a12 near an edge v_e, so
