@@ -33,7 +33,8 @@ contains
                     new_unittest('cylinder_sector_against_exact', test_cylinder), &
                     new_unittest('flat_distorted_plane', test_plane), &
                     new_unittest('curved_surface_against_brute_force', test_brute_force), &
-                    new_unittest('warm_start_equals_cold', test_warm_start) &
+                    new_unittest('warm_start_equals_cold', test_warm_start), &
+                    new_unittest('derivatives_against_differences', test_derivatives) &
                     ]
     end subroutine collect_projection
 
@@ -401,6 +402,36 @@ contains
         if (allocated(error)) return
         call check(error, worst < 1.0e-14_dp, 'a warm start differs from the cold answer by more than 1e-14')
     end subroutine test_warm_start
+
+    !> The tangents and second derivatives that a projection returns (the 3D contact
+    !> tangent's curvature terms) against central differences of the point and the
+    !> tangents on the curved distorted surface, at interior parameters of random cells.
+    subroutine test_derivatives(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(nurbs_patch_t) :: patch
+        type(lcg_t) :: rng
+        real(dp), parameter :: h = 1.0e-6_dp
+        real(dp) :: u(2), x(3), d1(3, 2), d2(3, 3), xp(3), xm(3), dp1(3, 2), dm1(3, 2), e(3, 3), worst
+        integer :: k, a, span(2)
+        patch = distorted(8, 7, 0.4_dp, 4242)
+        worst = 0.0_dp
+        do k = 1, 50
+            u = 0.02_dp + 0.96_dp*[rng%uniform(), rng%uniform()]
+            span = [find_span(patch%knots(1)%u, 2, u(1)), find_span(patch%knots(2)%u, 3, u(2))]
+            call surface_derivatives(patch, u, span, x, d1, d2)
+            do a = 1, 2
+                call surface_derivatives(patch, u + h*merge(1.0_dp, 0.0_dp, [1, 2] == a), span, xp, dp1, e)
+                call surface_derivatives(patch, u - h*merge(1.0_dp, 0.0_dp, [1, 2] == a), span, xm, dm1, e)
+                worst = max(worst, norm2((xp - xm)/(2*h) - d1(:, a)), norm2((dp1(:, a) - dm1(:, a))/(2*h) - d2(:, a)))
+                ! the mixed derivative both ways
+                worst = max(worst, norm2((dp1(:, 3 - a) - dm1(:, 3 - a))/(2*h) - d2(:, 3)))
+            end do
+        end do
+        print '(a, es10.2)', '    derivatives: worst difference from central differences', worst
+        ! central differences with h = 1e-6 on O(1) derivatives: truncation ~1e-11,
+        ! round-off ~1e-10
+        call check(error, worst < 1.0e-7_dp, 'a derivative differs from central differences')
+    end subroutine test_derivatives
 
     !> Queries per second on two 32 x 32-span surfaces, printed, not asserted: the
     !> outer sphere of the shell octant (degree 2, a Hertz ball's contact face) with
