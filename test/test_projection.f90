@@ -202,6 +202,18 @@ contains
             call project_on_surface(search, [rho*cos(t), rho*sin(t), z], res, found, converged)
             if (found) nbad = nbad + 1
         end do
+        ! a corner of four cells (angle pi/4 is the knot 0.5; z = 0.5 a knot), a corner
+        ! of the patch, and beyond that corner (found false, the corner still closest)
+        do k = 1, 3
+            rho = merge(0.7_dp, 3.0_dp, k == 1)
+            x = [rho*cos(0.25_dp*pi), rho*sin(0.25_dp*pi), 0.5_dp]
+            if (k > 1) x = [rho, 0.0_dp, 0.0_dp]
+            if (k == 3) x = x - [0.0_dp, 0.1_dp, 0.1_dp]
+            call project_on_surface(search, x, res, found, converged)
+            if ((found .neqv. k < 3) .or. .not. converged) nbad = nbad + 1
+            if (k == 1) worst = max(worst, norm2(res%x - [sqrt(2.0_dp), sqrt(2.0_dp), 0.5_dp]))
+            if (k > 1) worst = max(worst, norm2(res%x - [2.0_dp, 0.0_dp, 0.0_dp]))
+        end do
         print '(a, 2es10.2)', '    cylinder: point/normal, orthogonality errors', worst, worst_o
         call check(error, nbad == 0, 'a point over the sector not found or one beyond it found')
         if (allocated(error)) return
