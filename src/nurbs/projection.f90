@@ -80,8 +80,8 @@ module voiga_nurbs_projection
 
 contains
 
-    !> The search structure of `patch` (pdim 2, nsd 3, positive weights) in its
-    !> present control points; rebuild it whenever they move.
+    !> The search structure of `patch` (pdim 2, nsd 3, positive weights, degrees up to
+    !> `max_fixed_degree`) in its present control points; rebuild it whenever they move.
     pure subroutine new_surface_search(search, patch)
         type(surface_search_t), intent(out) :: search
         type(nurbs_patch_t), intent(in) :: patch
@@ -172,7 +172,8 @@ contains
     !> Point `x` [3], first derivatives `d1` [3, 2] (dS/du, dS/dv) and second
     !> derivatives `d2` [3, 3] (uu, vv, uv) of the surface at `u` [2], with the basis of
     !> the knot spans `span` [2] (a cell's own at its edges: one-sided across C0 knots).
-    !> Homogeneous sums then the quotient rule: no allocation, for the search's loops.
+    !> Homogeneous sums then the quotient rule: no allocation, for the search's loops
+    !> (so degrees up to `max_fixed_degree`, 20, as the basis's own fixed buffers).
     pure subroutine surface_derivatives(patch, u, span, x, d1, d2)
         type(nurbs_patch_t), intent(in) :: patch
         real(dp), intent(in) :: u(2)
