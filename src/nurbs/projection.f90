@@ -28,6 +28,7 @@ module voiga_nurbs_projection
     use voiga_kinds, only: dp
     use voiga_nurbs_patch, only: nurbs_patch_t
     use voiga_nurbs_basis, only: find_span, basis_ders_at, distinct_knots, max_fixed_degree
+    use voiga_nurbs_cell_tree, only: cell_tree_t, new_cell_tree, cells_within, nearest_box, box_distance2
     implicit none
     private
 
@@ -59,13 +60,9 @@ module voiga_nurbs_projection
         real(dp), allocatable :: samples(:, :, :)
         !> Diagonal of the control net's box: the length scale of the tolerances.
         real(dp) :: scale = 1.0_dp
-        !> A binary tree over the cells (each node a rectangle of cell indices split
-        !> along its longer side, node 1 the root): its box, the union of its cells'
-        !> [6, nnode], its children [2, nnode] (0 at a leaf) and a leaf's cell [nnode]
-        !> (0 inside). A query visits the nodes whose box is within reach, so its cost
-        !> grows like log(cells) plus the cells it tests, not like the cells.
-        real(dp), allocatable :: node_box(:, :)
-        integer, allocatable :: node_child(:, :), node_cell(:)
+        !> The cells' boxes in a tree (`voiga_nurbs_cell_tree`): a query visits the
+        !> nodes within reach, so its cost grows like log(cells) plus the cells it tests.
+        type(cell_tree_t) :: tree
     end type surface_search_t
 
     !> A projection's result. The normal is a1 x a2 / |a1 x a2|: for the zeta = 1 face
@@ -134,124 +131,8 @@ contains
                 end do
             end do
         end do
-        call build_tree(search, nu, nv)
+        call new_cell_tree(search%tree, search%boxes, nu, nv)
     end subroutine new_surface_search
-
-    !> The tree of `search` over its nu x nv cells: nodes in creation order from the
-    !> root, each splitting its index rectangle along the longer side; leaf boxes are
-    !> the cells', inner boxes the union of their children's (filled bottom-up, as a
-    !> child is always created after its parent).
-    pure subroutine build_tree(search, nu, nv)
-        type(surface_search_t), intent(inout) :: search
-        integer, intent(in) :: nu, nv
-        integer :: rect(4, 2*nu*nv), n, k, m
-        n = 1
-        rect(:, 1) = [1, nu, 1, nv]
-        allocate (search%node_child(2, 2*nu*nv), search%node_cell(2*nu*nv), search%node_box(6, 2*nu*nv))
-        search%node_child = 0
-        search%node_cell = 0
-        k = 0
-        do while (k < n)
-            k = k + 1
-            associate (r => rect(:, k))
-                if (r(1) == r(2) .and. r(3) == r(4)) then
-                    search%node_cell(k) = r(1) + (r(3) - 1)*nu
-                    search%node_box(:, k) = search%boxes(:, search%node_cell(k))
-                    cycle
-                end if
-                if (r(2) - r(1) >= r(4) - r(3)) then
-                    m = (r(1) + r(2))/2
-                    rect(:, n + 1) = [r(1), m, r(3), r(4)]
-                    rect(:, n + 2) = [m + 1, r(2), r(3), r(4)]
-                else
-                    m = (r(3) + r(4))/2
-                    rect(:, n + 1) = [r(1), r(2), r(3), m]
-                    rect(:, n + 2) = [r(1), r(2), m + 1, r(4)]
-                end if
-                search%node_child(:, k) = [n + 1, n + 2]
-                n = n + 2
-            end associate
-        end do
-        do k = n, 1, -1
-            if (search%node_cell(k) > 0) cycle
-            associate (c => search%node_child(:, k))
-                search%node_box(1:3, k) = min(search%node_box(1:3, c(1)), search%node_box(1:3, c(2)))
-                search%node_box(4:6, k) = max(search%node_box(4:6, c(1)), search%node_box(4:6, c(2)))
-            end associate
-        end do
-    end subroutine build_tree
-
-    !> The cells whose (axis-aligned) box is closer to `x` than sqrt(`bound2`) [n],
-    !> ascending, and their squared box distances `lb`.
-    pure subroutine cells_within(search, x, bound2, cells, lb, n)
-        type(surface_search_t), intent(in) :: search
-        real(dp), intent(in) :: x(3), bound2
-        integer, intent(out) :: cells(:), n
-        real(dp), intent(out) :: lb(:)
-        integer :: stack(64), top, k, j, c
-        real(dp) :: d, v
-        n = 0
-        top = 1
-        stack(1) = 1
-        do while (top > 0)
-            k = stack(top)
-            top = top - 1
-            d = box_distance2(search%node_box(:, k), x)
-            if (d >= bound2) cycle
-            if (search%node_cell(k) > 0) then
-                n = n + 1
-                cells(n) = search%node_cell(k)
-                lb(n) = d
-            else
-                stack(top + 1:top + 2) = search%node_child(:, k)
-                top = top + 2
-            end if
-        end do
-        ! ascending cells: the order the candidates were tested in before the tree
-        do k = 2, n
-            c = cells(k)
-            v = lb(k)
-            j = k - 1
-            do while (j >= 1)
-                if (cells(j) <= c) exit
-                cells(j + 1) = cells(j)
-                lb(j + 1) = lb(j)
-                j = j - 1
-            end do
-            cells(j + 1) = c
-            lb(j + 1) = v
-        end do
-    end subroutine cells_within
-
-    !> The cell whose box is nearest to `x` (the lowest index among equals) and its
-    !> squared distance: branch and bound down the tree.
-    pure subroutine nearest_box(search, x, c0, d0)
-        type(surface_search_t), intent(in) :: search
-        real(dp), intent(in) :: x(3)
-        integer, intent(out) :: c0
-        real(dp), intent(out) :: d0
-        integer :: stack(64), top, k
-        real(dp) :: d
-        c0 = 0
-        d0 = huge(1.0_dp)
-        top = 1
-        stack(1) = 1
-        do while (top > 0)
-            k = stack(top)
-            top = top - 1
-            d = box_distance2(search%node_box(:, k), x)
-            if (d > d0) cycle
-            if (search%node_cell(k) > 0) then
-                if (d < d0 .or. search%node_cell(k) < c0) then
-                    d0 = d
-                    c0 = search%node_cell(k)
-                end if
-            else
-                stack(top + 1:top + 2) = search%node_child(:, k)
-                top = top + 2
-            end if
-        end do
-    end subroutine nearest_box
 
     !> The orthonormal frame [3, 3] (rows) of cell `c` at its centre: a1, then the
     !> part of a2 normal to it, then their normal. Any frame gives a valid box; this
@@ -332,12 +213,6 @@ contains
         d2(:, 3) = (h(1:3, 6) - h(4, 2)*d1(:, 2) - h(4, 3)*d1(:, 1) - h(4, 6)*x)/h(4, 1)
     end subroutine surface_derivatives
 
-    !> Squared distance from `x` [3] to the box [xmin, ymin, zmin, xmax, ymax, zmax].
-    pure real(dp) function box_distance2(box, x)
-        real(dp), intent(in) :: box(6), x(3)
-        box_distance2 = sum(max(box(1:3) - x, 0.0_dp, x - box(4:6))**2)
-    end function box_distance2
-
     !> The cell (1 .. size(breaks) - 1) holding parameter `t` (clamped to the range).
     pure integer function locate(breaks, t) result(i)
         real(dp), intent(in) :: breaks(:), t
@@ -393,10 +268,10 @@ contains
         ! cell-oriented one, are closer, visited nearest first
         ! (the nearest box itself always: its sample may be as far as the box, or a
         ! rounding farther in the rotated frame)
-        call nearest_box(search, x, c0, d0)
+        call nearest_box(search%tree, x, c0, d0)
         call nearest_sample(search, x, c0, kbest, d2)
         bound = min(best2, d2)
-        call cells_within(search, x, max(bound, nearest(d0, 1.0_dp)), cells, lb, n)
+        call cells_within(search%tree, x, max(bound, nearest(d0, 1.0_dp)), cells, lb, n)
         nc = 0
         do j = 1, n
             c = cells(j)
@@ -429,7 +304,7 @@ contains
         ! may have stopped at a local one along the edge it reached first; the edges'
         ! own minima decide
         if (.not. found) then
-            call cells_within(search, x, res%distance**2, cells, lb, n)
+            call cells_within(search%tree, x, res%distance**2, cells, lb, n)
             call boundary_search(search, x, cells(1:n), lb(1:n), res)
             found = .not. beyond(search, x, res)
         end if
