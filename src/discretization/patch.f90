@@ -22,7 +22,8 @@ module voiga_discretization_patch
     private
 
     public :: discretization_t, element_t, boundary_t, new_discretization, boundary_cps, boundary_index, &
-              contact_boundary, contact_name, new_knots, orient_for_contact
+              contact_boundary, contact_name, new_knots, orient_for_contact, &
+              boundary_word
     !> An ascending copy of a short real vector (also the contact segments' cuts).
     public :: sorted
 
@@ -135,7 +136,7 @@ contains
         call orient_for_contact(coarse, names, layout%contact_edge, oriented, oriented_as, self%has_contact)
         if (len_trim(layout%contact_edge) > 0 .and. .not. self%has_contact) then
             call fatal_error(error, where//trim(contact_key(nd))//" = '"//trim(layout%contact_edge)// &
-                             "' is not "//article(nd)//' of this body ('//entity(nd)//'s: '// &
+                             "' is not "//article(nd)//' of this body ('//boundary_word(nd)//'s: '// &
                              name_list(names)//')', error_code%input)
             return
         end if
@@ -148,7 +149,7 @@ contains
         else
             if (any(layout%degree(:nd) < oriented%degree)) then
                 call fatal_error(error, where//degree_keys(nd)//' must be >= the degree of the exact '// &
-                                 'geometry (along the contact '//entity(nd)//' first)', error_code%input)
+                                 'geometry (along the contact '//boundary_word(nd)//' first)', error_code%input)
                 return
             end if
             self%bulk = oriented
@@ -195,19 +196,20 @@ contains
         end do
     end subroutine orient_for_contact
 
-    !> What a boundary of a patch of parametric dimension `nd` is: 'edge' or 'face'.
-    pure function entity(nd) result(word)
+    !> What a boundary of a patch of parametric dimension `nd` is: 'edge' or 'face'
+    !> (the word every message about a body's boundaries uses).
+    pure function boundary_word(nd) result(word)
         integer, intent(in) :: nd
         character(len=4) :: word
         word = merge('edge', 'face', nd == 2)
-    end function entity
+    end function boundary_word
 
     !> 'an edge' or 'a face'.
     pure function article(nd) result(words)
         integer, intent(in) :: nd
         character(len=:), allocatable :: words
         words = merge('an', 'a ', nd == 2)
-        words = trim(words)//' '//entity(nd)
+        words = trim(words)//' '//boundary_word(nd)
     end function article
 
     !> The layout's key for the contact boundary of a body of parametric dimension `nd`.
@@ -508,7 +510,7 @@ contains
         integer :: i
         i = boundary_index(self, name)
         if (i == 0) then
-            call fatal_error(error, 'no '//entity(self%pdim)//" named '"//trim(name)//"'", error_code%input)
+            call fatal_error(error, 'no '//boundary_word(self%pdim)//" named '"//trim(name)//"'", error_code%input)
             return
         end if
         cps = self%boundaries(i)%cps

@@ -4,7 +4,7 @@
 module voiga_model
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_discretization_patch, only: discretization_t, boundary_cps, boundary_index
+    use voiga_discretization_patch, only: discretization_t, boundary_cps, boundary_index, boundary_word
     use voiga_model_body, only: body_t, body_settings_t, new_body
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
                                  obstacle_motion_t, phase_friction_t, phase_of
@@ -144,7 +144,7 @@ contains
         p%body = ib
         p%edge = boundary_index(self%bodies(ib)%disc, inp%edge)
         if (p%edge == 0) then
-            call fatal_error(error, 'pressure: no '//trim(merge('edge', 'face', self%nsd == 2))//" named '"// &
+            call fatal_error(error, 'pressure: no '//boundary_word(self%nsd)//" named '"// &
                              trim(inp%edge)//"' on body '"//trim(inp%body)//"'", error_code%input)
             return
         end if

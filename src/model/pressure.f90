@@ -9,6 +9,7 @@ module voiga_model_pressure
     use voiga_model_assembly_pattern, only: body_dofs
     use voiga_discretization_element, only: element_basis, element_nfun
     use voiga_element_quadrature, only: gauss_legendre
+    use voiga_nurbs_patch, only: cross
     implicit none
     private
 
@@ -129,12 +130,5 @@ contains
             end associate
         end do
     end subroutine face_pressure
-
-    !> The cross product a x b.
-    pure function cross(a, b) result(c)
-        real(dp), intent(in) :: a(3), b(3)
-        real(dp) :: c(3)
-        c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-    end function cross
 
 end module voiga_model_pressure

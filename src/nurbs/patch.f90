@@ -16,7 +16,7 @@ module voiga_nurbs_patch
     private
 
     public :: nurbs_patch_t, knots_t, new_patch, patch_eval, patch_elevate, patch_insert, patch_boundary
-    public :: point_index, patch_basis, next_index, jacobian_determinant, patch_orient, oriented_names
+    public :: point_index, patch_basis, next_index, jacobian_determinant, cross, patch_orient, oriented_names
 
     !> One knot vector (a patch has one per parametric direction).
     type :: knots_t
@@ -143,6 +143,14 @@ contains
                   a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
         end if
     end function jacobian_determinant
+
+    !> The cross product a x b of two 3-vectors (a face's area vector from its two
+    !> tangents, a surface's normal).
+    pure function cross(a, b) result(c)
+        real(dp), intent(in) :: a(3), b(3)
+        real(dp) :: c(3)
+        c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+    end function cross
 
     !> Raise the degree along direction `dir` by `t` (each distinct knot gains
     !> multiplicity `t`: the continuity is kept; the geometry is unchanged).

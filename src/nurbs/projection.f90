@@ -26,7 +26,7 @@
 !> minimum of the edge it reached first.
 module voiga_nurbs_projection
     use voiga_kinds, only: dp
-    use voiga_nurbs_patch, only: nurbs_patch_t
+    use voiga_nurbs_patch, only: nurbs_patch_t, cross
     use voiga_nurbs_basis, only: find_span, basis_ders_at, distinct_knots, max_fixed_degree
     use voiga_nurbs_cell_tree, only: cell_tree_t, new_cell_tree, cells_within, nearest_box, box_distance2
     implicit none
@@ -422,12 +422,6 @@ contains
         end if
         if (norm2(n) > 0.0_dp) n = n/norm2(n)
     end function unit_normal
-
-    pure function cross(a, b) result(c)
-        real(dp), intent(in) :: a(3), b(3)
-        real(dp) :: c(3)
-        c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-    end function cross
 
     !> The result record of the surface at `u` in cell `c` for the point `x`.
     pure subroutine evaluate(search, x, c, span, u, res)

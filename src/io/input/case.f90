@@ -21,7 +21,7 @@ module voiga_io_input_case
     use voiga_model_loads, only: dirichlet_settings_t, pressure_settings_t, axis_names
     use voiga_contact_factory, only: contact_settings_t
     use voiga_solver_settings, only: solver_settings_t
-    use voiga_discretization_patch, only: discretization_t, boundary_index
+    use voiga_discretization_patch, only: discretization_t, boundary_index, boundary_word
     implicit none
     private
 
@@ -270,7 +270,7 @@ contains
             type(discretization_t), intent(in) :: disc
             type(error_t), allocatable, intent(out) :: error
             character(len=4) :: entity
-            entity = merge('edge', 'face', disc%pdim == 2)
+            entity = boundary_word(disc%pdim)
             call fatal_error(error, where//entity//': no '//entity//" named '"//trim(name)//"'"//link//"'"// &
                              trim(body)//"' ("//entity//'s: '//edge_names(disc)//')', error_code%input)
         end subroutine missing
