@@ -31,6 +31,7 @@ program voiga_tests
     use test_segment, only: collect_segment
     use test_method, only: collect_method
     use test_projection, only: collect_projection, projection_timing
+    use test_contact_3d, only: collect_contact_3d
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -64,7 +65,8 @@ program voiga_tests
              new_testsuite('newton', collect_newton), &
              new_testsuite('segment', collect_segment), &
              new_testsuite('method', collect_method), &
-             new_testsuite('projection', collect_projection) &
+             new_testsuite('projection', collect_projection), &
+             new_testsuite('contact_3d', collect_contact_3d) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)

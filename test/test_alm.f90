@@ -327,8 +327,8 @@ contains
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
-        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
-                                          rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=10.0_dp, &
+        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp, 0.0_dp], &
+                                          rigid_normal=[0.0_dp, 1.0_dp, 0.0_dp], penalty_normal=10.0_dp, &
                                           penalty_tangent=1.0_dp, friction=mu, method=method)
         call build_model(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], model, error)
         if (allocated(error)) return

@@ -347,8 +347,8 @@ contains
         c%solver%n_steps = [4, 2]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.02_dp, push, -0.02_dp], [2, 2]))]
         allocate (c%contact(1))
-        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
-                                          rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1.0e3_dp, &
+        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp, 0.0_dp], &
+                                          rigid_normal=[0.0_dp, 1.0_dp, 0.0_dp], penalty_normal=1.0e3_dp, &
                                           penalty_tangent=1.0e2_dp, friction=mu, method=method)
         call both_paths(c, [rectangle(0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp)], stats, u, error)
     end subroutine pressed_block

@@ -98,8 +98,8 @@ contains
         allocate (c%dirichlet(0), c%pressure(0), c%contact(1))
         c%contact(1)%slave = 'die'
         c%contact(1)%master = merge('rigid', 'slab ', rigid)
-        c%contact(1)%rigid_point = [0.0_dp, 0.0_dp]
-        c%contact(1)%rigid_normal = [0.0_dp, 1.0_dp]
+        c%contact(1)%rigid_point = [0.0_dp, 0.0_dp, 0.0_dp]
+        c%contact(1)%rigid_normal = [0.0_dp, 1.0_dp, 0.0_dp]
         c%contact(1)%penalty_normal = 100.0_dp
         c%contact(1)%penalty_tangent = 70.0_dp
         c%contact(1)%friction = mu
@@ -558,8 +558,8 @@ contains
         c%solver%n_steps = [2, 4]
         c%dirichlet = [bc('block', 'top', [.true., .true.], reshape([0.0_dp, -0.01_dp, push, -0.01_dp], [2, 2]))]
         allocate (c%contact(1))
-        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp], &
-                                       rigid_normal=[0.0_dp, 1.0_dp], penalty_normal=1000.0_dp, &
+        c%contact(1) = contact_settings_t(slave='block', master='rigid', rigid_point=[0.0_dp, 0.0_dp, 0.0_dp], &
+                                       rigid_normal=[0.0_dp, 1.0_dp, 0.0_dp], penalty_normal=1000.0_dp, &
                                        penalty_tangent=1000.0_dp, friction=mu)
         if (present(method)) c%contact(1)%method = method
         if (present(phases)) then

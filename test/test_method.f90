@@ -61,7 +61,7 @@ contains
             if (.not. (found .and. converged) .or. self%out(k)%gap >= 0.0_dp) cycle
             pn = -self%law%eps_n*self%out(k)%gap
             do a = 1, size(sp%r)
-                r(sp%dofs(2*a - 1:2*a)) = r(sp%dofs(2*a - 1:2*a)) - pn*self%w(k)*norm2(sp%a)*sp%r(a)*mp%n
+                r(sp%dofs(2*a - 1:2*a)) = r(sp%dofs(2*a - 1:2*a)) - pn*self%w(k)*norm2(sp%a)*sp%r(a)*mp%n(1:2)
             end do
             self%out(k)%pn = pn
             self%out(k)%state = state_stick

@@ -80,11 +80,11 @@ contains
             n = [cos(ang), sin(ang)]
             ! the closest point, normal and gap of an exact circle (round-off of the
             ! rational evaluation and the Newton iteration: 1e-12)
-            call check(error, maxval(abs(mp%x - 2.0_dp*n)), 0.0_dp, 'closest point on the circle', abs=1.0e-12_dp)
+            call check(error, maxval(abs(mp%x(1:2) - 2.0_dp*n)), 0.0_dp, 'closest point on the circle', abs=1.0e-12_dp)
             if (allocated(error)) return
-            call check(error, maxval(abs(mp%n - n)), 0.0_dp, 'outward radial normal', abs=1.0e-12_dp)
+            call check(error, maxval(abs(mp%n(1:2) - n)), 0.0_dp, 'outward radial normal', abs=1.0e-12_dp)
             if (allocated(error)) return
-            call check(error, dot_product(xs - mp%x, mp%n), rad - 2.0_dp, 'gap |x| - r', abs=1.0e-12_dp)
+            call check(error, dot_product(xs - mp%x(1:2), mp%n(1:2)), rad - 2.0_dp, 'gap |x| - r', abs=1.0e-12_dp)
             if (allocated(error)) return
             call check(error, size(mp%r) == 0 .and. size(mp%dofs) == 0 .and. mp%first > mp%last, &
                        'no master functions')
@@ -120,7 +120,7 @@ contains
         if (allocated(error)) return
         call check(error, mp1%xi, mp0%xi, 'same parameter', abs=1.0e-13_dp)
         if (allocated(error)) return
-        call check(error, maxval(abs(mp1%x - mp0%x - d)), 0.0_dp, 'point moved by d', abs=1.0e-13_dp)
+        call check(error, maxval(abs(mp1%x(1:2) - mp0%x(1:2) - d)), 0.0_dp, 'point moved by d', abs=1.0e-13_dp)
         if (allocated(error)) return
         call check(error, maxval(abs(mp1%n - mp0%n)), 0.0_dp, 'same normal', abs=1.0e-13_dp)
         if (allocated(error)) return
@@ -174,7 +174,7 @@ contains
         call check(error, moved%ndof == 2*moved%bodies(1)%disc%ncp .and. moved%pairs(1)%pair%n_blocks() == 0, &
                    'the obstacle adds no DOF and no stiffness block')
         if (allocated(error)) return
-        f_moved = moved%pairs(1)%pair%force
+        f_moved = moved%pairs(1)%pair%force(1:2)
         call check(error, f_moved(2) < -1.0e-3_dp, 'the punch presses the block')
         if (allocated(error)) return
         ! equilibrium: the support carries the contact force (to the Newton tolerance)
@@ -186,7 +186,7 @@ contains
         if (allocated(error)) return
         call punch_run(.false., fixed, u_fixed, reaction, error)
         if (allocated(error)) return
-        f_fixed = fixed%pairs(1)%pair%force
+        f_fixed = fixed%pairs(1)%pair%force(1:2)
         call check(error, maxval(abs(f_moved - f_fixed)), 0.0_dp, 'same contact force', &
                    abs=1.0e-9_dp*abs(f_fixed(2)))
         if (allocated(error)) return
@@ -212,7 +212,7 @@ contains
             allocate (c%dirichlet(1))
             c%dirichlet(1) = dirichlet_settings_t(body='block', edge='bottom', fix=[.true., .true., .false.])
             if (move) then
-                c%contact(1)%rigid_motion = reshape([0.0_dp, -d], [2, 1])
+                c%contact(1)%rigid_motion = reshape([0.0_dp, -d, 0.0_dp], [3, 1])
                 c%dirichlet(1)%values = reshape([0.0_dp, 0.0_dp], [2, 1])
             else
                 c%dirichlet(1)%values = reshape([0.0_dp, d], [2, 1])

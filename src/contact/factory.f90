@@ -18,6 +18,7 @@ module voiga_contact_factory
     implicit none
     private
 
+    public :: rigid_normal_of
     public :: contact_settings_t, contact_method_names, new_contact_pair, build_pair, automatic_penalty, &
               default_method, automatic
 
@@ -41,15 +42,20 @@ module voiga_contact_factory
     type :: contact_settings_t
         !> Slave body; master body, or 'rigid' for a rigid obstacle.
         character(len=32) :: slave = '', master = ''
-        !> Rigid line: a point on it and its outward normal.
-        real(dp) :: rigid_point(2) = 0.0_dp, rigid_normal(2) = [0.0_dp, 1.0_dp]
+        !> Rigid line (2D) or plane (3D): a point on it and its outward normal [nsd:
+        !> the first two in 2D]; how many components the case gave of each (0: the
+        !> default, the origin and the normal +y in 2D, +z in 3D).
+        real(dp) :: rigid_point(3) = 0.0_dp, rigid_normal(3) = [0.0_dp, 1.0_dp, 0.0_dp]
+        integer :: point_components = 0, normal_components = 0
         !> Rigid obstacle bounded by a curve of the geometry file instead of the line:
         !> its name ('' for the line) and the curve (read by `voiga_io_input_bodies`).
         character(len=32) :: rigid_curve = ''
         type(nurbs_curve_t) :: curve
         !> The rigid master's translation at the end of each load phase, shape
-        !> [2, n_phases] (linear within a phase, zero at time 0); unallocated: fixed.
+        !> [3, n_phases] (z: 0 in 2D) (linear within a phase, zero at time 0); unallocated: fixed.
         real(dp), allocatable :: rigid_motion(:, :)
+        !> Whether the case gave rigid_uz (only a solid case may).
+        logical :: motion_z = .false.
         !> Penalties (`automatic`: `automatic_penalty`, and the normal one for the
         !> tangential one) and the friction coefficient (the largest, when it changes
         !> with the phase).
@@ -71,6 +77,16 @@ module voiga_contact_factory
     end type contact_settings_t
 
 contains
+
+    !> The rigid master's outward normal in `nsd` dimensions: as given, or (none
+    !> given) +y in 2D, +z in 3D.
+    pure function rigid_normal_of(c, nsd) result(n)
+        type(contact_settings_t), intent(in) :: c
+        integer, intent(in) :: nsd
+        real(dp) :: n(nsd)
+        n = c%rigid_normal(1:nsd)
+        if (c%normal_components == 0 .and. nsd == 3) n = [0.0_dp, 0.0_dp, 1.0_dp]
+    end function rigid_normal_of
 
     !> The method of a pair whose case names none (`default_deformable`, `default_rigid`).
     pure function default_method(rigid_master) result(name)

@@ -20,6 +20,7 @@ module voiga_contact_gpts
     use voiga_contact_kinematics, only: point_operators
     use voiga_text, only: str, real_str
     use voiga_contact_pair, only: contact_pair_t, add_matrix
+    use voiga_contact_gpts3, only: gpts_point3
     implicit none
     private
 
@@ -122,7 +123,12 @@ contains
                 if (size(rl) /= nd) deallocate (rl, kl)
             end if
             if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
-            if (allocated(self%slip_bound)) then
+            if (self%nsd == 3) then
+                call gpts_point3(self%law, self%w(k), sp, mp, rl, kl, g, pn)
+                state = state_stick
+                pt = 0.0_dp
+                new_anchor = mp%xi
+            else if (allocated(self%slip_bound)) then
                 call gpts_point(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, pt, &
                                 new_anchor, self%slip_bound(k))
             else
@@ -140,8 +146,9 @@ contains
                 r(dofs(j)) = r(dofs(j)) + rl(j)
             end do
             ! partition of unity: the slave part sums to -da t
-            self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
-            self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+            do j = 1, self%nsd
+                self%force(j) = self%force(j) - sum(rl(j:size(sp%dofs):self%nsd))
+            end do
             if (present(add)) then
                 call self%fit_pattern(k, mp, inside)
                 if (inside) call add(dofs, kl)
@@ -232,6 +239,8 @@ contains
         integer :: n_active, n_holes, n_gaps, n_cp
 
         text = ''
+        ! (the diagnosis reads the points along an edge)
+        if (self%slave%npar > 1) return
         call self%zone(n_active, n_holes, n_gaps, n_cp)
         if (n_gaps < min_gaps .or. n_holes < min_hole_share*(n_active + n_holes) .or. &
             n_active <= n_cp) return
@@ -352,16 +361,16 @@ contains
         integer :: a, b
 
         call point_operators(sp, mp, gm, dm, ds)
-        n = mp%n
-        la = norm2(mp%a)
-        that = mp%a/la
-        las = norm2(sp%a)
-        ts = sp%a/las
+        n = mp%n(1:2)
+        la = norm2(mp%a(1:2))
+        that = mp%a(1:2)/la
+        las = norm2(sp%a(1:2))
+        ts = sp%a(1:2)/las
         da = las*w
-        g = dot_product(sp%x - mp%x, n)
+        g = dot_product(sp%x(1:2) - mp%x(1:2), n)
         pn = -law%eps_n*g
         ! linearization of the projection: dxi = c . du
-        den = dot_product(mp%a, mp%a) - g*dot_product(n, mp%a2)
+        den = dot_product(mp%a(1:2), mp%a(1:2)) - g*dot_product(n, mp%a2(1:2))
         do a = 1, size(r)
             c(a) = ((mp%a(1)*gm(1, a) + mp%a(2)*gm(2, a)) + g*(n(1)*dm(1, a) + n(2)*dm(2, a)))/den
         end do
@@ -385,7 +394,7 @@ contains
             ! Tresca: the same predictor and return map with the slip limit fixed
             ttr = law%eps_t*abs(slip)*la
             if (ttr <= bound) then
-                t = t - law%eps_t*slip*mp%a
+                t = t - law%eps_t*slip*mp%a(1:2)
                 tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*dslip + slip*amat(1, :))
                 tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*dslip + slip*amat(2, :))
                 pt = -law%eps_t*slip*la
@@ -403,7 +412,7 @@ contains
             ! elastic predictor on the convected coordinate
             ttr = law%eps_t*abs(slip)*la
             if (ttr <= law%mu*pn .or. .not. law%return_map) then
-                t = t - law%eps_t*slip*mp%a
+                t = t - law%eps_t*slip*mp%a(1:2)
                 tmat(1, :) = tmat(1, :) - law%eps_t*(mp%a(1)*dslip + slip*amat(1, :))
                 tmat(2, :) = tmat(2, :) - law%eps_t*(mp%a(2)*dslip + slip*amat(2, :))
                 pt = -law%eps_t*slip*la

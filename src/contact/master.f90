@@ -14,12 +14,17 @@ module voiga_contact_master
 
     !> The master at the projection of a slave point.
     type :: master_point_t
-        !> Convective coordinate, point, tangent dx/dxi, second derivative.
-        real(dp) :: xi = 0.0_dp, x(2) = 0.0_dp, a(2) = 0.0_dp, a2(2) = 0.0_dp
+        !> Convective coordinates (eta: a surface's second; 0 on a curve).
+        real(dp) :: xi = 0.0_dp, eta = 0.0_dp
+        !> Point, tangent dx/dxi, second derivative d2x/dxi2 [nsd; z = 0 in 2D]; on a
+        !> surface also dx/deta, d2x/deta2 and d2x/dxi deta.
+        real(dp) :: x(3) = 0.0_dp, a(3) = 0.0_dp, a2(3) = 0.0_dp
+        real(dp) :: b(3) = 0.0_dp, b2(3) = 0.0_dp, ab(3) = 0.0_dp
         !> Outward unit normal of the master body at the point.
-        real(dp) :: n(2) = 0.0_dp
-        !> Function values and derivatives at xi [nm] (empty for a rigid master).
-        real(dp), allocatable :: r(:), dr(:)
+        real(dp) :: n(3) = 0.0_dp
+        !> Function values and derivatives at xi (by eta: `drb`, a surface's) [nm]
+        !> (empty for a rigid master).
+        real(dp), allocatable :: r(:), dr(:), drb(:)
         !> Global DOFs of those functions [2 nm], order 2(k-1) + i.
         integer, allocatable :: dofs(:)
         !> Range of the master's control points (positions in `all_dofs` / 2) that
@@ -64,7 +69,8 @@ module voiga_contact_master
         pure subroutine project_interface(self, u, xs, mp, found, converged, start)
             import :: contact_master_t, master_point_t, dp
             class(contact_master_t), intent(in) :: self
-            real(dp), intent(in) :: u(:), xs(2)
+            !> `xs`: the slave point [nsd].
+            real(dp), intent(in) :: u(:), xs(:)
             type(master_point_t), intent(out) :: mp
             logical, intent(out) :: found
             !> False if the local Newton iteration did not converge.
@@ -93,12 +99,12 @@ contains
         ! a rigid master has nothing to update
     end subroutine master_prepare
 
-    !> Put a rigid master at its reference position translated by `offset`
+    !> Put a rigid master at its reference position translated by `offset` [nsd]
     !> (its prescribed motion at the current load time). Default: nothing (a
     !> deformable master moves with its body's DOFs).
     pure subroutine master_move(self, offset)
         class(contact_master_t), intent(inout) :: self
-        real(dp), intent(in) :: offset(2)
+        real(dp), intent(in) :: offset(:)
     end subroutine master_move
 
     !> Nothing: a deformable master's position is its body's.

@@ -67,7 +67,7 @@ contains
     !> master functions (no DOFs to couple).
     pure subroutine curve_project(self, u, xs, mp, found, converged, start)
         class(rigid_curve_t), intent(in) :: self
-        real(dp), intent(in) :: u(:), xs(2)
+        real(dp), intent(in) :: u(:), xs(:)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
         real(dp), intent(in), optional :: start
@@ -89,7 +89,7 @@ contains
     !> Translate the curve to its reference position plus `offset`.
     pure subroutine curve_move(self, offset)
         class(rigid_curve_t), intent(inout) :: self
-        real(dp), intent(in) :: offset(2)
+        real(dp), intent(in) :: offset(:)
         self%offset = offset
         self%surf%x0(1, :) = self%x_ref(1, :) + offset(1)
         self%surf%x0(2, :) = self%x_ref(2, :) + offset(2)

@@ -109,9 +109,9 @@ contains
                 do j = 0, m - 1
                     call surface_point_at(surf, u, sample_xi(k, j), surf%spans(k), self%sample_basis(:, 1, j + 1, k), &
                                           self%sample_basis(:, 2, j + 1, k), self%sample_basis(:, 3, j + 1, k), pt)
-                    self%samples(:, j + 1, k) = pt%x
-                    if (j == 0) self%ends(:, 1, k) = [pt%a, pt%a2]
-                    if (j == m - 1) self%ends(:, 2, k) = [pt%a, pt%a2]
+                    self%samples(:, j + 1, k) = pt%x(1:2)
+                    if (j == 0) self%ends(:, 1, k) = [pt%a(1:2), pt%a2(1:2)]
+                    if (j == m - 1) self%ends(:, 2, k) = [pt%a(1:2), pt%a2(1:2)]
                 end do
                 s = surf%spans(k)
                 xc(1, :) = surf%x0(1, s - p:s) + u(surf%dofs(1, s - p:s))
@@ -151,7 +151,8 @@ contains
     !> increment, against a sample spacing of 1/(2p + 2) of a span).
     pure subroutine nurbs_project(self, u, xs, mp, found, converged, start)
         class(nurbs_master_t), intent(in) :: self
-        real(dp), intent(in) :: u(:), xs(2)
+        !> The slave point [2].
+        real(dp), intent(in) :: u(:), xs(:)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
         real(dp), intent(in), optional :: start
@@ -162,7 +163,9 @@ contains
         real(dp) :: lb(size(self%surf%breaks) - 1)
         integer :: nspan, k, j, m, best_span, s0, k0, i, cur, ib
         logical :: ok, best_ok, at_end
+        real(dp) :: xq(2)
 
+        xq = xs(1:2)
         associate (br => self%surf%breaks)
             nspan = size(br) - 1
             ! 1. nearest sample (2p + 3 points per span), visiting the span whose box
@@ -171,7 +174,7 @@ contains
             !    (squared distances: the same order without square roots)
             m = n_samples(self)
             do k = 1, nspan
-                lb(k) = box_distance2(self%boxes(:, k), xs)
+                lb(k) = box_distance2(self%boxes(:, k), xq)
             end do
             best_d = huge(1.0_dp)
             best = br(1)
@@ -181,7 +184,7 @@ contains
                 k = modulo(k0 - 1 + i, nspan) + 1
                 if (lb(k) >= best_d) cycle
                 do j = 1, m
-                    d = (xs(1) - self%samples(1, j, k))**2 + (xs(2) - self%samples(2, j, k))**2
+                    d = (xq(1) - self%samples(1, j, k))**2 + (xq(2) - self%samples(2, j, k))**2
                     if (d < best_d) then
                         best_d = d
                         best = br(k) + (br(k + 1) - br(k))*real(j - 1, dp)/real(m - 1, dp)
@@ -201,9 +204,9 @@ contains
                 ! a neighbour span whose Newton would stop at its first point, the end
                 ! it shares with the sample's span: that point is known from `prepare`
                 ok = .false.
-                if (k /= s0) call settles_at_end(self, xs, k, best, ok, j)
+                if (k /= s0) call settles_at_end(self, xq, k, best, ok, j)
                 if (ok) then
-                    d = norm2(xs - self%samples(:, j, k))
+                    d = norm2(xq - self%samples(:, j, k))
                     if (d < best_d) then
                         best_d = d
                         best_span = k
@@ -218,9 +221,9 @@ contains
                     if (abs(start - best) <= (br(k + 1) - br(k))/real(m - 1, dp) .and. &
                         start >= br(k) .and. start <= br(k + 1)) xi0 = start
                 end if
-                call span_newton(self%surf, u, xs, k, xi0, pts(cur), ok)
+                call span_newton(self%surf, u, xq, k, xi0, pts(cur), ok)
                 if (.not. ok) converged = .false.
-                d = norm2(xs - pts(cur)%x)
+                d = norm2(xq - pts(cur)%x(1:2))
                 if (d < best_d) then
                     best_d = d
                     ib = cur
@@ -242,15 +245,15 @@ contains
             associate (best_pt => pts(ib))
                 ! 3. beyond the curve's ends: no orthogonal projection
                 found = best_span > 0
-                f = dot_product(xs - best_pt%x, best_pt%a)
-                tol = 1.0e-12_dp*norm2(best_pt%a)*max(best_d, 1.0_dp)
+                f = dot_product(xq - best_pt%x(1:2), best_pt%a(1:2))
+                tol = 1.0e-12_dp*norm2(best_pt%a(1:2))*max(best_d, 1.0_dp)
                 if (best_pt%xi <= br(1) .and. f < -tol) found = .false.
                 if (best_pt%xi >= br(nspan + 1) .and. f > tol) found = .false.
                 mp%xi = best_pt%xi
                 mp%x = best_pt%x
                 mp%a = best_pt%a
                 mp%a2 = best_pt%a2
-                mp%n = self%sign*[best_pt%a(2), -best_pt%a(1)]/norm2(best_pt%a)
+                mp%n = self%sign*[best_pt%a(2), -best_pt%a(1), 0.0_dp]/norm2(best_pt%a(1:2))
                 mp%r = best_pt%r
                 mp%dr = best_pt%dr
                 mp%dofs = best_pt%dofs
@@ -315,8 +318,8 @@ contains
         ok = .false.
         do it = 1, max_newton
             call surface_point(surf, u, xi, pt, surf%spans(k))
-            f = dot_product(xs - pt%x, pt%a)
-            df = -dot_product(pt%a, pt%a) + dot_product(xs - pt%x, pt%a2)
+            f = dot_product(xs - pt%x(1:2), pt%a(1:2))
+            df = -dot_product(pt%a(1:2), pt%a(1:2)) + dot_product(xs - pt%x(1:2), pt%a2(1:2))
             ! keep a bracket of the minimum of the distance: f > 0 -> it lies to the right
             if (f > 0.0_dp) then
                 lo = xi

@@ -36,13 +36,13 @@ contains
         integer :: a
 
         call point_operators(sp, mp, gm, dm, ds)
-        n = mp%n
-        la = norm2(mp%a)
-        that = mp%a/la
-        g = dot_product(sp%x - mp%x, n)
+        n = mp%n(1:2)
+        la = norm2(mp%a(1:2))
+        that = mp%a(1:2)/la
+        g = dot_product(sp%x(1:2) - mp%x(1:2), n)
         ! linearization of the projection: dxi = c . du; master tangent A = Dm + a2 (x) c
-        den = dot_product(mp%a, mp%a) - g*dot_product(n, mp%a2)
-        c = (matmul(mp%a, gm) + g*matmul(n, dm))/den
+        den = dot_product(mp%a(1:2), mp%a(1:2)) - g*dot_product(n, mp%a2(1:2))
+        c = (matmul(mp%a(1:2), gm) + g*matmul(n, dm))/den
         amat(1, :) = dm(1, :) + mp%a2(1)*c
         amat(2, :) = dm(2, :) + mp%a2(2)*c
         na = matmul(n, amat)/la     ! dn = -t_hat na, dt_hat = n na

@@ -22,7 +22,8 @@ module voiga_contact_pair
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, surface_basis, &
-                                     surface_point_at
+                                     surface_point_at, face_basis, face_point_at, n_elements
+    use voiga_nurbs_patch, only: cross
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive
     use voiga_text, only: str, real_str
@@ -41,16 +42,21 @@ module voiga_contact_pair
 
     !> Per-slave-point output of the last evaluation.
     type :: contact_point_out_t
-        !> Reference and current position of the slave point.
-        real(dp) :: x0(2) = 0.0_dp, x(2) = 0.0_dp
+        !> Reference and current position of the slave point [nsd; z = 0 in 2D].
+        real(dp) :: x0(3) = 0.0_dp, x(3) = 0.0_dp
         !> Normal gap; contact pressure and tangential traction per current length of
         !> the slave edge, and per reference length (nominal: `pn0` = `pn` x `stretch`).
         real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp, pn0 = 0.0_dp, pt0 = 0.0_dp
-        !> Current over reference length of the slave edge at the point, |a_s| / |A_s|.
+        !> Current over reference length of the slave edge at the point, |a_s| / |A_s|
+        !> (on a face: area, |a_1 x a_2| / |A_1 x A_2|).
         real(dp) :: stretch = 1.0_dp
+        !> The reference length (area, on a face) the point integrates: its weight
+        !> times |A_s| (|A_1 x A_2|).
+        real(dp) :: area0 = 0.0_dp
         !> Master convective coordinate of the projection, and the range of master
-        !> control points its functions belong to (empty for a rigid master).
-        real(dp) :: xi_m = 0.0_dp
+        !> control points its functions belong to (empty for a rigid master); `eta_m`
+        !> a master surface's second coordinate.
+        real(dp) :: xi_m = 0.0_dp, eta_m = 0.0_dp
         integer :: first = 1, last = 0
         integer :: state = state_inactive
     end type contact_point_out_t
@@ -82,6 +88,8 @@ module voiga_contact_pair
     !> A slave/master pair; the data every method shares.
     type, abstract :: contact_pair_t
         character(len=32) :: slave_name = '', master_name = ''
+        !> Spatial dimension (the slave's DOFs per control point).
+        integer :: nsd = 2
         integer :: slave_body = 0
         !> Master body index, 0 for a rigid master.
         integer :: master_body = 0
@@ -92,13 +100,15 @@ module voiga_contact_pair
         !> `penalty_normal` becomes, `voiga_contact_factory`'s `automatic_penalty`;
         !> the floor of ALM's softening).
         real(dp) :: eps_automatic = 0.0_dp
-        !> Gauss points per slave element.
+        !> Gauss points per slave element (per direction, on a face).
         integer :: n_gauss = 0
-        !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts].
-        real(dp), allocatable :: xi(:), w(:)
-        integer, allocatable :: span(:)
+        !> Slave points: parameter, weight (Gauss weight x d xi), knot span [npts];
+        !> on a face also the second parameter and its span (weight: x d eta).
+        real(dp), allocatable :: xi(:), w(:), eta(:)
+        integer, allocatable :: span(:), span_eta(:)
         !> The slave functions at each point (they do not change): values, first and
-        !> second derivatives [p + 1, 3, npts] (`surface_basis`).
+        !> second derivatives [p + 1, 3, npts] (`surface_basis`); on a face values and
+        !> the derivatives by xi and eta [(p + 1)(q + 1), 3, npts] (`face_basis`).
         real(dp), allocatable :: slave_basis(:, :, :)
         !> The pair's history (`voiga_contact_history`): the fields every method
         !> keeps with friction (mu > 0) and those its method adds (`setup_history`).
@@ -116,8 +126,8 @@ module voiga_contact_pair
         !> round-off) carries penalty stiffness, so bodies that start in contact are
         !> supported. 1e-12 of the slave surface's size.
         real(dp) :: gap_tol = 0.0_dp
-        !> Resultant contact force on the slave at the last evaluation.
-        real(dp) :: force(2) = 0.0_dp
+        !> Resultant contact force on the slave at the last evaluation [nsd; z = 0 in 2D].
+        real(dp) :: force(3) = 0.0_dp
         !> Counters: active point evaluations, of which frictional.
         integer(i8) :: n_evaluations = 0, n_friction = 0
         !> Deformable master: the master control points [mlo(e), mhi(e)] each slave
@@ -284,46 +294,89 @@ module voiga_contact_pair
 
 contains
 
-    !> Place the slave Gauss points (n_gauss per slave element; 0: degree + 1), the
-    !> pattern ranges and the gap tolerance, then the history (`setup_history`).
+    !> Place the slave Gauss points (n_gauss per slave element and direction; 0:
+    !> degree + 1), the pattern ranges and the gap tolerance, then the history
+    !> (`setup_history`).
     pure subroutine pair_setup(self)
         class(contact_pair_t), intent(inout) :: self
         real(dp), allocatable :: gx(:), gw(:)
         integer :: ne, ng, e, i, k, s
         real(dp) :: a, b
 
+        self%nsd = size(self%slave%dofs, 1)
         if (self%n_gauss <= 0) self%n_gauss = self%slave%degree + 1
         ng = self%n_gauss
-        ne = size(self%slave%breaks) - 1
-        allocate (gx(ng), gw(ng), self%xi(ne*ng), self%w(ne*ng), self%span(ne*ng))
+        allocate (gx(ng), gw(ng))
         call gauss_legendre(ng, gx, gw)
-        k = 0
-        do e = 1, ne
-            a = self%slave%breaks(e)
-            b = self%slave%breaks(e + 1)
-            do i = 1, ng
-                k = k + 1
-                self%xi(k) = a + 0.5_dp*(b - a)*(gx(i) + 1.0_dp)
-                self%w(k) = 0.5_dp*(b - a)*gw(i)
-                self%span(k) = self%slave%spans(e)
+        if (self%slave%npar > 1) then
+            call face_points(self, gx, gw)
+        else
+            ne = size(self%slave%breaks) - 1
+            allocate (self%xi(ne*ng), self%w(ne*ng), self%span(ne*ng))
+            k = 0
+            do e = 1, ne
+                a = self%slave%breaks(e)
+                b = self%slave%breaks(e + 1)
+                do i = 1, ng
+                    k = k + 1
+                    self%xi(k) = a + 0.5_dp*(b - a)*(gx(i) + 1.0_dp)
+                    self%w(k) = 0.5_dp*(b - a)*gw(i)
+                    self%span(k) = self%slave%spans(e)
+                end do
             end do
-        end do
-        allocate (self%slave_basis(self%slave%degree + 1, 3, ne*ng))
-        do k = 1, ne*ng
-            call surface_basis(self%slave, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
-                               self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), s)
-        end do
-        allocate (self%out(ne*ng))
+            allocate (self%slave_basis(self%slave%degree + 1, 3, ne*ng))
+            do k = 1, ne*ng
+                call surface_basis(self%slave, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
+                                   self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), s)
+            end do
+        end if
+        ne = n_elements(self%slave)
+        allocate (self%out(size(self%xi)))
         ! until the assembly fits them (assemble with refit), every slave element is
         ! coupled with the whole master
         allocate (self%mlo(ne), self%mhi(ne))
         self%mlo = 1
         self%mhi = 0
-        if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/2
+        if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/self%nsd
         self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
         call shared_history(self)
         call self%setup_history()
     end subroutine pair_setup
+
+    !> The Gauss points of a face: n_gauss^2 per cell (cells and points xi fastest),
+    !> from the 1D rule `gx`, `gw` on [-1, 1], and the functions there.
+    pure subroutine face_points(self, gx, gw)
+        class(contact_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: gx(:), gw(:)
+        integer :: ng, nu, nv, np, ci, cj, i, j, k
+        real(dp) :: lo(2), hi(2)
+        ng = size(gx)
+        nu = size(self%slave%spans)
+        nv = size(self%slave%spans_eta)
+        np = (self%slave%degree + 1)*(self%slave%degree_eta + 1)
+        allocate (self%xi(nu*nv*ng*ng), self%eta(nu*nv*ng*ng), self%w(nu*nv*ng*ng), &
+                  self%span(nu*nv*ng*ng), self%span_eta(nu*nv*ng*ng), self%slave_basis(np, 3, nu*nv*ng*ng))
+        k = 0
+        do cj = 1, nv
+            do ci = 1, nu
+                lo = [self%slave%breaks(ci), self%slave%breaks_eta(cj)]
+                hi = [self%slave%breaks(ci + 1), self%slave%breaks_eta(cj + 1)]
+                do j = 1, ng
+                    do i = 1, ng
+                        k = k + 1
+                        self%xi(k) = lo(1) + 0.5_dp*(hi(1) - lo(1))*(gx(i) + 1.0_dp)
+                        self%eta(k) = lo(2) + 0.5_dp*(hi(2) - lo(2))*(gx(j) + 1.0_dp)
+                        self%w(k) = 0.25_dp*(hi(1) - lo(1))*(hi(2) - lo(2))*gw(i)*gw(j)
+                        self%span(k) = self%slave%spans(ci)
+                        self%span_eta(k) = self%slave%spans_eta(cj)
+                        call face_basis(self%slave, self%xi(k), self%eta(k), [self%span(k), self%span_eta(k)], &
+                                        self%slave_basis(:, 1, k), self%slave_basis(:, 2, k), &
+                                        self%slave_basis(:, 3, k))
+                    end do
+                end do
+            end do
+        end do
+    end subroutine face_points
 
     !> The friction history every method keeps (mu > 0): projections, contact and
     !> gaps at the last converged state, one entry per slave point.
@@ -462,28 +515,39 @@ contains
         type(surface_point_t), intent(inout) :: sp
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
-        real(dp) :: a0(2)
-        if (allocated(self%slave_basis)) then
+        real(dp) :: a0(3), b0(3), jac0
+        if (self%slave%npar > 1) then
+            call face_point_at(self%slave, u, self%xi(k), self%eta(k), [self%span(k), self%span_eta(k)], &
+                               self%slave_basis(:, 1, k), self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
+        else if (allocated(self%slave_basis)) then
             call surface_point_at(self%slave, u, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
                                   self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
         else
             call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
         end if
         associate (out => self%out(k))
-            call reference_point(self%slave, sp, out%x0, a0)
+            call reference_point(self%slave, sp, out%x0, a0, b0)
             out%x = sp%x
-            out%stretch = norm2(sp%a)/norm2(a0)
+            if (self%slave%npar > 1) then
+                jac0 = norm2(cross(a0, b0))
+                out%stretch = norm2(cross(sp%a, sp%b))/jac0
+            else
+                jac0 = norm2(a0(1:2))
+                out%stretch = norm2(sp%a(1:2))/jac0
+            end if
+            out%area0 = self%w(k)*jac0
             out%state = state_inactive
             out%pn = 0.0_dp
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
             if (self%warm) then
-                call self%master%project(u, sp%x, mp, found, converged, out%xi_m)
+                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, out%xi_m)
             else
-                call self%master%project(u, sp%x, mp, found, converged)
+                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged)
             end if
             out%xi_m = mp%xi
+            out%eta_m = mp%eta
             out%first = mp%first
             out%last = mp%last
             out%gap = huge(1.0_dp)
@@ -491,18 +555,21 @@ contains
         end associate
     end subroutine pair_project_point
 
-    !> The reference position `x0` and tangent `a0` of the slave point `sp` (its
-    !> functions at the reference control points).
-    pure subroutine reference_point(slave, sp, x0, a0)
+    !> The reference position `x0` and tangents `a0` (by xi), `b0` (by eta, on a
+    !> face) of the slave point `sp` (its functions at the reference control points).
+    pure subroutine reference_point(slave, sp, x0, a0, b0)
         type(contact_surface_t), intent(in) :: slave
         type(surface_point_t), intent(in) :: sp
-        real(dp), intent(out) :: x0(2), a0(2)
-        integer :: j
+        real(dp), intent(out) :: x0(3), a0(3), b0(3)
+        integer :: j, d
+        d = size(slave%x0, 1)
         x0 = 0.0_dp
         a0 = 0.0_dp
+        b0 = 0.0_dp
         do j = 1, size(sp%local)
-            x0 = x0 + slave%x0(:, sp%local(j))*sp%r(j)
-            a0 = a0 + slave%x0(:, sp%local(j))*sp%dr(j)
+            x0(1:d) = x0(1:d) + slave%x0(:, sp%local(j))*sp%r(j)
+            a0(1:d) = a0(1:d) + slave%x0(:, sp%local(j))*sp%dr(j)
+            if (slave%npar > 1) b0(1:d) = b0(1:d) + slave%x0(:, sp%local(j))*sp%drb(j)
         end do
     end subroutine reference_point
 
@@ -517,18 +584,19 @@ contains
                          error_code%numeric)
     end subroutine pair_projection_error
 
-    !> Points n_gauss (e - 1) + 1 .. n_gauss e: the Gauss points `setup` places.
+    !> Points m (e - 1) + 1 .. m e, m = n_gauss^npar: the Gauss points `setup` places.
     pure function pair_point_range(self, e) result(range)
         class(contact_pair_t), intent(in) :: self
         integer, intent(in) :: e
-        integer :: range(2)
-        range = [(e - 1)*self%n_gauss + 1, e*self%n_gauss]
+        integer :: range(2), m
+        m = self%n_gauss**self%slave%npar
+        range = [(e - 1)*m + 1, e*m]
     end function pair_point_range
 
     pure integer function pair_point_element(self, k) result(e)
         class(contact_pair_t), intent(in) :: self
         integer, intent(in) :: k
-        e = (k - 1)/self%n_gauss + 1
+        e = (k - 1)/self%n_gauss**self%slave%npar + 1
     end function pair_point_element
 
     pure subroutine pair_set_friction(self, mu)
@@ -541,7 +609,7 @@ contains
     !> a deformable one, which moves with its body's displacement).
     pure subroutine pair_move_master(self, d)
         class(contact_pair_t), intent(inout) :: self
-        real(dp), intent(in) :: d(2)
+        real(dp), intent(in) :: d(:)
         call self%master%move(d)
     end subroutine pair_move_master
 

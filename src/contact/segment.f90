@@ -301,7 +301,7 @@ contains
         allocate (x(2, m), f(m))
         do j = 1, m
             call surface_point(self%slave, u, s(j), pt, self%slave%spans(e))
-            x(:, j) = pt%x
+            x(:, j) = pt%x(1:2)
         end do
         tol_eta = 1.0e-8_dp*(maxval(lines(5, :)) - minval(lines(5, :)))
         do il = 1, size(lines, 2)
@@ -318,7 +318,7 @@ contains
                         cycle
                     end if
                     call surface_point(self%slave, u, root, pt, self%slave%spans(e))
-                    call self%master%project(u, pt%x, mp, found, converged)
+                    call self%master%project(u, pt%x(1:2), mp, found, converged)
                     if (.not. (found .and. converged)) cycle
                     if (abs(mp%xi - eta) > tol_eta) cycle
                     cuts = [cuts, root]
@@ -353,7 +353,7 @@ contains
         xi = 0.5_dp*(lo + hi)
         do it = 1, max_newton
             call surface_point(slave, u, xi, pt, slave%spans(e))
-            f = dot_product(pt%x - xm, t)
+            f = dot_product(pt%x(1:2) - xm, t)
             if (f == 0.0_dp) return
             ! keep the sign change inside [lo, hi]
             if (sign(1.0_dp, f) == sign(1.0_dp, f_lo)) then
@@ -361,7 +361,7 @@ contains
             else
                 hi = xi
             end if
-            df = dot_product(pt%a, t)
+            df = dot_product(pt%a(1:2), t)
             next = 0.5_dp*(lo + hi)
             if (df /= 0.0_dp) next = xi - f/df
             if (next <= lo .or. next >= hi) next = 0.5_dp*(lo + hi)

@@ -1,21 +1,27 @@
-!> A body's contact edge as a univariate NURBS curve over its own control points:
-!> the VO layer (degree q) when the body has one, else the bulk's eta = 1 row. This
-!> is the trace of the element basis on eta = 1, so the contact integral uses the
-!> layer's degree-q functions (docs/theory.md, section 7).
+!> A body's contact boundary as a NURBS curve (a plane body's edge) or surface (a
+!> solid's face) over its own control points: the VO layer (degree q) when the body
+!> has one, else the bulk's last row (eta = 1) or layer (zeta = 1). This is the trace
+!> of the element basis on that boundary, so the contact integral uses the layer's
+!> degree-q functions (docs/theory.md, section 7). A face has a second parametric
+!> direction (eta: `degree_eta`, `knots_eta`, ...; control points xi fastest);
+!> everything about the first is named as for an edge.
 module voiga_contact_surface
     use voiga_kinds, only: dp
     use voiga_nurbs_basis, only: find_span, basis_ders_at, distinct_knots, max_fixed_degree
     use voiga_nurbs_rational, only: rationalize
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_discretization_patch, only: discretization_t
+    use voiga_nurbs_patch, only: knots_t
     implicit none
     private
 
     public :: contact_surface_t, new_contact_surface, new_curve_surface, surface_point_t, surface_point, &
-              surface_basis, surface_point_at, element_lengths
+              surface_basis, surface_point_at, element_lengths, n_elements, face_basis, face_point_at
 
     !> The contact edge of one body.
     type :: contact_surface_t
+        !> Parametric directions: 1 (an edge) or 2 (a face).
+        integer :: npar = 1
         integer :: degree = 0
         !> Knot vector [n + degree + 1] and weights [n].
         real(dp), allocatable :: knots(:), w(:)
@@ -27,41 +33,49 @@ module voiga_contact_surface
         real(dp), allocatable :: breaks(:)
         !> Knot-span index of each element along the edge [nel].
         integer, allocatable :: spans(:)
+        !> A face's second direction: degree, knots, breakpoints and spans (as the
+        !> first's), and the control points along xi; unset on an edge.
+        integer :: degree_eta = 0, n_xi = 0
+        real(dp), allocatable :: knots_eta(:), breaks_eta(:)
+        integer, allocatable :: spans_eta(:)
     end type contact_surface_t
 
     !> The curve at one parameter value, in a given configuration.
     type :: surface_point_t
-        real(dp) :: xi = 0.0_dp
-        !> Point, first and second parametric derivatives.
-        real(dp) :: x(2) = 0.0_dp, a(2) = 0.0_dp, a2(2) = 0.0_dp
-        !> Nonzero functions: values, first and second derivatives [p + 1].
-        real(dp), allocatable :: r(:), dr(:), d2r(:)
-        !> Global DOFs of those functions [2 (p + 1)], local order 2(k-1) + i.
+        !> Parameters (eta: a face's second; 0 on an edge).
+        real(dp) :: xi = 0.0_dp, eta = 0.0_dp
+        !> Point, first and second derivatives by xi, first by eta [nsd; z = 0 in 2D].
+        real(dp) :: x(3) = 0.0_dp, a(3) = 0.0_dp, a2(3) = 0.0_dp, b(3) = 0.0_dp
+        !> Nonzero functions: values, first and second derivatives by xi, first by eta
+        !> [nfun: p + 1 on an edge, (p + 1)(q + 1) on a face; `drb` empty on an edge].
+        real(dp), allocatable :: r(:), dr(:), d2r(:), drb(:)
+        !> Global DOFs of those functions [nsd nfun], local order nsd (k-1) + i.
         integer, allocatable :: dofs(:)
-        !> Their positions in the surface's arrays [p + 1].
+        !> Their positions in the surface's arrays [nfun].
         integer, allocatable :: local(:)
     end type surface_point_t
 
 contains
 
-    !> The contact edge (eta = 1) of `disc`, whose DOFs start after `dof0`.
+    !> The contact boundary (u_pdim = 1: an edge or a face) of `disc`, whose DOFs
+    !> start after `dof0`.
     pure subroutine new_contact_surface(self, disc, dof0)
         type(contact_surface_t), intent(out) :: self
         type(discretization_t), intent(in) :: disc
         integer, intent(in) :: dof0
-        integer :: ny, c
+        integer :: nb, last, c, np
+        np = disc%pdim - 1
         if (disc%has_layer) then
-            self%degree = disc%layer%degree(1)
-            self%knots = disc%layer%knots(1)%u
+            call set_directions(self, disc%layer%degree, disc%layer%knots, disc%layer%n)
             self%w = disc%layer%w
             self%cps = disc%layer_id
         else
-            ny = disc%bulk%n(2)
-            self%degree = disc%bulk%degree(1)
-            self%knots = disc%bulk%knots(1)%u
-            ! the last eta row of the flat weights (xi fastest)
-            self%w = disc%bulk%w((ny - 1)*disc%bulk%n(1) + 1:ny*disc%bulk%n(1))
-            self%cps = disc%bulk_id((ny - 1)*disc%bulk%n(1) + 1:ny*disc%bulk%n(1))
+            call set_directions(self, disc%bulk%degree(1:np), disc%bulk%knots(1:np), disc%bulk%n(1:np))
+            ! the last row (layer) of the flat weights (direction 1 fastest)
+            nb = product(disc%bulk%n(1:np))
+            last = disc%bulk%n(disc%pdim)
+            self%w = disc%bulk%w((last - 1)*nb + 1:last*nb)
+            self%cps = disc%bulk_id((last - 1)*nb + 1:last*nb)
         end if
         allocate (self%dofs(disc%nsd, size(self%cps)))
         do c = 1, disc%nsd
@@ -70,6 +84,20 @@ contains
         self%x0 = disc%x(:, self%cps)
         call set_spans(self)
     end subroutine new_contact_surface
+
+    !> Degrees and knots of the boundary's directions (one: an edge; two: a face).
+    pure subroutine set_directions(self, degree, knots, n)
+        type(contact_surface_t), intent(inout) :: self
+        integer, intent(in) :: degree(:), n(:)
+        type(knots_t), intent(in) :: knots(:)
+        self%npar = size(degree)
+        self%degree = degree(1)
+        self%knots = knots(1)%u
+        if (self%npar < 2) return
+        self%degree_eta = degree(2)
+        self%knots_eta = knots(2)%u
+        self%n_xi = n(1)
+    end subroutine set_directions
 
     !> A curve that belongs to no body (a rigid obstacle's), as a surface over a
     !> displacement vector of its own: control point k has the DOFs 2k - 1, 2k.
@@ -88,16 +116,95 @@ contains
         call set_spans(self)
     end subroutine new_curve_surface
 
-    !> The breakpoints and the knot span of each element, from the knots.
+    !> The breakpoints and the knot span of each element, from the knots (per
+    !> direction on a face).
     pure subroutine set_spans(self)
         type(contact_surface_t), intent(inout) :: self
-        integer :: k
-        self%breaks = distinct_knots(self%knots)
-        allocate (self%spans(size(self%breaks) - 1))
-        do k = 1, size(self%spans)
-            self%spans(k) = find_span(self%knots, self%degree, 0.5_dp*(self%breaks(k) + self%breaks(k + 1)))
-        end do
+        call direction_spans(self%knots, self%degree, self%breaks, self%spans)
+        if (self%npar > 1) call direction_spans(self%knots_eta, self%degree_eta, self%breaks_eta, self%spans_eta)
     end subroutine set_spans
+
+    pure subroutine direction_spans(knots, degree, breaks, spans)
+        real(dp), intent(in) :: knots(:)
+        integer, intent(in) :: degree
+        real(dp), allocatable, intent(out) :: breaks(:)
+        integer, allocatable, intent(out) :: spans(:)
+        integer :: k
+        breaks = distinct_knots(knots)
+        allocate (spans(size(breaks) - 1))
+        do k = 1, size(spans)
+            spans(k) = find_span(knots, degree, 0.5_dp*(breaks(k) + breaks(k + 1)))
+        end do
+    end subroutine direction_spans
+
+    !> Elements of the boundary: along the edge, or cells of the face (xi fastest).
+    pure integer function n_elements(self)
+        type(contact_surface_t), intent(in) :: self
+        n_elements = size(self%spans)
+        if (self%npar > 1) n_elements = n_elements*size(self%spans_eta)
+    end function n_elements
+
+    !> Nonzero functions on a face at (`xi`, `eta`) in the cell of spans `s`:
+    !> values `r` and first derivatives `dr` (by xi), `drb` (by eta) [(p + 1)(q + 1),
+    !> xi fastest]; configuration-independent, like `surface_basis`.
+    pure subroutine face_basis(self, xi, eta, s, r, dr, drb)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: xi, eta
+        integer, intent(in) :: s(2)
+        real(dp), intent(out) :: r(:), dr(:), drb(:)
+        real(dp) :: bu(2, self%degree + 1), bv(2, self%degree_eta + 1)
+        real(dp) :: b(size(r)), db(2, size(r)), d2b(0, size(r)), rd(2, size(r)), r2(0, size(r))
+        integer :: i, j, k, p, q
+        p = self%degree
+        q = self%degree_eta
+        call basis_ders_at(self%knots, p, s(1), xi, 1, bu)
+        call basis_ders_at(self%knots_eta, q, s(2), eta, 1, bv)
+        do j = 1, q + 1
+            do i = 1, p + 1
+                k = i + (j - 1)*(p + 1)
+                b(k) = bu(1, i)*bv(1, j)
+                db(1, k) = bu(2, i)*bv(1, j)
+                db(2, k) = bu(1, i)*bv(2, j)
+            end do
+        end do
+        call rationalize(self%w(face_ids(self, s)), b, db, d2b, r, rd, r2)
+        dr = rd(1, :)
+        drb = rd(2, :)
+    end subroutine face_basis
+
+    !> Positions in the surface's arrays of the functions of the face cell with
+    !> spans `s` [(p + 1)(q + 1), xi fastest].
+    pure function face_ids(self, s) result(ids)
+        type(contact_surface_t), intent(in) :: self
+        integer, intent(in) :: s(2)
+        integer :: ids((self%degree + 1)*(self%degree_eta + 1))
+        integer :: i, j, p, q
+        p = self%degree
+        q = self%degree_eta
+        do j = 1, q + 1
+            do i = 1, p + 1
+                ids(i + (j - 1)*(p + 1)) = s(1) - p + i - 1 + (s(2) - q + j - 2)*self%n_xi
+            end do
+        end do
+    end function face_ids
+
+    !> The face at (`xi`, `eta`) in the cell of spans `s` with displacements `u`,
+    !> from its functions there (`face_basis`).
+    pure subroutine face_point_at(self, u, xi, eta, s, r, dr, drb, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi, eta
+        integer, intent(in) :: s(2)
+        real(dp), intent(in) :: r(:), dr(:), drb(:)
+        type(surface_point_t), intent(inout) :: pt
+        call reuse_point(pt, size(r), size(self%dofs, 1), .true.)
+        pt%r = r
+        pt%dr = dr
+        pt%d2r = 0.0_dp
+        pt%drb = drb
+        pt%local = face_ids(self, s)
+        pt%eta = eta
+        call place_functions(self, u, xi, pt)
+    end subroutine face_point_at
 
     !> The nonzero functions of the curve at `xi` in knot span `span` (0: found from
     !> xi): values `r`, first and second derivatives `dr`, `d2r` [p + 1], and the span
@@ -150,7 +257,7 @@ contains
         integer :: forced, s
         forced = 0
         if (present(span)) forced = span
-        call reuse_point(pt, self%degree + 1)
+        call reuse_point(pt, self%degree + 1, size(self%dofs, 1), .false.)
         call surface_basis(self, xi, forced, pt%r, pt%dr, pt%d2r, s)
         call place_point(self, u, xi, s, pt)
     end subroutine surface_point
@@ -163,7 +270,7 @@ contains
         integer, intent(in) :: s
         real(dp), intent(in) :: r(:), dr(:), d2r(:)
         type(surface_point_t), intent(inout) :: pt
-        call reuse_point(pt, self%degree + 1)
+        call reuse_point(pt, self%degree + 1, size(self%dofs, 1), .false.)
         pt%r = r
         pt%dr = dr
         pt%d2r = d2r
@@ -176,35 +283,53 @@ contains
         real(dp), intent(in) :: u(:), xi
         integer, intent(in) :: s
         type(surface_point_t), intent(inout) :: pt
-        real(dp) :: x(2)
-        integer :: p, k, id
+        integer :: p, k
         p = self%degree
+        do k = 1, p + 1
+            pt%local(k) = s - p + k - 1
+        end do
+        call place_functions(self, u, xi, pt)
+    end subroutine place_point
+
+    !> The point, its derivatives and DOFs from the functions in `pt` and their
+    !> positions `pt%local`.
+    pure subroutine place_functions(self, u, xi, pt)
+        type(contact_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xi
+        type(surface_point_t), intent(inout) :: pt
+        real(dp) :: x
+        integer :: k, id, c, nsd
+        nsd = size(self%dofs, 1)
         pt%xi = xi
         pt%x = 0.0_dp
         pt%a = 0.0_dp
         pt%a2 = 0.0_dp
-        do k = 1, p + 1
-            id = s - p + k - 1
-            pt%local(k) = id
-            pt%dofs(2*k - 1) = self%dofs(1, id)
-            pt%dofs(2*k) = self%dofs(2, id)
-            x(1) = self%x0(1, id) + u(self%dofs(1, id))
-            x(2) = self%x0(2, id) + u(self%dofs(2, id))
-            pt%x = pt%x + pt%r(k)*x
-            pt%a = pt%a + pt%dr(k)*x
-            pt%a2 = pt%a2 + pt%d2r(k)*x
+        pt%b = 0.0_dp
+        do k = 1, size(pt%local)
+            id = pt%local(k)
+            do c = 1, nsd
+                pt%dofs(nsd*(k - 1) + c) = self%dofs(c, id)
+                x = self%x0(c, id) + u(self%dofs(c, id))
+                pt%x(c) = pt%x(c) + pt%r(k)*x
+                pt%a(c) = pt%a(c) + pt%dr(k)*x
+                pt%a2(c) = pt%a2(c) + pt%d2r(k)*x
+                if (self%npar > 1) pt%b(c) = pt%b(c) + pt%drb(k)*x
+            end do
         end do
-    end subroutine place_point
+    end subroutine place_functions
 
     !> `pt`'s arrays for `n` functions, kept when they have that size.
-    pure subroutine reuse_point(pt, n)
+    pure subroutine reuse_point(pt, n, nsd, face)
         type(surface_point_t), intent(inout) :: pt
-        integer, intent(in) :: n
+        !> Functions, DOFs per control point, and whether `drb` is needed (a face).
+        integer, intent(in) :: n, nsd
+        logical, intent(in) :: face
         call reuse(pt%r, n)
         call reuse(pt%dr, n)
         call reuse(pt%d2r, n)
+        call reuse(pt%drb, merge(n, 0, face))
         call reuse_int(pt%local, n)
-        call reuse_int(pt%dofs, 2*n)
+        call reuse_int(pt%dofs, nsd*n)
     contains
         pure subroutine reuse(a, n)
             real(dp), allocatable, intent(inout) :: a(:)
@@ -227,20 +352,55 @@ contains
         end subroutine reuse_int
     end subroutine reuse_point
 
-    !> The reference length of every element of the edge, as the chord between its
-    !> ends; shape: [elements along the edge].
+    !> The reference size of every element of the boundary: on an edge the chord
+    !> between its ends, on a face the shorter of the chords across the cell's
+    !> middle; shape: [n_elements].
     pure function element_lengths(self) result(h)
         type(contact_surface_t), intent(in) :: self
         real(dp), allocatable :: h(:), u0(:)
         type(surface_point_t) :: pa, pb
-        integer :: e
-        allocate (h(size(self%spans)), u0(maxval(self%dofs)))
+        integer :: e, i, j, ni
+        allocate (h(n_elements(self)), u0(maxval(self%dofs)))
         u0 = 0.0_dp
+        if (self%npar > 1) then
+            ni = size(self%spans)
+            do e = 1, size(h)
+                i = modulo(e - 1, ni) + 1
+                j = (e - 1)/ni + 1
+                h(e) = min(face_chord(i, j, 1), face_chord(i, j, 2))
+            end do
+            return
+        end if
         do e = 1, size(self%spans)
             call surface_point(self, u0, self%breaks(e), pa, self%spans(e))
             call surface_point(self, u0, self%breaks(e + 1), pb, self%spans(e))
             h(e) = norm2(pb%x - pa%x)
         end do
+    contains
+        !> The chord of cell (i, j) across its middle along direction d.
+        pure real(dp) function face_chord(i, j, d) result(c)
+            integer, intent(in) :: i, j, d
+            real(dp) :: ends(2, 2), mid(2)
+            real(dp) :: r((self%degree + 1)*(self%degree_eta + 1)), dr(size(r)), drb(size(r))
+            type(surface_point_t) :: pa, pb
+            integer :: s(2)
+            s = [self%spans(i), self%spans_eta(j)]
+            ends(:, 1) = self%breaks(i:i + 1)
+            ends(:, 2) = self%breaks_eta(j:j + 1)
+            mid = 0.5_dp*(ends(1, :) + ends(2, :))
+            if (d == 1) then
+                call face_basis(self, ends(1, 1), mid(2), s, r, dr, drb)
+                call face_point_at(self, u0, ends(1, 1), mid(2), s, r, dr, drb, pa)
+                call face_basis(self, ends(2, 1), mid(2), s, r, dr, drb)
+                call face_point_at(self, u0, ends(2, 1), mid(2), s, r, dr, drb, pb)
+            else
+                call face_basis(self, mid(1), ends(1, 2), s, r, dr, drb)
+                call face_point_at(self, u0, mid(1), ends(1, 2), s, r, dr, drb, pa)
+                call face_basis(self, mid(1), ends(2, 2), s, r, dr, drb)
+                call face_point_at(self, u0, mid(1), ends(2, 2), s, r, dr, drb, pb)
+            end if
+            c = norm2(pb%x - pa%x)
+        end function face_chord
     end function element_lengths
 
 end module voiga_contact_surface

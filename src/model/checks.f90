@@ -19,7 +19,7 @@ module voiga_model_checks
     use voiga_model, only: model_t
     use voiga_discretization_patch, only: contact_name
     use voiga_contact_pair, only: contact_pair_t
-    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, chord_lengths => element_lengths
     use voiga_contact_master, only: master_point_t
     use voiga_contact_master_nurbs, only: nurbs_master_t, outward_sign
     use voiga_contact_master_rigid, only: rigid_line_t
@@ -93,6 +93,11 @@ contains
         real(dp) :: gx(6), gw(6), u(maxval(surf%dofs))
         type(surface_point_t) :: pt
         integer :: e, i
+        ! a face's cells: their size as the contact surface measures it (chords)
+        if (surf%npar > 1) then
+            h = chord_lengths(surf)
+            return
+        end if
         call gauss_legendre(6, gx, gw)
         u = 0.0_dp
         allocate (h(size(surf%spans)), source=0.0_dp)
@@ -121,11 +126,16 @@ contains
         end do
     end function depth_ratios
 
-    !> "(x, y)"
+    !> "(x, y)" or "(x, y, z)"
     pure function point_str(x) result(text)
-        real(dp), intent(in) :: x(2)
+        real(dp), intent(in) :: x(:)
         character(len=:), allocatable :: text
-        text = '('//trim(adjustl(real_str(x(1), 'es11.4')))//', '//trim(adjustl(real_str(x(2), 'es11.4')))//')'
+        integer :: i
+        text = '('//trim(adjustl(real_str(x(1), 'es11.4')))
+        do i = 2, size(x)
+            text = text//', '//trim(adjustl(real_str(x(i), 'es11.4')))
+        end do
+        text = text//')'
     end function point_str
 
     !> The checks of the reference configuration, from each pair's evaluation there
@@ -186,7 +196,7 @@ contains
         list = [list, warning_t(pair_label(pair)//'the bodies overlap at the start: '//str(n)//' of '// &
                                 str(size(depth))//' slave points lie inside the master, the deepest by '// &
                                 trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
-                                point_str(pair%out(k)%x0)//' ('//trim(adjustl(real_str(depth(k), 'f6.2')))// &
+                                point_str(pair%out(k)%x0(1:pair%nsd))//' ('//trim(adjustl(real_str(depth(k), 'f6.2')))// &
                                 ' slave elements). If the bodies do not overlap, '//wrong_way(pair), &
                                 topic=pair_label(pair)//'the bodies overlap at the start')]
     end subroutine overlap_warning
@@ -197,7 +207,7 @@ contains
         character(len=:), allocatable :: text
         select type (m => pair%master)
         type is (rigid_line_t)
-            text = 'rigid_normal = '//vector_str(m%n)//' points into the slave (the obstacle lies on the '// &
+            text = 'rigid_normal = '//vector_str(m%n(1:m%nsd))//' points into the slave (the obstacle lies on the '// &
                    'side rigid_normal points away from): check rigid_normal and rigid_point'
         class is (rigid_curve_t)
             text = "the rigid curve '"//trim(m%name)//"' is the wrong way round (the obstacle lies on the "// &
@@ -230,7 +240,7 @@ contains
                                  str(n)//' of the '//str(found)//' slave points that face it, '// &
                                  str(nint(100.0_dp*share))//' % of their length; the deepest by '// &
                                  trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
-                                 point_str(pair%out(k)%x0)//'): '//overlap_remedy(model, pair, found)// &
+                                 point_str(pair%out(k)%x0(1:pair%nsd))//'): '//overlap_remedy(model, pair, found)// &
                                  '. If the bodies are meant to start overlapping, run with --allow-overlap '// &
                                  '(or allow_overlap = .true. in this &contact)', error_code%input)
                 return
@@ -261,11 +271,11 @@ contains
             if (behind > 0) then
                 text = 'the line through rigid_point = '//vector_str(m%p_ref)//' cuts through the slave body ('// &
                        str(behind)//' of the '//str(found)//' points lie on the side rigid_normal = '// &
-                       vector_str(m%n)//' points to): move rigid_point (the obstacle lies on the side '// &
+                       vector_str(m%n(1:m%nsd))//' points to): move rigid_point (the obstacle lies on the side '// &
                        'rigid_normal points away from)'
             else
-                text = 'rigid_normal = '//vector_str(m%n)//' points into the slave (the obstacle lies on the '// &
-                       'side rigid_normal points away from): give rigid_normal = '//vector_str(-m%n, .false.)
+                text = 'rigid_normal = '//vector_str(m%n(1:m%nsd))//' points into the slave (the obstacle lies on the '// &
+                       'side rigid_normal points away from): give rigid_normal = '//vector_str(-m%n(1:m%nsd), .false.)
             end if
         class is (rigid_curve_t)
             if (behind > 0) then
@@ -288,10 +298,14 @@ contains
     !> A vector as a case file takes it: "(a, b)", or "a, b" without `brackets`
     !> (`short_str`: '0.0, -1.0').
     pure function vector_str(x, brackets) result(text)
-        real(dp), intent(in) :: x(2)
+        real(dp), intent(in) :: x(:)
         logical, intent(in), optional :: brackets
         character(len=:), allocatable :: text
-        text = short_str(x(1))//', '//short_str(x(2))
+        integer :: i
+        text = short_str(x(1))
+        do i = 2, size(x)
+            text = text//', '//short_str(x(i))
+        end do
         if (present(brackets)) then
             if (.not. brackets) return
         end if
@@ -312,18 +326,21 @@ contains
         real(dp) :: ns(2), s
         integer :: k
         logical :: found, converged
+        ! (an edge's outward normal; a face's is not checked yet)
+        if (pair%slave%npar > 1) return
         gap = pair%out%gap
         where (gap < 0.0_dp) gap = huge(1.0_dp)
         if (all(gap > 1.0e300_dp)) return
         k = minloc(gap, dim=1)
         allocate (u(model%ndof), source=0.0_dp)
         call surface_point(pair%slave, u, pair%xi(k), sp, pair%span(k))
-        call pair%master%project(u, sp%x, mp, found, converged)
+        call pair%master%project(u, sp%x(1:2), mp, found, converged)
         if (.not. found) return
         s = outward_sign(model%bodies(pair%slave_body)%disc)
-        ns = s*[sp%a(2), -sp%a(1)]/norm2(sp%a)
-        if (dot_product(ns, mp%n) <= 0.0_dp) return
-        list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '//point_str(sp%x)// &
+        ns = s*[sp%a(2), -sp%a(1)]/norm2(sp%a(1:2))
+        if (dot_product(ns, mp%n(1:2)) <= 0.0_dp) return
+        list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '// &
+                                point_str(sp%x(1:2))// &
                                 ", faces away from it: the slave's contact_edge = '"// &
                                 contact_name(model%bodies(pair%slave_body)%disc)// &
                                 "' is on the side of its body away from the master; choose the edge that faces it"// &
@@ -337,7 +354,7 @@ contains
         character(len=:), allocatable :: text
         select type (m => pair%master)
         type is (rigid_line_t)
-            text = ', or rigid_normal = '//vector_str(m%n)//' points the wrong way (it points out of the '// &
+            text = ', or rigid_normal = '//vector_str(m%n(1:m%nsd))//' points the wrong way (it points out of the '// &
                    'obstacle, towards the slave)'
         class is (rigid_curve_t)
             text = ", or the rigid curve '"//trim(m%name)//"' is the wrong way round (its side)"
@@ -399,7 +416,7 @@ contains
                 k = maxloc(ratio, dim=1)
                 list = [list, warning_t(pair_label(pair)//'step '//str(step)//': a penetration of '// &
                                         trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
-                                        point_str(pair%out(k)%x)//' is '// &
+                                        point_str(pair%out(k)%x(1:pair%nsd))//' is '// &
                                         trim(adjustl(real_str(ratio(k), 'f6.2')))//' of its slave element '// &
                                         '(more than '//trim(adjustl(real_str(deep_fraction, 'f6.2')))// &
                                         '): the penalty is too soft for this load; raise penalty_normal', &

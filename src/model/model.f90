@@ -9,7 +9,7 @@ module voiga_model
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
                                  obstacle_motion_t, phase_friction_t, phase_of
     use voiga_contact_pair, only: pair_slot_t
-    use voiga_contact_factory, only: contact_settings_t, new_contact_pair
+    use voiga_contact_factory, only: contact_settings_t, new_contact_pair, rigid_normal_of
     use voiga_contact_surface, only: contact_surface_t, new_contact_surface
     use voiga_contact_master, only: contact_master_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
@@ -178,7 +178,7 @@ contains
             curve%name = inp%rigid_curve
             allocate (master, source=curve)
         else if (trim(inp%master) == 'rigid') then
-            call new_rigid_line(rigid, inp%rigid_point, inp%rigid_normal)
+            call new_rigid_line(rigid, inp%rigid_point(1:self%nsd), rigid_normal_of(inp, self%nsd))
             allocate (master, source=rigid)
         else
             im = find_body(self, inp%master)
@@ -238,7 +238,7 @@ contains
     pure subroutine set_contact_time(model, t)
         type(model_t), intent(inout) :: model
         real(dp), intent(in) :: t
-        integer :: k
+        integer :: k, c
         do k = 1, size(model%frictions)
             associate (f => model%frictions(k))
                 call model%pairs(f%pair)%pair%set_friction(f%values(phase_of(t, size(f%values))))
@@ -246,8 +246,8 @@ contains
         end do
         do k = 1, size(model%motions)
             associate (m => model%motions(k))
-                call model%pairs(m%pair)%pair%move_master([phase_value(m%values(1, :), t), &
-                                                            phase_value(m%values(2, :), t)])
+                call model%pairs(m%pair)%pair%move_master([(phase_value(m%values(c, :), t), &
+                                                             c=1, model%nsd)])
             end associate
         end do
     end subroutine set_contact_time

@@ -14,6 +14,9 @@ module voiga_io_input_bodies
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_size, only: body_size_t, body_size
     use voiga_discretization_layout, only: validate_layout
+    use voiga_contact_factory, only: contact_settings_t
+    use voiga_text, only: str
+    use voiga_kinds, only: dp
     implicit none
     private
 
@@ -66,8 +69,8 @@ contains
         end do
     end subroutine discretize_bodies
 
-    !> The bodies of a case are all plane or all solid; a solid model has no contact
-    !> yet (issues 42 and 41: docs/formats.md, "Solids").
+    !> The bodies of a case are all plane or all solid, and its `&contact` groups fit
+    !> that dimension (`check_contact_dimension`).
     subroutine check_dimensions(case, coarse, error)
         type(case_t), intent(in) :: case
         type(coarse_body_t), intent(in) :: coarse(:)
@@ -83,13 +86,43 @@ contains
             end if
         end do
         if (size(coarse) == 0) return
-        if (coarse(1)%patch%pdim /= 3) return
-        if (size(case%contact) > 0) then
-            call fatal_error(error, case%path//': &contact: contact between solids (volumes) is not '// &
-                             'implemented yet; a solid case has bodies, loads and no &contact (docs/formats.md, '// &
-                             '"Solids")', error_code%input)
-        end if
+        do i = 1, size(case%contact)
+            call check_contact_dimension(case%contact(i), coarse(1)%patch%pdim, &
+                                         case%path//': &contact ('//str(i)//'): ', error)
+            if (allocated(error)) return
+        end do
     end subroutine check_dimensions
+
+    !> A rigid master's point and normal have `nsd` components (or none given: the
+    !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
+    !> solids contact is, so far, frictionless GPTS against a rigid plane (issue 42:
+    !> the rest is refused here, naming what is missing).
+    subroutine check_contact_dimension(c, nsd, where, error)
+        type(contact_settings_t), intent(in) :: c
+        integer, intent(in) :: nsd
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: what
+        if (all(c%point_components /= [0, nsd])) then
+            what = 'rigid_point needs '//str(nsd)//' components'
+        else if (all(c%normal_components /= [0, nsd])) then
+            what = 'rigid_normal needs '//str(nsd)//' components'
+        else if (nsd == 2 .and. c%motion_z) then
+            what = 'rigid_uz moves a rigid master along z: a plane case has no z'
+        end if
+        if (nsd == 3 .and. .not. allocated(what)) then
+            if (trim(c%master) /= 'rigid' .or. len_trim(c%rigid_curve) > 0) then
+                what = 'contact of a solid with another solid or a rigid surface of the geometry file is not '// &
+                       'implemented yet (issue 42); a solid can touch a rigid plane (master = ''rigid'', '// &
+                       'rigid_point, rigid_normal)'
+            else if (trim(c%method) /= 'gpts') then
+                what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use 'gpts'"
+            else if (c%friction > 0.0_dp) then
+                what = 'friction between solids is not implemented yet (issue 42); use friction = 0'
+            end if
+        end if
+        if (allocated(what)) call fatal_error(error, where//what, error_code%input)
+    end subroutine check_contact_dimension
 
     !> 'a plane body' or 'a solid'.
     pure function kind_of(pdim) result(words)

@@ -347,6 +347,7 @@ contains
         class(contact_pair_t), intent(in) :: pair
         !> The spatial dimension (the points' positions have `nsd` components).
         integer, intent(in) :: nsd
+        integer :: i
         call h5%create_group(c)
         call h5%write_attr(c, 'slave', trim(pair%slave_name))
         call h5%write_attr(c, 'master', trim(pair%master_name))
@@ -355,9 +356,14 @@ contains
         call h5%write_attr(c, 'friction', pair%law%mu)
         call h5%write_attr(c, 'method', pair%method_name())
         call write_master(h5, c, pair%master%output())
-        call h5%write(c//'/force', pair%force)
+        call h5%write(c//'/force', pair%force(1:nsd))
         call write_points(h5, c, pair%out, nsd)
-        call h5%write(c//'/xi_slave', pair%xi)
+        if (allocated(pair%eta)) then
+            ! a face: (xi, eta) per point, [2, n] (h5py: (n, 2))
+            call h5%write(c//'/xi_slave', reshape([(pair%xi(i), pair%eta(i), i=1, size(pair%xi))], [2, size(pair%xi)]))
+        else
+            call h5%write(c//'/xi_slave', pair%xi)
+        end if
         ! committed friction history: what a restart needs
         call write_history(h5, c//'/history/', pair%history())
     end subroutine write_contact
@@ -395,7 +401,12 @@ contains
         call h5%write(c//'/p_n_nominal', [out%pn0])
         call h5%write(c//'/p_t_nominal', [out%pt0])
         call h5%write(c//'/stretch', [out%stretch])
-        call h5%write(c//'/xi_master', [out%xi_m])
+        call h5%write(c//'/area_ref', [out%area0])
+        if (nsd == 3) then
+            call h5%write(c//'/xi_master', reshape([(out(i)%xi_m, out(i)%eta_m, i=1, size(out))], [2, size(out)]))
+        else
+            call h5%write(c//'/xi_master', [out%xi_m])
+        end if
         call h5%write(c//'/state', [out%state])
     end subroutine write_points
 

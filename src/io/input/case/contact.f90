@@ -29,18 +29,18 @@ contains
         ! one character more than kept: a longer value is refused, not cut
         character(len=33) :: slave, master, rigid_curve
         character(len=17) :: method
-        real(dp) :: rigid_point(2), rigid_normal(2), penalty_normal, penalty_tangent, tolerance
-        real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases), friction(max_phases)
+        real(dp) :: rigid_point(3), rigid_normal(3), penalty_normal, penalty_tangent, tolerance
+        real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases), rigid_uz(max_phases), friction(max_phases)
         integer :: n_gauss, ios
         logical :: allow_overlap
         character(len=512) :: msg
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy, allow_overlap
+            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy, rigid_uz, allow_overlap
 
         slave = ''
         master = ''
-        rigid_point = 0.0_dp
-        rigid_normal = [0.0_dp, 1.0_dp]
+        rigid_point = unset()
+        rigid_normal = unset()
         penalty_normal = unset()
         penalty_tangent = unset()
         friction = unset()
@@ -50,6 +50,7 @@ contains
         rigid_curve = ''
         rigid_ux = unset()
         rigid_uy = unset()
+        rigid_uz = unset()
         allow_overlap = .false.
         read (text, nml=contact, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -62,11 +63,16 @@ contains
         call check_length(rigid_curve, 32, 'rigid_curve', path//trim(msg)//' ', error)
         call check_length(method, 16, 'method', path//trim(msg)//' ', error)
         if (allocated(error)) return
-        entry = contact_settings_t(slave=slave, master=master, rigid_point=rigid_point, rigid_normal=rigid_normal, &
-                                   rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
+        entry = contact_settings_t(slave=slave, master=master, rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
                                    penalty_tangent=penalty_tangent, n_gauss=n_gauss, &
                                    method=method, tolerance=tolerance, allow_overlap=allow_overlap)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
+        call take_vector(rigid_point, 'rigid_point', path//trim(msg)//' ', entry%rigid_point, &
+                         entry%point_components, error)
+        if (allocated(error)) return
+        call take_vector(rigid_normal, 'rigid_normal', path//trim(msg)//' ', entry%rigid_normal, &
+                         entry%normal_components, error)
+        if (allocated(error)) return
         call take_friction(friction, nph, path//trim(msg)//' ', entry, error)
         if (allocated(error)) return
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
@@ -80,7 +86,7 @@ contains
         if (is_unset(entry%penalty_normal)) entry%penalty_normal = automatic
         if (is_unset(entry%penalty_tangent)) entry%penalty_tangent = entry%penalty_normal
         if (is_unset(entry%tolerance)) entry%tolerance = automatic
-        call rigid_motion(entry, rigid_ux, rigid_uy, nph, path//trim(msg)//' ', error)
+        call rigid_motion(entry, rigid_ux, rigid_uy, rigid_uz, nph, path//trim(msg)//' ', error)
     contains
         subroutine try_contact(text, ios, msg)
             character(len=*), intent(in) :: text
@@ -170,23 +176,48 @@ contains
 
     !> The rigid master's translation per phase (`rigid_ux`, `rigid_uy`; only for a
     !> rigid master; none given: fixed).
-    subroutine rigid_motion(c, ux, uy, nph, where, error)
+    subroutine rigid_motion(c, ux, uy, uz, nph, where, error)
         type(contact_settings_t), intent(inout) :: c
-        real(dp), intent(in) :: ux(:), uy(:)
+        real(dp), intent(in) :: ux(:), uy(:), uz(:)
         integer, intent(in) :: nph
         character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: error
-        if (all(is_unset(ux)) .and. all(is_unset(uy))) return
+        if (all(is_unset(ux)) .and. all(is_unset(uy)) .and. all(is_unset(uz))) return
         if (trim(c%master) /= 'rigid') then
-            call fatal_error(error, where//"rigid_ux and rigid_uy move a rigid master: master = '"// &
+            call fatal_error(error, where//"rigid_ux, rigid_uy and rigid_uz move a rigid master: master = '"// &
                              trim(c%master)//"' is a body (move it by its &dirichlet)", error_code%input)
             return
         end if
-        allocate (c%rigid_motion(2, nph))
+        allocate (c%rigid_motion(3, nph))
         call phase_values(ux, .true., 'rigid_ux', where, nph, c%rigid_motion(1, :), error)
         if (allocated(error)) return
         call phase_values(uy, .true., 'rigid_uy', where, nph, c%rigid_motion(2, :), error)
+        if (allocated(error)) return
+        call phase_values(uz, .true., 'rigid_uz', where, nph, c%rigid_motion(3, :), error)
+        c%motion_z = .not. all(is_unset(uz))
     end subroutine rigid_motion
+
+    !> A rigid master's point or normal as the case gave it (`raw`, unset components
+    !> not given): the leading components given, kept in `v` over its default, and
+    !> their number `n` (checked against the dimension once the bodies are read:
+    !> `voiga_io_input_bodies`). A gap (a component given after one that is not) is
+    !> refused.
+    subroutine take_vector(raw, name, where, v, n, error)
+        real(dp), intent(in) :: raw(3)
+        character(len=*), intent(in) :: name, where
+        real(dp), intent(inout) :: v(3)
+        integer, intent(out) :: n
+        type(error_t), allocatable, intent(out) :: error
+        n = count(.not. is_unset(raw))
+        if (any(is_unset(raw(1:n)))) then
+            call fatal_error(error, where//name//' needs its leading components (x, y, and z in a solid case)', &
+                             error_code%input)
+            return
+        end if
+        if (n == 0) return
+        v = 0.0_dp
+        v(1:n) = raw(1:n)
+    end subroutine take_vector
 
     !> Penalties, friction, points and method in range.
     subroutine check_law(c, bodies, where, error)

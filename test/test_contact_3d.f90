@@ -1,0 +1,131 @@
+!> Contact on a solid's face (issue 42, the first step: frictionless GPTS against a
+!> rigid plane): the contact tangent of a curved face (a cylinder, with and without
+!> a VO layer) against finite differences, and the pair's geometry (reference area
+!> of the points, the plane's frame).
+module test_contact_3d
+    use voiga_kinds, only: dp
+    use voiga_error, only: error_t
+    use voiga_testdrive, only: unittest_t, new_unittest, check
+    use voiga_discretization_patch, only: discretization_t, new_discretization
+    use voiga_discretization_layout, only: layout_t
+    use voiga_contact_factory, only: contact_settings_t
+    use voiga_contact_law, only: state_stick
+    use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
+    use voiga_model, only: model_t
+    use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
+    use test_contact, only: contact_fd
+    use voiga_text, only: str
+    implicit none
+    private
+
+    public :: collect_contact_3d
+
+    !> The quarter ring's faces (`ring_block`): r = 1, r = 2, theta = 0, theta = 90 deg,
+    !> z = 0, z = 1.
+    character(len=32), parameter :: faces(6) = [character(len=32) :: 'inner', 'outer', 'start', 'end', &
+                                                 'bottom', 'top']
+
+contains
+
+    subroutine collect_contact_3d(testsuite)
+        type(unittest_t), allocatable, intent(out) :: testsuite(:)
+        testsuite = [ &
+                    new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
+                    new_unittest('contact_3d_face_area', test_face_area), &
+                    new_unittest('rigid_plane_frame', test_plane_frame) &
+                    ]
+    end subroutine collect_contact_3d
+
+    !> The quarter ring (E = 1) whose outer cylinder r = 2 is the slave face, against
+    !> the tilted plane through (1.9, 0, 0.5) whose obstacle lies beyond it (outward
+    !> normal towards the ring): the cylinder's points near theta = 0 penetrate.
+    subroutine ring_on_plane(layout, model, error)
+        type(layout_t), intent(in) :: layout
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_t) :: c
+        type(discretization_t) :: discs(1)
+        type(contact_settings_t) :: contact
+        c%bodies = [body_settings('ring', 'linear', 1.0_dp, layout)]
+        contact%slave = 'ring'
+        contact%master = 'rigid'
+        contact%method = 'gpts'
+        contact%rigid_point = [1.9_dp, 0.0_dp, 0.5_dp]
+        contact%rigid_normal = [-1.0_dp, -0.2_dp, 0.1_dp]
+        contact%point_components = 3
+        contact%normal_components = 3
+        c%contact = [contact]
+        call new_discretization(discs(1), ring_block(), faces, layout, '', error)
+        if (allocated(error)) return
+        call scene_model(c, discs, model, error)
+    end subroutine ring_on_plane
+
+    !> K of the pair against central differences of its residual at a perturbed
+    !> state (every DOF moved by up to 1e-3): the normal penalty, the area element of
+    !> the slave's face and its rotation; N2, a layer of degree 3 (NN3) and NN3.1,
+    !> with 2 and 3 Gauss points per direction.
+    subroutine test_tangent_fd(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(layout_t) :: layouts(3)
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:)
+        integer :: il, j
+        layouts = [layout3(2, [2, 3, 2], 0, 0, 'outer'), layout3(2, [1, 2, 2], 3, 0, 'outer'), &
+                   layout3(2, [1, 2, 1], 3, 1, 'outer')]
+        do il = 1, size(layouts)
+            call ring_on_plane(layouts(il), model, error)
+            if (allocated(error)) return
+            allocate (u(model%ndof))
+            do j = 1, size(u)
+                u(j) = 1.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+            end do
+            call contact_fd(model%pairs(1)%pair, u, state_stick, 'ring layout '//char(48 + il), error)
+            if (allocated(error)) return
+            deallocate (u)
+        end do
+    end subroutine test_tangent_fd
+
+    !> The points' reference areas add up to the face's: the quarter cylinder r = 2,
+    !> z in [0, 1], pi (its rational map integrated to the quadrature's accuracy).
+    subroutine test_face_area(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        call ring_on_plane(layout3(2, [1, 4, 2], 3, 0, 'outer'), model, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1)%pair)
+            call check(error, sum(pair%out%area0), acos(-1.0_dp), 'reference area of the slave face', &
+                       rel=1.0e-5_dp)
+            if (allocated(error)) return
+            ! layer degree 3: q + 1 = 4 points per direction and cell; the face's cells
+            ! are nel_xi x nel_eta = 1 x 4 (a layout counts along the patch turned so
+            ! that the contact face is zeta = 1)
+            call check(error, pair%nsd == 3 .and. size(pair%xi) == 4*16, "4 x 4 points on each of 4 cells, got "// &
+                       str(size(pair%xi)))
+        end associate
+    end subroutine test_face_area
+
+    !> The plane's frame: t, t2, n orthonormal and right-handed (t x t2 = n, as a
+    !> surface's a1 x a2 is its outward normal), for normals along and off the axes.
+    subroutine test_plane_frame(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(rigid_line_t) :: m
+        real(dp) :: normals(3, 4), f(3, 3), c(3)
+        integer :: i
+        normals = reshape([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, &
+                           -1.0_dp, -0.2_dp, 0.1_dp], [3, 4])
+        do i = 1, 4
+            call new_rigid_line(m, [0.0_dp, 0.0_dp, 0.0_dp], normals(:, i))
+            f(:, 1) = m%t
+            f(:, 2) = m%t2
+            f(:, 3) = m%n
+            call check(error, maxval(abs(matmul(transpose(f), f) - reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
+                       1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3]))) < 1.0e-14_dp, 'orthonormal frame')
+            if (allocated(error)) return
+            c = [m%t(2)*m%t2(3) - m%t(3)*m%t2(2), m%t(3)*m%t2(1) - m%t(1)*m%t2(3), m%t(1)*m%t2(2) - m%t(2)*m%t2(1)]
+            call check(error, maxval(abs(c - m%n)) < 1.0e-14_dp, 't x t2 = n')
+            if (allocated(error)) return
+        end do
+    end subroutine test_plane_frame
+
+end module test_contact_3d
