@@ -38,8 +38,8 @@ contains
             ng = rng(2) - rng(1) + 1
             if (ng <= 0) cycle
             associate (pts => self%out(rng(1):rng(2)))
-                h = norm2(maxval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2) - &
-                          minval(reshape([(pts(k)%x, k=1, ng)], [2, ng]), dim=2))
+                h = norm2(maxval(reshape([(pts(k)%x(1:self%nsd), k=1, ng)], [self%nsd, ng]), dim=2) - &
+                          minval(reshape([(pts(k)%x(1:self%nsd), k=1, ng)], [self%nsd, ng]), dim=2))
                 do k = 1, ng
                     if (pts(k)%first > pts(k)%last .or. pts(k)%gap >= h) cycle
                     w = pts(k)%last - pts(k)%first

@@ -259,15 +259,15 @@ contains
         do j = 1, nb
             if (j > 1) call surface_point(surf, u, surf%breaks(j), left, surf%spans(j - 1))
             if (j < nb) call surface_point(surf, u, surf%breaks(j), right, surf%spans(j))
-            if (j > 1) lines = reshape([lines, left%x, left%a, surf%breaks(j)], [5, size(lines, 2) + 1])
+            if (j > 1) lines = reshape([lines, left%x(1:2), left%a(1:2), surf%breaks(j)], [5, size(lines, 2) + 1])
             if (j == 1 .or. j == nb) then
-                if (j == 1) lines = reshape([lines, right%x, right%a, surf%breaks(j)], [5, size(lines, 2) + 1])
+                if (j == 1) lines = reshape([lines, right%x(1:2), right%a(1:2), surf%breaks(j)], [5, size(lines, 2) + 1])
                 cycle
             end if
             ! the same line unless the tangent turns at the knot
             turn = abs(left%a(1)*right%a(2) - left%a(2)*right%a(1))/(norm2(left%a)*norm2(right%a))
             if (turn > 1.0e-12_dp .or. dot_product(left%a, right%a) <= 0.0_dp) &
-                lines = reshape([lines, right%x, right%a, surf%breaks(j)], [5, size(lines, 2) + 1])
+                lines = reshape([lines, right%x(1:2), right%a(1:2), surf%breaks(j)], [5, size(lines, 2) + 1])
         end do
     end subroutine breakpoint_lines
 
