@@ -181,16 +181,18 @@ def _edge(grid: np.ndarray, sim: np.ndarray, level: float) -> float:
 
 def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     """Least-squares circle through ``points`` (n, 2) (the algebraic fit
-    x^2 + y^2 + D x + E y + F = 0): ``(centre, radius, rms distance from it)``."""
+    x^2 + y^2 + D x + E y + F = 0): ``(centre, radius, rms distance from it)``; a sphere
+    through points (n, 3) alike (``x^2 + y^2 + z^2 + D x + E y + G z + F = 0``)."""
     pts = np.asarray(points, dtype=float)
-    if len(pts) < 3:
-        raise HertzError("fewer than 3 slave points to fit a circle to")
+    if len(pts) < pts.shape[1] + 1:
+        raise HertzError(f"fewer than {pts.shape[1] + 1} slave points to fit a "
+                         f"{'circle' if pts.shape[1] == 2 else 'sphere'} to")
     design = np.column_stack([pts, np.ones(len(pts))])
     coef, *_ = np.linalg.lstsq(design, -(pts**2).sum(axis=1), rcond=None)
-    centre = -0.5 * coef[:2]
+    centre = -0.5 * coef[:-1]
     r2 = float(centre @ centre - coef[2])
     if not np.isfinite(r2) or r2 <= 0:
-        raise HertzError("the slave points near the contact do not lie on a circle")
+        raise HertzError("the slave points near the contact do not lie on a circle (sphere)")
     radius = float(np.sqrt(r2))
     rms = float(np.sqrt(np.mean((np.linalg.norm(pts - centre, axis=1) - radius) ** 2)))
     return centre, radius, rms
