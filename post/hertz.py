@@ -190,7 +190,7 @@ def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     design = np.column_stack([pts, np.ones(len(pts))])
     coef, *_ = np.linalg.lstsq(design, -(pts**2).sum(axis=1), rcond=None)
     centre = -0.5 * coef[:-1]
-    r2 = float(centre @ centre - coef[2])
+    r2 = float(centre @ centre - coef[-1])
     if not np.isfinite(r2) or r2 <= 0:
         raise HertzError("the slave points near the contact do not lie on a circle (sphere)")
     radius = float(np.sqrt(r2))
