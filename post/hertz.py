@@ -271,7 +271,7 @@ class HertzComparison:
         return Path(self.source).stem
 
 
-def _pair(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]:
+def contact_pair(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]:
     """The step and contact pair, or HertzError naming what is missing."""
     if step == 0:
         raise HertzError("step 0 is the reference configuration: no contact to compare")
@@ -358,7 +358,7 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
     """
     if configuration not in ("reference", "current"):
         raise ValueError(f"configuration must be 'reference' or 'current', not {configuration!r}")
-    st, c = _pair(result, step, pair)
+    st, c = contact_pair(result, step, pair)
     if c.rigid_point is None or c.rigid_normal is None:
         kind = "a rigid curve" if c.rigid_curve is not None else f"the body {c.master!r}"
         raise HertzError(f"{result.path}: pair {c.slave} -> {c.master} is not pressed on a rigid "

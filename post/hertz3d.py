@@ -36,7 +36,7 @@ from scipy.optimize import minimize_scalar
 from pre.files import save_figure
 
 from .field import evaluate
-from .hertz import CIRCLE_TOLERANCE, HertzError, fit_circle, fit_hertz, hertz_pressure
+from .hertz import CIRCLE_TOLERANCE, HertzError, contact_pair, fit_circle, fit_hertz, hertz_pressure
 from .naming import output_path
 from .reader import ContactOutput, Result, Step
 from .units import Units
@@ -226,17 +226,7 @@ def _contact(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]
     if result.dimension != 3:
         raise HertzError(f"{result.path}: dimension {result.dimension}; post hertz3d compares a "
                          "solid (dimension 3), post hertz a cylinder")
-    if step == 0:
-        raise HertzError("step 0 is the reference configuration: no contact to compare")
-    try:
-        st = result.select_step(step)
-    except IndexError as err:
-        raise HertzError(str(err)) from None
-    if st is None or not st.contact:
-        raise HertzError(f"{result.path}: step {st.step if st else 0} has no contact output")
-    if not -len(st.contact) <= pair < len(st.contact):
-        raise HertzError(f"{result.path}: no contact pair {pair + 1} (the file has {len(st.contact)})")
-    c = st.contact[pair]
+    st, c = contact_pair(result, step, pair)
     missing = [k for k in ("p_n_nominal", "area_ref") if getattr(c, k) is None]
     if missing:
         raise HertzError(f"{result.path}: step {st.step}, pair {pair + 1}: no {' and no '.join(missing)} "
