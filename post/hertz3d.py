@@ -324,6 +324,14 @@ MODELS = {4: "a quarter model: symmetry planes through the axis, the active poin
           1: "the whole contact"}
 
 
+def format_hertz3d(h: Hertz3dComparison) -> str:
+    """One line: P, a, p0, the L2 error and the fit (``post summary``)."""
+    shear = (f"  tau_max {h.shear.tau_max:.4f} p0 (Hertz {h.tau_hertz:.4f})" if h.shear is not None
+             else "")
+    return (f"P = {h.force:.6g} ({h.symmetry} x the pair's)  a = {h.a:.6g}  p0 = {h.p0:.6g}  "
+            f"L2 = {h.error.l2:.3%}  fit: a {h.a_error:+.2%}, p0 {h.p0_error:+.2%}{shear}")
+
+
 def hertz3d_report(h: Hertz3dComparison) -> list[str]:
     """The lines ``python -m post hertz3d`` prints."""
     e = h.error

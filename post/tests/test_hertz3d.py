@@ -26,6 +26,7 @@ from post.hertz3d import (
     symmetry_factor,
 )
 from post.reader import read_result
+from post.summary import summary_lines
 from pre.h5io import write_volume
 from pre.meshes import arc_parameter
 from pre.solids import ball_octant
@@ -69,7 +70,7 @@ def write_result(path: Path, x_ref: np.ndarray, p: np.ndarray, area: np.ndarray 
     with h5py.File(path, "w") as f:
         f.attrs.update({"status": "converged", "dimension": 3, "n_steps_done": 1, "n_steps_planned": 1,
                         "n_dofs": 3 * ncp, "title": "hertz3d synthetic", "scene": "hertz3d",
-                        "units": "mm, N"})
+                        "units": "mm, N", "warnings": ""})
         b = f.create_group("bodies/ball")
         b.attrs.update({"material": "linear", "youngs_modulus": E, "poisson_ratio": NU, "dof_offset": 0})
         b["control_points"] = vol.control_points.reshape(-1, 3)
@@ -205,6 +206,20 @@ def test_the_command(points, tmp_path: Path, capsys: pytest.CaptureFixture[str])
     # overrides: a Poisson ratio changes E*, a and the Hertz shear
     assert main(["hertz3d", str(path), "--poisson-ratio", "0.2", "--no-figure"]) == 0
     assert "nu = 0.2" in capsys.readouterr().out
+    # post summary adds one line for the scene
+    lines = summary_lines(read_result(path))
+    assert lines[-1].startswith("hertz3d vs analytic: P = ") and "L2 = 0.000%" in lines[-1]
+
+
+def test_run_figures(points, tmp_path: Path) -> None:  # noqa: ANN001
+    """``post run``'s figures of a hertz3d result: the hertz3d figure, no 2D contact
+    profile (plot-contact draws contact edges)."""
+    from post.run import make_figures
+
+    x, area, r = points
+    path = write_result(tmp_path / "run.h5", x, hertz_p(r), area, P / 4)
+    names = [p.name for p in make_figures(read_result(path), out=tmp_path / "figs", vtk=False)]
+    assert "run-hertz3d-000001.png" in names and not any("contact" in n for n in names)
 
 
 def test_without_area_ref(points, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # noqa: ANN001
