@@ -10,6 +10,8 @@ Subcommands:
   vtk            ParaView time series (.pvd + .vtu)
   hertz          a cylinder on a rigid flat against analytic Hertz in the reference
                  configuration (and the figure; several results: one overlay)
+  hertz3d        a sphere on a rigid plane (a 3D result) against Hertz's point contact:
+                 pressure over the contact disc, a and p0, the subsurface shear
   cattaneo       a cylinder pressed and sheared against Cattaneo-Mindlin's stick zone;
                  --halfplane: the incremental half-plane reference for a rigid flat
   study          a parameter study from a study file (docs/studies.md): derived cases
@@ -189,6 +191,33 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
             output.parent.mkdir(parents=True, exist_ok=True)
             print(plot_hertz([h for _, h in done], output, units=first.units))
     return code
+
+
+def _cmd_hertz3d(args: argparse.Namespace) -> int:
+    from .hertz import HertzError
+    from .hertz3d import hertz3d_comparison, hertz3d_figure, hertz3d_report
+
+    try:
+        result = _read(args.result, "hertz3d")
+        if not result.steps:
+            print(f"python -m post hertz3d: {args.result} has no converged step (status "
+                  f"{result.status!r})", file=sys.stderr)
+            return 1
+        if not result.converged and not args.partial:
+            print(f"python -m post hertz3d: {args.result}: the run has not converged (status "
+                  f"{result.status!r}); give --partial to compare step {result.steps[-1].step} anyway",
+                  file=sys.stderr)
+            return 2
+        h = hertz3d_comparison(result, step=args.step, radius=args.radius,
+                               youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
+                               symmetry=args.symmetry)
+    except (HertzError, OSError, KeyError, ValueError) as err:
+        print(f"python -m post hertz3d: {args.result}: {err}", file=sys.stderr)
+        return 2
+    print("\n".join(hertz3d_report(h)))
+    if not args.no_figure:
+        print(hertz3d_figure(result, h, args.out, args.output))
+    return 0
 
 
 def _cmd_cattaneo(args: argparse.Namespace) -> int:
@@ -547,6 +576,29 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--partial", action="store_true",
                    help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz)
+
+    s = sub.add_parser("hertz3d", help="a sphere on a rigid plane (3D result) against Hertz's point "
+                                       "contact (reference configuration, nominal pressure)")
+    s.add_argument("result", help="result file (.h5) of dimension 3 (the scene of pre hertz3d)")
+    s.add_argument("--step", type=int, default=-1,
+                   help="step number (>= 1) or -k for the k-th last (default: -1)")
+    s.add_argument("--radius", type=_positive, default=None,
+                   help="sphere radius (default: the sphere through the slave face's reference "
+                        "points near the contact)")
+    s.add_argument("--youngs-modulus", type=_positive, default=None,
+                   help="E (default: the slave body's, from the result)")
+    s.add_argument("--poisson-ratio", type=float, default=None,
+                   help="nu (default: the slave body's, from the result)")
+    s.add_argument("--symmetry", type=int, choices=(1, 2, 4), default=None,
+                   help="P over the pair's normal force: 4 a quarter model, 2 a half, 1 the whole "
+                        "sphere (default: from the active points' azimuths around the axis)")
+    s.add_argument("-o", "--output", default=None, help="PNG file of the figure")
+    s.add_argument("--out", default=None,
+                   help="folder for the figure <result>-hertz3d-<step>.png (default: next to the result)")
+    s.add_argument("--no-figure", action="store_true", help="only print the comparison")
+    s.add_argument("--partial", action="store_true",
+                   help="compare the last written step of a run that has not converged")
+    s.set_defaults(func=_cmd_hertz3d)
 
     s = sub.add_parser("cattaneo", help="a cylinder pressed and sheared against Cattaneo-Mindlin's "
                                         "stick zone (reference configuration, nominal traction)")

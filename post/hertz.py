@@ -181,16 +181,18 @@ def _edge(grid: np.ndarray, sim: np.ndarray, level: float) -> float:
 
 def fit_circle(points: np.ndarray) -> tuple[np.ndarray, float, float]:
     """Least-squares circle through ``points`` (n, 2) (the algebraic fit
-    x^2 + y^2 + D x + E y + F = 0): ``(centre, radius, rms distance from it)``."""
+    x^2 + y^2 + D x + E y + F = 0): ``(centre, radius, rms distance from it)``; a sphere
+    through points (n, 3) alike (``x^2 + y^2 + z^2 + D x + E y + G z + F = 0``)."""
     pts = np.asarray(points, dtype=float)
-    if len(pts) < 3:
-        raise HertzError("fewer than 3 slave points to fit a circle to")
+    if len(pts) < pts.shape[1] + 1:
+        raise HertzError(f"fewer than {pts.shape[1] + 1} slave points to fit a "
+                         f"{'circle' if pts.shape[1] == 2 else 'sphere'} to")
     design = np.column_stack([pts, np.ones(len(pts))])
     coef, *_ = np.linalg.lstsq(design, -(pts**2).sum(axis=1), rcond=None)
-    centre = -0.5 * coef[:2]
-    r2 = float(centre @ centre - coef[2])
+    centre = -0.5 * coef[:-1]
+    r2 = float(centre @ centre - coef[-1])
     if not np.isfinite(r2) or r2 <= 0:
-        raise HertzError("the slave points near the contact do not lie on a circle")
+        raise HertzError("the slave points near the contact do not lie on a circle (sphere)")
     radius = float(np.sqrt(r2))
     rms = float(np.sqrt(np.mean((np.linalg.norm(pts - centre, axis=1) - radius) ** 2)))
     return centre, radius, rms
@@ -269,7 +271,7 @@ class HertzComparison:
         return Path(self.source).stem
 
 
-def _pair(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]:
+def contact_pair(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]:
     """The step and contact pair, or HertzError naming what is missing."""
     if step == 0:
         raise HertzError("step 0 is the reference configuration: no contact to compare")
@@ -356,7 +358,7 @@ def hertz_comparison(result: Result, step: int = -1, pair: int = 0,
     """
     if configuration not in ("reference", "current"):
         raise ValueError(f"configuration must be 'reference' or 'current', not {configuration!r}")
-    st, c = _pair(result, step, pair)
+    st, c = contact_pair(result, step, pair)
     if c.rigid_point is None or c.rigid_normal is None:
         kind = "a rigid curve" if c.rigid_curve is not None else f"the body {c.master!r}"
         raise HertzError(f"{result.path}: pair {c.slave} -> {c.master} is not pressed on a rigid "

@@ -39,11 +39,19 @@ def make_figures(result: Result, out: Path | None = None, vtk: bool = True) -> l
                                          field=field))
     written += [write_history_csv(result, out=out), plot_history(result, out=out)]
     if result.steps[-1].contact:
-        written.append(plot_contact(result, out=out))
+        if result.dimension == 2:  # plot-contact draws a contact edge; a face has no profile figure yet
+            written.append(plot_contact(result, out=out))
         if result.scene == "hertz":
             from .hertz import HertzError, hertz_comparison, hertz_figure
             try:
                 written.append(hertz_figure(result, hertz_comparison(result), out))
+            except HertzError:
+                pass  # the summary says why
+        if result.scene == "hertz3d":
+            from .hertz import HertzError
+            from .hertz3d import hertz3d_comparison, hertz3d_figure
+            try:
+                written.append(hertz3d_figure(result, hertz3d_comparison(result), out))
             except HertzError:
                 pass  # the summary says why
     if vtk:

@@ -1,6 +1,6 @@
 """What a result file says, in a few lines (``python -m post summary``; printed by
 ``python -m post run``): status, steps and cost, the reactions and contact forces of
-the last converged step, and for the hertz scene the comparison with analytic Hertz."""
+the last converged step, and for the hertz (hertz3d) scene the comparison with analytic Hertz."""
 
 from __future__ import annotations
 
@@ -105,4 +105,10 @@ def summary_lines(result: Result) -> list[str]:
             lines.append("hertz vs analytic: " + format_hertz(hertz_comparison(result)))
         except ValueError as err:
             lines.append(f"hertz vs analytic: not available ({err})")
+    if result.scene == "hertz3d" and last.contact:
+        from .hertz3d import format_hertz3d, hertz3d_comparison
+        try:
+            lines.append("hertz3d vs analytic: " + format_hertz3d(hertz3d_comparison(result)))
+        except ValueError as err:
+            lines.append(f"hertz3d vs analytic: not available ({err})")
     return lines

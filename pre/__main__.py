@@ -5,6 +5,7 @@ Subcommands:
   geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
+  hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       refine a case with splipy and write the discretization dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -127,6 +128,29 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_hertz3d(args: argparse.Namespace) -> int:
+    from .files import OutputError
+    from .hertz import HertzCaseError
+    from .hertz3d import Ball, case_dofs, write_hertz3d
+
+    ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
+                poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material)
+    try:
+        geometry, cases, fresh = write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
+                                               n_steps=args.steps, method=args.method,
+                                               penalty_normal=args.penalty_normal)
+    except (HertzCaseError, OutputError, OSError) as err:
+        print(f"python -m pre hertz3d: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same ball)")
+    for case in cases:
+        mesh, layout = case.stem.split("-", 1)
+        print(f"wrote {case}: {case_dofs(ball, mesh, layout)['total']} DOFs")
+    print(f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
+          f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
+    return 0
+
+
 def _cmd_refine(args: argparse.Namespace) -> int:
     from .refine import discretize_case, write_dump
 
@@ -208,6 +232,28 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", required=True, help="folder for geometry.h5 and <mesh>-<layout>.nml")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz)
+
+    s = sub.add_parser("hertz3d", help="the 3D Hertz scene: a quarter hemisphere (ball octant) "
+                                       "pressed on a rigid plane; geometry.h5 and a case per mesh "
+                                       "and layout")
+    s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml (not cases/: voiga "
+                               "cannot run 3D contact yet)")
+    s.add_argument("--mesh", nargs="+", default=["m2"], help="mesh levels m1 .. m4 (default m2)")
+    s.add_argument("--layout", nargs="+", default=["NN2.2"],
+                   help="solid layouts, e.g. N2 N3 NN2.1 NN2.2 (default NN2.2)")
+    s.add_argument("--radius", type=float, default=1.0, help="ball radius R (default 1)")
+    s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
+    s.add_argument("--poisson-ratio", type=float, default=0.3, help="nu in (-1, 0.5) (default 0.3)")
+    s.add_argument("--indentation", type=float, default=0.01,
+                   help="downward displacement d of the top face, 0 < d < R/10 (default 0.01)")
+    s.add_argument("--material", default="linear", choices=("linear", "neo-hookean"),
+                   help="material law (default linear)")
+    s.add_argument("--steps", type=int, default=None, help="load steps (default 5)")
+    s.add_argument("--method", default="gpts", help="&contact method (default gpts)")
+    s.add_argument("--penalty-normal", type=float, default=None,
+                   help="&contact penalty_normal (default: none written, voiga's automatic one)")
+    s.add_argument("--force", action="store_true", help="overwrite existing files")
+    s.set_defaults(func=_cmd_hertz3d)
 
     s = sub.add_parser("cattaneo", help="a Cattaneo-Mindlin case: a half cylinder pressed onto a "
                                         "rigid flat, its mirror image or a block, then sheared")

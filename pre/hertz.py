@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import pairwise
 from pathlib import Path
@@ -229,6 +230,34 @@ def cylinder_geometry(radius: float) -> dict[str, Any]:
                                                     "eta0": "inner", "eta1": "outer"})}
 
 
+def write_shared_geometry(folder: Path, write: Callable[[Path], None], cases: list[Path],
+                          force: bool = False, other: str = "another cylinder") -> tuple[Path, bool]:
+    """Write ``folder/geometry.h5`` with ``write(path)`` (a writer of the whole file) unless
+    a file with the same bytes is there (kept: several meshes and layouts share it). The
+    ``cases`` that exist, or a geometry file with other contents (``other`` says whose),
+    are refused (HertzCaseError, nothing written) unless ``force``. Returns ``(geometry,
+    written)``; the caller writes the cases after it."""
+    geometry = check_output(folder / GEOMETRY_FILE)
+    for case in cases:
+        check_output(case)
+    tmp = folder / f".{GEOMETRY_FILE}.{os.getpid()}.tmp"
+    try:
+        write(tmp)
+        same = geometry.is_file() and geometry.read_bytes() == tmp.read_bytes()
+        clash = [p for p, exists in ([(c, c.exists()) for c in cases]
+                                     + [(geometry, geometry.exists() and not same)]) if exists]
+        if clash and not force:
+            raise HertzCaseError(" and ".join(map(str, clash))
+                                 + (" exist" if len(clash) > 1 else " exists")
+                                 + (f" (the geometry of {other})" if geometry in clash
+                                    else "") + "; nothing written (--force to overwrite)")
+        if not same:
+            os.replace(tmp, geometry)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return geometry, not same
+
+
 def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
                      force: bool = False, **options: Any) -> tuple[Path, Path, bool]:
     """Write ``out/geometry.h5`` and ``out/<mesh>-<layout>.nml`` (the committed layout).
@@ -240,23 +269,11 @@ def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     case = folder / f"{case_stem(mesh, layout, options.get('edge_refine', 1), options.get('surface_size'))}.nml"
-    geometry = check_output(folder / GEOMETRY_FILE)
-    check_output(case)
-    tmp = folder / f".{GEOMETRY_FILE}.{os.getpid()}.tmp"
-    try:
-        write_geometry(tmp, "hertz", cylinder_geometry(cyl.radius),
+
+    def geometry_file(path: Path) -> None:
+        write_geometry(path, "hertz", cylinder_geometry(cyl.radius),
                        generator="voiga pre (python -m pre hertz)")
-        same = geometry.is_file() and geometry.read_bytes() == tmp.read_bytes()
-        clash = [p for p, exists in ((case, case.exists()),
-                                     (geometry, geometry.exists() and not same)) if exists]
-        if clash and not force:
-            raise HertzCaseError(" and ".join(map(str, clash))
-                                 + (" exist" if len(clash) > 1 else " exists")
-                                 + (" (the geometry of another cylinder)" if geometry in clash
-                                    else "") + "; nothing written (--force to overwrite)")
-        if not same:
-            os.replace(tmp, geometry)
-    finally:
-        tmp.unlink(missing_ok=True)
+
+    geometry, fresh = write_shared_geometry(folder, geometry_file, [case], force)
     write_text(case, text)
-    return geometry, case, not same
+    return geometry, case, fresh

@@ -96,6 +96,21 @@ def hertz_m1_angles(a_exp: float = HERTZ_A_EXP) -> np.ndarray:
     return np.array(fine + coarse)
 
 
+def graded_angles(theta_c: float, n_fine: int, n_rest: int,
+                  sweep: float = math.pi / 2) -> list[float]:
+    """Interior breakpoint angles (from the arc's start) of an arc of ``sweep``:
+    ``n_fine`` elements uniform in angle over [0, theta_c], then ``n_rest`` growing
+    geometrically from that size to the arc's end (uniform when they cannot grow). The
+    2D hertz mesh (:func:`hertz_m1_angles`) keeps its uniform coarse part."""
+    h = theta_c / n_fine
+    fine = [theta_c * i / n_fine for i in range(1, n_fine + 1)]
+    rest = sweep - theta_c
+    sizes = (geometric_sizes(n_rest, h, rest) if n_rest * h < rest
+             else np.full(n_rest, rest / n_rest))
+    coarse = [theta_c + float(s) for s in np.cumsum(sizes)[:-1]]
+    return fine + coarse
+
+
 def hertz_xi_knots(level: int, a_exp: float = HERTZ_A_EXP) -> np.ndarray:
     """Interior arc knots of hertz mesh m<level>: the m1 angles mapped to the
     arc parameter, every m1 span split into 2^(level-1) equal spans."""
@@ -116,10 +131,11 @@ def geometric_sizes(n_el: int, h_min: float, length: float) -> np.ndarray:
     return np.array([h_min * r ** k for k in range(n_el)])  # Python pow: machine-independent
 
 
-def hertz_eta_knots(n_el: int, h_surface: float = HERTZ_H_SURFACE) -> np.ndarray:
+def hertz_eta_knots(n_el: int, h_surface: float = HERTZ_H_SURFACE,
+                    thickness: float = HERTZ_R_OUT - HERTZ_R_IN) -> np.ndarray:
     """Interior radial knots: ``n_el`` elements graded geometrically toward the
-    outer surface (``eta = 1``), smallest radial size ``h_surface``."""
-    thickness = HERTZ_R_OUT - HERTZ_R_IN
+    outer surface (``eta = 1``), smallest radial size ``h_surface`` across a wall of
+    ``thickness`` (the hertz annulus's 0.95; a solid ball's radius: 1)."""
     sizes = geometric_sizes(n_el, h_surface / thickness, 1.0)  # parameter sizes
     # from eta = 1 inward: 1 - cumulative size; the last one (eta = 0) is dropped
     inner, acc = [], 0.0

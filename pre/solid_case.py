@@ -19,6 +19,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from .layouts import solid_layout
+from .nurbs import KNOT_TOL
 from .spec import SpecError
 from .spec_check import MAX_ELEMENTS
 from .volume import DIRECTIONS, Volume, evaluate
@@ -176,3 +177,59 @@ def check_loads(data: dict[str, Any], volumes: dict[str, Volume]) -> None:
         if "p" not in t:
             _fail(f"{where}: p is required (force per reference area, positive into the body)")
         _phase_values(t["p"], f"{where}: p", phases)
+
+
+def _direction_functions(coarse: np.ndarray, p_coarse: int, degree: int, new: np.ndarray,
+                         linear: bool) -> tuple[int, int]:
+    """``(functions, distinct interior knots)`` of one direction after k-refinement of
+    the coarse knot vector ``coarse`` (degree ``p_coarse``) to ``degree`` with the new
+    interior knots ``new`` (each inserted once); ``linear``: the L1 basis (degree 1,
+    one node per breakpoint)."""
+    values, counts = np.unique(np.asarray(coarse, dtype=float), return_counts=True)
+    inner, mult = values[1:-1], counts[1:-1]
+    fresh = [k for k in np.asarray(new, dtype=float) if not np.any(np.abs(inner - k) <= KNOT_TOL)]
+    distinct = len(inner) + len(fresh)
+    if linear:
+        return 2 + distinct, distinct
+    return degree + 1 + int(np.sum(mult + degree - p_coarse)) + len(fresh), distinct
+
+
+def _new_knots(group: dict[str, Any], direction: str) -> np.ndarray:
+    """The interior knots a ``&body`` inserts along ``direction``: ``knots_<dir>``, else
+    ``i / nel_<dir>``."""
+    explicit = group.get(f"knots_{direction}")
+    if explicit is not None:
+        return np.atleast_1d(np.asarray(explicit, dtype=float))
+    nel = int(group.get(f"nel_{direction}", 1) or 1)
+    return np.array([i / nel for i in range(1, nel)])
+
+
+def solid_dofs(group: dict[str, Any], vol: Volume) -> dict[str, int]:
+    """DOFs of a solid with the ``&body`` settings ``group`` on the coarse volume ``vol``
+    (the counts of docs/formats.md, "Layouts in 3D"): ``interface`` (the layer's 3 m_1
+    m_2, or without a layer the contact face's bulk points), ``bulk`` and ``total``.
+    The group's directions are those of the patch voiga turns (contact face at zeta =
+    1); a new knot within 1e-12 of a coarse interior knot of that direction is the
+    coarse knot (compared in the volume's own orientation)."""
+    face = str(group.get("contact_face", "") or "")
+    k = DIRECTIONS.index(vol.face_key(face)[:-1]) if face else 2
+    order = [(k + 1) % 3, (k + 2) % 3, k]  # the turned patch's xi, eta, zeta
+    linear = group.get("basis", "nurbs") == "linear"
+    n, s = [], []
+    for d, direction in zip(order, DIRECTIONS, strict=True):
+        degree = 1 if linear else int(group.get(f"degree_{direction}", 2))
+        count, distinct = _direction_functions(vol.knots[d], vol.degree[d], degree,
+                                               _new_knots(group, direction), linear)
+        n.append(count)
+        s.append(distinct)
+    q, elevations = int(group.get("layer_degree", 0) or 0), int(group.get("layer_elevations", 0) or 0)
+    if q and face:
+        m = [_direction_functions(vol.knots[d], vol.degree[d], q, _new_knots(group, direction),
+                                  False)[0] + elevations * (s[i] + 1)
+             for i, (d, direction) in enumerate(zip(order[:2], DIRECTIONS[:2], strict=True))]
+        interface, bulk = 3 * m[0] * m[1], 3 * n[0] * n[1] * (n[2] - 1)
+    elif face:
+        interface, bulk = 3 * n[0] * n[1], 3 * n[0] * n[1] * (n[2] - 1)
+    else:
+        interface, bulk = 0, 3 * n[0] * n[1] * n[2]
+    return {"interface": interface, "bulk": bulk, "total": interface + bulk}

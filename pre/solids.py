@@ -57,6 +57,13 @@ the plane x = x_c (longitude 90 degrees), ``equator`` the plane z = z_c, ``pole`
 face collapsed onto the axis x = x_c, y = y_c, ``inner``/``outer`` the spheres
 (``outer``: the contact face)."""
 
+BALL_FACES = {"symmetry_y": "xi0", "top": "xi1", "symmetry_x": "eta0", "axis": "eta1",
+              "centre": "zeta0", "outer": "zeta1"}
+"""Face labels of a ball octant (:func:`ball_octant`): ``symmetry_y`` the plane
+y = y_c, ``top`` the plane z = z_c, ``symmetry_x`` the plane x = x_c, ``axis`` the face
+collapsed onto the axis y = y_c, z = z_c, ``centre`` the face collapsed onto the
+centre, ``outer`` the sphere (the contact face)."""
+
 SWEEP_ENDS = {"extrude": ("back", "front"), "revolve": ("plane", "turned")}
 """Default labels of the end faces of a swept 2D body: where the sweep starts (z = z0,
 or the patch itself in the plane z = 0) and where it ends (z = z1, or the patch turned
@@ -174,6 +181,35 @@ def shell_octant(r_in: float, r_out: float, centre: Point = (0.0, 0.0, 0.0),
     cp += np.asarray(centre, dtype=float)
     weights = np.broadcast_to(np.outer(w, w), (2, 3, 3)).copy()
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(SHELL_FACES, faces))
+
+
+def ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
+                faces: dict[str, str] | None = None) -> Volume:
+    """The octant ``x >= x_c, y >= y_c, z <= z_c`` of the ball ``|x - centre| <= radius``
+    (a quarter of the lower hemisphere) in spherical coordinates about the x axis,
+    ``x = rho cos(theta)``, ``(y, z) = rho sin(theta) (cos(phi), sin(phi))``: xi along phi
+    from -90 degrees (the plane y = y_c) to 0 (the plane z = z_c), eta along theta from
+    90 degrees (the plane x = x_c) to 0 (the x axis), zeta along rho from the centre to
+    the sphere. The exact rational NURBS: the tensor product of two quarter arcs (weights
+    ``w_i w_j``, ``w = (1, sqrt(1/2), 1)``) and a line; degrees (2, 2, 1), 3 x 3 x 2
+    control points, right-handed. The lowest point ``centre - (0, 0, radius)`` is the
+    corner ``(xi, eta, zeta) = (0, 0, 1)`` of the sphere, where nothing degenerates; the
+    faces ``eta = 1`` (onto the x axis) and ``zeta = 0`` (onto the centre) collapse, as
+    the shell octant's pole (allowed: boundary faces). Faces :data:`BALL_FACES`."""
+    radius = float(radius)
+    if not radius > 0:
+        raise ValueError(f"ball octant: need radius > 0, got {radius}")
+    w45 = math.sqrt(0.5)
+    phi = np.array([[0.0, -1.0], [1.0, -1.0], [1.0, 0.0]])  # (cos, sin) polygon, -90 .. 0 degrees
+    theta = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])  # (cos, sin) polygon, 90 .. 0 degrees
+    cp = np.zeros((2, 3, 3, 3))
+    for j in range(3):
+        cp[1, j, :, 0] = radius * theta[j, 0]
+        cp[1, j, :, 1:] = radius * theta[j, 1] * phi
+    cp += np.asarray(centre, dtype=float)
+    w = np.array([1.0, w45, 1.0])
+    weights = np.broadcast_to(np.outer(w, w), (2, 3, 3)).copy()
+    return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(BALL_FACES, faces))
 
 
 def _clockwise(patch: Patch, name: str) -> bool:
