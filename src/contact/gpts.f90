@@ -20,7 +20,7 @@ module voiga_contact_gpts
     use voiga_contact_kinematics, only: point_operators
     use voiga_text, only: str, real_str
     use voiga_contact_pair, only: contact_pair_t, add_matrix
-    use voiga_contact_gpts3, only: gpts_point3
+    use voiga_contact_face_kernels, only: gpts_point3
     implicit none
     private
 

@@ -23,6 +23,8 @@ module voiga_contact_mortar
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_mortar_kernels, only: mortar_point, node_touch_factors
+    use voiga_contact_face_kernels, only: mortar_point3
+    use voiga_contact_surface, only: face_ids, n_elements
     use voiga_contact_pair, only: contact_pair_t, add_matrix
     use voiga_contact_history, only: flag_value
     implicit none
@@ -183,8 +185,13 @@ contains
             call self%project_point(u, k, wk%sps(k), wk%mps(k), found, converged)
             associate (sp => wk%sps(k), mp => wk%mps(k), out => self%out(k), nodes => self%point_nodes(:, k), &
                        phi => self%point_values(:, k))
-                a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
-                wk%w0(k) = norm2(a0)*self%w(k)
+                if (self%slave%npar > 1) then
+                    ! a face: the reference area the point integrates (`project_point`)
+                    wk%w0(k) = out%area0
+                else
+                    a0 = matmul(self%slave%x0(:, sp%local), sp%dr)
+                    wk%w0(k) = norm2(a0)*self%w(k)
+                end if
                 wk%d_a(nodes) = wk%d_a(nodes) + wk%w0(k)*phi
                 if (self%h_xi > 0) then
                     self%hist%field(self%h_xi)%trial(k) = mp%xi
@@ -233,7 +240,7 @@ contains
         procedure(add_matrix), optional :: add
         real(dp), allocatable :: rl(:), kl(:, :)
         real(dp) :: pbar, tbar
-        integer :: k, nd
+        integer :: k, nd, i
         logical :: inside
 
         miss = .false.
@@ -250,14 +257,22 @@ contains
                 end if
                 if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
                 allocate (vec%gn(nd), vec%gt(nd), vec%m(nd))
-                call mortar_point(wk%w0(k), sp, mp, pbar, tbar, wk%dxi(k), wk%slip(k), self%law%mu > 0.0_dp, &
-                                  rl, kl, vec%gn, vec%gt, vec%m)
+                if (self%slave%npar > 1) then
+                    ! a face (frictionless: refused with friction where the case is read)
+                    call mortar_point3(wk%w0(k), sp, mp, pbar, rl, kl, vec%gn)
+                    vec%gt = 0.0_dp
+                    vec%m = 0.0_dp
+                else
+                    call mortar_point(wk%w0(k), sp, mp, pbar, tbar, wk%dxi(k), wk%slip(k), self%law%mu > 0.0_dp, &
+                                      rl, kl, vec%gn, vec%gt, vec%m)
+                end if
                 vec%dofs = [sp%dofs, mp%dofs]
                 self%n_evaluations = self%n_evaluations + 1
                 if (self%h_traction > 0) self%n_friction = self%n_friction + 1
                 r(vec%dofs) = r(vec%dofs) + rl
-                self%force(1) = self%force(1) - sum(rl(1:size(sp%dofs):2))
-                self%force(2) = self%force(2) - sum(rl(2:size(sp%dofs):2))
+                do i = 1, self%nsd
+                    self%force(i) = self%force(i) - sum(rl(i:size(sp%dofs):self%nsd))
+                end do
                 ! the interpolated tractions act per reference length (w0 = |A_s| w)
                 out%pn0 = pbar
                 out%pt0 = tbar
@@ -303,6 +318,8 @@ contains
                 do k = rng(1), rng(2)
                     if (.not. allocated(wk%vec(k)%dofs)) cycle
                     i = findloc(self%point_nodes(:, k), a, dim=1)
+                    ! (a face's range of cells holds rows beside the node's support)
+                    if (i == 0) cycle
                     c = wk%w0(k)*self%point_values(i, k)
                     pos = [(findloc(blk, wk%vec(k)%dofs(j), dim=1), j=1, size(wk%vec(k)%dofs))]
                     v(pos) = v(pos) + c*wk%vec(k)%gn
@@ -384,6 +401,10 @@ contains
         logical, allocatable :: used(:)
         integer :: e, p, lo, hi
 
+        if (self%slave%npar > 1) then
+            dofs = face_block_dofs(self, b)
+            return
+        end if
         p = self%slave%degree
         lo = huge(1)
         hi = 0
@@ -396,6 +417,23 @@ contains
         dofs = reshape(self%slave%dofs(:, lo:hi), [2*(hi - lo + 1)])
         dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
     end function mortar_block_dofs
+
+    !> Node b's block on a face (a rigid master: the slave DOFs only): the DOFs of the
+    !> control points of every cell whose functions include the node's.
+    pure function face_block_dofs(self, b) result(dofs)
+        class(mortar_pair_t), intent(in) :: self
+        integer, intent(in) :: b
+        integer, allocatable :: dofs(:), ids(:)
+        logical :: used(size(self%slave%cps))
+        integer :: e, nu
+        nu = size(self%slave%spans)
+        used = .false.
+        do e = self%node_first(b), self%node_last(b)
+            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
+            if (any(ids == b)) used(ids) = .true.
+        end do
+        dofs = reshape(self%slave%dofs(:, pack([(e, e=1, size(used))], used)), [3*count(used)])
+    end function face_block_dofs
 
     !> The multiplier basis; with friction the shared history and a tangential
     !> traction per node.
@@ -420,6 +458,10 @@ contains
         real(dp) :: s
         integer :: e, i, k, p, ne, ng, a
 
+        if (self%slave%npar > 1) then
+            call face_multipliers(self)
+            return
+        end if
         ne = size(self%slave%spans)
         ng = self%n_gauss
         p = self%slave%degree
@@ -455,6 +497,32 @@ contains
             end do
         end do
     end subroutine setup_multipliers
+
+    !> The multiplier basis on a face: the slave face's functions at each point (as
+    !> `setup` computed them), and each node's support as the range of cells (flat,
+    !> xi fastest) from its first to its last.
+    pure subroutine face_multipliers(self)
+        class(mortar_pair_t), intent(inout) :: self
+        integer :: k, e, ne, a, nu
+        integer, allocatable :: ids(:)
+        ne = n_elements(self%slave)
+        nu = size(self%slave%spans)
+        allocate (self%point_nodes(size(self%slave_basis, 1), size(self%xi)), &
+                  self%node_first(size(self%slave%cps)), self%node_last(size(self%slave%cps)))
+        do k = 1, size(self%xi)
+            self%point_nodes(:, k) = face_ids(self%slave, [self%span(k), self%span_eta(k)])
+        end do
+        self%point_values = self%slave_basis(:, 1, :)
+        self%node_first = huge(1)
+        self%node_last = 0
+        do e = 1, ne
+            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
+            do a = 1, size(ids)
+                self%node_first(ids(a)) = min(self%node_first(ids(a)), e)
+                self%node_last(ids(a)) = max(self%node_last(ids(a)), e)
+            end do
+        end do
+    end subroutine face_multipliers
 
     !> A control point was in contact at the last converged state (friction only).
     pure logical function mortar_contact_last(self)

@@ -16,7 +16,7 @@ module voiga_contact_surface
     private
 
     public :: contact_surface_t, new_contact_surface, new_curve_surface, surface_point_t, surface_point, &
-              surface_basis, surface_point_at, element_lengths, n_elements, face_basis, face_point_at
+              surface_basis, surface_point_at, element_lengths, n_elements, face_basis, face_point_at, face_ids
 
     !> The contact edge of one body.
     type :: contact_surface_t

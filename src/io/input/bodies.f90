@@ -95,8 +95,8 @@ contains
 
     !> A rigid master's point and normal have `nsd` components (or none given: the
     !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
-    !> solids contact is, so far, frictionless GPTS against a rigid plane (issue 42:
-    !> the rest is refused here, naming what is missing).
+    !> solids contact is, so far, frictionless GPTS or mortar against a rigid plane
+    !> (issue 42: the rest is refused here, naming what is missing).
     subroutine check_contact_dimension(c, nsd, where, error)
         type(contact_settings_t), intent(in) :: c
         integer, intent(in) :: nsd
@@ -115,8 +115,9 @@ contains
                 what = 'contact of a solid with another solid or a rigid surface of the geometry file is not '// &
                        'implemented yet (issue 42); a solid can touch a rigid plane (master = ''rigid'', '// &
                        'rigid_point, rigid_normal)'
-            else if (trim(c%method) /= 'gpts') then
-                what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use 'gpts'"
+            else if (all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
+                what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
+                       "'mortar' or 'gpts'"
             else if (c%friction > 0.0_dp) then
                 what = 'friction between solids is not implemented yet (issue 42); use friction = 0'
             end if

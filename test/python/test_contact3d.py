@@ -1,0 +1,148 @@
+"""Contact on a solid's face (issue 42, first step: frictionless GPTS and mortar against
+a rigid plane) through the command line. A box pressed onto a rigid plane by a uniform
+pressure on its top carries that pressure uniformly (the contact patch test against a
+rigid flat, which every method must pass); the sphere of `pre hertz3d` runs and its
+result reads in `post hertz3d` with its contact force equal to the integral of the
+pressure; what is not implemented on faces yet is refused with its cause named."""
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from pre.solids import box, write_volumes
+
+P = 0.01
+
+CASE = """&case
+  title = 'box on a plane', geometry = 'geometry.h5', output = 'box.h5', n_bodies = 1
+/
+&body
+  name = 'block', material = '{material}', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, degree_zeta = 2, nel_xi = 3, nel_eta = 2, nel_zeta = 2,
+  contact_face = 'bottom', layer_degree = {q}, layer_elevations = {k}
+/
+&solver
+  n_steps = 2
+/
+&dirichlet
+  body = 'block', face = 'left', fix_x = .true.
+/
+&dirichlet
+  body = 'block', face = 'front', fix_y = .true.
+/
+&pressure
+  body = 'block', face = 'top', p = {p}
+/
+&contact
+  slave = 'block', master = 'rigid'{contact}
+/
+"""
+
+PLANE = ", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 0.0, 1.0"
+
+
+def box_case(tmp: Path, contact: str = PLANE + ", method = 'gpts'", material: str = "linear", q: int = 0,
+             k: int = 0, p: float = P) -> Path:
+    """The box [0, 2] x [0, 1] x [0, 1] on the plane z = 0, pressed by `p` on its top,
+    held in x and y by its symmetry planes x = 0 and y = 0 (frictionless contact
+    cannot hold it there)."""
+    write_volumes(tmp / "geometry.h5", {"block": box((0.0, 2.0), (0.0, 1.0), (0.0, 1.0))})
+    case = tmp / "box.nml"
+    case.write_text(CASE.format(material=material, q=q, k=k, p=p, contact=contact))
+    return case
+
+
+def run(voiga_bin: Path, case: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([str(voiga_bin), str(case), "--quiet", *args], capture_output=True, text=True,
+                          timeout=300)
+
+
+def last_contact(path: Path) -> dict[str, np.ndarray]:
+    with h5py.File(path) as f:
+        step = sorted(f["steps"])[-1]
+        g = f[f"steps/{step}/contact/1"]
+        return {name: g[name][()] for name in g}
+
+
+@pytest.mark.parametrize("method", ["gpts", "mortar"])
+@pytest.mark.parametrize("layer", [(0, 0), (3, 1)])
+def test_uniform_pressure_on_a_plane(voiga_bin: Path, tmp_path: Path, method: str, layer: tuple[int, int]) -> None:
+    """Linear: the uniform state is the discrete solution, so every point carries p to
+    round-off (N2, and NN3.1 with its layer on the contact face), and the contact force
+    is p times the area, along the plane's normal."""
+    res = run(voiga_bin, box_case(tmp_path, PLANE + f", method = '{method}'", q=layer[0], k=layer[1]))
+    assert res.returncode == 0, res.stderr
+    c = last_contact(tmp_path / "box.h5")
+    p = c["p_n_nominal"]
+    assert c["x_ref"].shape == (p.size, 3) and c["xi_slave"].shape == (p.size, 2)
+    assert np.all(c["state"] == 1)
+    assert (p.max() - p.min()) / P < 1e-10
+    assert abs(p.mean() / P - 1.0) < 1e-10
+    assert np.allclose(c["force"], [0.0, 0.0, 2.0 * P], atol=1e-13, rtol=1e-10)
+    assert abs(c["area_ref"].sum() - 2.0) < 1e-12
+
+
+def test_uniform_pressure_finite_strain(voiga_bin: Path, tmp_path: Path) -> None:
+    """Neo-Hookean, pressed by 20 % of E: the box spreads laterally (stretch > 1 of the
+    contact face's area), the pressure per reference area stays uniform, and its
+    integral is the load (a dead pressure on the top, which spreads as the bottom)."""
+    res = run(voiga_bin, box_case(tmp_path, PLANE + ", method = 'mortar'", material="neo-hookean", p=0.2))
+    assert res.returncode == 0, res.stderr
+    c = last_contact(tmp_path / "box.h5")
+    p = c["p_n_nominal"]
+    assert (p.max() - p.min()) / p.mean() < 1e-8
+    assert abs((p * c["area_ref"]).sum() - c["force"][2]) < 1e-10
+    assert abs(c["force"][2] - 0.4) < 1e-8
+    assert c["stretch"].min() > 1.05
+
+
+def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
+    """No rigid_normal in a solid case: the plane's outward normal is +z."""
+    res = run(voiga_bin, box_case(tmp_path, ", rigid_point = 0.0, 0.0, 0.0"))
+    assert res.returncode == 0, res.stderr
+    assert np.allclose(last_contact(tmp_path / "box.h5")["rigid_normal"], [0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize(("contact", "message"), [
+    (PLANE + ", friction = 0.3", "friction between solids is not implemented yet"),
+    (PLANE + ", method = 'segment'", "method = 'segment' is not implemented for solids yet"),
+    (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
+    (", rigid_point = 0.0, 0.0", "rigid_point needs 3 components"),
+    (", rigid_curve = 'arc'", "contact of a solid with another solid or a rigid surface"),
+])
+def test_refused_with_the_cause(voiga_bin: Path, tmp_path: Path, contact: str, message: str) -> None:
+    res = run(voiga_bin, box_case(tmp_path, contact), "--check")
+    assert res.returncode != 0
+    assert message in res.stderr, res.stderr
+    assert not (tmp_path / "box.h5").exists()
+
+
+def test_rigid_uz_in_a_plane_case(voiga_bin: Path, tmp_path: Path) -> None:
+    """rigid_uz moves a rigid master along z: a plane case has none."""
+    case = Path(__file__).resolve().parents[2] / "cases" / "hertz" / "m1-N2.nml"
+    text = case.read_text().replace("  method = 'gpts'", "  method = 'gpts'\n  rigid_uz = 0.1")
+    (tmp_path / "c.nml").write_text(text.replace("geometry = 'geometry.h5'", f"geometry = '{case.parent}/geometry.h5'"))
+    res = run(voiga_bin, tmp_path / "c.nml", "--check")
+    assert res.returncode != 0 and "a plane case has no z" in res.stderr, res.stderr
+
+
+def test_hertz3d_runs_and_reads(voiga_bin: Path, tmp_path: Path) -> None:
+    """`pre hertz3d` m1 N2 with mortar: the run converges, the contact force is the
+    integral of the nominal pressure over the reference area, and `post hertz3d`
+    reads the result (its numbers are in docs/verification.md)."""
+    out = tmp_path / "h"
+    subprocess.run(["python3", "-m", "pre", "hertz3d", str(out), "--mesh", "m1", "--layout", "N2", "--method",
+                    "mortar"], check=True, capture_output=True, cwd=Path(__file__).resolve().parents[2])
+    case = out / "m1-N2.nml"
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    c = last_contact(out / "m1-N2.h5")
+    assert abs((c["p_n_nominal"] * c["area_ref"]).sum() - c["force"][2]) < 1e-10 * c["force"][2]
+    post = subprocess.run(["python3", "-m", "post", "hertz3d", str(out / "m1-N2.h5"), "--no-figure"],
+                          capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
+    assert post.returncode == 0, post.stderr
+    assert "relative L2 error of p" in post.stdout
