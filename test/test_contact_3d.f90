@@ -13,6 +13,7 @@ module test_contact_3d
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
+    use voiga_nurbs_patch, only: nurbs_patch_t, new_patch, knots_t
     use test_contact, only: contact_fd
     use voiga_text, only: str
     implicit none
@@ -25,12 +26,17 @@ module test_contact_3d
     character(len=32), parameter :: faces(6) = [character(len=32) :: 'inner', 'outer', 'start', 'end', &
                                                  'bottom', 'top']
 
+    !> A box's faces: x = x0, x1, y = y0, y1, z = z0, z1.
+    character(len=32), parameter :: box_faces(6) = [character(len=32) :: 'left', 'right', 'front', 'back', &
+                                                     'bottom', 'top']
+
 contains
 
     subroutine collect_contact_3d(testsuite)
         type(unittest_t), allocatable, intent(out) :: testsuite(:)
         testsuite = [ &
                     new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
+                    new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
                     new_unittest('contact_3d_face_area', test_face_area), &
                     new_unittest('rigid_plane_frame', test_plane_frame) &
                     ]
@@ -85,6 +91,66 @@ contains
             deallocate (u)
         end do
     end subroutine test_tangent_fd
+
+    !> Two blocks, the upper one's bottom face (slave) pressed 0.02 into the lower
+    !> one's top face (master), non-matching, at a perturbed state (every DOF moved by
+    !> up to 2e-3, so both faces are curved and the master's tangents and curvature
+    !> enter): K of the pair against central differences, GPTS and mortar, N2 and NN3.
+    subroutine test_tangent_fd_deformable(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=6), parameter :: methods(2) = [character(len=6) :: 'gpts', 'mortar']
+        type(scene_t) :: c
+        type(discretization_t) :: discs(2)
+        type(contact_settings_t) :: contact
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:)
+        integer :: im, iq, j
+        do im = 1, 2
+            do iq = 0, 3, 3
+                c%bodies = [body_settings('upper', 'linear', 1.0_dp, layout3(2, [2, 2, 1], iq, 0, 'bottom')), &
+                            body_settings('lower', 'linear', 1.0_dp, layout3(2, [3, 2, 1], 0, 0, 'top'))]
+                contact%slave = 'upper'
+                contact%master = 'lower'
+                contact%method = methods(im)
+                c%contact = [contact]
+                call new_discretization(discs(1), unit_box(-0.02_dp), box_faces, c%bodies(1)%layout, '', error)
+                if (allocated(error)) return
+                call new_discretization(discs(2), unit_box(-1.0_dp), box_faces, c%bodies(2)%layout, '', error)
+                if (allocated(error)) return
+                call scene_model(c, discs, model, error)
+                if (allocated(error)) return
+                allocate (u(model%ndof))
+                do j = 1, size(u)
+                    u(j) = 2.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+                end do
+                call contact_fd(model%pairs(1)%pair, u, state_stick, trim(methods(im))//' blocks, layer '// &
+                                char(48 + iq), error)
+                if (allocated(error)) return
+                deallocate (u)
+            end do
+        end do
+    end subroutine test_tangent_fd_deformable
+
+    !> The box [0, 1] x [0, 1] x [z0, z0 + 1] (degree 1).
+    function unit_box(z0) result(patch)
+        real(dp), intent(in) :: z0
+        type(nurbs_patch_t) :: patch
+        real(dp) :: cp(3, 8)
+        integer :: i, j, k, a
+        type(knots_t) :: lin
+        a = 0
+        do k = 0, 1
+            do j = 0, 1
+                do i = 0, 1
+                    a = a + 1
+                    cp(:, a) = [real(i, dp), real(j, dp), z0 + real(k, dp)]
+                end do
+            end do
+        end do
+        lin = knots_t([0.0_dp, 0.0_dp, 1.0_dp, 1.0_dp])
+        patch = new_patch([1, 1, 1], [lin, lin, lin], [2, 2, 2], cp, [(1.0_dp, a=1, 8)])
+    end function unit_box
 
     !> The points' reference areas add up to the face's: the quarter cylinder r = 2,
     !> z in [0, 1], pi (its rational map integrated to the quadrature's accuracy).

@@ -184,7 +184,7 @@ contains
         integer, allocatable :: dofs(:)
         allocate (dofs(0))
         if (self%mlo(b) <= self%mhi(b)) &
-            dofs = [self%element_dofs(b), mdofs(2*self%mlo(b) - 1:2*self%mhi(b))]
+            dofs = [self%element_dofs(b), mdofs(self%nsd*(self%mlo(b) - 1) + 1:self%nsd*self%mhi(b))]
     end function gpts_block_dofs
 
     !> With friction: a stick anchor per slave point (`anchor`).

@@ -75,9 +75,10 @@ module voiga_contact_master
             logical, intent(out) :: found
             !> False if the local Newton iteration did not converge.
             logical, intent(out) :: converged
-            !> Where the same slave point projected at the last evaluation: a start
-            !> for the local iteration (its result does not depend on it but by rounding).
-            real(dp), intent(in), optional :: start
+            !> Where the same slave point projected at the last evaluation (its
+            !> parameters: [xi] on a curve, [xi, eta] on a surface): a start for the
+            !> local iteration (its result does not depend on it but by rounding).
+            real(dp), intent(in), optional :: start(:)
         end subroutine project_interface
     end interface
 

@@ -70,7 +70,7 @@ contains
         real(dp), intent(in) :: u(:), xs(:)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
-        real(dp), intent(in), optional :: start
+        real(dp), intent(in), optional :: start(:)
         if (size(u) < 0) return   ! the curve has no DOFs in u
         call nurbs_project(self, self%zero, xs, mp, found, converged, start)
         deallocate (mp%r, mp%dr, mp%dofs)

@@ -155,7 +155,7 @@ contains
         real(dp), intent(in) :: u(:), xs(:)
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
-        real(dp), intent(in), optional :: start
+        real(dp), intent(in), optional :: start(:)
         ! two evaluation buffers: the current one (cur) and the best so far (ib), whose
         ! roles swap instead of copying a point (and its arrays) on every improvement
         type(surface_point_t) :: pts(2)
@@ -218,8 +218,8 @@ contains
                 end if
                 xi0 = best
                 if (k == s0 .and. present(start)) then
-                    if (abs(start - best) <= (br(k + 1) - br(k))/real(m - 1, dp) .and. &
-                        start >= br(k) .and. start <= br(k + 1)) xi0 = start
+                    if (abs(start(1) - best) <= (br(k + 1) - br(k))/real(m - 1, dp) .and. &
+                        start(1) >= br(k) .and. start(1) <= br(k + 1)) xi0 = start(1)
                 end if
                 call span_newton(self%surf, u, xq, k, xi0, pts(cur), ok)
                 if (.not. ok) converged = .false.

@@ -61,7 +61,7 @@ contains
         type(master_point_t), intent(out) :: mp
         logical, intent(out) :: found, converged
         !> Not needed: the projection on a line is explicit.
-        real(dp), intent(in), optional :: start
+        real(dp), intent(in), optional :: start(:)
         integer :: d
         if (size(u) < 0) return   ! u is not needed: the line has no DOFs
         d = self%nsd

@@ -402,7 +402,7 @@ contains
         integer :: e, p, lo, hi
 
         if (self%slave%npar > 1) then
-            dofs = face_block_dofs(self, b)
+            dofs = face_block_dofs(self, b, mdofs)
             return
         end if
         p = self%slave%degree
@@ -418,21 +418,26 @@ contains
         dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
     end function mortar_block_dofs
 
-    !> Node b's block on a face (a rigid master: the slave DOFs only): the DOFs of the
-    !> control points of every cell whose functions include the node's.
-    pure function face_block_dofs(self, b) result(dofs)
+    !> Node b's block on a face: the DOFs of the control points of every cell whose
+    !> functions include the node's, then the master ranges of those cells (`mdofs`:
+    !> the master's DOFs, 3 per control point; none for a rigid master).
+    pure function face_block_dofs(self, b, mdofs) result(dofs)
         class(mortar_pair_t), intent(in) :: self
-        integer, intent(in) :: b
+        integer, intent(in) :: b, mdofs(:)
         integer, allocatable :: dofs(:), ids(:)
-        logical :: used(size(self%slave%cps))
+        logical :: used(size(self%slave%cps)), mused(size(mdofs)/3)
         integer :: e, nu
         nu = size(self%slave%spans)
         used = .false.
+        mused = .false.
         do e = self%node_first(b), self%node_last(b)
             ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
-            if (any(ids == b)) used(ids) = .true.
+            if (.not. any(ids == b)) cycle
+            used(ids) = .true.
+            if (self%mlo(e) <= self%mhi(e)) mused(self%mlo(e):self%mhi(e)) = .true.
         end do
         dofs = reshape(self%slave%dofs(:, pack([(e, e=1, size(used))], used)), [3*count(used)])
+        dofs = [dofs, pack(mdofs, reshape(spread(mused, 1, 3), [size(mdofs)]))]
     end function face_block_dofs
 
     !> The multiplier basis; with friction the shared history and a tangential

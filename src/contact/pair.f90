@@ -22,7 +22,7 @@ module voiga_contact_pair
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, surface_basis, &
-                                     surface_point_at, face_basis, face_point_at, n_elements
+                                     surface_point_at, face_basis, face_point_at, n_elements, face_ids
     use voiga_nurbs_patch, only: cross
     use voiga_contact_master, only: contact_master_t, master_point_t
     use voiga_contact_law, only: contact_law_t, state_inactive
@@ -541,8 +541,10 @@ contains
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
-            if (self%warm) then
-                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, out%xi_m)
+            if (self%warm .and. self%slave%npar > 1) then
+                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, [out%xi_m, out%eta_m])
+            else if (self%warm) then
+                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, [out%xi_m])
             else
                 call self%master%project(u, sp%x(1:self%nsd), mp, found, converged)
             end if

@@ -22,7 +22,14 @@ contains
     end procedure pair_fit_pattern
 
     module procedure pair_element_dofs
-        integer :: s, p
+        integer :: s, p, nu
+        integer, allocatable :: ids(:)
+        if (self%slave%npar > 1) then
+            nu = size(self%slave%spans)
+            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
+            dofs = reshape(self%slave%dofs(:, ids), [3*size(ids)])
+            return
+        end if
         p = self%slave%degree
         s = self%slave%spans(e)
         dofs = reshape(self%slave%dofs(:, s - p:s), [size(self%slave%dofs, 1)*(p + 1)])
@@ -63,7 +70,7 @@ contains
         changed = .false.
         if (.not. self%master%deformable) return
         allocate (lo(size(self%mlo)), hi(size(self%mhi)))
-        call self%wanted_ranges(size(self%master%all_dofs())/2, block, lo, hi)
+        call self%wanted_ranges(size(self%master%all_dofs())/self%nsd, block, lo, hi)
         changed = any(lo /= self%mlo) .or. any(hi /= self%mhi)
         if (.not. changed) return
         self%mlo = lo

@@ -9,11 +9,12 @@ module voiga_model
     use voiga_model_loads, only: dirichlet_t, pressure_t, dirichlet_settings_t, pressure_settings_t, phase_value, &
                                  obstacle_motion_t, phase_friction_t, phase_of
     use voiga_contact_pair, only: pair_slot_t
-    use voiga_contact_factory, only: contact_settings_t, new_contact_pair, rigid_normal_of
+    use voiga_contact_factory, only: contact_settings_t, new_contact_pair, rigid_normal_of, default_method
     use voiga_contact_surface, only: contact_surface_t, new_contact_surface
     use voiga_contact_master, only: contact_master_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
+    use voiga_contact_master_face, only: face_master_t, new_face_master
     use voiga_contact_master_curve, only: rigid_curve_t, new_rigid_curve
     implicit none
     private
@@ -163,6 +164,8 @@ contains
         type(rigid_line_t) :: rigid
         type(rigid_curve_t) :: curve
         type(nurbs_master_t) :: body_master
+        type(face_master_t) :: face_master
+        type(contact_settings_t) :: settings
         integer :: ib, im
 
         ib = find_body(self, inp%slave)
@@ -180,13 +183,19 @@ contains
         else if (trim(inp%master) == 'rigid') then
             call new_rigid_line(rigid, inp%rigid_point(1:self%nsd), rigid_normal_of(inp, self%nsd))
             allocate (master, source=rigid)
+        else if (self%nsd == 3) then
+            im = find_body(self, inp%master)
+            call new_face_master(face_master, self%bodies(im)%disc, self%bodies(im)%dof0)
+            allocate (master, source=face_master)
         else
             im = find_body(self, inp%master)
             call new_nurbs_master(body_master, self%bodies(im)%disc, self%bodies(im)%dof0)
             allocate (master, source=body_master)
         end if
-        call new_contact_pair(slot%pair, inp, slave, master, [ib, im], plane_modulus(self, ib, im), self%ndof, &
-                              error)
+        settings = inp
+        if (.not. inp%method_given) settings%method = default_method(trim(inp%master) == 'rigid', self%nsd)
+        call new_contact_pair(slot%pair, settings, slave, master, [ib, im], plane_modulus(self, ib, im), &
+                              self%ndof, error)
     end subroutine new_pair
 
     !> The plane-strain modulus E* of a pair: 1/E* = sum over its deformable bodies

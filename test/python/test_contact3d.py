@@ -112,7 +112,7 @@ def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
     (PLANE + ", method = 'segment'", "method = 'segment' is not implemented for solids yet"),
     (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
     (", rigid_point = 0.0, 0.0", "rigid_point needs 3 components"),
-    (", rigid_curve = 'arc'", "contact of a solid with another solid or a rigid surface"),
+    (", rigid_curve = 'arc'", "contact of a solid with a rigid surface of the geometry file"),
 ])
 def test_refused_with_the_cause(voiga_bin: Path, tmp_path: Path, contact: str, message: str) -> None:
     res = run(voiga_bin, box_case(tmp_path, contact), "--check")
@@ -146,3 +146,85 @@ def test_hertz3d_runs_and_reads(voiga_bin: Path, tmp_path: Path) -> None:
                           capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
     assert post.returncode == 0, post.stderr
     assert "relative L2 error of p" in post.stdout
+
+
+BLOCKS = """&case
+  title = 'blocks', geometry = 'geometry.h5', output = 'blocks.h5', n_bodies = 2
+/
+&body
+  name = 'upper', material = 'linear', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, degree_zeta = 2, nel_xi = 3, nel_eta = 2, nel_zeta = 2,
+  contact_face = 'bottom'
+/
+&body
+  name = 'lower', material = 'linear', youngs_modulus = 1.0, poisson_ratio = 0.3,
+  degree_xi = 2, degree_eta = 2, degree_zeta = 2, nel_xi = {nx}, nel_eta = {ny}, nel_zeta = 2,
+  contact_face = 'top'
+/
+&solver
+  n_steps = 1
+/
+&dirichlet
+  body = 'upper', face = 'left', fix_x = .true.
+/
+&dirichlet
+  body = 'upper', face = 'front', fix_y = .true.
+/
+&dirichlet
+  body = 'lower', face = 'left', fix_x = .true.
+/
+&dirichlet
+  body = 'lower', face = 'front', fix_y = .true.
+/
+&dirichlet
+  body = 'lower', face = 'bottom', fix_z = .true.
+/
+&pressure
+  body = 'upper', face = 'top', p = 0.01
+/
+&contact
+  slave = 'upper', master = 'lower'{method}
+/
+"""
+
+
+def blocks_spread(voiga_bin: Path, tmp: Path, nx: int, ny: int, method: str) -> tuple[float, np.ndarray]:
+    """The contact patch test between solids: the block [0, 2] x [0, 1] x [0, 1] (3 x 2
+    cells on its bottom face) pressed by 0.01 onto the block below it (`nx` x `ny`
+    cells on its top face); (max - min) / mean of the slave points' pressure, and the
+    contact force."""
+    write_volumes(tmp / "geometry.h5", {"upper": box((0.0, 2.0), (0.0, 1.0), (0.0, 1.0)),
+                                        "lower": box((0.0, 2.0), (0.0, 1.0), (-1.0, 0.0))})
+    case = tmp / "blocks.nml"
+    case.write_text(BLOCKS.format(nx=nx, ny=ny, method=method))
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    c = last_contact(tmp / "blocks.h5")
+    p = c["p_n_nominal"]
+    return (p.max() - p.min()) / p.mean(), c["force"]
+
+
+@pytest.mark.parametrize("method", ["", ", method = 'gpts'"])
+def test_blocks_matching_faces(voiga_bin: Path, tmp_path: Path, method: str) -> None:
+    """Matching faces: every method (the default on solids is mortar) passes the
+    contact patch test to round-off, and the force is the load."""
+    spread, force = blocks_spread(voiga_bin, tmp_path, 3, 2, method)
+    assert spread < 1e-12
+    assert np.allclose(force, [0.0, 0.0, 0.02], atol=1e-15, rtol=1e-12)
+
+
+def test_blocks_non_matching_faces(voiga_bin: Path, tmp_path: Path) -> None:
+    """Non-matching faces (3 x 2 cells on 5 x 3): the force is the load, but the
+    pressure is off by the quadrature error of the master's kinks inside slave cells,
+    as in 2D (docs/verification.md, "Contact on faces"): mortar's spread is below
+    GPTS's and falls with the points per cell (a segment-based method on faces, which
+    would pass exactly, is issue 42's next step)."""
+    spreads = {}
+    for method, n in [("gpts", 3), ("mortar", 3), ("mortar", 6), ("mortar", 9)]:
+        folder = tmp_path / f"{method}{n}"
+        folder.mkdir()
+        spread, force = blocks_spread(voiga_bin, folder, 5, 3, f", method = '{method}', n_gauss = {n}")
+        assert np.allclose(force, [0.0, 0.0, 0.02], atol=1e-6, rtol=1e-10)
+        spreads[method, n] = spread
+    assert spreads["mortar", 3] < spreads["gpts", 3]
+    assert spreads["mortar", 9] < spreads["mortar", 6] < spreads["mortar", 3] < 0.02

@@ -111,11 +111,11 @@ contains
             what = 'rigid_uz moves a rigid master along z: a plane case has no z'
         end if
         if (nsd == 3 .and. .not. allocated(what)) then
-            if (trim(c%master) /= 'rigid' .or. len_trim(c%rigid_curve) > 0) then
-                what = 'contact of a solid with another solid or a rigid surface of the geometry file is not '// &
-                       'implemented yet (issue 42); a solid can touch a rigid plane (master = ''rigid'', '// &
-                       'rigid_point, rigid_normal)'
-            else if (all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
+            if (len_trim(c%rigid_curve) > 0) then
+                what = 'contact of a solid with a rigid surface of the geometry file is not implemented yet '// &
+                       '(issue 42); a solid can touch a rigid plane (master = ''rigid'', rigid_point, '// &
+                       'rigid_normal) or another solid'
+            else if (c%method_given .and. all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
                 what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
                        "'mortar' or 'gpts'"
             else if (c%friction > 0.0_dp) then

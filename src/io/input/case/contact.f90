@@ -78,7 +78,9 @@ contains
         call check_pair(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         ! none named: the default for the kind of master
-        if (len_trim(entry%method) == 0) entry%method = default_method(trim(entry%master) == 'rigid')
+        ! (the plane default here; a solid case's is the model's, which knows the dimension)
+        entry%method_given = len_trim(entry%method) > 0
+        if (.not. entry%method_given) entry%method = default_method(trim(entry%master) == 'rigid', 2)
         call check_law(entry, bodies, path//trim(msg)//' ', error)
         if (allocated(error)) return
         ! not given: left to the pair (the automatic penalty, the tangential one the
