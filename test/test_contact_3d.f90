@@ -166,7 +166,7 @@ contains
             ! layer degree 3: q + 1 = 4 points per direction and cell; the face's cells
             ! are nel_xi x nel_eta = 1 x 4 (a layout counts along the patch turned so
             ! that the contact face is zeta = 1)
-            call check(error, pair%nsd == 3 .and. size(pair%xi) == 4*16, "4 x 4 points on each of 4 cells, got "// &
+            call check(error, pair%nsd == 3 .and. size(pair%xi) == 4*16, '4 x 4 points on each of 4 cells, got '// &
                        str(size(pair%xi)))
         end associate
     end subroutine test_face_area

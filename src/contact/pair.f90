@@ -292,6 +292,28 @@ module voiga_contact_pair
         end subroutine pair_refit_ranges
     end interface
 
+    !> Where the slave points lie and what they see (`voiga_contact_pair_points`).
+    interface
+        !> The Gauss points of a face: n_gauss^2 per cell (cells and points xi fastest),
+        !> from the 1D rule `gx`, `gw` on [-1, 1], and the functions there.
+        pure module subroutine face_points(self, gx, gw)
+            class(contact_pair_t), intent(inout) :: self
+            real(dp), intent(in) :: gx(:), gw(:)
+        end subroutine face_points
+
+        !> Evaluate slave point `k` at `u` and project it onto the master (`prepare`d):
+        !> its output record is reset to not in contact, with its positions, projection
+        !> and gap (huge without a projection).
+        pure module subroutine pair_project_point(self, u, k, sp, mp, found, converged)
+            class(contact_pair_t), intent(inout) :: self
+            real(dp), intent(in) :: u(:)
+            integer, intent(in) :: k
+            type(surface_point_t), intent(inout) :: sp
+            type(master_point_t), intent(out) :: mp
+            logical, intent(out) :: found, converged
+        end subroutine pair_project_point
+    end interface
+
 contains
 
     !> Place the slave Gauss points (n_gauss per slave element and direction; 0:
@@ -342,41 +364,6 @@ contains
         call shared_history(self)
         call self%setup_history()
     end subroutine pair_setup
-
-    !> The Gauss points of a face: n_gauss^2 per cell (cells and points xi fastest),
-    !> from the 1D rule `gx`, `gw` on [-1, 1], and the functions there.
-    pure subroutine face_points(self, gx, gw)
-        class(contact_pair_t), intent(inout) :: self
-        real(dp), intent(in) :: gx(:), gw(:)
-        integer :: ng, nu, nv, np, ci, cj, i, j, k
-        real(dp) :: lo(2), hi(2)
-        ng = size(gx)
-        nu = size(self%slave%spans)
-        nv = size(self%slave%spans_eta)
-        np = (self%slave%degree + 1)*(self%slave%degree_eta + 1)
-        allocate (self%xi(nu*nv*ng*ng), self%eta(nu*nv*ng*ng), self%w(nu*nv*ng*ng), &
-                  self%span(nu*nv*ng*ng), self%span_eta(nu*nv*ng*ng), self%slave_basis(np, 3, nu*nv*ng*ng))
-        k = 0
-        do cj = 1, nv
-            do ci = 1, nu
-                lo = [self%slave%breaks(ci), self%slave%breaks_eta(cj)]
-                hi = [self%slave%breaks(ci + 1), self%slave%breaks_eta(cj + 1)]
-                do j = 1, ng
-                    do i = 1, ng
-                        k = k + 1
-                        self%xi(k) = lo(1) + 0.5_dp*(hi(1) - lo(1))*(gx(i) + 1.0_dp)
-                        self%eta(k) = lo(2) + 0.5_dp*(hi(2) - lo(2))*(gx(j) + 1.0_dp)
-                        self%w(k) = 0.25_dp*(hi(1) - lo(1))*(hi(2) - lo(2))*gw(i)*gw(j)
-                        self%span(k) = self%slave%spans(ci)
-                        self%span_eta(k) = self%slave%spans_eta(cj)
-                        call face_basis(self%slave, self%xi(k), self%eta(k), [self%span(k), self%span_eta(k)], &
-                                        self%slave_basis(:, 1, k), self%slave_basis(:, 2, k), &
-                                        self%slave_basis(:, 3, k))
-                    end do
-                end do
-            end do
-        end do
-    end subroutine face_points
 
     !> The friction history every method keeps (mu > 0): projections, contact and
     !> gaps at the last converged state, one entry per slave point.
@@ -504,76 +491,6 @@ contains
         character(len=:), allocatable :: text
         text = ''
     end function pair_failure_diagnosis
-
-    !> Evaluate slave point `k` at `u` and project it onto the master (`prepare`d):
-    !> its output record is reset to not in contact, with its positions, projection
-    !> and gap (huge without a projection).
-    pure subroutine pair_project_point(self, u, k, sp, mp, found, converged)
-        class(contact_pair_t), intent(inout) :: self
-        real(dp), intent(in) :: u(:)
-        integer, intent(in) :: k
-        type(surface_point_t), intent(inout) :: sp
-        type(master_point_t), intent(out) :: mp
-        logical, intent(out) :: found, converged
-        real(dp) :: a0(3), b0(3), jac0
-        if (self%slave%npar > 1) then
-            call face_point_at(self%slave, u, self%xi(k), self%eta(k), [self%span(k), self%span_eta(k)], &
-                               self%slave_basis(:, 1, k), self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
-        else if (allocated(self%slave_basis)) then
-            call surface_point_at(self%slave, u, self%xi(k), self%span(k), self%slave_basis(:, 1, k), &
-                                  self%slave_basis(:, 2, k), self%slave_basis(:, 3, k), sp)
-        else
-            call surface_point(self%slave, u, self%xi(k), sp, self%span(k))
-        end if
-        associate (out => self%out(k))
-            call reference_point(self%slave, sp, out%x0, a0, b0)
-            out%x = sp%x
-            if (self%slave%npar > 1) then
-                jac0 = norm2(cross(a0, b0))
-                out%stretch = norm2(cross(sp%a, sp%b))/jac0
-            else
-                jac0 = norm2(a0(1:2))
-                out%stretch = norm2(sp%a(1:2))/jac0
-            end if
-            out%area0 = self%w(k)*jac0
-            out%state = state_inactive
-            out%pn = 0.0_dp
-            out%pt = 0.0_dp
-            out%pn0 = 0.0_dp
-            out%pt0 = 0.0_dp
-            if (self%warm .and. self%slave%npar > 1) then
-                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, [out%xi_m, out%eta_m])
-            else if (self%warm) then
-                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, [out%xi_m])
-            else
-                call self%master%project(u, sp%x(1:self%nsd), mp, found, converged)
-            end if
-            out%xi_m = mp%xi
-            out%eta_m = mp%eta
-            out%first = mp%first
-            out%last = mp%last
-            out%gap = huge(1.0_dp)
-            if (found) out%gap = dot_product(sp%x - mp%x, mp%n)
-        end associate
-    end subroutine pair_project_point
-
-    !> The reference position `x0` and tangents `a0` (by xi), `b0` (by eta, on a
-    !> face) of the slave point `sp` (its functions at the reference control points).
-    pure subroutine reference_point(slave, sp, x0, a0, b0)
-        type(contact_surface_t), intent(in) :: slave
-        type(surface_point_t), intent(in) :: sp
-        real(dp), intent(out) :: x0(3), a0(3), b0(3)
-        integer :: j, d
-        d = size(slave%x0, 1)
-        x0 = 0.0_dp
-        a0 = 0.0_dp
-        b0 = 0.0_dp
-        do j = 1, size(sp%local)
-            x0(1:d) = x0(1:d) + slave%x0(:, sp%local(j))*sp%r(j)
-            a0(1:d) = a0(1:d) + slave%x0(:, sp%local(j))*sp%dr(j)
-            if (slave%npar > 1) b0(1:d) = b0(1:d) + slave%x0(:, sp%local(j))*sp%drb(j)
-        end do
-    end subroutine reference_point
 
     !> The error of a slave point whose projection did not converge.
     pure subroutine pair_projection_error(self, k, error)

@@ -261,7 +261,8 @@ contains
             if (j < nb) call surface_point(surf, u, surf%breaks(j), right, surf%spans(j))
             if (j > 1) lines = reshape([lines, left%x(1:2), left%a(1:2), surf%breaks(j)], [5, size(lines, 2) + 1])
             if (j == 1 .or. j == nb) then
-                if (j == 1) lines = reshape([lines, right%x(1:2), right%a(1:2), surf%breaks(j)], [5, size(lines, 2) + 1])
+                if (j == 1) lines = reshape([lines, right%x(1:2), right%a(1:2), surf%breaks(j)], &
+                                            [5, size(lines, 2) + 1])
                 cycle
             end if
             ! the same line unless the tangent turns at the knot

@@ -196,7 +196,8 @@ contains
         list = [list, warning_t(pair_label(pair)//'the bodies overlap at the start: '//str(n)//' of '// &
                                 str(size(depth))//' slave points lie inside the master, the deepest by '// &
                                 trim(adjustl(real_str(-pair%out(k)%gap, 'es10.3')))//' at '// &
-                                point_str(pair%out(k)%x0(1:pair%nsd))//' ('//trim(adjustl(real_str(depth(k), 'f6.2')))// &
+                                point_str(pair%out(k)%x0(1:pair%nsd))//' ('// &
+                                trim(adjustl(real_str(depth(k), 'f6.2')))// &
                                 ' slave elements). If the bodies do not overlap, '//wrong_way(pair), &
                                 topic=pair_label(pair)//'the bodies overlap at the start')]
     end subroutine overlap_warning
@@ -274,7 +275,8 @@ contains
                        vector_str(m%n(1:m%nsd))//' points to): move rigid_point (the obstacle lies on the side '// &
                        'rigid_normal points away from)'
             else
-                text = 'rigid_normal = '//vector_str(m%n(1:m%nsd))//' points into the slave (the obstacle lies on the '// &
+                text = 'rigid_normal = '//vector_str(m%n(1:m%nsd))//' points into the slave (the obstacle lies '// &
+                       'on the '// &
                        'side rigid_normal points away from): give rigid_normal = '//vector_str(-m%n(1:m%nsd), .false.)
             end if
         class is (rigid_curve_t)
