@@ -38,6 +38,7 @@ contains
         type(unittest_t), allocatable, intent(out) :: testsuite(:)
         testsuite = [ &
                     new_unittest('update_solves_as_whole_lu', test_update_vs_lu), &
+                    new_unittest('lazy_update_solves_as_whole_lu', test_lazy_vs_lu), &
                     new_unittest('update_beyond_max_rank_factorizes_whole', test_whole), &
                     new_unittest('update_outside_reach_factorizes_whole', test_outside_reach), &
                     new_unittest('linear_gpts_factorizes_once', test_gpts), &
@@ -203,6 +204,21 @@ contains
     !> once, with the reach ordered last.
     subroutine test_update_vs_lu(error)
         type(error_t), allocatable, intent(out) :: error
+        call update_vs_lu(.false., error)
+    end subroutine test_update_vs_lu
+
+    !> The same with the reach updated lazily (a reach above `eager_reach`, as a solid's
+    !> contact face): the columns of K0^-1 computed for the first tangent's DOFs serve
+    !> the next ones, and the solves, determinants and the single factorization are
+    !> those of the eager update.
+    subroutine test_lazy_vs_lu(error)
+        type(error_t), allocatable, intent(out) :: error
+        call update_vs_lu(.true., error)
+    end subroutine test_lazy_vs_lu
+
+    subroutine update_vs_lu(lazy, error)
+        logical, intent(in) :: lazy
+        type(error_t), allocatable, intent(out) :: error
         integer, parameter :: n = 60
         integer, parameter :: cdofs(5) = [7, 8, 31, 32, 50], reach(7) = [50, 7, 8, 12, 31, 32, 44]
         type(csc_matrix_t) :: k0, k
@@ -216,7 +232,7 @@ contains
         if (allocated(error)) return
         fixed = .false.
         fixed(1) = .true.
-        call new_bulk_update(fast, k0, fixed, reach, error)
+        call new_bulk_update(fast, k0, fixed, reach, error, eager_reach=merge(0, size(reach), lazy))
         if (allocated(error)) return
         call check(error, fast%max_rank >= size(cdofs), 'an update of 5 DOFs is within max_rank')
         if (allocated(error)) return
@@ -267,7 +283,7 @@ contains
         end do
         call fast%factorizations(sym, num)
         call check(error, num, 1, 'K0 factorized once for three tangents')
-    end subroutine test_update_vs_lu
+    end subroutine update_vs_lu
 
     !> A tangent that differs from K0 on a DOF outside the reach (as a bulk that
     !> changed would) is factorized whole and solves as UMFPACK does.

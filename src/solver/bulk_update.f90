@@ -17,6 +17,14 @@
 !> exact whatever the caller assembled: where it differs outside R (a body that is
 !> not linear after all, another Dirichlet set) or on more DOFs than the dense work
 !> pays for, K is factorized whole.
+!>
+!> A large reach (a solid's contact face: thousands of DOFs, where S's |R|^3 would cost
+!> more than many factorizations) is updated lazily instead: K0 factorized without an
+!> ordering constraint, and the columns Z of K0^-1 computed only for the DOFs contact
+!> has coupled so far, when a tangent first needs them (one solve with L and L^T each,
+!> kept for the run: K0 does not change); then S_CC = Z_C rows, and
+!>
+!>     x0 = K0^-1 b,    (I + S_CC D_CC) y = x0_C,    x = x0 - Z_C D_CC y.
 module voiga_solver_bulk_update
     use, intrinsic :: iso_c_binding, only: c_int
     use voiga_kinds, only: dp
@@ -48,6 +56,13 @@ module voiga_solver_bulk_update
     !> Largest reach by default: S, dense of order |R|, takes at most 128 MiB (a
     !> contact edge of 4096 DOFs; hertz m4 NN2.2 has 436, m6 N2 580).
     integer, parameter :: default_max_reach = 4096
+    !> A reach larger than this is updated lazily (see the module): S's |R|^3 flops
+    !> (1e9 here) then cost more than the columns contact couples (the 2D cases' reaches,
+    !> at most 580, stay eager; a solid's face of 3072 DOFs took 6 s to form S).
+    integer, parameter :: default_eager_reach = 1024
+    !> The lazy columns of K0^-1 take at most this many bytes; a tangent needing more
+    !> is factorized whole.
+    real(dp), parameter :: max_column_bytes = 1024.0_dp**3
 
     !> K0 counts as symmetric when max |K0 - K0^T| <= this x max |K0| (rounding of
     !> the element integrals: each element matrix is symmetric but summed in the
@@ -79,6 +94,12 @@ module voiga_solver_bulk_update
         real(dp), allocatable, private :: d(:, :), lu(:, :)
         integer, private :: sign_m = 0
         real(dp), private :: log_m = 0.0_dp
+        !> Lazy mode: the columns of K0^-1 computed so far [n, capacity] (`nz` of them),
+        !> each DOF's column (0: none yet) [n], and the reach's size.
+        logical, private :: lazy = .false.
+        real(dp), allocatable, private :: z(:, :)
+        integer, allocatable, private :: zcol(:)
+        integer, private :: nz = 0, m_reach = 0
     contains
         procedure :: factor => bulk_factor
         procedure :: solve => bulk_solve
@@ -100,18 +121,23 @@ contains
     !> error with code `numeric`: the caller then factorizes whole tangents (a body
     !> that only contact holds in place has a singular K0). A reach of more than
     !> `max_reach` DOFs (default `default_max_reach`) is an error too: S would not pay.
-    subroutine new_bulk_update(self, k0, fixed, reach, error, max_reach)
+    subroutine new_bulk_update(self, k0, fixed, reach, error, max_reach, eager_reach)
         type(bulk_update_t), intent(out) :: self
         type(csc_matrix_t), intent(in) :: k0
         logical, intent(in) :: fixed(:)
         integer, intent(in) :: reach(:)
         type(error_t), allocatable, intent(out) :: error
-        integer, intent(in), optional :: max_reach
+        !> Largest eager reach (default `default_max_reach`), and the reach beyond
+        !> which the update is lazy (default `default_eager_reach`).
+        integer, intent(in), optional :: max_reach, eager_reach
         real(dp) :: rel
-        integer :: m, k, limit
+        integer :: m, k, limit, eager
         limit = default_max_reach
         if (present(max_reach)) limit = max_reach
-        if (size(reach) > limit) then
+        eager = default_eager_reach
+        if (present(eager_reach)) eager = eager_reach
+        self%lazy = size(reach) > eager
+        if (size(reach) > limit .and. .not. self%lazy) then
             call fatal_error(error, 'bulk update: contact can reach '//str(size(reach))//' DOFs, more than '// &
                              str(limit)//' (the dense S of their K0^-1 would take '// &
                              real_str(8.0_dp*real(size(reach), dp)**2/2.0_dp**20, 'f0.0')//' MiB)')
@@ -125,7 +151,11 @@ contains
                              real_str(rel, 'es9.2')//')', error_code%numeric)
             return
         end if
-        call self%chol%factor_last(self%k0, reach, error)
+        if (self%lazy) then
+            call self%chol%factor(self%k0, error)
+        else
+            call self%chol%factor_last(self%k0, reach, error)
+        end if
         if (allocated(error)) return
         if (self%chol%rcond < singular_rcond) then
             call fatal_error(error, 'the bulk stiffness is singular (CHOLMOD''s reciprocal condition estimate '// &
@@ -134,6 +164,13 @@ contains
         end if
         self%max_rank = max(min_rank, floor((3.0_dp*self%chol%flops/8.0_dp)**(1.0_dp/3.0_dp)))
         m = size(reach)
+        self%m_reach = m
+        if (self%lazy) then
+            allocate (self%at(k0%n), self%zcol(k0%n), source=0)
+            self%at(reach) = 1
+            allocate (self%z(k0%n, 0), self%l_rr(0, 0), self%c(0), self%piv(0), self%d(0, 0), self%lu(0, 0))
+            return
+        end if
         self%perm = self%chol%permutation()
         allocate (self%at(k0%n), source=0)
         self%at(self%perm(k0%n - m + 1:)) = [(k, k=1, m)]
@@ -174,6 +211,10 @@ contains
         self%c = update_dofs(a, self%base)
         self%whole = size(self%c) > self%max_rank
         if (.not. self%whole) self%whole = any(self%at(self%c) == 0)
+        if (.not. self%whole .and. self%lazy) then
+            call lazy_columns(self, error)
+            if (allocated(error)) return
+        end if
         if (self%whole) then
             call self%full%factor(a, error)
             return
@@ -267,7 +308,12 @@ contains
                 if (i == 0) cycle
                 v = a%values(p) - self%base(p)
                 self%d(i, q) = v
-                if (v /= 0.0_dp) self%lu(:, q) = self%lu(:, q) + v*self%s(idx, idx(i))
+                if (v == 0.0_dp) cycle
+                if (self%lazy) then
+                    self%lu(:, q) = self%lu(:, q) + v*self%z(self%c, self%zcol(self%c(i)))
+                else
+                    self%lu(:, q) = self%lu(:, q) + v*self%s(idx, idx(i))
+                end if
             end do
             self%lu(q, q) = self%lu(q, q) + 1.0_dp
         end do
@@ -349,6 +395,10 @@ contains
             call self%full%solve_columns(a, b, x, error)
             return
         end if
+        if (self%lazy) then
+            call lazy_solve(self, a, b, x, error)
+            return
+        end if
         allocate (w, mold=b)
         call self%chol%forward(b(self%perm, :), w, error)
         if (allocated(error)) return
@@ -384,6 +434,58 @@ contains
         w_r = w_r - z
     end subroutine reach_correction
 
+    !> Lazy mode: the columns of K0^-1 of the DOFs of C not computed yet, solved for
+    !> at once and kept; if they would take more than `max_column_bytes`, the tangent
+    !> is factorized whole instead (`whole`).
+    subroutine lazy_columns(self, error)
+        type(bulk_update_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: e(:, :), cols(:, :), grown(:, :)
+        integer, allocatable :: missing(:)
+        integer :: n, j
+        n = size(self%zcol)
+        missing = pack(self%c, self%zcol(self%c) == 0)
+        if (size(missing) == 0) return
+        if (8.0_dp*real(n, dp)*real(self%nz + size(missing), dp) > max_column_bytes) then
+            self%whole = .true.
+            return
+        end if
+        allocate (e(n, size(missing)), cols(n, size(missing)), source=0.0_dp)
+        do j = 1, size(missing)
+            e(missing(j), j) = 1.0_dp
+        end do
+        call self%chol%solve_columns(self%k0, e, cols, error)
+        if (allocated(error)) return
+        if (self%nz + size(missing) > size(self%z, 2)) then
+            allocate (grown(n, max(2*size(self%z, 2), self%nz + size(missing))))
+            grown(:, 1:self%nz) = self%z(:, 1:self%nz)
+            call move_alloc(grown, self%z)
+        end if
+        self%z(:, self%nz + 1:self%nz + size(missing)) = cols
+        self%zcol(missing) = [(self%nz + j, j=1, size(missing))]
+        self%nz = self%nz + size(missing)
+    end subroutine lazy_columns
+
+    !> Lazy mode: X0 = K0^-1 B, (I + S_CC D_CC) Y = X0_C, X = X0 - Z_C D_CC Y.
+    subroutine lazy_solve(self, a, b, x, error)
+        type(bulk_update_t), intent(inout) :: self
+        type(csc_matrix_t), intent(in) :: a
+        real(dp), intent(in) :: b(:, :)
+        real(dp), intent(out) :: x(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), allocatable :: y(:, :)
+        integer :: info
+        call self%chol%solve_columns(a, b, x, error)
+        if (allocated(error) .or. size(self%c) == 0) return
+        y = x(self%c, :)
+        call lu_solve(self%lu, self%piv, y, info)
+        if (info /= 0) then
+            call fatal_error(error, 'bulk update: dense solve failed (info '//str(info)//')')
+            return
+        end if
+        x = x - matmul(self%z(:, self%zcol(self%c)), matmul(self%d, y))
+    end subroutine lazy_solve
+
     pure logical function bulk_has_determinant(self)
         class(bulk_update_t), intent(in) :: self
         bulk_has_determinant = .true.
@@ -418,7 +520,7 @@ contains
 
     pure integer function bulk_reach(self) result(n)
         class(bulk_update_t), intent(in) :: self
-        n = size(self%l_rr, 1)
+        n = self%m_reach
     end function bulk_reach
 
 end module voiga_solver_bulk_update
