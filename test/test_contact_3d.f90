@@ -9,7 +9,8 @@ module test_contact_3d
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_layout, only: layout_t
     use voiga_contact_factory, only: contact_settings_t
-    use voiga_contact_law, only: state_stick
+    use voiga_contact_law, only: state_stick, state_slip
+    use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
@@ -37,6 +38,7 @@ contains
         testsuite = [ &
                     new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
                     new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
+                    new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
                     new_unittest('contact_3d_face_area', test_face_area), &
                     new_unittest('rigid_plane_frame', test_plane_frame) &
                     ]
@@ -45,10 +47,12 @@ contains
     !> The quarter ring (E = 1) whose outer cylinder r = 2 is the slave face, against
     !> the tilted plane through (1.9, 0, 0.5) whose obstacle lies beyond it (outward
     !> normal towards the ring): the cylinder's points near theta = 0 penetrate.
-    subroutine ring_on_plane(layout, model, error)
+    subroutine ring_on_plane(layout, model, error, mu)
         type(layout_t), intent(in) :: layout
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
+        !> Coulomb's coefficient (default 0).
+        real(dp), intent(in), optional :: mu
         type(scene_t) :: c
         type(discretization_t) :: discs(1)
         type(contact_settings_t) :: contact
@@ -60,6 +64,7 @@ contains
         contact%rigid_normal = [-1.0_dp, -0.2_dp, 0.1_dp]
         contact%point_components = 3
         contact%normal_components = 3
+        if (present(mu)) contact%friction = mu
         c%contact = [contact]
         call new_discretization(discs(1), ring_block(), faces, layout, '', error)
         if (allocated(error)) return
@@ -131,6 +136,70 @@ contains
             end do
         end do
     end subroutine test_tangent_fd_deformable
+
+    !> Coulomb friction on the tangent plane: every point in contact at the last
+    !> converged state, anchored `shift` (in both master coordinates) behind its present
+    !> projection; K against central differences when every point sticks (mu = 0.5, a
+    !> shift of 1e-5) and when every point slips (mu = 0.3, 0.05), on the ring against
+    !> the tilted plane (N2, NN3) and in Tresca mode (a fixed bound of 0.2 mu p_N, the
+    !> outer loop's); and a point that touched in this step (open at the last converged
+    !> state with a gap of 1e-3 there: only the slip after the touch counts).
+    subroutine test_friction_fd(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(layout_t) :: layouts(2)
+        integer :: il
+        layouts = [layout3(2, [2, 3, 2], 0, 0, 'outer'), layout3(2, [1, 2, 2], 3, 0, 'outer')]
+        do il = 1, 2
+            call friction_fd(layouts(il), 0.5_dp, 1.0e-5_dp, state_stick, 'stick', error)
+            if (allocated(error)) return
+            call friction_fd(layouts(il), 0.3_dp, 0.05_dp, state_slip, 'slip', error)
+            if (allocated(error)) return
+        end do
+        call friction_fd(layouts(1), 0.3_dp, 0.05_dp, state_slip, 'tresca', error, tresca=0.2_dp)
+        if (allocated(error)) return
+        call friction_fd(layouts(2), 0.5_dp, 1.0e-5_dp, state_stick, 'touch', error, touch=1.0e-3_dp)
+    end subroutine test_friction_fd
+
+    subroutine friction_fd(layout, mu, shift, want, label, error, tresca, touch)
+        type(layout_t), intent(in) :: layout
+        real(dp), intent(in) :: mu, shift
+        integer, intent(in) :: want
+        character(len=*), intent(in) :: label
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), intent(in), optional :: tresca, touch
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:), r(:)
+        integer :: j
+        call ring_on_plane(layout, model, error, mu)
+        if (allocated(error)) return
+        allocate (u(model%ndof), r(model%ndof))
+        do j = 1, size(u)
+            u(j) = 1.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+        end do
+        r = 0.0_dp
+        call model%pairs(1)%pair%evaluate(u, r, error)
+        if (allocated(error)) return
+        select type (pair => model%pairs(1)%pair)
+        type is (gpts_pair_t)
+            associate (h => pair%hist%field)
+                h(pair%h_active)%last = 1.0_dp
+                h(pair%h_anchor)%last = pair%out%xi_m - shift
+                h(pair%h_anchor_eta)%last = pair%out%eta_m - shift
+                if (present(tresca)) pair%slip_bound = tresca*mu*max(0.0_dp, pair%out%pn)
+                if (present(touch)) then
+                    h(pair%h_active)%last = 0.0_dp
+                    h(pair%h_xi)%last = pair%out%xi_m - shift
+                    h(pair%h_eta)%last = pair%out%eta_m - shift
+                    h(pair%h_gap)%last = touch
+                end if
+            end associate
+        class default
+            call check(error, .false., 'a GPTS pair')
+            return
+        end select
+        call contact_fd(model%pairs(1)%pair, u, want, 'friction '//label, error)
+    end subroutine friction_fd
 
     !> The box [0, 1] x [0, 1] x [z0, z0 + 1] (degree 1).
     function unit_box(z0) result(patch)

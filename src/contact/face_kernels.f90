@@ -7,9 +7,8 @@
 !> law's parameters, the history and the output are the pairs' (docs/theory.md,
 !> section 7, "Faces").
 !>
-!> Normal contact only: the tangential (Coulomb) part on the two-dimensional
-!> tangent plane is issue 42's next step, and a frictional pair on a face is refused
-!> where the case is read.
+!> Friction: GPTS only (Coulomb on the tangent plane, `coulomb3`); a frictional
+!> mortar pair on a face is refused where the case is read.
 !>
 !> Local DOFs of a point: the slave point's functions first (3 per function), then
 !> the master's (none for a rigid master), as in `voiga_contact_kinematics`.
@@ -17,7 +16,7 @@ module voiga_contact_face_kernels
     use voiga_kinds, only: dp
     use voiga_contact_surface, only: surface_point_t
     use voiga_contact_master, only: master_point_t
-    use voiga_contact_law, only: contact_law_t
+    use voiga_contact_law, only: contact_law_t, state_stick, state_slip
     use voiga_nurbs_patch, only: cross
     implicit none
     private
@@ -27,35 +26,111 @@ module voiga_contact_face_kernels
 contains
 
     !> Residual `r` (internal-force sign: r = -int G^T t da) and tangent `k` of an
-    !> active slave point on a face, t = p_N n with p_N = -eps_n g. `w` is the Gauss
-    !> weight times the parametric Jacobian of the slave cell: da = |a_1 x a_2| w.
-    pure subroutine gpts_point3(law, w, sp, mp, r, k, g, pn)
+    !> active slave point on a face, t = p_N n + t_T with p_N = -eps_n g. `w` is the
+    !> Gauss weight times the parametric Jacobian of the slave cell: da = |a_1 x a_2| w.
+    !> Frictionless when mu = 0 (no friction code runs). With friction, Coulomb's law on
+    !> the tangent plane by an elastic predictor on the convected slip since the stick
+    !> anchor and a radial return (section 7, "Faces"): the slip s = xi - anchor (for a
+    !> point that touched in this step, the part after the touch, as on an edge), its
+    !> vector g_T = s^alpha m_alpha, the trial t_T = -eps_T g_T; beyond mu p_N (or the
+    !> prescribed `bound`, Tresca mode) t_T = mu p_N nu, nu = t_tr / |t_tr|, and the anchor
+    !> follows to where |t_tr| = mu p_N.
+    pure subroutine gpts_point3(law, w, sp, mp, anchor, touch, gap0, r, k, state, g, pn, tt, new_anchor, bound)
         type(contact_law_t), intent(in) :: law
         real(dp), intent(in) :: w
         type(surface_point_t), intent(in) :: sp
         type(master_point_t), intent(in) :: mp
+        !> The committed stick anchor (master coordinates), whether the point was open at
+        !> the last converged state and its gap there (`voiga_contact_gpts`, `gpts_point`).
+        real(dp), intent(in) :: anchor(2), gap0
+        logical, intent(in) :: touch
         real(dp), intent(out) :: r(:), k(:, :)
-        !> Normal gap and contact pressure (>= 0 in contact).
-        real(dp), intent(out) :: g, pn
-        real(dp) :: gm(3, size(r)), dm(3, size(r), 2), c(size(r), 2), ng(size(r)), dn(3, size(r)), &
-                    dda(size(r)), gt(size(r)), t(3), da
+        integer, intent(out) :: state
+        !> Normal gap, contact pressure (>= 0 in contact), tangential traction [3].
+        real(dp), intent(out) :: g, pn, tt(3)
+        real(dp), intent(out) :: new_anchor(2)
+        real(dp), intent(in), optional :: bound
+        real(dp) :: gm(3, size(r)), dm(3, size(r), 2), dmt(3, size(r), 2), c(size(r), 2), ng(size(r)), &
+                    dn(3, size(r)), dda(size(r)), gt(size(r)), dt(3, size(r)), t(3), da
         integer :: a, b
-        call face_linearization(sp, mp, w, g, da, gm, dm, c, ng, dn, dda)
+        call face_linearization(sp, mp, w, g, da, gm, dm, c, ng, dn, dda, dmt)
         pn = -law%eps_n*g
-        t = pn*mp%n
+        do a = 1, size(r)
+            dt(:, a) = -law%eps_n*mp%n*ng(a) + pn*dn(:, a)
+        end do
+        tt = 0.0_dp
+        state = state_stick
+        new_anchor = [mp%xi, mp%eta]
+        if (law%mu > 0.0_dp) call coulomb3(law, mp, anchor, touch, gap0, g, pn, c, ng, dmt, tt, dt, state, &
+                                           new_anchor, bound)
+        t = pn*mp%n + tt
         do a = 1, size(r)
             gt(a) = dot_product(t, gm(:, a))
         end do
         r = -da*gt
         do a = 1, size(r)
-            ! dt = -eps_n n ng^T + pn dn; the master functions move with xi; da varies
+            ! the master functions move with xi; da varies
             do b = 1, size(r)
-                k(b, a) = -da*dot_product(gm(:, b), -law%eps_n*mp%n*ng(a) + pn*dn(:, a)) &
+                k(b, a) = -da*dot_product(gm(:, b), dt(:, a)) &
                           + da*(dot_product(dm(:, b, 1), t)*c(a, 1) + dot_product(dm(:, b, 2), t)*c(a, 2)) &
                           - gt(b)*dda(a)
             end do
         end do
     end subroutine gpts_point3
+
+    !> The tangential traction `tt` of Coulomb's law on a face (see `gpts_point3`), added
+    !> with its derivative to `dt` [3, nd]; `c` the projection's derivative [nd, 2],
+    !> `ng` the gap's, `dmt` the master tangents' total derivatives [3, nd, 2].
+    pure subroutine coulomb3(law, mp, anchor, touch, gap0, g, pn, c, ng, dmt, tt, dt, state, new_anchor, bound)
+        type(contact_law_t), intent(in) :: law
+        type(master_point_t), intent(in) :: mp
+        real(dp), intent(in) :: anchor(2), gap0, g, pn, c(:, :), ng(:), dmt(:, :, :)
+        logical, intent(in) :: touch
+        real(dp), intent(out) :: tt(3)
+        real(dp), intent(inout) :: dt(:, :), new_anchor(2)
+        integer, intent(inout) :: state
+        real(dp), intent(in), optional :: bound
+        real(dp) :: s(2), ds(size(ng), 2), gtv(3), dg(3, size(ng)), nu(3), limit, f, tr
+        integer :: a
+        s = [mp%xi, mp%eta] - anchor
+        ds = c
+        if (touch) then
+            ! only the slip after the interpolated touch counts (none without a projection then)
+            if (gap0 < huge(1.0_dp) .and. gap0 > g) then
+                f = -g/(gap0 - g)
+                ds(:, 1) = f*c(:, 1) - s(1)*gap0/(gap0 - g)**2*ng
+                ds(:, 2) = f*c(:, 2) - s(2)*gap0/(gap0 - g)**2*ng
+                s = f*s
+            else
+                s = 0.0_dp
+                ds = 0.0_dp
+            end if
+        end if
+        gtv = s(1)*mp%a + s(2)*mp%b
+        do a = 1, size(ng)
+            dg(:, a) = mp%a*ds(a, 1) + mp%b*ds(a, 2) + s(1)*dmt(:, a, 1) + s(2)*dmt(:, a, 2)
+        end do
+        tt = -law%eps_t*gtv
+        tr = norm2(tt)
+        limit = law%mu*pn
+        if (present(bound)) limit = bound
+        new_anchor = [mp%xi, mp%eta] - s
+        if (tr <= limit .or. .not. law%return_map) then
+            dt = dt - law%eps_t*dg
+            return
+        end if
+        ! radial return: t_T = limit nu; d nu = (I - nu nu^T) d t_tr / |t_tr|
+        state = state_slip
+        nu = tt/tr
+        tt = limit*nu
+        do a = 1, size(ng)
+            dg(:, a) = -law%eps_t*dg(:, a)
+            dt(:, a) = dt(:, a) + limit/tr*(dg(:, a) - nu*dot_product(nu, dg(:, a)))
+            ! Coulomb: the bound moves with p_N (Tresca: it is fixed)
+            if (.not. present(bound)) dt(:, a) = dt(:, a) - law%mu*law%eps_n*ng(a)*nu
+        end do
+        new_anchor = [mp%xi, mp%eta] - (limit/tr)*s
+    end subroutine coulomb3
 
     !> The mortar-type point on a face (frictionless): residual `r` = -w0 G^T (pbar n)
     !> at the fixed interpolated pressure `pbar` (per reference area, `w0` the point's
@@ -92,11 +167,13 @@ contains
     !> normal's dn = `dn` du = -a^alpha (n . dm_alpha), dm_alpha = Dm_alpha du +
     !> m_alpha,beta c_beta du (a^alpha contravariant); the area element's d(da) =
     !> `dda` du = da a_s^alpha . Ds_alpha du.
-    pure subroutine face_linearization(sp, mp, w, g, da, gm, dm, c, ng, dn, dda)
+    pure subroutine face_linearization(sp, mp, w, g, da, gm, dm, c, ng, dn, dda, dmt)
         type(surface_point_t), intent(in) :: sp
         type(master_point_t), intent(in) :: mp
         real(dp), intent(in) :: w
         real(dp), intent(out) :: g, da, gm(:, :), dm(:, :, :), c(:, :), ng(:), dn(:, :), dda(:)
+        !> The master tangents' total derivatives dm_alpha [3, nd, 2] (optional).
+        real(dp), intent(out), optional :: dmt(:, :, :)
         real(dp) :: ds(3, size(ng), 2), n(3), mt(3, 2), mc(3, 2), sc(3, 2), amat(2, 2), ainv(2, 2), &
                     h(3, 2, 2), q(2), na(2), det
         integer :: a, b, al
@@ -128,6 +205,7 @@ contains
             do al = 1, 2
                 na(al) = dot_product(n, dm(:, a, al)) + dot_product(n, h(:, al, 1))*c(a, 1) + &
                          dot_product(n, h(:, al, 2))*c(a, 2)
+                if (present(dmt)) dmt(:, a, al) = dm(:, a, al) + h(:, al, 1)*c(a, 1) + h(:, al, 2)*c(a, 2)
             end do
             dn(:, a) = -(mc(:, 1)*na(1) + mc(:, 2)*na(2))
             dda(a) = da*(dot_product(sc(:, 1), ds(:, a, 1)) + dot_product(sc(:, 2), ds(:, a, 2)))

@@ -42,6 +42,8 @@ module voiga_contact_gpts
         !> The index in `hist` of the stick anchors (master convective coordinate)
         !> [npts]; 0 without friction.
         integer :: h_anchor = 0
+        !> On a face, the anchors' second coordinate (`anchor_eta`).
+        integer :: h_anchor_eta = 0
         !> Tresca mode while allocated (only with mu > 0) [npts]: the slip limit of each
         !> slave point is this prescribed traction instead of mu p_N (never committed).
         real(dp), allocatable :: slip_bound(:)
@@ -84,7 +86,7 @@ contains
         type(master_point_t) :: mp
         real(dp), allocatable :: rl(:), kl(:, :)
         integer, allocatable :: dofs(:)
-        real(dp) :: g, pn, pt, anchor, new_anchor, gap0
+        real(dp) :: g, pn, pt, anchor, new_anchor, gap0, new_anchor2(2)
         integer :: k, state, nd, j
         logical :: found, converged, inside, touch
 
@@ -98,6 +100,10 @@ contains
                 self%hist%field(self%h_active)%trial(k) = 0.0_dp
                 self%hist%field(self%h_anchor)%trial(k) = mp%xi
                 self%hist%field(self%h_gap)%trial(k) = self%out(k)%gap
+            end if
+            if (self%h_anchor_eta > 0) then
+                self%hist%field(self%h_eta)%trial(k) = mp%eta
+                self%hist%field(self%h_anchor_eta)%trial(k) = mp%eta
             end if
             if (.not. found) cycle
             if (self%out(k)%gap >= self%gap_tol) cycle
@@ -124,10 +130,9 @@ contains
             end if
             if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
             if (self%nsd == 3) then
-                call gpts_point3(self%law, self%w(k), sp, mp, rl, kl, g, pn)
-                state = state_stick
-                pt = 0.0_dp
-                new_anchor = mp%xi
+                call face_point(self, k, sp, mp, touch, gap0, rl, kl, state, pn, new_anchor2)
+                pt = norm2(self%out(k)%tt)
+                new_anchor = new_anchor2(1)
             else if (allocated(self%slip_bound)) then
                 call gpts_point(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, pt, &
                                 new_anchor, self%slip_bound(k))
@@ -165,8 +170,43 @@ contains
                 if (self%law%mu <= 0.0_dp) new_anchor = mp%xi
                 self%hist%field(self%h_anchor)%trial(k) = new_anchor
             end if
+            if (self%h_anchor_eta > 0) then
+                if (self%law%mu <= 0.0_dp) new_anchor2(2) = mp%eta
+                self%hist%field(self%h_anchor_eta)%trial(k) = new_anchor2(2)
+            end if
         end do
     end subroutine gpts_evaluate
+
+    !> `gpts_point3` at slave point `k` of a face, with its committed anchor (both
+    !> coordinates; for a point that touched in this step, its projection at the last
+    !> converged state) and, in Tresca mode, its slip bound; the tangential traction
+    !> goes to the point's output.
+    pure subroutine face_point(self, k, sp, mp, touch, gap0, rl, kl, state, pn, new_anchor)
+        class(gpts_pair_t), intent(inout) :: self
+        integer, intent(in) :: k
+        type(surface_point_t), intent(in) :: sp
+        type(master_point_t), intent(in) :: mp
+        logical, intent(in) :: touch
+        real(dp), intent(in) :: gap0
+        real(dp), intent(out) :: rl(:), kl(:, :), pn, new_anchor(2)
+        integer, intent(out) :: state
+        real(dp) :: anchor(2), g
+        anchor = [mp%xi, mp%eta]
+        if (self%h_anchor_eta > 0) then
+            if (touch) then
+                anchor = [self%hist%field(self%h_xi)%last(k), self%hist%field(self%h_eta)%last(k)]
+            else
+                anchor = [self%hist%field(self%h_anchor)%last(k), self%hist%field(self%h_anchor_eta)%last(k)]
+            end if
+        end if
+        if (allocated(self%slip_bound)) then
+            call gpts_point3(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, &
+                             self%out(k)%tt, new_anchor, self%slip_bound(k))
+        else
+            call gpts_point3(self%law, self%w(k), sp, mp, anchor, touch, gap0, rl, kl, state, g, pn, &
+                             self%out(k)%tt, new_anchor)
+        end if
+    end subroutine face_point
 
     !> With a deformable master, one pattern block per slave element (its edge DOFs
     !> and its master range); none with a rigid master.
@@ -192,6 +232,7 @@ contains
         class(gpts_pair_t), intent(inout) :: self
         if (self%law%mu <= 0.0_dp) return
         call self%hist%add('anchor', size(self%xi), self%h_anchor)
+        if (self%slave%npar > 1) call self%hist%add('anchor_eta', size(self%xi), self%h_anchor_eta)
     end subroutine gpts_setup_history
 
     !> The Tresca fixed point applies to a frictional GPTS pair (its slip limits

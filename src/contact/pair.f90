@@ -47,6 +47,9 @@ module voiga_contact_pair
         !> Normal gap; contact pressure and tangential traction per current length of
         !> the slave edge, and per reference length (nominal: `pn0` = `pn` x `stretch`).
         real(dp) :: gap = 0.0_dp, pn = 0.0_dp, pt = 0.0_dp, pn0 = 0.0_dp, pt0 = 0.0_dp
+        !> On a face, the tangential traction vector per current area [3] (`pt` is
+        !> its length).
+        real(dp) :: tt(3) = 0.0_dp
         !> Current over reference length of the slave edge at the point, |a_s| / |A_s|
         !> (on a face: area, |a_1 x a_2| / |A_1 x A_2|).
         real(dp) :: stretch = 1.0_dp
@@ -120,6 +123,8 @@ module voiga_contact_pair
         !> without a projection: where between that state and this one a point that
         !> was open first touched).
         integer :: h_xi = 0, h_active = 0, h_gap = 0
+        !> On a face, the second coordinate of the projection there (`eta_last`; 0 on an edge).
+        integer :: h_eta = 0
         !> Output of the last evaluation [npts].
         type(contact_point_out_t), allocatable :: out(:)
         !> Points with gap < gap_tol are active: a point that touches (gap = 0 up to
@@ -375,6 +380,7 @@ contains
         call self%hist%add('xi_last', n, self%h_xi, per_point=.true.)
         call self%hist%add('active_last', n, self%h_active, flags=.true., per_point=.true.)
         call self%hist%add('gap_last', n, self%h_gap, initial=huge(1.0_dp), per_point=.true.)
+        if (self%slave%npar > 1) call self%hist%add('eta_last', n, self%h_eta, per_point=.true.)
     end subroutine shared_history
 
     pure subroutine pair_commit(self)

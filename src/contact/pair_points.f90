@@ -65,6 +65,7 @@ contains
             out%pt = 0.0_dp
             out%pn0 = 0.0_dp
             out%pt0 = 0.0_dp
+            out%tt = 0.0_dp
             if (self%warm .and. self%slave%npar > 1) then
                 call self%master%project(u, sp%x(1:self%nsd), mp, found, converged, [out%xi_m, out%eta_m])
             else if (self%warm) then

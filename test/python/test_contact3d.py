@@ -65,7 +65,7 @@ def last_contact(path: Path) -> dict[str, np.ndarray]:
     with h5py.File(path) as f:
         step = sorted(f["steps"])[-1]
         g = f[f"steps/{step}/contact/1"]
-        return {name: g[name][()] for name in g}
+        return {name: g[name][()] for name in g if isinstance(g[name], h5py.Dataset)}
 
 
 @pytest.mark.parametrize("method", ["gpts", "mortar"])
@@ -108,7 +108,7 @@ def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(("contact", "message"), [
-    (PLANE + ", friction = 0.3", "friction between solids is not implemented yet"),
+    (PLANE + ", method = 'mortar', friction = 0.3", "friction on solids is implemented for method = 'gpts' only"),
     (PLANE + ", method = 'segment'", "method = 'segment' is not implemented for solids yet"),
     (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
     (", rigid_point = 0.0, 0.0", "rigid_point needs 3 components"),
@@ -228,3 +228,22 @@ def test_blocks_non_matching_faces(voiga_bin: Path, tmp_path: Path) -> None:
         spreads[method, n] = spread
     assert spreads["mortar", 3] < spreads["gpts", 3]
     assert spreads["mortar", 9] < spreads["mortar", 6] < spreads["mortar", 3] < 0.02
+
+
+def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path) -> None:
+    """Coulomb friction on the tangent plane (GPTS, the method a frictional pair on a
+    solid takes): the box pressed by 0.01 (phase 1), then the plane slid 0.05 along x
+    under it (phase 2). Every point ends slipping, the friction force approaches
+    mu F_N along the sliding direction and the transverse one (from the press's
+    lateral expansion, held by friction) dies out."""
+    case = box_case(tmp_path, PLANE + ", friction = 0.3, rigid_ux = 0.0, 0.05")
+    text = case.read_text().replace("n_steps = 2", "n_steps = 2, 4").replace("p = 0.01", "p = 0.01, 0.01")
+    case.write_text(text)
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    c = last_contact(tmp_path / "box.h5")
+    assert np.all(c["state"] == 2)
+    fx, fy, fz = c["force"]
+    assert abs(fz - 0.02) < 1e-12
+    assert abs(fx / fz - 0.3) < 1e-5 and abs(fy / fz) < 1e-3
+    assert c["p_t"].shape == (c["p_n"].size, 3)

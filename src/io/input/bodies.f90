@@ -118,8 +118,9 @@ contains
             else if (c%method_given .and. all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
                 what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
                        "'mortar' or 'gpts'"
-            else if (c%friction > 0.0_dp) then
-                what = 'friction between solids is not implemented yet (issue 42); use friction = 0'
+            else if (c%friction > 0.0_dp .and. c%method_given .and. trim(c%method) /= 'gpts') then
+                what = 'friction on solids is implemented for method = ''gpts'' only so far (issue 42); '// &
+                       'give method = ''gpts'' or friction = 0'
             end if
         end if
         if (allocated(what)) call fatal_error(error, where//what, error_code%input)

@@ -397,9 +397,15 @@ contains
         call h5%write(c//'/gap', a1)
         ! ([ ]: contiguous copies of the points' components)
         call h5%write(c//'/p_n', [out%pn])
-        call h5%write(c//'/p_t', [out%pt])
         call h5%write(c//'/p_n_nominal', [out%pn0])
-        call h5%write(c//'/p_t_nominal', [out%pt0])
+        if (nsd == 3) then
+            ! a face: the tangential traction vector, per current and per reference area
+            call h5%write(c//'/p_t', reshape([(out(i)%tt, i=1, size(out))], [3, size(out)]))
+            call h5%write(c//'/p_t_nominal', reshape([(out(i)%tt*out(i)%stretch, i=1, size(out))], [3, size(out)]))
+        else
+            call h5%write(c//'/p_t', [out%pt])
+            call h5%write(c//'/p_t_nominal', [out%pt0])
+        end if
         call h5%write(c//'/stretch', [out%stretch])
         call h5%write(c//'/area_ref', [out%area0])
         if (nsd == 3) then
