@@ -555,22 +555,44 @@ contains
     pure real(dp) function mortar_step_limit(self, overshoot) result(frac)
         class(mortar_pair_t), intent(in) :: self
         real(dp), intent(in) :: overshoot
-        real(dp) :: tol
+        real(dp) :: tol, depth
         integer :: a
         frac = 1.0_dp
         associate (before => self%accepted, last => self%last)
             if (.not. allocated(last%g) .or. .not. allocated(before%g)) return
             if (size(before%g) /= size(last%g)) return
+            depth = face_depth(self)
             do a = 1, size(last%g)
                 tol = self%gap_tol*last%d(a)
                 ! (huge: no point of the support had a projection, nothing to interpolate)
-                if (before%g(a) >= tol .and. before%g(a) < huge(1.0_dp) .and. last%g(a) < tol) &
-                    frac = min(frac, overshoot*before%g(a)/(before%g(a) - last%g(a)))
+                if (before%g(a) >= tol .and. before%g(a) < huge(1.0_dp) .and. last%g(a) < tol - depth*last%d(a)) &
+                    frac = min(frac, overshoot*(before%g(a) + depth*last%d(a))/(before%g(a) - last%g(a)))
                 if (before%state(a) == state_slip .and. last%state(a) /= state_inactive .and. &
                     before%t_trial(a)*last%t_trial(a) < 0.0_dp) &
                     frac = min(frac, before%t_trial(a)/(before%t_trial(a) - last%t_trial(a)))
             end do
         end associate
     end function mortar_step_limit
+
+    !> How deep a control point may close in one Newton step without being limited:
+    !> on a face, the deepest mean penetration -g_A / D_A, at the accepted iterate or
+    !> after the step, of the control points active at the accepted iterate (a point
+    !> closing no deeper carries no more penalty force than those the tangent already
+    !> holds); 0 on an edge, and before any is active.
+    !> On a face the zone's edge crosses hundreds of control points over a load step,
+    !> at as many different fractions of it: limiting every step to the first crossing
+    !> took 22 Newton iterations for the first step of hertz3d m2 NN2.2.
+    pure real(dp) function face_depth(self) result(depth)
+        class(mortar_pair_t), intent(in) :: self
+        integer :: a
+        depth = 0.0_dp
+        if (self%slave%npar < 2) return
+        associate (before => self%accepted, last => self%last)
+            do a = 1, size(before%g)
+                if (before%state(a) == state_inactive .or. before%d(a) <= 0.0_dp) cycle
+                depth = max(depth, -before%g(a)/before%d(a), -last%g(a)/last%d(a))
+            end do
+        end associate
+    end function face_depth
 
 end module voiga_contact_mortar
