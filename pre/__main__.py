@@ -249,7 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--material", default="linear", choices=("linear", "neo-hookean"),
                    help="material law (default linear)")
     s.add_argument("--steps", type=int, default=None, help="load steps (default 5)")
-    s.add_argument("--method", default="gpts", help="&contact method (default gpts)")
+    s.add_argument("--method", default="mortar", help="&contact method (default mortar, voiga's on solids)")
     s.add_argument("--penalty-normal", type=float, default=None,
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")

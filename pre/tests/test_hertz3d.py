@@ -184,7 +184,7 @@ def test_the_command_writes_cases_that_parse(tmp_path: Path, capsys: pytest.Capt
         assert fixed == {"top": ["fix_z"], "symmetry_x": ["fix_x"], "symmetry_y": ["fix_y"]}
         assert nml["dirichlet"][0]["uz"] == -0.01
         c = nml["contact"]
-        assert (c["slave"], c["master"], c["method"]) == (BODY, "rigid", "gpts")
+        assert (c["slave"], c["master"], c["method"]) == (BODY, "rigid", "mortar")
         assert c["rigid_point"] == [0.0, 0.0, -1.0] and c["rigid_normal"] == [0.0, 0.0, 1.0]
         assert "penalty_normal" not in c
         assert nml["case"]["output"] == f"{stem}.h5" and nml["case"]["geometry"] == "geometry.h5"

@@ -270,7 +270,8 @@ contains
         select type (m => pair%master)
         type is (rigid_line_t)
             if (behind > 0) then
-                text = 'the line through rigid_point = '//vector_str(m%p_ref)//' cuts through the slave body ('// &
+                text = 'the line through rigid_point = '//vector_str(m%p_ref(1:m%nsd))// &
+                       ' cuts through the slave body ('// &
                        str(behind)//' of the '//str(found)//' points lie on the side rigid_normal = '// &
                        vector_str(m%n(1:m%nsd))//' points to): move rigid_point (the obstacle lies on the side '// &
                        'rigid_normal points away from)'

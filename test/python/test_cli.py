@@ -135,7 +135,7 @@ BAD_CASES = [
     ("master = 'slab'", "master = 'anvil2'", ["&contact (1)", "master = 'anvil2'"]),
     ("master = 'slab'", "master = 'rigid', rigid_curve = 'roller'",
      ["&contact (1)", "rigid_curve", "no curve 'roller'"]),
-    ("master = 'slab'", "master = 'slab', rigid_uy = -1.0, -1.0", ["&contact (1)", "rigid_ux and rigid_uy"]),
+    ("master = 'slab'", "master = 'slab', rigid_uy = -1.0, -1.0", ["&contact (1)", "rigid_uy and rigid_uz move a rigid"]),
     ("master = 'slab'", "master = 'rigid', rigid_uy = -1.0", ["&contact (1)", "rigid_uy", "one value per load phase"]),
     ("n_steps = 10, 200", "n_steps = 10, 0", ["&solver", "n_steps"]),
     ("&contact", "&output\n  fields = 'stresses'\n/\n&contact", ["&output", "'stresses'", "'von_mises'"]),
