@@ -1,0 +1,231 @@
+"""Automatic refinement of the contact zone: from a result, the refined case
+(``python -m pre refine RESULT.h5``), and the solve-estimate-refine loop (``python -m
+post run CASE --adapt``). docs/howto.md has the recipes, docs/theory.md the indicator.
+
+The refined case is the result's own case (``case_file``, the provenance voiga writes)
+with new explicit ``knots_xi`` and ``knots_eta`` for every slave body and every
+deformable master: the result's element boundaries (the old knots, kept: the mesh
+nests) plus knots around every free edge of every zone at every converged step, so
+that one mesh resolves the edge over the whole load history, and thinner element rows
+at the contact surface, graded back to the old mesh (:mod:`pre.zone_refine`). Only
+knots are added, so the solver's refinement of the unchanged geometry file is NURBS
+knot insertion: the geometry is kept exactly. The wanted element size at an edge is the
+old one times ``(SAFETY * target / estimate)^(1 / RATE)``, at most ``1 / MIN_FACTOR``
+times finer per cycle; edges already below the target keep their elements. The surface
+row is made thinner by the same factor, but not thinner than the wanted size along the
+edge (a row much thinner than the elements are long made the edge worse: 1.0 % instead
+of 0.25 % at step 2 of the m2 cycle of docs/verification.md).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pre.cases import read_case, to_namelist_text
+from pre.files import check_output, write_text
+from pre.nurbs import evaluate_patch
+from pre.zone_refine import SizeRequest, interior, split_breaks
+
+from .indicator import ZoneMeasure, measure
+from .plot import breakpoints
+from .reader import Body, Result, read_result
+
+SAFETY = 0.8
+"""The wanted error is this fraction of the target."""
+RATE = 1.5
+"""The edge error's order in the element size used to size the elements: the estimate
+falls like ``(h / w)^RATE`` (docs/theory.md: 1 for the singularity alone; the cycles of
+docs/verification.md fall faster, as the edge's position sharpens too)."""
+MIN_FACTOR = 0.125
+"""No element at an edge becomes more than 1 / MIN_FACTOR times smaller in one cycle."""
+DEFAULT_TARGET = 0.002
+"""The default target of the estimated edge error (0.2 %)."""
+SAMPLES_PER_SPAN = 16
+"""Points per element at which an edge's length coordinate is sampled."""
+
+
+class AdaptError(ValueError):
+    """A result that cannot be refined from (the message says why)."""
+
+
+@dataclass
+class RefinedCase:
+    """What :func:`refine_result` wrote."""
+
+    case: Path
+    source: Path
+    """The case the result came from."""
+    n_dofs: int
+    """DOFs of the refined case (pre's discretization of it)."""
+    estimate: float
+    """The result's largest estimated edge error (over pairs and steps)."""
+    bodies: dict[str, tuple[int, int]]
+    """Body -> (elements along the contact edge, element rows across) after refinement."""
+
+
+def parse_target(text: str) -> float:
+    """``'0.2%'`` -> 0.002, ``'0.002'`` -> 0.002; ValueError unless in (0, 1)."""
+    value = float(text[:-1]) / 100 if text.strip().endswith("%") else float(text)
+    if not 0.0 < value < 1.0 or not math.isfinite(value):
+        raise ValueError(f"target {text!r} must be in (0, 100%)")
+    return value
+
+
+def _edge_length(body: Body, direction: int, at: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(parameters, reference length)`` sampled along the body's direction
+    ``direction`` (0: xi on the contact edge eta = 1; 1: eta across at xi = ``at``,
+    measured from eta = 1 inward, so increasing towards eta = 0 is negative)."""
+    breaks = breakpoints(body)[direction]
+    t = np.unique(np.concatenate([np.linspace(a, b, SAMPLES_PER_SPAN + 1)
+                                  for a, b in zip(breaks[:-1], breaks[1:], strict=True)]))
+    xi, eta = (t, np.ones_like(t)) if direction == 0 else (np.full_like(t, at), t)
+    pts = evaluate_patch(body.bulk, xi, eta)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    return t, s
+
+
+def _factor(estimate: float, target: float) -> float:
+    if not math.isfinite(estimate):
+        return MIN_FACTOR
+    if estimate <= target:
+        return 1.0
+    return float(np.clip((SAFETY * target / estimate) ** (1.0 / RATE), MIN_FACTOR, 1.0))
+
+
+@dataclass
+class _Requests:
+    along: list[SizeRequest]
+    across: list[tuple[float, float]]
+    """(xi where, wanted size of the surface row)."""
+
+
+def _requests(result: Result, measures: list[ZoneMeasure], target: float) -> dict[str, _Requests]:
+    """Per body (slaves and deformable masters) the wanted sizes around the edges."""
+    out: dict[str, _Requests] = {}
+    lengths: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def along(body: Body, xi: float) -> float:
+        if body.name not in lengths:
+            lengths[body.name] = _edge_length(body, 0, 0.0)
+        t, s = lengths[body.name]
+        return float(np.interp(xi, t, s))
+
+    for m in measures:
+        for e in m.edges:
+            f = _factor(e.estimate, target)
+            if f >= 1.0:
+                continue
+            names = [(m.slave, e.xi)]
+            master_xi = _master_parameter(result, m, e.xi)
+            if master_xi is not None:
+                names.append((m.master, master_xi))
+            for name, xi in names:
+                body = result.body(name)
+                req = out.setdefault(name, _Requests([], []))
+                req.along.append(SizeRequest(position=along(body, xi), size=f * e.h_tangent,
+                                             reach=e.h_tangent))
+                req.across.append((xi, min(e.h_normal, max(f * e.h_normal, f * e.h_tangent))))
+    return out
+
+
+def _master_parameter(result: Result, m: ZoneMeasure, xi: float) -> float | None:
+    """The deformable master's edge parameter opposite the slave's edge at ``xi`` (None
+    for a rigid master): that of the slave point in contact nearest to it."""
+    if m.master not in result.bodies:
+        return None
+    st = next(s for s in result.steps if s.step == m.step)
+    c = st.contact[m.pair]
+    on = np.flatnonzero(c.active & np.isfinite(c.xi_master))
+    if not on.size:
+        return None
+    return float(c.xi_master[on[np.argmin(np.abs(c.xi_slave[on] - xi))]])
+
+
+def refined_breaks(body: Body, req: _Requests) -> tuple[np.ndarray, np.ndarray]:
+    """The body's new (xi, eta) breaks for the requests."""
+    bx, be = breakpoints(body)[:2]
+    t, s = _edge_length(body, 0, 0.0)
+    new_xi = split_breaks(bx, np.interp(bx, t, s), req.along)
+    new_eta = be
+    if req.across:
+        xi, size = min(req.across, key=lambda r: r[1])
+        t, s = _edge_length(body, 1, xi)
+        depth = s[-1] - np.interp(be, t, s)  # distance from the surface eta = 1
+        # in the increasing coordinate -depth, the surface is at 0
+        new_eta = split_breaks(be, -depth, [SizeRequest(position=0.0, size=size, reach=size)])
+    return new_xi, new_eta
+
+
+def next_stem(stem: str) -> str:
+    """``m2-NN2.2`` -> ``m2-NN2.2-zone1``; ``m2-NN2.2-zone1`` -> ``m2-NN2.2-zone2``."""
+    match = re.fullmatch(r"(.*)-zone(\d+)", stem)
+    return f"{match.group(1)}-zone{int(match.group(2)) + 1}" if match else f"{stem}-zone1"
+
+
+def _groups(case: Path) -> dict[str, Any]:
+    """The case's namelist groups as plain dicts (repeated groups as lists)."""
+    nml = read_case(case)
+    out: dict[str, Any] = {}
+    # the keys of a repeated group are its entries' own (f90nml); their text is the name
+    for name in dict.fromkeys(str(k).lower() for k in nml.keys()):
+        value = nml[name]
+        out[name] = [dict(v) for v in value] if isinstance(value, list) else dict(value)
+    return out
+
+
+def source_case(result: Result) -> Path:
+    """The case file the result came from (root attribute ``case_file``)."""
+    case = Path(result.case_file) if result.case_file else None
+    if case is None or not case.is_file():
+        raise AdaptError(f"{result.path}: the case it came from ({result.case_file or 'not recorded'}) "
+                         "is not there")
+    return case
+
+
+def refine_result(path: str | Path, target: float = DEFAULT_TARGET, out: str | Path | None = None,
+                  force: bool = False) -> RefinedCase:
+    """Write the refined case of the result at ``path`` into ``out`` (default: a folder
+    ``<next stem>`` beside the result) as ``<next stem>.nml``; its geometry path points at
+    the original geometry. AdaptError when the result has no contact or its case is
+    gone; an existing case file is refused unless ``force``."""
+    result = read_result(path)
+    if not result.steps:
+        raise AdaptError(f"{result.path}: no converged step to refine from")
+    case = source_case(result)
+    measures = measure(result)
+    if not measures:
+        raise AdaptError(f"{result.path}: no contact at any converged step: nothing to refine")
+    groups = _groups(case)
+    stem = next_stem(case.stem)
+    folder = Path(out) if out is not None else result.path.parent / stem
+    folder.mkdir(parents=True, exist_ok=True)
+    target_case = check_output(folder / f"{stem}.nml")
+    if target_case.exists() and not force:
+        raise AdaptError(f"{target_case} exists; nothing written (--force to overwrite)")
+    bodies = groups["body"] if isinstance(groups["body"], list) else [groups["body"]]
+    sizes: dict[str, tuple[int, int]] = {}
+    for name, req in _requests(result, measures, target).items():
+        new_xi, new_eta = refined_breaks(result.body(name), req)
+        entry = next(b for b in bodies if str(b["name"]) == name)
+        for key in ("nel_xi", "nel_eta"):
+            entry.pop(key, None)
+        entry["knots_xi"], entry["knots_eta"] = interior(new_xi), interior(new_eta)
+        sizes[name] = (len(new_xi) - 1, len(new_eta) - 1)
+    cg = groups["case"]
+    geometry = (case.parent / str(cg["geometry"])).resolve()
+    cg["geometry"] = os.path.relpath(geometry, folder.resolve())
+    cg["output"] = f"{stem}.h5"
+    cg["title"] = f"{cg.get('title', case.stem)}, contact zone refined (target {target:.2%})"
+    write_text(target_case, to_namelist_text(groups))
+    from pre.refine import discretize_case
+
+    n_dofs = sum(b.total_dofs for b in discretize_case(target_case).bodies.values())
+    estimate = max(m.estimate for m in measures)
+    return RefinedCase(case=target_case, source=case, n_dofs=n_dofs, estimate=estimate, bodies=sizes)
