@@ -47,6 +47,18 @@ MIN_FACTOR = 0.125
 """No element at an edge becomes more than 1 / MIN_FACTOR times smaller in one cycle."""
 DEFAULT_TARGET = 0.002
 """The default target of the estimated edge error (0.2 %)."""
+NORMAL_GROWTH = 1.2
+"""Largest ratio of neighbouring rows in the grading from the surface row inward."""
+ROW = 1.5
+"""The surface row is made (at most) this many times thicker than the finest wanted
+element along an edge."""
+ASPECT = 1.0
+"""Largest ratio of an edge element's length along the edge to the surface row's
+thickness after refinement."""
+REACH = 0.03
+"""The wanted size holds within this fraction of the zone's half-width of an edge (or
+the distance between the points that bracket it, when larger): the edge moves a little
+when the mesh is refined."""
 SAMPLES_PER_SPAN = 16
 """Points per element at which an edge's length coordinate is sampled."""
 
@@ -107,31 +119,37 @@ class _Requests:
 
 
 def _requests(result: Result, measures: list[ZoneMeasure], target: float) -> dict[str, _Requests]:
-    """Per body (slaves and deformable masters) the wanted sizes around the edges."""
-    out: dict[str, _Requests] = {}
-    lengths: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    """Per body (slaves and deformable masters) the wanted sizes around the edges.
 
-    def along(body: Body, xi: float) -> float:
-        if body.name not in lengths:
-            lengths[body.name] = _edge_length(body, 0, 0.0)
-        t, s = lengths[body.name]
-        return float(np.interp(xi, t, s))
-
+    An edge above the target wants elements ``delta = f h_along`` long (f of
+    :func:`_factor`). The surface row is one for the whole body: ``ROW`` times the
+    smallest delta, when thinner than it is. Every edge of the history then gets
+    elements along it of at most ``ASPECT`` times that row (elements longer than the
+    row is thick placed the edge worse, docs/verification.md)."""
+    wanted: list[tuple[str, float, float, float, float]] = []  # body, xi, h, delta, reach
     for m in measures:
         for e in m.edges:
             f = _factor(e.estimate, target)
-            if f >= 1.0:
-                continue
-            names = [(m.slave, e.xi)]
+            delta = f * e.h_tangent if f < 1.0 else math.inf
+            reach = max(REACH * e.half_width, e.bracket)
+            wanted.append((m.slave, e.xi, e.h_tangent, delta, reach))
             master_xi = _master_parameter(result, m, e.xi)
             if master_xi is not None:
-                names.append((m.master, master_xi))
-            for name, xi in names:
-                body = result.body(name)
-                req = out.setdefault(name, _Requests([], []))
-                req.along.append(SizeRequest(position=along(body, xi), size=f * e.h_tangent,
-                                             reach=e.h_tangent))
-                req.across.append((xi, min(e.h_normal, max(f * e.h_normal, f * e.h_tangent))))
+                wanted.append((m.master, master_xi, e.h_tangent, delta, reach))
+    out: dict[str, _Requests] = {}
+    for name in dict.fromkeys(w[0] for w in wanted):
+        mine = [w for w in wanted if w[0] == name]
+        finest = min(w[3] for w in mine)
+        if not math.isfinite(finest):
+            continue
+        row = ROW * finest
+        body = result.body(name)
+        t, s = _edge_length(body, 0, 0.0)
+        along = [SizeRequest(position=float(np.interp(xi, t, s)), size=min(h, delta, ASPECT * row),
+                             reach=reach) for _, xi, h, delta, reach in mine]
+        xi_row = min(mine, key=lambda w: w[3])[1]
+        out[name] = _Requests(along=[r for r, w in zip(along, mine, strict=True) if r.size < w[2]],
+                              across=[(xi_row, row)])
     return out
 
 
@@ -159,7 +177,8 @@ def refined_breaks(body: Body, req: _Requests) -> tuple[np.ndarray, np.ndarray]:
         t, s = _edge_length(body, 1, xi)
         depth = s[-1] - np.interp(be, t, s)  # distance from the surface eta = 1
         # in the increasing coordinate -depth, the surface is at 0
-        new_eta = split_breaks(be, -depth, [SizeRequest(position=0.0, size=size, reach=size)])
+        new_eta = split_breaks(be, -depth, [SizeRequest(position=0.0, size=size, reach=size)],
+                               growth=NORMAL_GROWTH)
     return new_xi, new_eta
 
 
@@ -222,10 +241,62 @@ def refine_result(path: str | Path, target: float = DEFAULT_TARGET, out: str | P
     geometry = (case.parent / str(cg["geometry"])).resolve()
     cg["geometry"] = os.path.relpath(geometry, folder.resolve())
     cg["output"] = f"{stem}.h5"
-    cg["title"] = f"{cg.get('title', case.stem)}, contact zone refined (target {target:.2%})"
+    title = re.sub(r", contact zone refined .*$", "", str(cg.get("title", case.stem)))
+    cg["title"] = f"{title}, contact zone refined ({stem.rpartition('-')[2]}, target {target:.2%})"
     write_text(target_case, to_namelist_text(groups))
     from pre.refine import discretize_case
 
     n_dofs = sum(b.total_dofs for b in discretize_case(target_case).bodies.values())
     estimate = max(m.estimate for m in measures)
     return RefinedCase(case=target_case, source=case, n_dofs=n_dofs, estimate=estimate, bodies=sizes)
+
+
+MAX_CYCLES = 3
+"""Refinement cycles of ``post run --adapt`` unless ``--cycles`` says otherwise."""
+
+
+@dataclass
+class Cycle:
+    """One solve of the loop."""
+
+    result: Path
+    n_dofs: int
+    estimate: float
+    seconds: float
+    """Wall time of the solve (the result file's ``wall_time``)."""
+
+
+def largest_estimate(result: Result) -> float:
+    """The largest estimated edge error over the pairs and steps (0 without contact)."""
+    return max((m.estimate for m in measure(result)), default=0.0)
+
+
+def adapt_case(case: str | Path, out: str | Path | None = None, target: float = DEFAULT_TARGET,
+               cycles: int = MAX_CYCLES, binary: str | Path | None = None,
+               quiet: bool = True) -> tuple[list[Cycle], int]:
+    """The solve-estimate-refine loop: solve ``case`` (in ``out`` when given, else where
+    it is), and while the largest estimated edge error exceeds ``target`` and fewer than
+    ``cycles`` refinements were made, write the refined case (:func:`refine_result`, in
+    a folder ``<stem>-zone<k>`` beside the result) and solve it. Prints a line per
+    cycle; returns the cycles and voiga's last exit code (the loop stops on any code
+    but 0). The refined cases lie side by side in the folder of the first run."""
+    from .solver import result_path, run_voiga, stage_case, voiga_binary
+
+    program = voiga_binary(binary)
+    run = stage_case(Path(case), Path(out)) if out is not None else Path(case)
+    folder = run.parent
+    done: list[Cycle] = []
+    while True:
+        path = result_path(run)
+        code = run_voiga(program, run, quiet=quiet, overwrite=out is not None or bool(done))
+        if code != 0 or not path.is_file():
+            return done, code or 1
+        result = read_result(path)
+        done.append(Cycle(result=path, n_dofs=result.n_dofs, estimate=largest_estimate(result),
+                          seconds=result.wall_time))
+        c = done[-1]
+        print(f"cycle {len(done) - 1}: {c.n_dofs} DOFs, estimated edge error {c.estimate:.3%}, "
+              f"solve {c.seconds:.3g} s ({c.result})")
+        if c.estimate <= target or len(done) > cycles:
+            return done, 0
+        run = refine_result(path, target, folder / next_stem(run.stem), force=True).case

@@ -69,6 +69,11 @@ class EdgeMeasure:
     """``h_normal / w``."""
     raw: float
     """The uncalibrated estimate (the fit's L2 residual over the edge elements)."""
+    bracket: float = 0.0
+    """Reference distance between the last point in contact and the first one out: how
+    well the points place the edge."""
+    half_width: float = math.nan
+    """w of the edge's zone."""
 
     @property
     def estimate(self) -> float:
@@ -237,7 +242,8 @@ def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure
             raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
             edges.append(EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
                                      ratio_tangent=h / w if w > 0 else math.inf,
-                                     ratio_normal=hn / w if w > 0 else math.inf, raw=raw))
+                                     ratio_normal=hn / w if w > 0 else math.inf, raw=raw,
+                                     bracket=float(abs(s[j] - s[i])), half_width=float(w)))
         out.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step,
                                time=st.time, xi_range=(float(xi[i0]), float(xi[i1])),
                                half_width=float(w),

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-GROWTH = 1.3
+GROWTH = 1.5
 """Largest ratio of neighbouring element sizes in the grading back to the old mesh."""
 SAMPLES = 400
 """Points per old span at which the density is integrated."""
