@@ -42,7 +42,7 @@ from .reader import Body, ContactOutput, Result
 FIT_BAND = 0.5
 """The fit of p^2 near an edge uses the points within this fraction of the zone's
 half-width from the edge (and at least the two elements nearest it)."""
-CALIBRATION = 0.8
+CALIBRATION = 0.65
 """Scales the raw estimate to the measured L2 error at the edges (docs/theory.md)."""
 WARN_ESTIMATE = 0.005
 """A pair whose estimated edge error exceeds this (0.5 %) at a step is warned about."""
