@@ -55,8 +55,8 @@ class EdgeMeasure:
     """One free edge of a contact zone."""
 
     xi: float
-    """Slave-edge parameter of the edge (midway between the last point in contact and
-    the first one out)."""
+    """Slave-edge parameter of the edge: where the fit of p^2 reaches zero when that is
+    between the last point in contact and the first one out, else midway between them."""
     side: int
     """+1: the zone lies at smaller xi (the edge is its upper end); -1: at larger xi."""
     h_tangent: float
@@ -161,16 +161,17 @@ def _element(breaks: np.ndarray, xi: float) -> tuple[float, float]:
     return float(breaks[k]), float(breaks[k + 1])
 
 
-def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> float:
+def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float]:
     """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
     pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
-    d^2`` to the points with ``h <= d <= band`` (NaN when fewer than three such points:
-    the zone is too short for an interior to fit; then all points in contact are used)."""
+    d^2`` to the points with ``h <= d <= band`` (when fewer than three such points, all
+    points in contact), and the distance of the fit's edge (its root, NaN when it has
+    none); ``(NaN, NaN)`` for fewer than three points in contact."""
     fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
     if np.count_nonzero(fit) < 3:
         fit = p > 0
     if np.count_nonzero(fit) < 3:
-        return math.nan
+        return math.nan, math.nan
     dd = d[fit]
     design = np.column_stack([np.ones_like(dd), dd, dd**2])
     coef, *_ = np.linalg.lstsq(design, p[fit] ** 2, rcond=None)
@@ -182,7 +183,7 @@ def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> float
     near = d < 2 * h
     order = np.argsort(d[near])
     x, r = d[near][order], (p[near] - ref[near])[order]
-    return float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0
+    return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root
 
 
 def design_at(d: np.ndarray) -> np.ndarray:
@@ -237,7 +238,9 @@ def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure
             mask = np.zeros(n, dtype=bool)
             mask[i0:i1 + 1] = True
             mask[(d < 0) & (d > -2 * h)] = True
-            residual = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+            residual, root = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+            if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
+                xe = float(np.interp(se - side * root, s, xi))
             hn = normal_size(body, xe)
             raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
             edges.append(EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
