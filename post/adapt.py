@@ -54,10 +54,10 @@ NORMAL_GROWTH = 1.2
 ROW = 1.5
 """The surface row is made (at most) this many times thicker than the finest wanted
 element along an edge."""
-ASPECT = 1.0
+ASPECT = 1.5
 """Largest ratio of an edge element's length along the edge to the surface row's
 thickness after refinement."""
-REACH = 0.03
+REACH = 0.015
 """The wanted size holds within this fraction of the zone's half-width of an edge (or
 the distance between the points that bracket it, when larger): the edge moves a little
 when the mesh is refined."""
