@@ -35,9 +35,9 @@ from pre.files import check_output, write_text
 from pre.nurbs import evaluate_patch
 from pre.zone_refine import SizeRequest, interior, split_breaks
 
-from .indicator import ZoneMeasure, measure
+from .indicator import ZoneMeasure, measure, nominal_pressure
 from .plot import breakpoints
-from .reader import Body, Result, read_result
+from .reader import Body, ContactOutput, Result, read_result
 
 SAFETY = 0.8
 """The wanted error is this fraction of the target."""
@@ -219,12 +219,17 @@ def _groups(case: Path) -> dict[str, Any]:
 
 
 def source_case(result: Result) -> Path:
-    """The case file the result came from (root attribute ``case_file``)."""
-    case = Path(result.case_file) if result.case_file else None
-    if case is None or not case.is_file():
-        raise AdaptError(f"{result.path}: the case it came from ({result.case_file or 'not recorded'}) "
-                         "is not there")
-    return case
+    """The case file the result came from: the root attribute ``case_path`` (absolute),
+    else the file named by ``case_file`` beside the result."""
+    recorded = str(result.attrs.get("case_path") or "")
+    candidates = [Path(recorded)] if recorded else []
+    if result.case_file:  # relative to where voiga ran: look beside the result
+        candidates.append(result.path.parent / Path(result.case_file).name)
+    for case in candidates:
+        if case.is_file():
+            return case
+    raise AdaptError(f"{result.path}: the case it came from ({recorded or result.case_file or 'not recorded'}) "
+                     "is not there")
 
 
 def refine_result(path: str | Path, target: float = DEFAULT_TARGET, out: str | Path | None = None,
@@ -283,6 +288,33 @@ class Cycle:
     estimate: float
     seconds: float
     """Wall time of the solve (the result file's ``wall_time``)."""
+    change: float = math.nan
+    """:func:`pressure_change` from the previous cycle's result (NaN for the first)."""
+
+
+def pressure_change(old: Result, new: Result) -> float:
+    """The largest relative L2 change of the contact pressure (per reference length)
+    from ``old`` to ``new`` over the steps and pairs both have: ``||p_new - p_old|| /
+    ||p_new||`` along the slave edge's parameter (the same in both: knot insertion keeps
+    the parametrization), each profile the linear interpolant of its points."""
+    worst = 0.0
+    before = {s.step: s for s in old.steps}
+    for st in new.steps:
+        if st.step not in before:
+            continue
+        for c_new, c_old in zip(st.contact, before[st.step].contact, strict=False):
+            grid = np.unique(np.concatenate([c_new.xi_slave, c_old.xi_slave]))
+            p_new = _profile(c_new, grid)
+            p_old = _profile(c_old, grid)
+            norm = float(np.trapezoid(p_new**2, grid))
+            if norm > 0:
+                worst = max(worst, float(np.sqrt(np.trapezoid((p_new - p_old) ** 2, grid) / norm)))
+    return worst
+
+
+def _profile(c: ContactOutput, grid: np.ndarray) -> np.ndarray:
+    order = np.argsort(c.xi_slave, kind="stable")
+    return np.interp(grid, c.xi_slave[order], nominal_pressure(c)[order], left=0.0, right=0.0)
 
 
 def largest_estimate(result: Result) -> float:
@@ -305,17 +337,21 @@ def adapt_case(case: str | Path, out: str | Path | None = None, target: float = 
     run = stage_case(Path(case), Path(out)) if out is not None else Path(case)
     folder = run.parent
     done: list[Cycle] = []
+    previous: Result | None = None
     while True:
         path = result_path(run)
         code = run_voiga(program, run, quiet=quiet, overwrite=out is not None or bool(done))
         if code != 0 or not path.is_file():
             return done, code or 1
         result = read_result(path)
+        change = pressure_change(previous, result) if previous is not None else math.nan
         done.append(Cycle(result=path, n_dofs=result.n_dofs, estimate=largest_estimate(result),
-                          seconds=result.wall_time))
+                          seconds=result.wall_time, change=change))
+        previous = result
         c = done[-1]
-        print(f"cycle {len(done) - 1}: {c.n_dofs} DOFs, estimated edge error {c.estimate:.3%}, "
-              f"solve {c.seconds:.3g} s ({c.result})")
+        print(f"cycle {len(done) - 1}: {c.n_dofs} DOFs, estimated edge error {c.estimate:.3%}"
+              + (f", pressure change from cycle {len(done) - 2} {c.change:.3%}" if done[:-1] else "")
+              + f", solve {c.seconds:.3g} s ({c.result})")
         if c.estimate <= target or len(done) > cycles:
             return done, 0
         run = refine_result(path, target, folder / next_stem(run.stem), force=True).case
