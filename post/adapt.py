@@ -1,20 +1,20 @@
 """Automatic refinement of the contact zone: from a result, the refined case
 (``python -m pre refine RESULT.h5``), and the solve-estimate-refine loop (``python -m
-post run CASE --adapt``). docs/howto.md has the recipes, docs/theory.md the indicator.
+post run CASE --adapt``). docs/howto.md has the recipes, docs/contact-accuracy.md the indicator and the rules.
 
 The refined case is the result's own case (``case_file``, the provenance voiga writes)
 with new explicit ``knots_xi`` and ``knots_eta`` for every slave body and every
 deformable master: the result's element boundaries (the old knots, kept: the mesh
 nests) plus a knot at every free edge of every zone at every converged step (where the
 indicator's fit puts it) and knots around it, so that one mesh resolves the edge over
-the whole load history (docs/theory.md, section 8), and thinner element rows
+the whole load history (docs/contact-accuracy.md), and thinner element rows
 at the contact surface, graded back to the old mesh (:mod:`pre.zone_refine`). Only
 knots are added, so the solver's refinement of the unchanged geometry file is NURBS
 knot insertion: the geometry is kept exactly. The wanted element size at an edge is the
 old one times ``(SAFETY * target / estimate)^(1 / RATE)``, at most ``1 / MIN_FACTOR``
 times finer per cycle; edges already below the target keep their elements. The surface
 row follows the finest wanted size, and no edge keeps elements much longer than the row
-is thick (:func:`_requests`; docs/theory.md, section 8, says why).
+is thick (:func:`_requests`; docs/contact-accuracy.md says why).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ SAFETY = 0.8
 """The wanted error is this fraction of the target."""
 RATE = 1.5
 """The edge error's order in the element size used to size the elements: the estimate
-falls like ``(h / w)^RATE`` (docs/theory.md, section 8: 1 for the singularity alone; the
+falls like ``(h / w)^RATE`` (docs/contact-accuracy.md: 1 for the singularity alone; the
 cycles fall faster, as the edge's position sharpens too)."""
 MIN_FACTOR = 0.125
 """No element at an edge becomes more than 1 / MIN_FACTOR times smaller in one cycle."""
@@ -128,7 +128,7 @@ def _requests(result: Result, measures: list[ZoneMeasure], target: float) -> dic
     :func:`_factor`). The surface row is one for the whole body: ``ROW`` times the
     smallest delta, when thinner than it is. Every edge of the history then gets
     elements along it of at most ``ASPECT`` times that row (elements longer than the
-    row is thick placed the edge worse, docs/theory.md, section 8)."""
+    row is thick placed the edge worse, docs/contact-accuracy.md)."""
     wanted: list[tuple[str, float, float, float, float]] = []  # body, xi, h, delta, reach
     for m in measures:
         for e in m.edges:

@@ -1,6 +1,5 @@
-"""How well the mesh resolves the edges of a contact zone (``python -m post summary``,
-``python -m post indicator``; the derivation is docs/theory.md, "Contact-zone accuracy
-indicator").
+"""How well the mesh resolves the edges of a contact zone (``python -m post summary``;
+the derivation is docs/theory.md, section 8, the details docs/contact-accuracy.md).
 
 Per contact pair and converged step, every zone (a run of slave points in contact, in
 slave-parameter order) is measured on the slave's contact edge in the reference
@@ -20,7 +19,7 @@ configuration:
   it is extrapolated to the edge, and the L2 difference of the computed pressure from it
   over the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
   estimate. ``CALIBRATION`` scales it to the L2 error the Hertz comparison measures there
-  (docs/theory.md gives the fit of the constant).
+  (docs/contact-accuracy.md gives the fit of the constant).
 
 A pair's estimate at a step is the root of the sum of the squares of its edges'
 (the squares of an L2 split add up). The estimate is the part of the error the mesh
@@ -43,7 +42,7 @@ FIT_BAND = 0.5
 """The fit of p^2 near an edge uses the points within this fraction of the zone's
 half-width from the edge (and at least the two elements nearest it)."""
 CALIBRATION = 0.65
-"""Scales the raw estimate to the measured L2 error at the edges (docs/theory.md)."""
+"""Scales the raw estimate to the measured L2 error at the edges (docs/contact-accuracy.md)."""
 WARN_ESTIMATE = 0.005
 """A pair whose estimated edge error exceeds this (0.5 %) at a step is warned about."""
 MIN_POINTS = 3

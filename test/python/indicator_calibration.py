@@ -1,4 +1,4 @@
-"""The calibration of the contact-zone indicator (post/indicator.py, docs/theory.md):
+"""The calibration of the contact-zone indicator (post/indicator.py, docs/contact-accuracy.md):
 
     python test/python/indicator_calibration.py [--out DIR]
 
