@@ -3,6 +3,7 @@
 Subcommands:
   run            solve a case with voiga, print what it found, write figures and ParaView files
   summary        what a result file says, in a few lines
+  indicator      how well the mesh resolves each contact zone's edges, per pair and step
   plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG;
                  a solid: a 3D view of its boundary)
   plot-contact   p_N and p_T along the contact (PNG)
@@ -130,6 +131,24 @@ def _cmd_summary(args: argparse.Namespace) -> int:
 
     for line in summary_lines(_result(args)):
         print(line)
+    return 0
+
+
+def _cmd_indicator(args: argparse.Namespace) -> int:
+    from .indicator import format_zone, measure
+
+    result = _result(args)
+    if result.dimension != 2:
+        print(f"python -m post indicator: {args.result}: contact output is plane only so far",
+              file=sys.stderr)
+        return 2
+    zones = measure(result)
+    if not zones:
+        print(f"python -m post indicator: {args.result}: no contact at any converged step",
+              file=sys.stderr)
+        return 2
+    for m in zones:
+        print(format_zone(m))
     return 0
 
 
@@ -507,6 +526,10 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("summary", help="what a result file says, in a few lines")
     s.add_argument("result", help="result file (.h5) written by voiga")
     s.set_defaults(func=_cmd_summary)
+
+    s = sub.add_parser("indicator", help="contact-zone accuracy per pair, step and zone (docs/contact-accuracy.md)")
+    s.add_argument("result", help="result file (.h5) written by voiga")
+    s.set_defaults(func=_cmd_indicator)
 
     s = sub.add_parser("history", help="reactions and contact forces vs load time (CSV, PNG)")
     s.add_argument("result", help="result file (.h5) written by voiga")

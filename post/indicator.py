@@ -277,8 +277,10 @@ def format_zone(m: ZoneMeasure) -> str:
     if not m.resolved:
         return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.n_points} point(s) in "
                 f"contact, {m.elements_across:.2g} slave elements: the zone is not resolved")
+    several = len(m.edges) > 1
     edges = "; ".join(f"edge at xi = {e.xi:.4g}: h/w = {e.ratio_tangent:.3g} along, "
-                      f"{e.ratio_normal:.3g} across, {e.estimate:.2%}" for e in m.edges) or "no free edge"
+                      f"{e.ratio_normal:.3g} across" + (f", {e.estimate:.2%}" if several else "")
+                      for e in m.edges) or "no free edge"
     return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.elements_across:.1f} slave "
             f"elements across the zone (half-width {m.half_width:.4g}); {edges}; "
             f"estimated edge error {m.estimate:.2%}")

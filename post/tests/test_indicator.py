@@ -134,3 +134,13 @@ def test_refine_refuses_results_it_cannot_use(stretch_h5: Path, m2: Path, tmp_pa
     assert "missing.h5" in capsys.readouterr().err
     assert pre_main(["refine", str(m2.with_suffix(".nml"))]) == 2  # a case needs -o
     assert indicator_lines(read_result(stretch_h5)) == []
+
+
+def test_indicator_command(m4: Path, stretch_h5: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from post.__main__ import main as post_main
+
+    assert post_main(["indicator", str(m4)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 5 and lines[0].startswith("contact cylinder -> rigid, step 1: ")
+    assert post_main(["indicator", str(stretch_h5)]) == 2
+    assert "no contact" in capsys.readouterr().err
