@@ -47,7 +47,7 @@ MIN_FACTOR = 0.125
 """No element at an edge becomes more than 1 / MIN_FACTOR times smaller in one cycle."""
 DEFAULT_TARGET = 0.002
 """The default target of the estimated edge error (0.2 %)."""
-NORMAL_GROWTH = 1.2
+NORMAL_GROWTH = 1.5
 """Largest ratio of neighbouring rows in the grading from the surface row inward."""
 ROW = 1.5
 """The surface row is made (at most) this many times thicker than the finest wanted
