@@ -144,3 +144,20 @@ def test_indicator_command(m4: Path, stretch_h5: Path, capsys: pytest.CaptureFix
     assert len(lines) == 5 and lines[0].startswith("contact cylinder -> rigid, step 1: ")
     assert post_main(["indicator", str(stretch_h5)]) == 2
     assert "no contact" in capsys.readouterr().err
+
+
+def test_refine_deformable_master_too(press_h5: Path, tmp_path: Path) -> None:
+    """A die pressed and slid on a slab (NURBS master): the slave and the master are
+    both refined around the zone's edges, their maps unchanged."""
+    done = refine_result(press_h5, out=tmp_path / "z")
+    result = read_result(press_h5)
+    pair = result.steps[-1].contact[0]
+    assert set(done.bodies) == {pair.slave, pair.master}
+    refined = discretize_case(done.case).bodies
+    before = discretize_case(press_h5.parent / "case.nml").bodies
+    rng = np.random.default_rng(5)
+    xi, eta = rng.random(100), rng.random(100)
+    for name in done.bodies:
+        assert len(np.unique(refined[name].bulk.knots_xi)) > len(np.unique(before[name].bulk.knots_xi))
+        assert np.allclose(evaluate_patch(refined[name].bulk, xi, eta),
+                           evaluate_patch(before[name].bulk, xi, eta), rtol=0, atol=1e-12)
