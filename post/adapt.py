@@ -94,9 +94,10 @@ def parse_target(text: str) -> float:
 
 
 def _edge_length(body: Body, direction: int, at: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(parameters, reference length)`` sampled along the body's direction
-    ``direction`` (0: xi on the contact edge eta = 1; 1: eta across at xi = ``at``,
-    measured from eta = 1 inward, so increasing towards eta = 0 is negative)."""
+    """``(parameters, reference length from the direction's start)`` sampled along the
+    body's direction ``direction`` (0: xi on the contact edge eta = 1; 1: eta across the
+    body at xi = ``at``), ``SAMPLES_PER_SPAN`` points per element (the polyline's
+    length)."""
     breaks = breakpoints(body)[direction]
     t = np.unique(np.concatenate([np.linspace(a, b, SAMPLES_PER_SPAN + 1)
                                   for a, b in zip(breaks[:-1], breaks[1:], strict=True)]))

@@ -37,6 +37,7 @@ from pre.nurbs import evaluate_patch
 
 from .plot import breakpoints
 from .reader import Body, ContactOutput, Result
+from .summary import slave_element_size
 
 FIT_BAND = 0.5
 """The fit of p^2 near an edge uses the points within this fraction of the zone's
@@ -155,11 +156,6 @@ def _covered(breaks: np.ndarray, lo: float, hi: float) -> float:
     return float(np.sum(overlap / spans))
 
 
-def _element(breaks: np.ndarray, xi: float) -> tuple[float, float]:
-    k = int(np.clip(np.searchsorted(breaks, xi, side="right") - 1, 0, len(breaks) - 2))
-    return float(breaks[k]), float(breaks[k + 1])
-
-
 def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float]:
     """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
     pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
@@ -198,54 +194,63 @@ def _first_root(coef: np.ndarray, start: float) -> float:
     return float(below.max()) if below.size else -math.inf
 
 
+@dataclass(frozen=True)
+class _Profile:
+    """A pair's slave points at a step in slave-parameter order."""
+
+    xi: np.ndarray
+    s: np.ndarray
+    """Reference distance along the slave edge (:func:`arc_coordinate`)."""
+    p: np.ndarray
+    """Nominal pressure."""
+
+
+def _measure_edge(result: Result, c: ContactOutput, prof: _Profile, zone: tuple[int, int],
+                  i: int, side: int, w: float, norm: float) -> EdgeMeasure:
+    """The free edge of ``zone`` after its point ``i`` (``side`` +1: the zone's upper
+    end, -1: its lower end); ``w`` the zone's half-width, ``norm`` its squared L2 norm."""
+    xi, s, p = prof.xi, prof.s, prof.p
+    j = i + side  # the first point out of contact
+    xe, se = 0.5 * (xi[i] + xi[j]), 0.5 * (s[i] + s[j])
+    h = slave_element_size(result, c, float(xe))
+    d = side * (se - s)  # distance into the zone
+    mask = np.zeros(len(xi), dtype=bool)  # the zone's points and those out within 2 h
+    mask[zone[0]:zone[1] + 1] = True
+    mask[(d < 0) & (d > -2 * h)] = True
+    residual, root = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+    if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
+        xe = float(np.interp(se - side * root, s, xi))
+    hn = normal_size(result.body(c.slave), float(xe))
+    raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
+    return EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
+                       ratio_tangent=h / w if w > 0 else math.inf,
+                       ratio_normal=hn / w if w > 0 else math.inf, raw=raw,
+                       bracket=float(abs(s[j] - s[i])), half_width=float(w))
+
+
 def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure]:
     """The zones of contact pair ``pair`` (0-based) at converged step ``step_index``
     (an index into ``result.steps``)."""
     st = result.steps[step_index]
     c = st.contact[pair]
-    body = result.body(c.slave)
     order = np.argsort(c.xi_slave, kind="stable")
-    xi, x_ref = c.xi_slave[order], c.x_ref[order]
-    p, active = nominal_pressure(c)[order], c.active[order]
-    s = arc_coordinate(x_ref)
-    breaks = element_breaks(body)
+    prof = _Profile(xi=c.xi_slave[order], s=arc_coordinate(c.x_ref[order]),
+                    p=nominal_pressure(c)[order])
+    xi, s, p = prof.xi, prof.s, prof.p
+    breaks = element_breaks(result.body(c.slave))
     n = len(xi)
     out: list[ZoneMeasure] = []
-    for i0, i1 in zones(active & (p > 0)):
-        free = [(i1, +1)] if i1 < n - 1 else []
-        free = ([(i0, -1)] if i0 > 0 else []) + free
-        # edges midway between the last point in contact and the first one out
+    for i0, i1 in zones(c.active[order] & (p > 0)):
+        free = ([(i0, -1)] if i0 > 0 else []) + ([(i1, +1)] if i1 < n - 1 else [])
+        # the zone's ends midway between its outer points and the first ones out
         s_lo = 0.5 * (s[i0] + s[i0 - 1]) if i0 > 0 else s[0]
         s_hi = 0.5 * (s[i1] + s[i1 + 1]) if i1 < n - 1 else s[-1]
-        length = s_hi - s_lo
-        w = 0.5 * length if len(free) == 2 else length
+        w = 0.5 * (s_hi - s_lo) if len(free) == 2 else s_hi - s_lo
         xi_lo = 0.5 * (xi[i0] + xi[i0 - 1]) if i0 > 0 else breaks[0]
         xi_hi = 0.5 * (xi[i1] + xi[i1 + 1]) if i1 < n - 1 else breaks[-1]
-        zone_p = slice(max(i0 - 1, 0), min(i1 + 2, n))
-        norm = float(np.trapezoid(p[zone_p] ** 2, s[zone_p]))
-        edges = []
-        for i, side in free:
-            j = i + side  # the first point out of contact
-            xe = 0.5 * (xi[i] + xi[j])
-            se = 0.5 * (s[i] + s[j])
-            a, b = _element(breaks, xe)
-            inside = (xi >= a) & (xi <= b)
-            h = float(np.ptp(s[inside])) * (b - a) / max(float(np.ptp(xi[inside])), 1e-300) \
-                if np.count_nonzero(inside) > 1 else math.nan
-            d = side * (se - s)  # distance into the zone
-            # this zone's points and the ones out of contact beyond this edge
-            mask = np.zeros(n, dtype=bool)
-            mask[i0:i1 + 1] = True
-            mask[(d < 0) & (d > -2 * h)] = True
-            residual, root = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
-            if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
-                xe = float(np.interp(se - side * root, s, xi))
-            hn = normal_size(body, xe)
-            raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
-            edges.append(EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
-                                     ratio_tangent=h / w if w > 0 else math.inf,
-                                     ratio_normal=hn / w if w > 0 else math.inf, raw=raw,
-                                     bracket=float(abs(s[j] - s[i])), half_width=float(w)))
+        around = slice(max(i0 - 1, 0), min(i1 + 2, n))
+        norm = float(np.trapezoid(p[around] ** 2, s[around]))
+        edges = [_measure_edge(result, c, prof, (i0, i1), i, side, w, norm) for i, side in free]
         out.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step,
                                time=st.time, xi_range=(float(xi[i0]), float(xi[i1])),
                                half_width=float(w),
