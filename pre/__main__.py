@@ -269,7 +269,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("input", help="result file (.h5) to refine the contact zone of, or case namelist (.nml)")
     s.add_argument("-o", "--output", default=None, help="dump file (.h5), for a case")
     s.add_argument("--target", default="0.2%",
-                   help="estimated edge error to refine to, e.g. 0.2%% (default; docs/theory.md)")
+                   help="estimated edge error to refine to, e.g. 0.2%% (default; docs/contact-accuracy.md)")
     s.add_argument("--out", default=None,
                    help="folder of the refined case (default: <case>-zone<k> beside the result)")
     s.add_argument("--force", action="store_true", help="overwrite an existing refined case")
