@@ -3,6 +3,7 @@
 Subcommands:
   run            solve a case with voiga, print what it found, write figures and ParaView files
   summary        what a result file says, in a few lines
+  indicator      how well the mesh resolves each contact zone's edges, per pair and step
   plot-deformed  draw every body deformed, coloured by |u|, a component or a stress (PNG;
                  a solid: a 3D view of its boundary)
   plot-contact   p_N and p_T along the contact (PNG)
@@ -77,8 +78,54 @@ def _result(args: argparse.Namespace):
 def _cmd_run(args: argparse.Namespace) -> int:
     from .run import run_case
 
+    if args.adapt:
+        return _run_adapt(args)
+
     return run_case(args.case, out=args.out, binary=args.binary, quiet=args.quiet,
                     figures=not args.no_figures, vtk=not args.no_vtk, overwrite=args.overwrite)
+
+
+def _run_adapt(args: argparse.Namespace) -> int:
+    """``post run CASE --adapt``: the solve-estimate-refine loop (post.adapt), then the
+    summary and figures of the last result."""
+    import time
+
+    from .adapt import AdaptError, adapt_case, parse_target
+    from .run import make_figures
+    from .summary import summary_lines
+
+    try:
+        target = parse_target(args.target)
+    except ValueError as err:
+        print(f"python -m post run: {err}", file=sys.stderr)
+        return 2
+    start = time.monotonic()
+    try:
+        cycles, code = adapt_case(args.case, args.out, target, args.cycles, args.binary, quiet=True)
+    except AdaptError as err:
+        print(f"python -m post run --adapt: {err}", file=sys.stderr)
+        return 2
+    if not cycles:
+        print(f"voiga exited with {code} (its message is above); no summary, no figures written",
+              file=sys.stderr)
+        return code
+    last = cycles[-1]
+    total = time.monotonic() - start
+    met = "met" if last.estimate <= target else "not met"
+    print(f"target {target:.2%} {met} after {len(cycles) - 1} refinement(s): {last.n_dofs} DOFs; "
+          f"the loop took {total:.3g} s, {total / max(last.seconds, 1e-9):.3g} times the last solve "
+          f"({last.seconds:.3g} s)")
+    from .reader import read_result
+
+    result = read_result(last.result)
+    print()
+    for line in summary_lines(result):
+        print(line)
+    if not args.no_figures:
+        for p in make_figures(result, vtk=not args.no_vtk):
+            print(f"  {p}")
+    print(f"result: {last.result}")
+    return code
 
 
 def _cmd_summary(args: argparse.Namespace) -> int:
@@ -86,6 +133,24 @@ def _cmd_summary(args: argparse.Namespace) -> int:
 
     for line in summary_lines(_result(args)):
         print(line)
+    return 0
+
+
+def _cmd_indicator(args: argparse.Namespace) -> int:
+    from .indicator import format_zone, measure
+
+    result = _result(args)
+    if result.dimension != 2:
+        print(f"python -m post indicator: {args.result}: contact output is plane only so far",
+              file=sys.stderr)
+        return 2
+    zones = measure(result)
+    if not zones:
+        print(f"python -m post indicator: {args.result}: no contact at any converged step",
+              file=sys.stderr)
+        return 2
+    for m in zones:
+        print(format_zone(m))
     return 0
 
 
@@ -478,11 +543,22 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--overwrite", action="store_true",
                    help="replace an existing result in the case's own folder (with --out it is "
                         "always replaced: the folder is this tool's)")
+    s.add_argument("--adapt", action="store_true",
+                   help="solve, estimate the contact-zone edge error, refine the zone and solve "
+                        "again until the estimate meets --target (docs/howto.md)")
+    s.add_argument("--target", default="0.2%", help="with --adapt: the estimated edge error to reach "
+                                                    "(default 0.2%%)")
+    s.add_argument("--cycles", type=int, default=3, help="with --adapt: at most this many "
+                                                         "refinements (default 3)")
     s.set_defaults(func=_cmd_run)
 
     s = sub.add_parser("summary", help="what a result file says, in a few lines")
     s.add_argument("result", help="result file (.h5) written by voiga")
     s.set_defaults(func=_cmd_summary)
+
+    s = sub.add_parser("indicator", help="contact-zone accuracy per pair, step and zone (docs/contact-accuracy.md)")
+    s.add_argument("result", help="result file (.h5) written by voiga")
+    s.set_defaults(func=_cmd_indicator)
 
     s = sub.add_parser("history", help="reactions and contact forces vs load time (CSV, PNG)")
     s.add_argument("result", help="result file (.h5) written by voiga")

@@ -37,7 +37,7 @@ def _runnable(path: Path) -> bool:
 def in_checkout() -> bool:
     """Whether this package runs from a source checkout (its fpm.toml beside it), not
     from an installed copy (site-packages has no build folder)."""
-    return (CHECKOUT_BINARY.parents[2] / "fpm.toml").is_file()
+    return (CHECKOUT_BINARY.parents[3] / "fpm.toml").is_file()
 
 
 def voiga_binary(explicit: str | Path | None = None) -> Path:

@@ -99,6 +99,9 @@ def summary_lines(result: Result) -> list[str]:
                      f"{x[:, 0].max():.4g}]")
         lines.append(line)
     lines += warnings_for(result)
+    if result.dimension == 2 and any(c.active.any() for s in steps for c in s.contact):
+        from .indicator import indicator_lines
+        lines += indicator_lines(result)
     if result.scene == "hertz" and last.contact:
         from .hertz import format_hertz, hertz_comparison
         try:

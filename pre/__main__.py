@@ -7,7 +7,7 @@ Subcommands:
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
-  refine       refine a case with splipy and write the discretization dump
+  refine       a result: its case refined at the contact zone; a case: the splipy dump
   plot-layout  draw a body's control nets and contact basis functions
   figures      write the figures of docs/figures/
 """
@@ -152,14 +152,43 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
 
 
 def _cmd_refine(args: argparse.Namespace) -> int:
+    if not args.input.endswith(".nml"):
+        return _refine_zone(args)
     from .refine import discretize_case, write_dump
 
-    disc = discretize_case(args.case)
+    if args.output is None:
+        print("python -m pre refine: a case (.nml) needs -o DUMP.h5 (the discretization dump); "
+              "a result file (.h5) is refined at its contact zone", file=sys.stderr)
+        return 2
+    disc = discretize_case(args.input)
     write_dump(args.output, disc)
     for name, b in disc.bodies.items():
         layer = f", layer degree {b.layer.degree} x {len(b.layer.weights)}" if b.layer else ""
         print(f"{name}: bulk degree {b.bulk.degree} {b.bulk.shape[1]} x {b.bulk.shape[0]}{layer}; "
               f"DOF interface {b.interface_dofs} bulk {b.bulk_dofs} total {b.total_dofs}")
+    return 0
+
+
+def _refine_zone(args: argparse.Namespace) -> int:
+    """``pre refine RESULT.h5``: the case refined at the contact zone's edges (the
+    measurements and the case are the result's: post.adapt)."""
+    from post.adapt import AdaptError, parse_target, refine_result
+    from post.reader import BadResultError
+
+    from .files import OutputError
+
+    try:
+        target = parse_target(args.target)
+        done = refine_result(args.input, target, args.out, force=args.force)
+    except (AdaptError, BadResultError, OutputError, FileNotFoundError, ValueError) as err:
+        print(f"python -m pre refine: {err}", file=sys.stderr)
+        return 2
+    print(f"{args.input}: largest estimated edge error {done.estimate:.2%} (target {target:.2%})")
+    for name, (n_along, n_across) in done.bodies.items():
+        print(f"  {name}: {n_along} elements along the contact edge, {n_across} rows across")
+    if not done.bodies:
+        print("  every edge meets the target: the case is written unchanged")
+    print(f"wrote {done.case} ({done.n_dofs} DOFs; from {done.source})")
     return 0
 
 
@@ -281,9 +310,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_cattaneo)
 
-    s = sub.add_parser("refine", help="refine a case with splipy; write the discretization dump")
-    s.add_argument("case", help="case namelist (.nml)")
-    s.add_argument("-o", "--output", required=True, help="dump file (.h5)")
+    s = sub.add_parser("refine", help="a result: its case refined at the contact zone's edges; "
+                                      "a case (.nml): refine with splipy, write the discretization dump")
+    s.add_argument("input", help="result file (.h5) to refine the contact zone of, or case namelist (.nml)")
+    s.add_argument("-o", "--output", default=None, help="dump file (.h5), for a case")
+    s.add_argument("--target", default="0.2%",
+                   help="estimated edge error to refine to, e.g. 0.2%% (default; docs/contact-accuracy.md)")
+    s.add_argument("--out", default=None,
+                   help="folder of the refined case (default: <case>-zone<k> beside the result)")
+    s.add_argument("--force", action="store_true", help="overwrite an existing refined case")
     s.set_defaults(func=_cmd_refine)
 
     s = sub.add_parser("plot-layout", help="control nets and contact basis of one body (PNG)")

@@ -1,0 +1,306 @@
+"""How well the mesh resolves the edges of a contact zone (``python -m post summary``;
+the derivation is docs/theory.md, section 8, the details docs/contact-accuracy.md).
+
+Per contact pair and converged step, every zone (a run of slave points in contact, in
+slave-parameter order) is measured on the slave's contact edge in the reference
+configuration:
+
+- ``elements_across``: slave elements the zone covers (a partly covered element counts
+  with the covered fraction of its length);
+- at each *free* edge (a zone that reaches the first or last slave point ends at a
+  symmetry cut or at the end of the edge, not at a free edge): the tangential size of the
+  slave element that holds the edge and the size of the surface element row across the
+  edge, both relative to the zone's half-width ``w`` (half the zone's length between two
+  free edges, its whole length from a cut to one free edge);
+- an estimate of the relative L2 error of the pressure made at that edge. Near a free
+  edge of a smooth contact the pressure squared is smooth, ``p^2 = c1 d + c2 d^2 + ...``
+  in the distance ``d`` into the zone (Hertz: exactly so); fitted to the points between
+  one edge element and ``FIT_BAND`` w from the edge, where the mesh resolves the profile,
+  it is extrapolated to the edge, and the L2 difference of the computed pressure from it
+  over the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
+  estimate. ``CALIBRATION`` scales it to the L2 error the Hertz comparison measures there
+  (docs/contact-accuracy.md gives the fit of the constant).
+
+A pair's estimate at a step is the root of the sum of the squares of its edges'
+(the squares of an L2 split add up). The estimate is the part of the error the mesh
+makes at the edges; the interior and the penalty's own compliance are not in it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pre.nurbs import evaluate_patch
+
+from .plot import breakpoints
+from .reader import Body, ContactOutput, Result
+from .summary import slave_element_size
+
+FIT_BAND = 0.5
+"""The fit of p^2 near an edge uses the points within this fraction of the zone's
+half-width from the edge (and at least the two elements nearest it)."""
+CALIBRATION = 0.65
+"""Scales the raw estimate to the measured L2 error at the edges (docs/contact-accuracy.md)."""
+WARN_ESTIMATE = 0.005
+"""A pair whose estimated edge error exceeds this (0.5 %) at a step is warned about."""
+MIN_POINTS = 3
+"""Fewer points in contact than this: the zone is not resolved at all."""
+
+
+@dataclass(frozen=True)
+class EdgeMeasure:
+    """One free edge of a contact zone."""
+
+    xi: float
+    """Slave-edge parameter of the edge: where the fit of p^2 reaches zero when that is
+    between the last point in contact and the first one out, else midway between them."""
+    side: int
+    """+1: the zone lies at smaller xi (the edge is its upper end); -1: at larger xi."""
+    h_tangent: float
+    """Reference length of the slave element holding the edge."""
+    h_normal: float
+    """Reference size of the surface element row across the slave edge at the edge."""
+    ratio_tangent: float
+    """``h_tangent / w``."""
+    ratio_normal: float
+    """``h_normal / w``."""
+    raw: float
+    """The uncalibrated estimate (the fit's L2 residual over the edge elements)."""
+    bracket: float = 0.0
+    """Reference distance between the last point in contact and the first one out: how
+    well the points place the edge."""
+    half_width: float = math.nan
+    """w of the edge's zone."""
+
+    @property
+    def estimate(self) -> float:
+        """Estimated relative L2 error of the pressure made at this edge."""
+        return CALIBRATION * self.raw
+
+
+@dataclass(frozen=True)
+class ZoneMeasure:
+    """One contact zone of a pair at a step."""
+
+    pair: int
+    slave: str
+    master: str
+    step: int
+    time: float
+    xi_range: tuple[float, float]
+    """Slave-edge parameters of the zone's first and last points in contact."""
+    half_width: float
+    """w: the zone's reference half-width (see the module docstring)."""
+    elements_across: float
+    n_points: int
+    """Slave points in contact."""
+    edges: list[EdgeMeasure] = field(default_factory=list)
+
+    @property
+    def resolved(self) -> bool:
+        """Enough points in contact to measure the zone at all."""
+        return self.n_points >= MIN_POINTS
+
+    @property
+    def estimate(self) -> float:
+        """Estimated relative L2 error of the zone's pressure made at its edges (inf for
+        a zone of fewer than :data:`MIN_POINTS` points)."""
+        if not self.resolved:
+            return math.inf
+        return float(np.sqrt(sum(e.estimate**2 for e in self.edges)))
+
+
+def nominal_pressure(c: ContactOutput) -> np.ndarray:
+    """The pressure per reference length (``p_n`` in files without it)."""
+    return c.p_n_nominal if c.p_n_nominal is not None else c.p_n
+
+
+def arc_coordinate(x_ref: np.ndarray) -> np.ndarray:
+    """(n,) reference distance along the polyline through the points (in their order)."""
+    steps = np.linalg.norm(np.diff(x_ref, axis=0), axis=1)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def element_breaks(body: Body) -> np.ndarray:
+    """The slave edge's element boundaries in its parameter (the bulk's xi breaks)."""
+    return breakpoints(body)[0]
+
+
+def normal_size(body: Body, xi: float) -> float:
+    """Reference distance across the surface element row at the edge parameter ``xi``:
+    from eta = 1 to the row's inner boundary (the bulk's last eta break)."""
+    eta = breakpoints(body)[1]
+    inner = float(eta[-2]) if len(eta) > 1 else 0.0
+    pts = evaluate_patch(body.bulk, np.array([xi, xi]), np.array([1.0, inner]))
+    return float(np.linalg.norm(pts[0] - pts[1]))
+
+
+def zones(active: np.ndarray) -> list[tuple[int, int]]:
+    """Index ranges ``(first, last)`` (inclusive) of the runs of True in ``active``."""
+    on = np.flatnonzero(active)
+    if not on.size:
+        return []
+    cuts = np.flatnonzero(np.diff(on) > 1)
+    starts = np.concatenate([[on[0]], on[cuts + 1]])
+    ends = np.concatenate([on[cuts], [on[-1]]])
+    return list(zip(starts.tolist(), ends.tolist(), strict=True))
+
+
+def _covered(breaks: np.ndarray, lo: float, hi: float) -> float:
+    """Elements of ``breaks`` covered by [lo, hi], partly covered ones by their fraction."""
+    spans = np.diff(breaks)
+    overlap = np.clip(np.minimum(breaks[1:], hi) - np.maximum(breaks[:-1], lo), 0.0, None)
+    return float(np.sum(overlap / spans))
+
+
+def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float]:
+    """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
+    pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
+    d^2`` to the points with ``h <= d <= band`` (when fewer than three such points, all
+    points in contact), and the distance of the fit's edge (its root, NaN when it has
+    none); ``(NaN, NaN)`` for fewer than three points in contact."""
+    fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
+    if np.count_nonzero(fit) < 3:
+        fit = p > 0
+    if np.count_nonzero(fit) < 3:
+        return math.nan, math.nan
+    dd = d[fit]
+    design = np.column_stack([np.ones_like(dd), dd, dd**2])
+    coef, *_ = np.linalg.lstsq(design, p[fit] ** 2, rcond=None)
+    q = design_at(d) @ coef
+    ref = np.sqrt(np.clip(q, 0.0, None))
+    # no pressure beyond the fit's edge (the root of q nearest the zone)
+    root = _first_root(coef, float(dd.min()))
+    ref[d < root] = 0.0
+    near = d < 2 * h
+    order = np.argsort(d[near])
+    x, r = d[near][order], (p[near] - ref[near])[order]
+    return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root
+
+
+def design_at(d: np.ndarray) -> np.ndarray:
+    """The columns ``1, d, d^2`` of the edge fit at ``d``."""
+    return np.column_stack([np.ones_like(d), d, d**2])
+
+
+def _first_root(coef: np.ndarray, start: float) -> float:
+    """The largest root of ``c0 + c1 d + c2 d^2`` below ``start`` (-inf when none)."""
+    roots = np.roots(coef[::-1]) if abs(coef[2]) > 0 else np.array([-coef[0] / coef[1]])
+    real = np.real(roots[np.abs(np.imag(roots)) < 1e-12])
+    below = real[real < start]
+    return float(below.max()) if below.size else -math.inf
+
+
+@dataclass(frozen=True)
+class _Profile:
+    """A pair's slave points at a step in slave-parameter order."""
+
+    xi: np.ndarray
+    s: np.ndarray
+    """Reference distance along the slave edge (:func:`arc_coordinate`)."""
+    p: np.ndarray
+    """Nominal pressure."""
+
+
+def _measure_edge(result: Result, c: ContactOutput, prof: _Profile, zone: tuple[int, int],
+                  i: int, side: int, w: float, norm: float) -> EdgeMeasure:
+    """The free edge of ``zone`` after its point ``i`` (``side`` +1: the zone's upper
+    end, -1: its lower end); ``w`` the zone's half-width, ``norm`` its squared L2 norm."""
+    xi, s, p = prof.xi, prof.s, prof.p
+    j = i + side  # the first point out of contact
+    xe, se = 0.5 * (xi[i] + xi[j]), 0.5 * (s[i] + s[j])
+    h = slave_element_size(result, c, float(xe))
+    d = side * (se - s)  # distance into the zone
+    mask = np.zeros(len(xi), dtype=bool)  # the zone's points and those out within 2 h
+    mask[zone[0]:zone[1] + 1] = True
+    mask[(d < 0) & (d > -2 * h)] = True
+    residual, root = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+    if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
+        xe = float(np.interp(se - side * root, s, xi))
+    hn = normal_size(result.body(c.slave), float(xe))
+    raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
+    return EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
+                       ratio_tangent=h / w if w > 0 else math.inf,
+                       ratio_normal=hn / w if w > 0 else math.inf, raw=raw,
+                       bracket=float(abs(s[j] - s[i])), half_width=float(w))
+
+
+def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure]:
+    """The zones of contact pair ``pair`` (0-based) at converged step ``step_index``
+    (an index into ``result.steps``)."""
+    st = result.steps[step_index]
+    c = st.contact[pair]
+    order = np.argsort(c.xi_slave, kind="stable")
+    prof = _Profile(xi=c.xi_slave[order], s=arc_coordinate(c.x_ref[order]),
+                    p=nominal_pressure(c)[order])
+    xi, s, p = prof.xi, prof.s, prof.p
+    breaks = element_breaks(result.body(c.slave))
+    n = len(xi)
+    out: list[ZoneMeasure] = []
+    for i0, i1 in zones(c.active[order] & (p > 0)):
+        free = ([(i0, -1)] if i0 > 0 else []) + ([(i1, +1)] if i1 < n - 1 else [])
+        # the zone's ends midway between its outer points and the first ones out
+        s_lo = 0.5 * (s[i0] + s[i0 - 1]) if i0 > 0 else s[0]
+        s_hi = 0.5 * (s[i1] + s[i1 + 1]) if i1 < n - 1 else s[-1]
+        w = 0.5 * (s_hi - s_lo) if len(free) == 2 else s_hi - s_lo
+        xi_lo = 0.5 * (xi[i0] + xi[i0 - 1]) if i0 > 0 else breaks[0]
+        xi_hi = 0.5 * (xi[i1] + xi[i1 + 1]) if i1 < n - 1 else breaks[-1]
+        around = slice(max(i0 - 1, 0), min(i1 + 2, n))
+        norm = float(np.trapezoid(p[around] ** 2, s[around]))
+        edges = [_measure_edge(result, c, prof, (i0, i1), i, side, w, norm) for i, side in free]
+        out.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step,
+                               time=st.time, xi_range=(float(xi[i0]), float(xi[i1])),
+                               half_width=float(w),
+                               elements_across=_covered(breaks, xi_lo, xi_hi),
+                               n_points=i1 - i0 + 1, edges=edges))
+    return out
+
+
+def measure(result: Result) -> list[ZoneMeasure]:
+    """Every zone of every pair at every converged step, in step then pair order."""
+    out: list[ZoneMeasure] = []
+    for k, st in enumerate(result.steps):
+        for pair in range(len(st.contact)):
+            out += measure_pair(result, k, pair)
+    return out
+
+
+def worst(measures: list[ZoneMeasure]) -> dict[int, ZoneMeasure]:
+    """Per pair, the zone and step with the largest estimate."""
+    out: dict[int, ZoneMeasure] = {}
+    for m in measures:
+        if m.pair not in out or m.estimate > out[m.pair].estimate:
+            out[m.pair] = m
+    return out
+
+
+def format_zone(m: ZoneMeasure) -> str:
+    """One line: elements across, h/w at each edge, the estimate."""
+    if not m.resolved:
+        return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.n_points} point(s) in "
+                f"contact, {m.elements_across:.2g} slave elements: the zone is not resolved")
+    several = len(m.edges) > 1
+    edges = "; ".join(f"edge at xi = {e.xi:.4g}: h/w = {e.ratio_tangent:.3g} along, "
+                      f"{e.ratio_normal:.3g} across" + (f", {e.estimate:.2%}" if several else "")
+                      for e in m.edges) or "no free edge"
+    return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.elements_across:.1f} slave "
+            f"elements across the zone (half-width {m.half_width:.4g}); {edges}; "
+            f"estimated edge error {m.estimate:.2%}")
+
+
+def indicator_lines(result: Result) -> list[str]:
+    """The summary's lines: per pair the step with the largest estimate (and its zone),
+    and a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`."""
+    lines: list[str] = []
+    for m in worst(measure(result)).values():
+        lines.append("  accuracy: " + format_zone(m))
+        if m.estimate > WARN_ESTIMATE:
+            lines.append(f"warning: contact {m.slave} -> {m.master}: the mesh resolves the "
+                         f"contact zone's edge poorly (estimated pressure error "
+                         + (f"{m.estimate:.2%}" if math.isfinite(m.estimate) else "unbounded")
+                         + f" at step {m.step}, above {WARN_ESTIMATE:.1%}): refine the zone "
+                         f"with `python -m pre refine {result.path}` (docs/howto.md)")
+    return lines

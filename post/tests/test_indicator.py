@@ -1,0 +1,163 @@
+"""post/indicator.py, post/adapt.py and `pre refine RESULT.h5`: the contact-zone indicator
+and the refined case (hertz runs need the voiga binary; conftest.py)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from post.adapt import AdaptError, next_stem, parse_target, pressure_change, refine_result
+from post.hertz import hertz_comparison
+from post.indicator import CALIBRATION, WARN_ESTIMATE, _edge_residual, indicator_lines, measure, zones
+from post.plot import breakpoints
+from post.reader import read_result
+from post.summary import summary_lines
+from pre.__main__ import main as pre_main
+from pre.nurbs import evaluate_patch
+from pre.refine import discretize_case
+
+from .conftest import CASES, TIMEOUT
+
+
+def _hertz(voiga: Path, folder: Path, mesh: str) -> Path:
+    """The committed hertz case ``mesh`` NN2.2 with voiga's default contact settings
+    (its penalty and method dropped), solved in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    shutil.copy(CASES / "hertz" / "geometry.h5", folder / "geometry.h5")
+    text = (CASES / "hertz" / f"{mesh}-NN2.2.nml").read_text()
+    (folder / f"{mesh}-NN2.2.nml").write_text(re.sub(r"\n *(penalty_normal|method) = [^\n]*", "", text))
+    subprocess.run([str(voiga), f"{mesh}-NN2.2.nml", "--quiet"], cwd=folder, check=True,
+                   timeout=TIMEOUT, stdin=subprocess.DEVNULL, capture_output=True)
+    return folder / f"{mesh}-NN2.2.h5"
+
+
+@pytest.fixture(scope="module")
+def m2(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _hertz(voiga, tmp_path_factory.mktemp("m2"), "m2")
+
+
+@pytest.fixture(scope="module")
+def m4(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _hertz(voiga, tmp_path_factory.mktemp("m4"), "m4")
+
+
+def test_zones_are_runs_of_contact() -> None:
+    active = np.array([False, True, True, False, True, False, False, True, True, True])
+    assert zones(active) == [(1, 2), (4, 4), (7, 9)]
+    assert zones(np.zeros(4, dtype=bool)) == []
+
+
+def test_edge_fit_reproduces_a_hertz_profile() -> None:
+    """p^2 quadratic in the distance from the edge (Hertz): the fit is exact, no residual,
+    and its root is the edge."""
+    a, h = 1.0, 0.05
+    d = np.linspace(-0.1, 0.6, 71)  # distance into the zone from the edge
+    x = a - d
+    p = np.sqrt(np.clip(1 - x**2, 0, None))
+    residual, root = _edge_residual(d, p, h, 0.5)
+    assert residual < 1e-24 and abs(root) < 1e-10
+    bumped = p.copy()
+    bumped[(d > 0) & (d < h)] *= 1.1  # 10 % off in the edge element
+    assert _edge_residual(d, bumped, h, 0.5)[0] > 1e-6
+
+
+def test_indicator_flags_the_coarse_committed_mesh(m4: Path) -> None:
+    """hertz m4 NN2.2 (default contact settings): 1.4 % against Hertz at step 1, flagged."""
+    result = read_result(m4)
+    ms = measure(result)
+    assert [m.step for m in ms] == [1, 2, 3, 4, 5]
+    first = ms[0]
+    assert len(first.edges) == 1  # the symmetry cut is no edge
+    edge = first.edges[0]
+    assert 9 < first.elements_across < 12 and 0.05 < edge.ratio_tangent < 0.2
+    assert first.estimate > WARN_ESTIMATE
+    lines = summary_lines(result)
+    assert any(line.startswith("warning:") and "pre refine" in line for line in lines)
+    assert any("accuracy:" in line for line in lines)
+    # calibrated on these cases: the estimate within a factor 2 of the edge's error
+    for m in ms:
+        edge_error = hertz_comparison(result, step=m.step, reference="circle").error.l2_edge
+        assert 0.5 < edge_error / m.estimate < 2.0, (m.step, edge_error, m.estimate)
+    assert 0.5 < CALIBRATION < 1.0
+
+
+def test_targets_and_stems() -> None:
+    assert parse_target("0.2%") == pytest.approx(0.002) and parse_target("0.01") == 0.01
+    for bad in ("0", "150%", "nan", "x"):
+        with pytest.raises(ValueError):
+            parse_target(bad)
+    assert next_stem("m2-NN2.2") == "m2-NN2.2-zone1" and next_stem("a-zone9") == "a-zone10"
+
+
+def test_refined_case_keeps_the_geometry_and_nests(m2: Path, voiga: Path, tmp_path: Path) -> None:
+    """`pre refine RESULT.h5`: knots only added (the old breaks kept), the refined
+    discretization maps the same points as the old one (knot insertion), the DOF count it
+    reports is voiga's, and the refined run resolves the zone better."""
+    out = tmp_path / "z1"
+    assert pre_main(["refine", str(m2), "--out", str(out)]) == 0
+    case = out / "m2-NN2.2-zone1.nml"
+    assert case.is_file()
+    assert pre_main(["refine", str(m2), "--out", str(out)]) == 2  # not overwritten
+    old = read_result(m2).bodies["cylinder"]
+    new_disc = discretize_case(case).bodies["cylinder"]
+    old_disc = discretize_case(m2.with_suffix(".nml")).bodies["cylinder"]
+    new_breaks = np.unique(new_disc.bulk.knots_xi)
+    assert all(np.isclose(new_breaks, b, atol=1e-14).any() for b in breakpoints(old)[0])
+    assert len(new_breaks) > len(breakpoints(old)[0])
+    rng = np.random.default_rng(3)
+    xi, eta = rng.random(200), rng.random(200)
+    assert np.allclose(evaluate_patch(new_disc.bulk, xi, eta), evaluate_patch(old_disc.bulk, xi, eta),
+                       rtol=0, atol=1e-12)
+    subprocess.run([str(voiga), case.name, "--quiet"], cwd=out, check=True, timeout=TIMEOUT,
+                   stdin=subprocess.DEVNULL, capture_output=True)
+    refined = read_result(out / "m2-NN2.2-zone1.h5")
+    assert refined.n_dofs == new_disc.total_dofs
+    worst_old = max(m.estimate for m in measure(read_result(m2)))
+    worst_new = max(m.estimate for m in measure(refined))
+    assert worst_new < worst_old / 10
+    assert pressure_change(read_result(m2), refined) > 0.01  # the coarse profile was off
+
+
+def test_refine_refuses_results_it_cannot_use(stretch_h5: Path, m2: Path, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(AdaptError, match="no contact"):
+        refine_result(stretch_h5, out=tmp_path / "a")
+    moved = tmp_path / "moved.h5"
+    shutil.copy(m2, moved)
+    shutil.copy(m2.with_suffix(".nml"), tmp_path / "m2-NN2.2.nml")
+    assert pre_main(["refine", str(tmp_path / "missing.h5")]) == 2
+    assert "missing.h5" in capsys.readouterr().err
+    assert pre_main(["refine", str(m2.with_suffix(".nml"))]) == 2  # a case needs -o
+    assert indicator_lines(read_result(stretch_h5)) == []
+
+
+def test_indicator_command(m4: Path, stretch_h5: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from post.__main__ import main as post_main
+
+    assert post_main(["indicator", str(m4)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 5 and lines[0].startswith("contact cylinder -> rigid, step 1: ")
+    assert post_main(["indicator", str(stretch_h5)]) == 2
+    assert "no contact" in capsys.readouterr().err
+
+
+def test_refine_deformable_master_too(press_h5: Path, tmp_path: Path) -> None:
+    """A die pressed and slid on a slab (NURBS master): the slave and the master are
+    both refined around the zone's edges, their maps unchanged."""
+    done = refine_result(press_h5, out=tmp_path / "z")
+    result = read_result(press_h5)
+    pair = result.steps[-1].contact[0]
+    assert set(done.bodies) == {pair.slave, pair.master}
+    refined = discretize_case(done.case).bodies
+    before = discretize_case(press_h5.parent / "case.nml").bodies
+    rng = np.random.default_rng(5)
+    xi, eta = rng.random(100), rng.random(100)
+    for name in done.bodies:
+        assert len(np.unique(refined[name].bulk.knots_xi)) > len(np.unique(before[name].bulk.knots_xi))
+        assert np.allclose(evaluate_patch(refined[name].bulk, xi, eta),
+                           evaluate_patch(before[name].bulk, xi, eta), rtol=0, atol=1e-12)
