@@ -44,7 +44,7 @@ from .volume import Volume, check_volume
 
 SOLID_METHOD = "mortar"
 """The contact method the cases name: voiga's default on solids (GPTS's n_gauss^2
-constraints per face cell lock; docs/verification.md, "Contact on faces")."""
+constraints per face cell lock; docs/verification-faces.md)."""
 
 SCENE = "hertz3d"
 BODY = "ball"

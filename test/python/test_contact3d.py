@@ -216,7 +216,7 @@ def test_blocks_matching_faces(voiga_bin: Path, tmp_path: Path, method: str) -> 
 def test_blocks_non_matching_faces(voiga_bin: Path, tmp_path: Path) -> None:
     """Non-matching faces (3 x 2 cells on 5 x 3): the force is the load, but the
     pressure is off by the quadrature error of the master's kinks inside slave cells,
-    as in 2D (docs/verification.md, "Contact on faces"): mortar's spread is below
+    as in 2D (docs/verification-faces.md): mortar's spread is below
     GPTS's and falls with the points per cell (a segment-based method on faces, which
     would pass exactly, is issue 42's next step)."""
     spreads = {}
