@@ -39,6 +39,8 @@ contains
                     new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
                     new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
                     new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
+                    new_unittest('rigid_surface_flat_is_the_plane', test_flat_surface), &
+                    new_unittest('rigid_surface_tangent_fd', test_surface_fd), &
                     new_unittest('contact_3d_face_area', test_face_area), &
                     new_unittest('rigid_plane_frame', test_plane_frame) &
                     ]
@@ -200,6 +202,110 @@ contains
         end select
         call contact_fd(model%pairs(1)%pair, u, want, 'friction '//label, error)
     end subroutine friction_fd
+
+    !> A flat rigid NURBS surface (the plane z = 0.02 as a bilinear patch over
+    !> [-1, 2]^2, its normal +z) acts as the rigid plane through the same point: the
+    !> residual, tangent and pressures of the box pressed onto it agree to round-off.
+    subroutine test_flat_surface(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: plane, surf
+        real(dp), allocatable :: u(:), r1(:), r2(:)
+        type(lcg_t) :: rng
+        integer :: j
+        call box_on_rigid(bump_patch(0.02_dp, 0.0_dp, 1), .false., plane, error)
+        if (allocated(error)) return
+        call box_on_rigid(bump_patch(0.02_dp, 0.0_dp, 1), .true., surf, error)
+        if (allocated(error)) return
+        allocate (u(plane%ndof), r1(plane%ndof), r2(plane%ndof))
+        do j = 1, size(u)
+            u(j) = 1.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+        end do
+        r1 = 0.0_dp
+        r2 = 0.0_dp
+        call plane%pairs(1)%pair%evaluate(u, r1, error)
+        if (allocated(error)) return
+        call surf%pairs(1)%pair%evaluate(u, r2, error)
+        if (allocated(error)) return
+        call check(error, maxval(abs(r1 - r2)) <= 1.0e-12_dp*maxval(abs(r1)) .and. maxval(abs(r1)) > 0.0_dp, &
+                   'the same contact residual on the plane and on the flat surface')
+        if (allocated(error)) return
+        call check(error, maxval(abs(plane%pairs(1)%pair%out%pn - surf%pairs(1)%pair%out%pn)), 0.0_dp, &
+                   'the same pressures', abs=1.0e-12_dp)
+    end subroutine test_flat_surface
+
+    !> A curved rigid surface (a biquadratic bump whose top rises 0.04 into the box's
+    !> bottom face): the contact tangent against differences, with the master's curvature in
+    !> the projection and the normal (GPTS and mortar).
+    subroutine test_surface_fd(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=6), parameter :: methods(2) = [character(len=6) :: 'gpts', 'mortar']
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:)
+        integer :: im, j
+        do im = 1, 2
+            call box_on_rigid(bump_patch(-0.01_dp, 0.2_dp, 2), .true., model, error, methods(im))
+            if (allocated(error)) return
+            allocate (u(model%ndof))
+            do j = 1, size(u)
+                u(j) = 1.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+            end do
+            call contact_fd(model%pairs(1)%pair, u, state_stick, 'rigid bump '//trim(methods(im)), error)
+            if (allocated(error)) return
+            deallocate (u)
+        end do
+    end subroutine test_surface_fd
+
+    !> The unit box (N2, 2 x 2 cells on its bottom) over a rigid obstacle: the surface
+    !> `patch` (with `surface`), else the plane z = 0.02.
+    subroutine box_on_rigid(patch, surface, model, error, method)
+        type(nurbs_patch_t), intent(in) :: patch
+        logical, intent(in) :: surface
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in), optional :: method
+        type(scene_t) :: c
+        type(discretization_t) :: discs(1)
+        type(contact_settings_t) :: contact
+        c%bodies = [body_settings('box', 'linear', 1.0_dp, layout3(2, [2, 2, 1], 0, 0, 'bottom'))]
+        contact%slave = 'box'
+        contact%master = 'rigid'
+        contact%method = 'gpts'
+        if (present(method)) contact%method = method
+        contact%rigid_point = [0.0_dp, 0.0_dp, 0.02_dp]
+        contact%rigid_normal = [0.0_dp, 0.0_dp, 1.0_dp]
+        contact%point_components = 3
+        contact%normal_components = 3
+        if (surface) then
+            contact%rigid_surface = 'bump'
+            contact%surface = patch
+        end if
+        c%contact = [contact]
+        call new_discretization(discs(1), unit_box(0.0_dp), box_faces, c%bodies(1)%layout, '', error)
+        if (allocated(error)) return
+        call scene_model(c, discs, model, error)
+    end subroutine box_on_rigid
+
+    !> The surface over [-1, 2]^2 of degree `p` (1 or 2) at z = `z0`, its middle control
+    !> point raised by `rise` (degree 2: a bump into the box above), normal +z.
+    function bump_patch(z0, rise, p) result(patch)
+        real(dp), intent(in) :: z0, rise
+        integer, intent(in) :: p
+        type(nurbs_patch_t) :: patch
+        real(dp) :: cp(3, (p + 1)**2)
+        type(knots_t) :: kv
+        integer :: i, j, a
+        a = 0
+        do j = 0, p
+            do i = 0, p
+                a = a + 1
+                cp(:, a) = [-1.0_dp + 3.0_dp*real(i, dp)/real(p, dp), -1.0_dp + 3.0_dp*real(j, dp)/real(p, dp), z0]
+            end do
+        end do
+        if (p == 2) cp(3, 5) = cp(3, 5) + rise
+        kv = knots_t([(0.0_dp, i=0, p), (1.0_dp, i=0, p)])
+        patch = new_patch([p, p], [kv, kv], [p + 1, p + 1], cp, [(1.0_dp, a=1, (p + 1)**2)])
+    end function bump_patch
 
     !> The box [0, 1] x [0, 1] x [z0, z0 + 1] (degree 1).
     function unit_box(z0) result(patch)

@@ -8,6 +8,7 @@ module voiga_contact_factory
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_nurbs_curve, only: nurbs_curve_t
+    use voiga_nurbs_patch, only: nurbs_patch_t
     use voiga_contact_surface, only: contact_surface_t, element_lengths
     use voiga_contact_master, only: contact_master_t
     use voiga_contact_pair, only: contact_pair_t, automatic
@@ -57,6 +58,11 @@ module voiga_contact_factory
         !> its name ('' for the line) and the curve (read by `voiga_io_input_bodies`).
         character(len=32) :: rigid_curve = ''
         type(nurbs_curve_t) :: curve
+        !> In a solid case, a rigid obstacle bounded by a surface of the geometry file
+        !> (/surfaces/<name>; its normal a_1 x a_2 points out of the obstacle): its name
+        !> ('' for the plane) and the surface (read by `voiga_io_input_bodies`).
+        character(len=32) :: rigid_surface = ''
+        type(nurbs_patch_t) :: surface
         !> The rigid master's translation at the end of each load phase, shape
         !> [3, n_phases] (z: 0 in 2D) (linear within a phase, zero at time 0); unallocated: fixed.
         real(dp), allocatable :: rigid_motion(:, :)

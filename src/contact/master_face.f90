@@ -11,12 +11,12 @@ module voiga_contact_master_face
     use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, jacobian_determinant
     use voiga_nurbs_projection, only: surface_search_t, surface_projection_t, new_surface_search, &
                                       project_on_surface
-    use voiga_contact_master, only: contact_master_t, master_point_t
-    use voiga_contact_surface, only: contact_surface_t, new_contact_surface, face_basis, face_ids
+    use voiga_contact_master, only: contact_master_t, master_point_t, master_no_dofs, master_output_t
+    use voiga_contact_surface, only: contact_surface_t, new_contact_surface, face_basis, face_ids, new_patch_surface
     implicit none
     private
 
-    public :: face_master_t, new_face_master
+    public :: face_master_t, new_face_master, rigid_surface_t, new_rigid_surface
 
     !> A body's contact face acting as master.
     type, extends(contact_master_t) :: face_master_t
@@ -31,7 +31,87 @@ module voiga_contact_master_face
         procedure :: prepare => face_prepare
     end type face_master_t
 
+    !> A rigid obstacle of a solid case bounded by a surface of the geometry file (a
+    !> spherical or cylindrical indenter, a die), without DOFs, moved as a whole by its
+    !> prescribed motion: the face master's search and projection run on the surface's
+    !> own control points with a zero displacement vector, and `move` translates the
+    !> control points (as `voiga_contact_master_curve` does for a curve). Its normal
+    !> a_1 x a_2 points out of the obstacle.
+    type, extends(face_master_t) :: rigid_surface_t
+        !> Control points at load time 0 [3, n], the (zero) displacement vector [3 n],
+        !> the translation from there, and the surface's name (for messages).
+        real(dp), allocatable :: x_ref(:, :), zero(:)
+        real(dp) :: offset(3) = 0.0_dp
+        character(len=32) :: name = ''
+    contains
+        procedure :: project => surface_project
+        procedure :: all_dofs => surface_all_dofs
+        procedure :: prepare => surface_prepare
+        procedure :: move => surface_move
+        procedure :: output => surface_output
+    end type rigid_surface_t
+
 contains
+
+    !> The obstacle bounded by `patch` (pdim 2, nsd 3) at its reference position.
+    pure subroutine new_rigid_surface(self, patch)
+        type(rigid_surface_t), intent(out) :: self
+        type(nurbs_patch_t), intent(in) :: patch
+        self%deformable = .false.
+        call new_patch_surface(self%surf, patch)
+        self%sign = 1.0_dp
+        self%x_ref = patch%cp
+        allocate (self%zero(3*size(patch%w)), source=0.0_dp)
+    end subroutine new_rigid_surface
+
+    !> The search structure of the surface where it is now.
+    pure subroutine surface_prepare(self, u)
+        class(rigid_surface_t), intent(inout) :: self
+        real(dp), intent(in) :: u(:)
+        if (size(u) < 0) return   ! the surface has no DOFs in u
+        call face_prepare(self, self%zero)
+    end subroutine surface_prepare
+
+    !> The face master's projection, without master functions (no DOFs to couple).
+    pure subroutine surface_project(self, u, xs, mp, found, converged, start)
+        class(rigid_surface_t), intent(in) :: self
+        real(dp), intent(in) :: u(:), xs(:)
+        type(master_point_t), intent(out) :: mp
+        logical, intent(out) :: found, converged
+        real(dp), intent(in), optional :: start(:)
+        if (size(u) < 0) return   ! the surface has no DOFs in u
+        call face_project(self, self%zero, xs, mp, found, converged, start)
+        deallocate (mp%r, mp%dr, mp%drb, mp%dofs)
+        allocate (mp%r(0), mp%dr(0), mp%drb(0), mp%dofs(0))
+        mp%first = 1
+        mp%last = 0
+    end subroutine surface_project
+
+    pure function surface_all_dofs(self) result(dofs)
+        class(rigid_surface_t), intent(in) :: self
+        integer, allocatable :: dofs(:)
+        dofs = master_no_dofs(self)
+    end function surface_all_dofs
+
+    !> Translate the surface to its reference position plus `offset` [3].
+    pure subroutine surface_move(self, offset)
+        class(rigid_surface_t), intent(inout) :: self
+        real(dp), intent(in) :: offset(:)
+        integer :: c
+        self%offset = offset
+        do c = 1, 3
+            self%surf%x0(c, :) = self%x_ref(c, :) + offset(c)
+        end do
+    end subroutine surface_move
+
+    !> Its translation from load time 0.
+    pure function surface_output(self) result(out)
+        class(rigid_surface_t), intent(in) :: self
+        type(master_output_t) :: out
+        out%curve_name = ''
+        out%names = [character(len=16) :: 'rigid_offset']
+        out%vectors = reshape(self%offset, [3, 1])
+    end function surface_output
 
     !> The contact face of `disc` (DOFs after `dof0`) as a master.
     subroutine new_face_master(self, disc, dof0)

@@ -11,12 +11,13 @@ module voiga_contact_surface
     use voiga_nurbs_rational, only: rationalize
     use voiga_nurbs_curve, only: nurbs_curve_t
     use voiga_discretization_patch, only: discretization_t
-    use voiga_nurbs_patch, only: knots_t
+    use voiga_nurbs_patch, only: knots_t, nurbs_patch_t
     implicit none
     private
 
     public :: contact_surface_t, new_contact_surface, new_curve_surface, surface_point_t, surface_point, &
-              surface_basis, surface_point_at, element_lengths, n_elements, face_basis, face_point_at, face_ids
+              surface_basis, surface_point_at, element_lengths, n_elements, face_basis, face_point_at, face_ids, &
+              new_patch_surface
 
     !> The contact edge of one body.
     type :: contact_surface_t
@@ -115,6 +116,23 @@ contains
         self%x0 = curve%cp
         call set_spans(self)
     end subroutine new_curve_surface
+
+    !> A surface that belongs to no body (a rigid obstacle's, pdim 2, nsd 3), as a face
+    !> over a displacement vector of its own: control point k has the DOFs 3k - 2 .. 3k.
+    pure subroutine new_patch_surface(self, patch)
+        type(contact_surface_t), intent(out) :: self
+        type(nurbs_patch_t), intent(in) :: patch
+        integer :: k, c
+        call set_directions(self, patch%degree, patch%knots, patch%n)
+        self%w = patch%w
+        self%cps = [(k, k=1, size(patch%w))]
+        allocate (self%dofs(3, size(self%cps)))
+        do c = 1, 3
+            self%dofs(c, :) = 3*(self%cps - 1) + c
+        end do
+        self%x0 = patch%cp
+        call set_spans(self)
+    end subroutine new_patch_surface
 
     !> The breakpoints and the knot span of each element, from the knots (per
     !> direction on a face).

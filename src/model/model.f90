@@ -14,7 +14,7 @@ module voiga_model
     use voiga_contact_master, only: contact_master_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_contact_master_nurbs, only: nurbs_master_t, new_nurbs_master
-    use voiga_contact_master_face, only: face_master_t, new_face_master
+    use voiga_contact_master_face, only: face_master_t, new_face_master, rigid_surface_t, new_rigid_surface
     use voiga_contact_master_curve, only: rigid_curve_t, new_rigid_curve
     implicit none
     private
@@ -165,6 +165,7 @@ contains
         type(rigid_curve_t) :: curve
         type(nurbs_master_t) :: body_master
         type(face_master_t) :: face_master
+        type(rigid_surface_t) :: surface
         type(contact_settings_t) :: settings
         integer :: ib, im
 
@@ -183,6 +184,10 @@ contains
         else if (trim(inp%master) == 'rigid') then
             call new_rigid_line(rigid, inp%rigid_point(1:self%nsd), rigid_normal_of(inp, self%nsd))
             allocate (master, source=rigid)
+        else if (trim(inp%master) == 'rigid' .and. len_trim(inp%rigid_surface) > 0) then
+            call new_rigid_surface(surface, inp%surface)
+            surface%name = inp%rigid_surface
+            allocate (master, source=surface)
         else if (self%nsd == 3) then
             im = find_body(self, inp%master)
             call new_face_master(face_master, self%bodies(im)%disc, self%bodies(im)%dof0)

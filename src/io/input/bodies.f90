@@ -7,7 +7,7 @@ module voiga_io_input_bodies
     use voiga_io_input_case, only: case_t
     use voiga_model_body, only: body_settings_t
     use voiga_io_hdf5, only: h5file_t
-    use voiga_io_input_geometry, only: read_patch, read_volume, read_curve
+    use voiga_io_input_geometry, only: read_patch, read_volume, read_curve, read_surface
     use voiga_io_input_resources, only: check_size
     use voiga_nurbs_surface, only: nurbs_surface_t, surface_patch
     use voiga_nurbs_patch, only: nurbs_patch_t
@@ -109,13 +109,14 @@ contains
             what = 'rigid_normal needs '//str(nsd)//' components'
         else if (nsd == 2 .and. c%motion_z) then
             what = 'rigid_uz moves a rigid master along z: a plane case has no z'
+        else if (nsd == 2 .and. len_trim(c%rigid_surface) > 0) then
+            what = 'rigid_surface bounds a rigid obstacle of a solid case: in a plane case use rigid_curve'
+        else if (nsd == 3 .and. len_trim(c%rigid_curve) > 0) then
+            what = 'rigid_curve bounds a rigid obstacle of a plane case: in a solid case use rigid_surface '// &
+                   '(a surface of the geometry file)'
         end if
         if (nsd == 3 .and. .not. allocated(what)) then
-            if (len_trim(c%rigid_curve) > 0) then
-                what = 'contact of a solid with a rigid surface of the geometry file is not implemented yet '// &
-                       '(issue 42); a solid can touch a rigid plane (master = ''rigid'', rigid_point, '// &
-                       'rigid_normal) or another solid'
-            else if (c%method_given .and. all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
+            if (c%method_given .and. all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
                 what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
                        "'mortar' or 'gpts'"
             else if (c%friction > 0.0_dp .and. c%method_given .and. trim(c%method) /= 'gpts') then
@@ -203,17 +204,24 @@ contains
         character(len=16) :: buf
         integer :: k
 
-        if (all([(len_trim(case%contact(k)%rigid_curve) == 0, k=1, size(case%contact))])) return
+        if (all([(len_trim(case%contact(k)%rigid_curve) == 0 .and. len_trim(case%contact(k)%rigid_surface) == 0, &
+                  k=1, size(case%contact))])) return
         call geo%open(case%geometry, 'r', error)
         if (allocated(error)) then
             error%message = case%path//': &case: geometry: '//error%message
             return
         end if
         do k = 1, size(case%contact)
+            write (buf, '(i0)') k
+            if (len_trim(case%contact(k)%rigid_surface) > 0) then
+                call read_surface(geo, case%contact(k)%rigid_surface, case%contact(k)%surface, error)
+                if (allocated(error)) error%message = case%path//': &contact ('//trim(buf)//'): rigid_surface: '// &
+                                                      error%message
+            end if
+            if (allocated(error)) exit
             if (len_trim(case%contact(k)%rigid_curve) == 0) cycle
             call read_curve(geo, case%contact(k)%rigid_curve, case%contact(k)%curve, error)
             if (allocated(error)) then
-                write (buf, '(i0)') k
                 error%message = case%path//': &contact ('//trim(buf)//'): rigid_curve: '//error%message
                 exit
             end if

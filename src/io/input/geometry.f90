@@ -15,7 +15,7 @@ module voiga_io_input_geometry
     implicit none
     private
 
-    public :: read_patch, read_volume, read_curve, validate_knots, geometry_units, check_jacobian
+    public :: read_patch, read_volume, read_curve, read_surface, validate_knots, geometry_units, check_jacobian
 
     !> Sample points per knot span and direction for the sign of det J (a fold
     !> narrower than about 1/32 of a span of the exact geometry could hide between them).
@@ -238,6 +238,50 @@ contains
         end if
         curve%cp = cp
     end subroutine read_curve
+
+    !> Read the surface `name` (/surfaces/<name>: a rigid obstacle's boundary in a
+    !> solid case) from the open geometry file `h5`: degree (2,), knots_xi, knots_eta,
+    !> control_points (n_eta, n_xi, 3), weights (n_eta, n_xi).
+    subroutine read_surface(h5, name, patch, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        type(nurbs_patch_t), intent(out) :: patch
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: directions(2) = ['xi ', 'eta']
+        character(len=:), allocatable :: g, where
+        integer, allocatable :: degree(:)
+        real(dp), allocatable :: cp(:, :, :), w(:, :)
+        type(knots_t) :: knots(2)
+        integer :: d
+
+        g = '/surfaces/'//trim(name)
+        call read_degree(h5, 'surface', name, g, 2, degree, where, error)
+        if (allocated(error)) return
+        do d = 1, 2
+            call h5%read(g//'/knots_'//trim(directions(d)), knots(d)%u, error, max_knots)
+            if (allocated(error)) return
+        end do
+        call h5%read(g//'/control_points', cp, error, 3_int64*max_points)
+        if (allocated(error)) return
+        call h5%read(g//'/weights', w, error, int(max_points, int64))
+        if (allocated(error)) return
+        if (size(cp, 1) /= 3 .or. any(shape(w) /= shape(cp(1, :, :)))) then
+            call fatal_error(error, where//'control_points must have shape (n_eta, n_xi, 3) and weights '// &
+                             '(n_eta, n_xi)', error_code%input)
+            return
+        end if
+        do d = 1, 2
+            call validate_knots(knots(d)%u, degree(d), size(w, d), where//'knots_'//trim(directions(d)), error)
+            if (allocated(error)) return
+        end do
+        if (.not. all(ieee_is_finite(cp))) then
+            call fatal_error(error, where//'control_points must be finite', error_code%input)
+        else if (.not. all(w > 0.0_dp .and. ieee_is_finite(w))) then
+            call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
+        else
+            patch = new_patch(degree, knots, shape(w), reshape(cp, [3, size(w)]), reshape(w, [size(w)]))
+        end if
+    end subroutine read_surface
 
     !> The `n` degrees of the spline in group `g` (a `what` called `name`: 'body' or
     !> 'curve'), each in 1..20; `where` begins the messages about it.

@@ -27,7 +27,7 @@ contains
         type(contact_settings_t), intent(out) :: entry
         type(error_t), allocatable, intent(out) :: error
         ! one character more than kept: a longer value is refused, not cut
-        character(len=33) :: slave, master, rigid_curve
+        character(len=33) :: slave, master, rigid_curve, rigid_surface
         character(len=17) :: method
         real(dp) :: rigid_point(3), rigid_normal(3), penalty_normal, penalty_tangent, tolerance
         real(dp) :: rigid_ux(max_phases), rigid_uy(max_phases), rigid_uz(max_phases), friction(max_phases)
@@ -35,7 +35,8 @@ contains
         logical :: allow_overlap
         character(len=512) :: msg
         namelist /contact/ slave, master, rigid_point, rigid_normal, penalty_normal, penalty_tangent, &
-            friction, n_gauss, method, tolerance, rigid_curve, rigid_ux, rigid_uy, rigid_uz, allow_overlap
+            friction, n_gauss, method, tolerance, rigid_curve, rigid_surface, rigid_ux, rigid_uy, rigid_uz, &
+            allow_overlap
 
         slave = ''
         master = ''
@@ -48,6 +49,7 @@ contains
         method = ''
         tolerance = unset()
         rigid_curve = ''
+        rigid_surface = ''
         rigid_ux = unset()
         rigid_uy = unset()
         rigid_uz = unset()
@@ -61,9 +63,11 @@ contains
         call check_length(slave, 32, 'slave', path//trim(msg)//' ', error)
         call check_length(master, 32, 'master', path//trim(msg)//' ', error)
         call check_length(rigid_curve, 32, 'rigid_curve', path//trim(msg)//' ', error)
+        call check_length(rigid_surface, 32, 'rigid_surface', path//trim(msg)//' ', error)
         call check_length(method, 16, 'method', path//trim(msg)//' ', error)
         if (allocated(error)) return
-        entry = contact_settings_t(slave=slave, master=master, rigid_curve=rigid_curve, penalty_normal=penalty_normal, &
+        entry = contact_settings_t(slave=slave, master=master, rigid_curve=rigid_curve, rigid_surface=rigid_surface, &
+                                   penalty_normal=penalty_normal, &
                                    penalty_tangent=penalty_tangent, n_gauss=n_gauss, &
                                    method=method, tolerance=tolerance, allow_overlap=allow_overlap)
         write (msg, '(a,i0,a)') ': &contact (', k, '): '
@@ -157,6 +161,9 @@ contains
             if (len_trim(c%rigid_curve) > 0) then
                 call fatal_error(error, where//"rigid_curve names the curve of a rigid master, but master = '"// &
                                  trim(c%master)//"' (set master = 'rigid')", error_code%input)
+            else if (len_trim(c%rigid_surface) > 0) then
+                call fatal_error(error, where//"rigid_surface names the surface of a rigid master, but master = '"// &
+                                 trim(c%master)//"' (set master = 'rigid')", error_code%input)
             else if (ib == 0) then
                 call fatal_error(error, where//"master = '"//trim(c%master)// &
                                  "' is neither a body of the case nor 'rigid'", error_code%input)
@@ -166,7 +173,10 @@ contains
                 call fatal_error(error, where//"master = '"//trim(c%master)// &
                                  "' has no contact_edge in its &body", error_code%input)
             end if
-        else if (len_trim(c%rigid_curve) > 0) then
+        else if (len_trim(c%rigid_curve) > 0 .and. len_trim(c%rigid_surface) > 0) then
+            call fatal_error(error, where//'rigid_curve and rigid_surface: give one (a curve in a plane case, '// &
+                             'a surface in a solid one)', error_code%input)
+        else if (len_trim(c%rigid_curve) > 0 .or. len_trim(c%rigid_surface) > 0) then
             return   ! the geometry file must have it (checked when it is read)
         else if (.not. all(ieee_is_finite(c%rigid_point)) .or. .not. all(ieee_is_finite(c%rigid_normal)) .or. &
                  norm2(c%rigid_normal) <= 0.0_dp .or. any(abs(c%rigid_point) > max_value) .or. &
