@@ -11,6 +11,7 @@ module test_contact_3d
     use voiga_contact_factory, only: contact_settings_t
     use voiga_contact_law, only: state_stick, state_slip
     use voiga_contact_gpts, only: gpts_pair_t
+    use voiga_contact_master_face, only: rigid_surface_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
@@ -284,6 +285,13 @@ contains
         call new_discretization(discs(1), unit_box(0.0_dp), box_faces, c%bodies(1)%layout, '', error)
         if (allocated(error)) return
         call scene_model(c, discs, model, error)
+        if (allocated(error)) return
+        select type (m => model%pairs(1)%pair%master)
+        type is (rigid_surface_t)
+            call check(error, surface, 'the plane was asked for, not the surface')
+        class default
+            call check(error, .not. surface, 'the surface was asked for, not the plane')
+        end select
     end subroutine box_on_rigid
 
     !> The surface over [-1, 2]^2 of degree `p` (1 or 2) at z = `z0`, its middle control

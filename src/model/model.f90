@@ -181,13 +181,13 @@ contains
             call new_rigid_curve(curve, inp%curve)
             curve%name = inp%rigid_curve
             allocate (master, source=curve)
-        else if (trim(inp%master) == 'rigid') then
-            call new_rigid_line(rigid, inp%rigid_point(1:self%nsd), rigid_normal_of(inp, self%nsd))
-            allocate (master, source=rigid)
         else if (trim(inp%master) == 'rigid' .and. len_trim(inp%rigid_surface) > 0) then
             call new_rigid_surface(surface, inp%surface)
             surface%name = inp%rigid_surface
             allocate (master, source=surface)
+        else if (trim(inp%master) == 'rigid') then
+            call new_rigid_line(rigid, inp%rigid_point(1:self%nsd), rigid_normal_of(inp, self%nsd))
+            allocate (master, source=rigid)
         else if (self%nsd == 3) then
             im = find_body(self, inp%master)
             call new_face_master(face_master, self%bodies(im)%disc, self%bodies(im)%dof0)
