@@ -399,20 +399,18 @@ contains
         call h5%write(c//'/p_n', [out%pn])
         call h5%write(c//'/p_n_nominal', [out%pn0])
         if (nsd == 3) then
-            ! a face: the tangential traction vector, per current and per reference area
+            ! a face: the tangential traction vector (per current and per reference area),
+            ! the projection's two parameters
             call h5%write(c//'/p_t', reshape([(out(i)%tt, i=1, size(out))], [3, size(out)]))
             call h5%write(c//'/p_t_nominal', reshape([(out(i)%tt*out(i)%stretch, i=1, size(out))], [3, size(out)]))
+            call h5%write(c//'/xi_master', reshape([(out(i)%xi_m, out(i)%eta_m, i=1, size(out))], [2, size(out)]))
         else
             call h5%write(c//'/p_t', [out%pt])
             call h5%write(c//'/p_t_nominal', [out%pt0])
+            call h5%write(c//'/xi_master', [out%xi_m])
         end if
         call h5%write(c//'/stretch', [out%stretch])
         call h5%write(c//'/area_ref', [out%area0])
-        if (nsd == 3) then
-            call h5%write(c//'/xi_master', reshape([(out(i)%xi_m, out(i)%eta_m, i=1, size(out))], [2, size(out)]))
-        else
-            call h5%write(c//'/xi_master', [out%xi_m])
-        end if
         call h5%write(c//'/state', [out%state])
     end subroutine write_points
 
