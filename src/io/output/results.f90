@@ -358,12 +358,10 @@ contains
         call write_master(h5, c, pair%master%output())
         call h5%write(c//'/force', pair%force(1:nsd))
         call write_points(h5, c, pair%out, nsd)
-        if (allocated(pair%eta)) then
-            ! a face: (xi, eta) per point, [2, n] (h5py: (n, 2))
-            call h5%write(c//'/xi_slave', reshape([(pair%xi(i), pair%eta(i), i=1, size(pair%xi))], [2, size(pair%xi)]))
-        else
-            call h5%write(c//'/xi_slave', pair%xi)
-        end if
+        ! (a face: (xi, eta) per point, [2, n], h5py: (n, 2))
+        if (allocated(pair%eta)) call h5%write(c//'/xi_slave', &
+                                               reshape([(pair%xi(i), pair%eta(i), i=1, size(pair%xi))], [2, size(pair%xi)]))
+        if (.not. allocated(pair%eta)) call h5%write(c//'/xi_slave', pair%xi)
         ! committed friction history: what a restart needs
         call write_history(h5, c//'/history/', pair%history())
     end subroutine write_contact
