@@ -359,8 +359,8 @@ contains
         call h5%write(c//'/force', pair%force(1:nsd))
         call write_points(h5, c, pair%out, nsd)
         ! (a face: (xi, eta) per point, [2, n], h5py: (n, 2))
-        if (allocated(pair%eta)) call h5%write(c//'/xi_slave', &
-                                               reshape([(pair%xi(i), pair%eta(i), i=1, size(pair%xi))], [2, size(pair%xi)]))
+        if (allocated(pair%eta)) call h5%write(c//'/xi_slave', reshape([(pair%xi(i), pair%eta(i), &
+                                                                           i=1, size(pair%xi))], [2, size(pair%xi)]))
         if (.not. allocated(pair%eta)) call h5%write(c//'/xi_slave', pair%xi)
         ! committed friction history: what a restart needs
         call write_history(h5, c//'/history/', pair%history())
