@@ -16,7 +16,7 @@ module voiga_contact_master_face
     implicit none
     private
 
-    public :: face_master_t, new_face_master, rigid_surface_t, new_rigid_surface
+    public :: face_master_t, new_face_master, rigid_surface_t, new_rigid_surface, face_outward_sign
 
     !> A body's contact face acting as master.
     type, extends(contact_master_t) :: face_master_t

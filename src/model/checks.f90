@@ -19,7 +19,10 @@ module voiga_model_checks
     use voiga_model, only: model_t
     use voiga_discretization_patch, only: contact_name
     use voiga_contact_pair, only: contact_pair_t
-    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, chord_lengths => element_lengths
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, surface_point, face_point_at, &
+                                     chord_lengths => element_lengths
+    use voiga_contact_master_face, only: face_outward_sign
+    use voiga_nurbs_patch, only: cross
     use voiga_contact_master, only: master_point_t
     use voiga_contact_master_nurbs, only: nurbs_master_t, outward_sign
     use voiga_contact_master_rigid, only: rigid_line_t
@@ -326,27 +329,37 @@ contains
         type(surface_point_t) :: sp
         type(master_point_t) :: mp
         real(dp), allocatable :: u(:), gap(:)
-        real(dp) :: ns(2), s
-        integer :: k
+        real(dp) :: ns(3), s
+        integer :: k, d
         logical :: found, converged
-        ! (an edge's outward normal; a face's is not checked yet)
-        if (pair%slave%npar > 1) return
         gap = pair%out%gap
         where (gap < 0.0_dp) gap = huge(1.0_dp)
         if (all(gap > 1.0e300_dp)) return
         k = minloc(gap, dim=1)
         allocate (u(model%ndof), source=0.0_dp)
-        call surface_point(pair%slave, u, pair%xi(k), sp, pair%span(k))
-        call pair%master%project(u, sp%x(1:2), mp, found, converged)
+        d = pair%nsd
+        ns = 0.0_dp
+        if (pair%slave%npar > 1) then
+            ! a face: s a_1 x a_2 points out of the body (s the sign of its det J)
+            call face_point_at(pair%slave, u, pair%xi(k), pair%eta(k), [pair%span(k), pair%span_eta(k)], &
+                               pair%slave_basis(:, 1, k), pair%slave_basis(:, 2, k), pair%slave_basis(:, 3, k), sp)
+            s = face_outward_sign(model%bodies(pair%slave_body)%disc)
+            ns = s*cross(sp%a, sp%b)/norm2(cross(sp%a, sp%b))
+        else
+            call surface_point(pair%slave, u, pair%xi(k), sp, pair%span(k))
+            s = outward_sign(model%bodies(pair%slave_body)%disc)
+            ns(1:2) = s*[sp%a(2), -sp%a(1)]/norm2(sp%a(1:2))
+        end if
+        call pair%master%project(u, sp%x(1:d), mp, found, converged)
         if (.not. found) return
-        s = outward_sign(model%bodies(pair%slave_body)%disc)
-        ns = s*[sp%a(2), -sp%a(1)]/norm2(sp%a(1:2))
-        if (dot_product(ns, mp%n(1:2)) <= 0.0_dp) return
+        if (dot_product(ns, mp%n) <= 0.0_dp) return
         list = [list, warning_t(pair_label(pair)//'the slave point closest to the master, at '// &
-                                point_str(sp%x(1:2))// &
-                                ", faces away from it: the slave's contact_edge = '"// &
+                                point_str(sp%x(1:d))// &
+                                ", faces away from it: the slave's "//merge('contact_face', 'contact_edge', d == 3)// &
+                                " = '"// &
                                 contact_name(model%bodies(pair%slave_body)%disc)// &
-                                "' is on the side of its body away from the master; choose the edge that faces it"// &
+                                "' is on the side of its body away from the master; choose the "// &
+                                merge('face', 'edge', d == 3)//' that faces it'// &
                                 rigid_alternative(pair), &
                                 topic=pair_label(pair)//'the slave faces away from the master')]
     end subroutine facing_warning

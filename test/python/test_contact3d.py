@@ -305,3 +305,14 @@ def test_rigid_sphere_indents_a_block(voiga_bin: Path, tmp_path: Path) -> None:
     on = p > 0.0
     c0, c1 = np.linalg.lstsq(np.c_[np.ones(on.sum()), r[on] ** 2], p[on] ** 2, rcond=None)[0]
     assert abs(np.sqrt(-c0 / c1) / a_hertz - 1.0) < 0.2
+
+
+def test_face_away_from_the_plane_warns(voiga_bin: Path, tmp_path: Path) -> None:
+    """The box's top face as the slave of the plane below it: the set-up check names
+    the face that faces away (as for an edge in 2D), the remedy, and the plane's side."""
+    case = box_case(tmp_path, PLANE + ", method = 'mortar'")
+    case.write_text(case.read_text().replace("contact_face = 'bottom'", "contact_face = 'top'")
+                    .replace("rigid_point = 0.0, 0.0, 0.0", "rigid_point = 0.0, 0.0, -0.5"))
+    res = run(voiga_bin, case, "--check")
+    assert "faces away from it: the slave's contact_face = 'top'" in res.stderr, res.stderr
+    assert "choose the face that faces it" in res.stderr
