@@ -301,14 +301,17 @@ contains
         type(mortar_work_t), intent(in) :: wk
         procedure(add_matrix) :: add
         real(dp), allocatable :: v(:), q(:), mm(:), kc(:, :)
-        integer, allocatable :: blk(:), pos(:), mdofs(:)
+        integer, allocatable :: blk(:), pos(:), mdofs(:), at(:)
         real(dp) :: c
         integer :: k, i, a, e, j, rng(2)
 
         mdofs = self%master%all_dofs()
+        ! each block DOF's position in its block (0 elsewhere): no search per point
+        allocate (at(max(maxval(self%slave%dofs), maxval([0, mdofs]))), source=0)
         do a = 1, size(self%node_first)
             if (wk%st_a(a) == state_inactive) cycle
             blk = self%block_dofs(a, mdofs)
+            at(blk) = [(j, j=1, size(blk))]
             allocate (v(size(blk)), q(size(blk)), mm(size(blk)), pos(0))
             v = 0.0_dp
             q = 0.0_dp
@@ -321,7 +324,7 @@ contains
                     ! (a face's range of cells holds rows beside the node's support)
                     if (i == 0) cycle
                     c = wk%w0(k)*self%point_values(i, k)
-                    pos = [(findloc(blk, wk%vec(k)%dofs(j), dim=1), j=1, size(wk%vec(k)%dofs))]
+                    pos = at(wk%vec(k)%dofs)
                     v(pos) = v(pos) + c*wk%vec(k)%gn
                     if (self%law%mu > 0.0_dp) then
                         q(pos) = q(pos) + c*wk%vec(k)%gt
@@ -348,6 +351,7 @@ contains
             end if
             call add(blk, kc)
             call self%keep_coupling(a, blk, v, q, mm)
+            at(blk) = 0
             deallocate (v, q, mm, pos, kc)
         end do
     end subroutine mortar_coupling
