@@ -16,7 +16,7 @@ NAMELISTS: dict[str, frozenset[str]] = {
     "pressure": frozenset({"body", "edge", "face", "p"}),
     "contact": frozenset({"slave", "master", "rigid_point", "rigid_normal", "penalty_normal",
                           "penalty_tangent", "friction", "n_gauss", "method", "tolerance", "rigid_curve",
-                          "rigid_ux", "rigid_uy", "rigid_uz", "allow_overlap"}),
+                          "rigid_surface", "rigid_ux", "rigid_uy", "rigid_uz", "allow_overlap"}),
     "output": frozenset({"fields", "samples", "every", "steps"}),
 }
 """Namelist group -> its variables, as the readers in ``src/io/input/case/`` declare them (a
