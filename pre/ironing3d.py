@@ -123,14 +123,15 @@ def slab_knots(mesh: str) -> dict[str, list[float]]:
 
 
 def iron_case(iron: Iron, mesh: str, layout: str, steps: Sequence[int] | None = None,
-              n_gauss: int = DEFAULT_GAUSS, penalty_normal: float | None = None) -> dict[str, Any]:
+              n_gauss: int | None = DEFAULT_GAUSS, penalty_normal: float | None = None) -> dict[str, Any]:
     """The namelist groups of the case ``mesh``, ``layout`` (module docstring).
-    ``steps``: (press, slide) steps; ``penalty_normal`` None leaves it to voiga."""
+    ``steps``: (press, slide) steps; ``n_gauss`` and ``penalty_normal`` None leave them
+    to voiga (its n_gauss is the contact layer's degree + 1)."""
     iron.check()
     press, slide = steps if steps is not None else (PRESS_STEPS, SLIDE_STEPS)
     if press < 1 or slide < 1:
         raise HertzCaseError(f"steps {press}, {slide} must be >= 1")
-    if n_gauss < 1:
+    if n_gauss is not None and n_gauss < 1:
         raise HertzCaseError(f"n_gauss {n_gauss} must be >= 1")
     knots = slab_knots(mesh)
     vol = scene_geometry()[BODY]
@@ -146,8 +147,10 @@ def iron_case(iron: Iron, mesh: str, layout: str, steps: Sequence[int] | None = 
     body = {(f"knots_{k[4:]}" if k.startswith("nel_") else k):
             (knots[f"knots_{k[4:]}"] if k.startswith("nel_") else v) for k, v in group.items()}
     contact: dict[str, Any] = {"slave": BODY, "master": "rigid", "rigid_surface": DIE, "method": "gpts",
-                               "n_gauss": int(n_gauss), "friction": float(iron.friction),
+                               "friction": float(iron.friction),
                                "rigid_ux": [0.0, SLIDE], "rigid_uz": [-iron.indentation] * 2}
+    if n_gauss is not None:
+        contact["n_gauss"] = int(n_gauss)
     if penalty_normal is not None:
         if not 0 < penalty_normal < math.inf:
             raise HertzCaseError(f"penalty_normal {penalty_normal!r} must be > 0")
