@@ -34,7 +34,7 @@ from .h5io import write_geometry
 from .hertz import HertzCaseError, write_shared_geometry
 from .meshes import geometric_sizes
 from .rigid_surfaces import add_surfaces, sphere_cap
-from .solid_case import solid_body_group, solid_dofs
+from .solid_case import knotted_body_group, solid_dofs
 from .solids import box
 from .volume import Volume, check_volume
 
@@ -135,17 +135,12 @@ def iron_case(iron: Iron, mesh: str, layout: str, steps: Sequence[int] | None = 
         raise HertzCaseError(f"n_gauss {n_gauss} must be >= 1")
     knots = slab_knots(mesh)
     vol = scene_geometry()[BODY]
-    spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE,
-            "nel": [len(knots[f"knots_{d}"]) + 1 for d in ("xi", "eta", "zeta")],
-            "material": "neo-hookean", "youngs_modulus": iron.youngs_modulus,
-            "poisson_ratio": iron.poisson_ratio}
-    try:
-        group = solid_body_group(spec, vol, {})
+    spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE, "material": "neo-hookean",
+            "youngs_modulus": iron.youngs_modulus, "poisson_ratio": iron.poisson_ratio}
+    try:   # the top face is zeta = 1: the patch voiga solves on keeps the box's directions
+        body = knotted_body_group(spec, vol, knots)
     except ValueError as err:
         raise HertzCaseError(str(err)) from None
-    # the top face is zeta = 1: the patch voiga solves on keeps the box's directions
-    body = {(f"knots_{k[4:]}" if k.startswith("nel_") else k):
-            (knots[f"knots_{k[4:]}"] if k.startswith("nel_") else v) for k, v in group.items()}
     contact: dict[str, Any] = {"slave": BODY, "master": "rigid", "rigid_surface": DIE, "method": "gpts",
                                "friction": float(iron.friction),
                                "rigid_ux": [0.0, SLIDE], "rigid_uz": [-iron.indentation] * 2}
