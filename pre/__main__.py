@@ -314,8 +314,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--friction", type=float, default=0.3, help="Coulomb's mu (default 0.3)")
     s.add_argument("--steps", type=int, nargs=2, default=None, metavar=("PRESS", "SLIDE"),
                    help="steps of the press and slide phases (default 10 40)")
-    s.add_argument("--n-gauss", type=int, default=2,
-                   help="&contact n_gauss per direction (default 2; 0: none written, voiga's layer degree + 1)")
+    s.add_argument("--n-gauss", type=int, default=0,
+                   help="&contact n_gauss per direction (default 0: none written, voiga's layer degree + 1)")
     s.add_argument("--penalty-normal", type=float, default=None,
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")

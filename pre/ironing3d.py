@@ -11,8 +11,9 @@ touching the slab at (1, 0, 0).
 Loads: the slab's bottom fixed, ``uy = 0`` on its symmetry face y = 0 (``front``); the
 die moves down by the indentation d = 0.1 in :data:`PRESS_STEPS` steps, then along x by
 :data:`SLIDE` in :data:`SLIDE_STEPS` steps (``rigid_ux``, ``rigid_uz``, two load
-phases); GPTS contact (the only frictional method on faces) with ``n_gauss`` points per
-direction of a slave cell and friction mu (0.3).
+phases); GPTS contact (the only frictional method on faces) with voiga's default
+``n_gauss`` (the layer's degree + 1 points per direction of a slave cell; or the given
+one) and friction mu (0.3).
 
 Mesh m<k> (:data:`MESHES`): uniform along x (``nx`` elements over the slab's length),
 across ``fine`` elements over the path's band ``0 <= y <= BAND`` and ``rest`` beyond,
@@ -60,14 +61,16 @@ MESHES: dict[str, tuple[int, int, int, int]] = {
     "m1": (16, 2, 1, 3),
     "m2": (24, 3, 1, 4),
     "m3": (32, 4, 2, 5),
+    "m4": (48, 6, 2, 6),
 }
-"""Mesh -> (nx, fine, rest, nz): element size along the path 0.25, 0.167, 0.125 (about
-1.1, 0.75, 0.56 contact radii), across ``BAND / fine`` alike."""
+"""Mesh -> (nx, fine, rest, nz): element size along the path 0.25, 0.167, 0.125, 0.083
+(about 1.1, 0.75, 0.56, 0.37 contact radii), across ``BAND / fine`` alike."""
 
 LAYOUTS: tuple[str, ...] = ("N2", "NN2.1", "NN2.2")
-DEFAULT_GAUSS = 2
-"""``&contact n_gauss``: points per direction of a slave cell (docs/ironing3d.md: the
-default q + 1 locks more)."""
+DEFAULT_GAUSS: int | None = None
+"""``&contact n_gauss``: None leaves voiga's default, the contact layer's degree + 1 per
+direction of a slave cell (docs/ironing3d.md: 2 points, which lock less in the Hertz
+scene, oscillate 3 to 8 times more here and cut steps in the VO layer)."""
 
 
 @dataclass(frozen=True)

@@ -55,12 +55,13 @@ def test_the_case_names_the_die_and_the_phases(tmp_path: Path) -> None:
                  "--steps", "5", "20"]) == 0
     nml = f90nml.read(tmp_path / "m2-NN2.2.nml")
     c = nml["contact"]
-    assert (c["method"], c["rigid_surface"], c["friction"], c["n_gauss"]) == ("gpts", DIE, 0.2, 2)
+    assert (c["method"], c["rigid_surface"], c["friction"]) == ("gpts", DIE, 0.2)
+    assert "n_gauss" not in c                       # voiga's default: the layer's degree + 1
     assert list(c["rigid_ux"]) == [0.0, 2.0] and list(c["rigid_uz"]) == [-0.1, -0.1]
     assert list(nml["solver"]["n_steps"]) == [5, 20]
     assert nml["body"]["layer_degree"] == 2 and nml["body"]["layer_elevations"] == 2
     assert nml["body"]["contact_face"] == "top"
-    assert "n_gauss" not in iron_case(Iron(), "m1", "N2", n_gauss=None)["contact"][0]
+    assert iron_case(Iron(), "m1", "N2", n_gauss=2)["contact"][0]["n_gauss"] == 2
 
 
 def test_existing_files_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
