@@ -129,48 +129,51 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_hertz3d(args: argparse.Namespace) -> int:
+def _write_scene3d(command: str, write: Callable[[], Any], dofs: Callable[[str, str], dict[str, int]],
+                   same: str, closing: str) -> int:
+    """Run a 3D scene's writer ``write()`` (``(geometry, cases, geometry written)``); a
+    refusal is one line on stderr naming ``python -m pre COMMAND`` and exit code 2. Print
+    what was written, each case's DOFs (``dofs(mesh, layout)``) and ``closing``."""
     from .files import OutputError
     from .hertz import HertzCaseError
+
+    try:
+        geometry, cases, fresh = write()
+    except (HertzCaseError, OutputError, OSError) as err:
+        print(f"python -m pre {command}: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same {same})")
+    for case in cases:
+        mesh, layout = case.stem.split("-", 1)
+        print(f"wrote {case}: {dofs(mesh, layout)['total']} DOFs")
+    print(closing)
+    return 0
+
+
+def _cmd_hertz3d(args: argparse.Namespace) -> int:
     from .hertz3d import Ball, case_dofs, write_hertz3d
 
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
                 poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material)
-    try:
-        geometry, cases, fresh = write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
-                                               n_steps=args.steps, method=args.method,
-                                               penalty_normal=args.penalty_normal)
-    except (HertzCaseError, OutputError, OSError) as err:
-        print(f"python -m pre hertz3d: {err}", file=sys.stderr)
-        return 2
-    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same ball)")
-    for case in cases:
-        mesh, layout = case.stem.split("-", 1)
-        print(f"wrote {case}: {case_dofs(ball, mesh, layout)['total']} DOFs")
-    print(f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
-          f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
-    return 0
+    return _write_scene3d(
+        "hertz3d", lambda: write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
+                                         n_steps=args.steps, method=args.method,
+                                         penalty_normal=args.penalty_normal),
+        lambda mesh, layout: case_dofs(ball, mesh, layout), "ball",
+        f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
+        f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
 
 
 def _cmd_ironing3d(args: argparse.Namespace) -> int:
-    from .files import OutputError
-    from .hertz import HertzCaseError
     from .ironing3d import Iron, case_dofs, write_ironing3d
 
     iron = Iron(friction=args.friction)
-    try:
-        geometry, cases, fresh = write_ironing3d(iron, args.mesh, args.layout, args.out, force=args.force,
-                                                 steps=args.steps, n_gauss=args.n_gauss or None,
-                                                 penalty_normal=args.penalty_normal)
-    except (HertzCaseError, OutputError, OSError) as err:
-        print(f"python -m pre ironing3d: {err}", file=sys.stderr)
-        return 2
-    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same die)")
-    for case in cases:
-        mesh, layout = case.stem.split("-", 1)
-        print(f"wrote {case}: {case_dofs(iron, mesh, layout)['total']} DOFs")
-    print(f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
-    return 0
+    return _write_scene3d(
+        "ironing3d", lambda: write_ironing3d(iron, args.mesh, args.layout, args.out, force=args.force,
+                                             steps=args.steps, n_gauss=args.n_gauss or None,
+                                             penalty_normal=args.penalty_normal),
+        lambda mesh, layout: case_dofs(iron, mesh, layout), "die",
+        f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
 
 
 def _cmd_refine(args: argparse.Namespace) -> int:
