@@ -52,8 +52,8 @@ SLIDE = 2.0
 the slab's end)."""
 PRESS_STEPS, SLIDE_STEPS = 10, 40
 CAP_HALF_ANGLE = 45.0
-"""Degrees of the sphere cap around its lowest point (it spans x, y within +- 0.35 R
-... +- 0.71 R of the centre: beyond the contact's radius)."""
+"""Degrees of the sphere cap around its lowest point: it spans x and y within R sin 45
+= 0.35 of its centre, beyond the contact's radius (about 0.22)."""
 BAND = 0.5
 """The band 0 <= y <= BAND along the path that the ``fine`` elements across cover."""
 
