@@ -13,6 +13,8 @@ Subcommands:
                  configuration (and the figure; several results: one overlay)
   hertz3d        a sphere on a rigid plane (a 3D result) against Hertz's point contact:
                  pressure over the contact disc, a and p0, the subsurface shear
+  ironing        an ironing run's force history (2D: the die's Px, Py; 3D: the contact
+                 force's F_x, F_z) and its oscillation over the sliding phase (and a figure)
   cattaneo       a cylinder pressed and sheared against Cattaneo-Mindlin's stick zone;
                  --halfplane: the incremental half-plane reference for a rigid flat
   study          a parameter study from a study file (docs/studies.md): derived cases
@@ -282,6 +284,26 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
     print("\n".join(hertz3d_report(h)))
     if not args.no_figure:
         print(hertz3d_figure(result, h, args.out, args.output))
+    return 0
+
+
+def _cmd_ironing(args: argparse.Namespace) -> int:
+    import json
+
+    from .ironing3d import IroningError, ironing_figure, ironing_forces, ironing_report
+
+    try:
+        result = _read(args.result, "ironing")
+        h = ironing_forces(result, pair=args.pair)
+    except (IroningError, OSError, KeyError, ValueError) as err:
+        print(f"python -m post ironing: {args.result}: {err}", file=sys.stderr)
+        return 2
+    print("\n".join(ironing_report(h)))
+    if args.json:
+        print(json.dumps({"n_dofs": h.n_dofs, "wall_time": h.wall_time, "newton": h.newton,
+                          "steps": len(h.steps), **h.measures}))
+    if not args.no_figure:
+        print(ironing_figure(result, h, args.out, args.output))
     return 0
 
 
@@ -675,6 +697,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--partial", action="store_true",
                    help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz3d)
+
+    s = sub.add_parser("ironing", help="an ironing run's force history and its oscillation over the "
+                                       "sliding phase (2D: die reactions; 3D: contact force)")
+    s.add_argument("result", help="result file (.h5): cases/ironing* (2D) or pre ironing3d (3D)")
+    s.add_argument("--pair", type=int, default=1, help="3D: the contact pair (default 1)")
+    s.add_argument("--json", action="store_true", help="also print the measures as one JSON line")
+    s.add_argument("-o", "--output", default=None, help="PNG file of the figure")
+    s.add_argument("--out", default=None,
+                   help="folder for the figure <result>-ironing.png (default: next to the result)")
+    s.add_argument("--no-figure", action="store_true", help="only print the measures")
+    s.set_defaults(func=_cmd_ironing)
 
     s = sub.add_parser("cattaneo", help="a cylinder pressed and sheared against Cattaneo-Mindlin's "
                                         "stick zone (reference configuration, nominal traction)")

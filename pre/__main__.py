@@ -6,6 +6,7 @@ Subcommands:
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane (issue 42)
+  ironing3d    the 3D ironing scene: a rigid sphere pressed into a slab and slid (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       a result: its case refined at the contact zone; a case: the splipy dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -128,27 +129,51 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_hertz3d(args: argparse.Namespace) -> int:
+def _write_scene3d(command: str, write: Callable[[], Any], dofs: Callable[[str, str], dict[str, int]],
+                   same: str, closing: str) -> int:
+    """Run a 3D scene's writer ``write()`` (``(geometry, cases, geometry written)``); a
+    refusal is one line on stderr naming ``python -m pre COMMAND`` and exit code 2. Print
+    what was written, each case's DOFs (``dofs(mesh, layout)``) and ``closing``."""
     from .files import OutputError
     from .hertz import HertzCaseError
+
+    try:
+        geometry, cases, fresh = write()
+    except (HertzCaseError, OutputError, OSError) as err:
+        print(f"python -m pre {command}: {err}", file=sys.stderr)
+        return 2
+    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same {same})")
+    for case in cases:
+        mesh, layout = case.stem.split("-", 1)
+        print(f"wrote {case}: {dofs(mesh, layout)['total']} DOFs")
+    print(closing)
+    return 0
+
+
+def _cmd_hertz3d(args: argparse.Namespace) -> int:
     from .hertz3d import Ball, case_dofs, write_hertz3d
 
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
                 poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material)
-    try:
-        geometry, cases, fresh = write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
-                                               n_steps=args.steps, method=args.method,
-                                               penalty_normal=args.penalty_normal)
-    except (HertzCaseError, OutputError, OSError) as err:
-        print(f"python -m pre hertz3d: {err}", file=sys.stderr)
-        return 2
-    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same ball)")
-    for case in cases:
-        mesh, layout = case.stem.split("-", 1)
-        print(f"wrote {case}: {case_dofs(ball, mesh, layout)['total']} DOFs")
-    print(f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
-          f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
-    return 0
+    return _write_scene3d(
+        "hertz3d", lambda: write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
+                                         n_steps=args.steps, method=args.method,
+                                         penalty_normal=args.penalty_normal),
+        lambda mesh, layout: case_dofs(ball, mesh, layout), "ball",
+        f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
+        f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
+
+
+def _cmd_ironing3d(args: argparse.Namespace) -> int:
+    from .ironing3d import Iron, case_dofs, write_ironing3d
+
+    iron = Iron(friction=args.friction)
+    return _write_scene3d(
+        "ironing3d", lambda: write_ironing3d(iron, args.mesh, args.layout, args.out, force=args.force,
+                                             steps=args.steps, n_gauss=args.n_gauss or None,
+                                             penalty_normal=args.penalty_normal),
+        lambda mesh, layout: case_dofs(iron, mesh, layout), "die",
+        f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
 
 
 def _cmd_refine(args: argparse.Namespace) -> int:
@@ -283,6 +308,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz3d)
+
+    s = sub.add_parser("ironing3d", help="the 3D ironing scene: a rigid sphere pressed into a Neo-Hookean "
+                                         "slab and slid along it (docs/ironing3d.md)")
+    s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml")
+    s.add_argument("--mesh", nargs="+", default=["m1"], help="mesh levels m1 .. m3 (default m1)")
+    s.add_argument("--layout", nargs="+", default=["N2"], help="solid layouts, e.g. N2 NN2.1 NN2.2 (default N2)")
+    s.add_argument("--friction", type=float, default=0.3, help="Coulomb's mu (default 0.3)")
+    s.add_argument("--steps", type=int, nargs=2, default=None, metavar=("PRESS", "SLIDE"),
+                   help="steps of the press and slide phases (default 10 40)")
+    s.add_argument("--n-gauss", type=int, default=0,
+                   help="&contact n_gauss per direction (default 0: none written, voiga's layer degree + 1)")
+    s.add_argument("--penalty-normal", type=float, default=None,
+                   help="&contact penalty_normal (default: none written, voiga's automatic one)")
+    s.add_argument("--force", action="store_true", help="overwrite existing files")
+    s.set_defaults(func=_cmd_ironing3d)
 
     s = sub.add_parser("cattaneo", help="a Cattaneo-Mindlin case: a half cylinder pressed onto a "
                                         "rigid flat, its mirror image or a block, then sheared")

@@ -38,7 +38,7 @@ from .files import write_text
 from .h5io import write_geometry
 from .hertz import Cylinder, HertzCaseError, write_shared_geometry
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
-from .solid_case import solid_body_group, solid_dofs
+from .solid_case import knotted_body_group, solid_dofs
 from .solids import ball_octant
 from .volume import Volume, check_volume
 
@@ -112,16 +112,12 @@ def ball_case(ball: Ball, mesh: str, layout: str, n_steps: int | None = None,
     ball.check()
     knots = ball_knots(ball, mesh)
     vol = ball_geometry(ball)[BODY]
-    spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE,
-            "nel": [len(knots[f"knots_{d}"]) + 1 for d in ("xi", "eta", "zeta")],
-            "material": ball.material, "youngs_modulus": ball.youngs_modulus,
-            "poisson_ratio": ball.poisson_ratio}
+    spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE, "material": ball.material,
+            "youngs_modulus": ball.youngs_modulus, "poisson_ratio": ball.poisson_ratio}
     try:
-        group = solid_body_group(spec, vol, {})
+        body = knotted_body_group(spec, vol, knots)
     except ValueError as err:
         raise HertzCaseError(str(err)) from None
-    body = {(f"knots_{k[4:]}" if k.startswith("nel_") else k):
-            (knots[f"knots_{k[4:]}"] if k.startswith("nel_") else v) for k, v in group.items()}
     if n_steps is not None and n_steps < 1:
         raise HertzCaseError(f"steps {n_steps} must be >= 1")
     contact: dict[str, Any] = {"slave": BODY, "master": "rigid",

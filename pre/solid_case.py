@@ -119,6 +119,18 @@ def solid_body_group(b: dict[str, Any], vol: Volume, defaults: dict[str, Any]) -
             "poisson_ratio": float(opt["poisson_ratio"])}
 
 
+def knotted_body_group(spec: dict[str, Any], vol: Volume, knots: dict[str, list[float]]) -> dict[str, Any]:
+    """:func:`solid_body_group` of ``spec`` (its ``nel`` one more than the knots per
+    direction) with the interior knots ``knots_xi``, ``knots_eta``, ``knots_zeta`` of
+    ``knots`` in place of the element counts. The knots run along the patch voiga
+    solves on: the volume's own directions when the contact face is ``zeta = 1`` (the
+    scenes' bodies). SpecError as :func:`solid_body_group`."""
+    spec = {**spec, "nel": [len(knots[f"knots_{d}"]) + 1 for d in DIRECTIONS]}
+    return {(f"knots_{k[4:]}" if k.startswith("nel_") else k):
+            (knots[f"knots_{k[4:]}"] if k.startswith("nel_") else v)
+            for k, v in solid_body_group(spec, vol, {}).items()}
+
+
 def load_phases(data: dict[str, Any]) -> int:
     """The number of load phases: the entries of ``[solver] n_steps`` (one without)."""
     n_steps = data.get("solver", {}).get("n_steps", 1)
