@@ -34,7 +34,8 @@ contains
                     new_unittest('wrong_type_or_rank_refused', test_wrong_type), &
                     new_unittest('wide_integers_range_checked', test_wide_integers), &
                     new_unittest('wrong_attributes_refused', test_wrong_attributes), &
-                    new_unittest('hundreds_of_cuts_finish_the_file', test_many_cuts) &
+                    new_unittest('hundreds_of_cuts_finish_the_file', test_many_cuts), &
+                    new_unittest('failure_before_any_step_finishes_the_file', test_no_records) &
                     ]
     end subroutine collect_hdf5
 
@@ -70,6 +71,33 @@ contains
         call results%h5%close(error)
         call remove(path)
     end subroutine test_many_cuts
+
+    !> A run that failed before its steps began (the stiffness pattern out of memory:
+    !> hertz3d m3 NN2.2 on a block) has no records allocated: its result file still
+    !> gets its status and no cut (the writer read the size of the unallocated
+    !> records and died, losing the message).
+    subroutine test_no_records(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(results_t) :: results
+        type(solver_stats_t) :: stats
+        character(len=:), allocatable :: path, status
+        integer :: n
+        path = scratch('no-records')
+        call results%h5%open(path, 'w', error)
+        if (allocated(error)) return
+        call results%finish('failed: out of memory', 1.0_dp, stats, error)
+        if (allocated(error)) return
+        call results%h5%open(path, 'r', error)
+        if (allocated(error)) return
+        call results%h5%read_attr_str('/', 'status', status, error)
+        if (allocated(error)) return
+        call results%h5%read_attr_int('/', 'n_cuts', n, error)
+        if (allocated(error)) return
+        call check(error, status == 'failed: out of memory' .and. n == 0, 'status and no cuts: '//status)
+        if (allocated(error)) return
+        call results%h5%close(error)
+        call remove(path)
+    end subroutine test_no_records
 
     !> A scratch file name under build/ (fpm runs the tests from the project root).
     function scratch(name) result(path)

@@ -8,7 +8,7 @@ module voiga_solver_records
     implicit none
     private
 
-    public :: step_record_t, cut_record_t, solver_stats_t, stage_names, append_cut, wall_seconds
+    public :: step_record_t, cut_record_t, solver_stats_t, stage_names, append_cut, wall_seconds, n_cut_records
 
     !> Stages whose seconds are recorded per step.
     character(len=*), parameter :: stage_names(5) = [character(len=13) :: 'assembly', 'contact', &
@@ -90,6 +90,14 @@ module voiga_solver_records
     end type solver_stats_t
 
 contains
+
+    !> The cuts recorded (0 also when a run failed before its steps began, e.g. out of
+    !> memory for the stiffness pattern, and nothing was allocated).
+    pure integer function n_cut_records(stats) result(n)
+        type(solver_stats_t), intent(in) :: stats
+        n = 0
+        if (allocated(stats%cut_records)) n = size(stats%cut_records)
+    end function n_cut_records
 
     !> Wall-clock seconds since an arbitrary origin.
     real(dp) function wall_seconds()

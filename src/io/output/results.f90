@@ -26,7 +26,7 @@ module voiga_io_output_results
     use voiga_io_output_fields, only: write_fields, sample_bodies
     use voiga_contact_master, only: master_output_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t, contact_point_out_t
-    use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t
+    use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t, n_cut_records
     use voiga_solver_progress, only: progress_t, step_report_t
     use voiga_solver_stepping, only: resume_t
     implicit none
@@ -474,8 +474,8 @@ contains
         end if
         if (self%h5%is_open()) call self%h5%begin_write(65536_int64, error)
         if (self%h5%is_open() .and. .not. allocated(error)) then
-            call self%h5%write_attr('/', 'n_cuts', size(stats%cut_records))
-            if (size(stats%cut_records) > 0) call write_cuts(self%h5, '', stats%cut_records)
+            call self%h5%write_attr('/', 'n_cuts', n_cut_records(stats))
+            if (n_cut_records(stats) > 0) call write_cuts(self%h5, '', stats%cut_records)
             call self%h5%write_attr('/', 'tresca_retries', stats%tresca_retries)
             call self%h5%write_attr('/', 'tresca_accepted', stats%tresca_accepted)
             call self%h5%write_attr('/', 'fixed_point_iterations', stats%fixed_point_iterations)
