@@ -142,6 +142,7 @@ contains
         real(dp), intent(in) :: e_star
         type(error_t), allocatable, intent(out) :: error
         real(dp), allocatable :: u0(:), r0(:)
+        logical :: refitted
         pair%slave_name = settings%slave
         pair%master_name = settings%master
         pair%slave_body = bodies(1)
@@ -165,6 +166,9 @@ contains
         call pair%evaluate(u0, r0, error)
         if (allocated(error)) return
         call pair%commit()
+        ! a face's master is too large to couple every slave cell with all of it in the
+        ! first pattern (an edge's is not): its ranges start from these projections
+        if (pair%slave%npar > 1) call pair%refit_ranges(8, refitted)
         pair%n_evaluations = 0
         pair%n_friction = 0
     end subroutine build_pair
