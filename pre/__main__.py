@@ -5,7 +5,7 @@ Subcommands:
   geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
-  hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane (issue 42)
+  hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane or a block (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       a result: its case refined at the contact zone; a case: the splipy dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -131,10 +131,12 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
 def _cmd_hertz3d(args: argparse.Namespace) -> int:
     from .files import OutputError
     from .hertz import HertzCaseError
-    from .hertz3d import Ball, case_dofs, write_hertz3d
+    from .hertz3d import Ball, body_dofs, write_hertz3d
 
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
-                poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material)
+                poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material,
+                master=args.master, block_size=args.block_size,
+                block_youngs_modulus=args.block_youngs_modulus, block_poisson_ratio=args.block_poisson_ratio)
     try:
         geometry, cases, fresh = write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
                                                n_steps=args.steps, method=args.method,
@@ -142,10 +144,13 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
     except (HertzCaseError, OutputError, OSError) as err:
         print(f"python -m pre hertz3d: {err}", file=sys.stderr)
         return 2
-    print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same ball)")
+    print(f"wrote {geometry}" if fresh else
+          f"kept {geometry} (the same {'ball' if ball.master == 'rigid' else 'ball and block'})")
     for case in cases:
         mesh, layout = case.stem.split("-", 1)
-        print(f"wrote {case}: {case_dofs(ball, mesh, layout)['total']} DOFs")
+        dofs = body_dofs(ball, mesh, layout)
+        each = f" ({', '.join(f'{name} {n}' for name, n in dofs.items())})" if len(dofs) > 1 else ""
+        print(f"wrote {case}: {sum(dofs.values())} DOFs{each}")
     print(f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
           f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
     return 0
@@ -263,7 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_hertz)
 
     s = sub.add_parser("hertz3d", help="the 3D Hertz scene: a quarter hemisphere (ball octant) "
-                                       "pressed on a rigid plane; geometry.h5 and a case per mesh "
+                                       "pressed on a rigid plane or an elastic block; geometry.h5 and a case per mesh "
                                        "and layout")
     s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml (not cases/: voiga "
                                "cannot run 3D contact yet)")
@@ -281,6 +286,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--method", default="mortar", help="&contact method (default mortar, voiga's on solids)")
     s.add_argument("--penalty-normal", type=float, default=None,
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
+    s.add_argument("--master", default="rigid", choices=("rigid", "block"),
+                   help="rigid: the rigid plane z = -R (default); block: an elastic block "
+                        "[0, L] x [0, L] x [-R - H, -R] under the ball, its bottom fixed")
+    s.add_argument("--block-size", type=float, default=1.0,
+                   help="--master block: L = H over R (default 1, ten contact radii)")
+    s.add_argument("--block-youngs-modulus", type=float, default=None,
+                   help="--master block: the block's E (default: the ball's)")
+    s.add_argument("--block-poisson-ratio", type=float, default=None,
+                   help="--master block: the block's nu (default: the ball's)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz3d)
 
