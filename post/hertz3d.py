@@ -39,11 +39,10 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from pre.files import save_figure
+from pre.volume import Volume, jacobian
 
 from .field import evaluate
 from .hertz import CIRCLE_TOLERANCE, HertzError, contact_pair, fit_circle, fit_hertz, hertz_pressure
-from pre.volume import Volume, jacobian
-
 from .naming import output_path
 from .reader import ContactOutput, Result, Step
 from .units import Units
