@@ -135,7 +135,7 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
 
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
                 poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material,
-                master=args.master, block_size=args.block_size,
+                master=args.master, block_size=args.block_size, block_cell=args.block_cell,
                 block_youngs_modulus=args.block_youngs_modulus, block_poisson_ratio=args.block_poisson_ratio)
     try:
         geometry, cases, fresh = write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
@@ -291,6 +291,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "[0, L] x [0, L] x [-R - H, -R] under the ball, its bottom fixed")
     s.add_argument("--block-size", type=float, default=1.0,
                    help="--master block: L = H over R (default 1, ten contact radii)")
+    s.add_argument("--block-cell", type=float, default=1.3,
+                   help="--master block: its top cells over the ball's fine ones (default 1.3: "
+                        "comparable, not matching)")
     s.add_argument("--block-youngs-modulus", type=float, default=None,
                    help="--master block: the block's E (default: the ball's)")
     s.add_argument("--block-poisson-ratio", type=float, default=None,

@@ -32,11 +32,11 @@ x = 0 with ``fix_x``, ``symmetry_y`` y = 0 with ``fix_y``), its ``bottom`` fixed
 its ``top`` (z = -R) the master face of ``&contact slave = 'ball', master = 'block'``;
 the ball's material unless given, the ball's layout. Its knots are graded toward the
 contact point (0, 0, -R) as the ball's (:func:`block_knots`): along x and y cells
-:data:`BLOCK_CELL` times the ball's fine ones over the ball's fine zone ``R
-sin(theta_c)``, then the ball's ``rest`` count growing to L; along z the ball's
-``radial`` count growing from that size at the top to the bottom. The two contact faces
-do not match (a mortar integral over the ball's cells crosses the block's kinks).
-"""
+``block_cell`` (default :data:`BLOCK_CELL`) times the ball's fine ones over the ball's
+fine zone ``R sin(theta_c)``, then the ball's ``rest`` count growing to L; along z the
+ball's ``radial`` count growing from that size at the top to the bottom. The two
+contact faces do not match (a mortar integral over the ball's cells crosses the
+block's kinks)."""
 
 from __future__ import annotations
 
@@ -104,6 +104,8 @@ class Ball(Cylinder):
     """:data:`MASTERS`: the rigid plane or the block."""
     block_size: float = BLOCK_SIZE
     """The block's L = H over R."""
+    block_cell: float = BLOCK_CELL
+    """The block's top cells over the ball's fine ones (:data:`BLOCK_CELL`)."""
     block_youngs_modulus: float | None = None
     """The block's E (None: the ball's)."""
     block_poisson_ratio: float | None = None
@@ -118,6 +120,8 @@ class Ball(Cylinder):
             raise HertzCaseError(f"master {self.master!r} must be one of {', '.join(MASTERS)}")
         if not (math.isfinite(self.block_size) and 0.25 <= self.block_size <= 100):
             raise HertzCaseError(f"block size {self.block_size!r} must be from 0.25 to 100 (L = H over R)")
+        if not (math.isfinite(self.block_cell) and 0.25 <= self.block_cell <= 4):
+            raise HertzCaseError(f"block cell {self.block_cell!r} must be from 0.25 to 4 (over the ball's)")
         e, nu = self.block_material
         if not (math.isfinite(e) and e > 0):
             raise HertzCaseError(f"block youngs modulus {e!r} must be > 0")
@@ -161,9 +165,10 @@ def ball_knots(ball: Ball, mesh: str) -> dict[str, list[float]]:
     return {"knots_xi": angle, "knots_eta": list(angle), "knots_zeta": [float(k) for k in rho]}
 
 
-def block_knots(ball: Ball, mesh: str, cell: float = BLOCK_CELL) -> dict[str, list[float]]:
+def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, list[float]]:
     """The block's ``knots_xi``, ``knots_eta`` (x and y over L), ``knots_zeta`` (z over H,
-    1 at the top) on mesh ``mesh`` (module docstring): cells ``cell`` times the ball's
+    1 at the top) on mesh ``mesh`` (module docstring): cells ``cell`` (default the
+    ball's ``block_cell``) times the ball's
     fine arc ``R theta_c / fine`` over at least the ball's fine zone ``R sin(theta_c)``
     along x and y, then ``rest`` cells growing to L; ``radial`` cells across, growing
     from that size at the top (:func:`pre.meshes.hertz_eta_knots`)."""
@@ -172,7 +177,7 @@ def block_knots(ball: Ball, mesh: str, cell: float = BLOCK_CELL) -> dict[str, li
     fine, rest, radial = MESHES[mesh]
     theta_c = hertz_theta_c(ball.half_width / ball.radius)
     side = float(ball.block_size) * float(ball.radius)
-    h = cell * ball.radius * theta_c / fine
+    h = (ball.block_cell if cell is None else cell) * ball.radius * theta_c / fine
     n_fine = math.ceil(ball.radius * math.sin(theta_c) / h - 1e-9)
     along = [x / side for x in graded_angles(n_fine * h, n_fine, rest, sweep=side)]
     depth = hertz_eta_knots(radial, h / side, thickness=1.0)

@@ -404,3 +404,14 @@ def test_voiga_check_counts_the_block(tmp_path: Path) -> None:
         for name, n in dofs.items():
             assert any(line.startswith(f"dofs {name} ") and f"total={n}" in line for line in lines), lines
         assert f"dofs all total={sum(dofs.values())}" in lines
+
+
+def test_block_cell_option(tmp_path: Path) -> None:
+    """--block-cell sets the block's top cells over the ball's fine ones."""
+    assert main(["hertz3d", str(tmp_path), "--master", "block", "--block-cell", "0.77", "--mesh", "m2",
+                 "--layout", "N2"]) == 0
+    nml = f90nml.read(str(tmp_path / "m2-N2.nml"))
+    h = 0.77 * math.asin(0.15) / MESHES["m2"][0]
+    assert nml["body"][1]["knots_xi"][0] == pytest.approx(h, rel=1e-12)
+    assert block_knots(Ball(master="block", block_cell=0.77), "m2") == block_knots(Ball(master="block"), "m2", 0.77)
+    assert main(["hertz3d", str(tmp_path / "x"), "--master", "block", "--block-cell", "5"]) == 2
