@@ -179,6 +179,10 @@ def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, l
     side = float(ball.block_size) * float(ball.radius)
     h = (ball.block_cell if cell is None else cell) * ball.radius * theta_c / fine
     n_fine = math.ceil(ball.radius * math.sin(theta_c) / h - 1e-9)
+    if n_fine * h > side / 2 or radial * h >= side:
+        raise HertzCaseError(f"block size {ball.block_size:g} R is too small for the contact zone on {mesh}: "
+                             f"its cells span {n_fine * h:g} along the top (at most half the block, "
+                             f"{side / 2:g}) and {radial * h:g} in depth (less than {side:g})")
     along = [x / side for x in graded_angles(n_fine * h, n_fine, rest, sweep=side)]
     depth = hertz_eta_knots(radial, h / side, thickness=1.0)
     return {"knots_xi": along, "knots_eta": list(along), "knots_zeta": [float(k) for k in depth]}

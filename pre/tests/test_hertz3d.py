@@ -20,6 +20,7 @@ from splipy import Surface
 
 from pre.__main__ import main
 from pre.h5io import read_volumes
+from pre.hertz import HertzCaseError
 from pre.hertz3d import (
     BLOCK,
     BLOCK_CELL,
@@ -415,3 +416,11 @@ def test_block_cell_option(tmp_path: Path) -> None:
     assert nml["body"][1]["knots_xi"][0] == pytest.approx(h, rel=1e-12)
     assert block_knots(Ball(master="block", block_cell=0.77), "m2") == block_knots(Ball(master="block"), "m2", 0.77)
     assert main(["hertz3d", str(tmp_path / "x"), "--master", "block", "--block-cell", "5"]) == 2
+    # a block too small for the zone's cells: refused, not graded backwards
+    with pytest.raises(HertzCaseError, match="too small"):
+        block_knots(Ball(master="block", block_size=0.25, indentation=0.05), "m1")
+    with pytest.raises(HertzCaseError, match="too small"):
+        block_knots(Ball(master="block", block_size=0.25, block_cell=4.0), "m1")
+    for size, cell in [(0.5, 1.3), (2.0, 4.0), (100.0, 0.25)]:
+        k = np.diff([0.0, *block_knots(Ball(master="block", block_size=size, block_cell=cell), "m4")["knots_xi"], 1.0])
+        assert np.all(k > 0)
