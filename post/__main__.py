@@ -11,7 +11,7 @@ Subcommands:
   vtk            ParaView time series (.pvd + .vtu)
   hertz          a cylinder on a rigid flat against analytic Hertz in the reference
                  configuration (and the figure; several results: one overlay)
-  hertz3d        a sphere on a rigid plane (a 3D result) against Hertz's point contact:
+  hertz3d        a sphere on a rigid plane or a block (3D result) against Hertz's point contact:
                  pressure over the contact disc, a and p0, the subsurface shear
   ironing        an ironing run's force history (2D: the die's Px, Py; 3D: the contact
                  force's F_x, F_z) and its oscillation over the sliding phase (and a figure)
@@ -277,7 +277,8 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
             return 2
         h = hertz3d_comparison(result, step=args.step, radius=args.radius,
                                youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
-                               symmetry=args.symmetry)
+                               symmetry=args.symmetry, master_youngs_modulus=args.master_youngs_modulus,
+                               master_poisson_ratio=args.master_poisson_ratio)
     except (HertzError, OSError, KeyError, ValueError) as err:
         print(f"python -m post hertz3d: {args.result}: {err}", file=sys.stderr)
         return 2
@@ -675,7 +676,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz)
 
-    s = sub.add_parser("hertz3d", help="a sphere on a rigid plane (3D result) against Hertz's point "
+    s = sub.add_parser("hertz3d", help="a sphere on a rigid plane or a block (3D result) against Hertz's point "
                                        "contact (reference configuration, nominal pressure)")
     s.add_argument("result", help="result file (.h5) of dimension 3 (the scene of pre hertz3d)")
     s.add_argument("--step", type=int, default=-1,
@@ -690,6 +691,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--symmetry", type=int, choices=(1, 2, 4), default=None,
                    help="P over the pair's normal force: 4 a quarter model, 2 a half, 1 the whole "
                         "sphere (default: from the active points' azimuths around the axis)")
+    s.add_argument("--master-youngs-modulus", type=_positive, default=None,
+                   help="a body master's E (default: its own, from the result)")
+    s.add_argument("--master-poisson-ratio", type=float, default=None,
+                   help="a body master's nu (default: its own, from the result)")
     s.add_argument("-o", "--output", default=None, help="PNG file of the figure")
     s.add_argument("--out", default=None,
                    help="folder for the figure <result>-hertz3d-<step>.png (default: next to the result)")

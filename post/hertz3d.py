@@ -1,5 +1,5 @@
-"""A sphere pressed on a rigid plane against Hertz's point contact
-(``python -m post hertz3d``; the scene of ``python -m pre hertz3d``, issue 42).
+"""A sphere pressed on a rigid plane or on an elastic body's flat face against Hertz's
+point contact (``python -m post hertz3d``; the scene of ``python -m pre hertz3d``, issue 42).
 
 What is compared, as in :mod:`post.hertz` (small-strain Hertz, the reference
 configuration): the nominal pressure ``p_n_nominal`` (force per reference area) at the
@@ -8,15 +8,20 @@ reference area it integrates (Gauss weight x reference surface Jacobian), all fr
 ``/steps/<k>/contact/<pair>`` of a result of dimension 3.
 
 The contact axis is the line through the centre of the sphere fitted to the slave
-points near the contact (:func:`post.hertz.fit_circle` in 3D) along the rigid plane's
-normal; its foot on the sphere is the contact's centre and r the distance of a point
-from the axis (reference configuration). For the scene of ``pre hertz3d`` this is the
-lowest point (0, 0, -R) and the z axis. The model is a quarter (or half) of the sphere
+points near the contact (:func:`post.hertz.fit_circle` in 3D) along the plane's normal:
+the rigid plane's, or for a body master the reference normal of its contact face (the
+bulk volume's ``zeta = 1``) at the active points' ``xi_master``, weighted by their
+forces, the face flat there to :data:`FLAT_TOLERANCE` (:func:`contact_plane`); its foot
+on the sphere is the contact's centre and r the distance of a point from the axis
+(reference configuration). For the scene of ``pre hertz3d`` this is the lowest point
+(0, 0, -R) and the z axis. The model is a quarter (or half) of the sphere
 when its active points lie within 90 (180) degrees around the axis: the symmetry
 planes then pass through the axis, and the total force P is 4 (2) times the pair's
 force along the normal; else P is that force.
 
-Hertz for a sphere of radius R on a rigid flat: ``E* = E / (1 - nu^2)``,
+Hertz for a sphere of radius R on a flat: ``E* = E / (1 - nu^2)`` on a rigid one,
+``1 / E* = (1 - nu^2) / E + (1 - nu_m^2) / E_m`` on an elastic body (the master's
+``E_m``, ``nu_m``; a half-space),
 ``a = (3 P R / (4 E*))^(1/3)``, ``p0 = 3 P / (2 pi a^2)``, ``p(r) = p0 sqrt(1 - r^2/a^2)``.
 The subsurface field on the axis (Johnson, Contact Mechanics, eq. 3.45; depth z):
 ``sigma_z = -p0 / (1 + z^2/a^2)``, ``sigma_r = p0 (-(1 + nu)(1 - (z/a) atan(a/z)) +
@@ -34,6 +39,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from pre.files import save_figure
+from pre.volume import Volume, jacobian
 
 from .field import evaluate
 from .hertz import CIRCLE_TOLERANCE, HertzError, contact_pair, fit_circle, fit_hertz, hertz_pressure
@@ -50,13 +56,28 @@ DEPTH_RANGE = 3.0
 """Samples of the stress down to this many a below the contact's centre are compared."""
 AXIS_TOLERANCE = 1e-6
 """A stress sample within this fraction of a from the axis is on the axis."""
+FLAT_TOLERANCE = 1e-3
+"""A body master's contact face is flat when its normals at the active points are within
+this angle (radians) of their mean: Hertz's sphere on a flat (a curved master would add
+its curvature to the sphere's)."""
+
+
+def effective_modulus(youngs_modulus: float, poisson_ratio: float,
+                      master: tuple[float, float] | None = None) -> float:
+    """Hertz's E*: ``E / (1 - nu^2)`` on a rigid flat (``master`` None), else
+    ``1 / ((1 - nu^2) / E + (1 - nu_m^2) / E_m)`` with ``master = (E_m, nu_m)``."""
+    compliance = (1.0 - poisson_ratio**2) / youngs_modulus
+    if master is not None:
+        compliance += (1.0 - master[1] ** 2) / master[0]
+    return 1.0 / compliance
 
 
 def sphere_reference(force: float, youngs_modulus: float, poisson_ratio: float,
-                     radius: float) -> tuple[float, float]:
-    """Contact radius a and peak pressure p0 of a sphere of ``radius`` pressed on a rigid
-    flat by the total force ``force`` (Hertz; E* = E / (1 - nu^2))."""
-    e_star = youngs_modulus / (1.0 - poisson_ratio**2)
+                     radius: float, master: tuple[float, float] | None = None) -> tuple[float, float]:
+    """Contact radius a and peak pressure p0 of a sphere of ``radius`` pressed on a flat
+    by the total force ``force`` (Hertz; E* of :func:`effective_modulus`: a rigid flat,
+    or an elastic one of ``master = (E_m, nu_m)``)."""
+    e_star = effective_modulus(youngs_modulus, poisson_ratio, master)
     a = (3.0 * force * radius / (4.0 * e_star)) ** (1.0 / 3.0)
     return float(a), float(3.0 * force / (2.0 * math.pi * a * a))
 
@@ -150,6 +171,10 @@ class Hertz3dComparison:
     poisson_ratio: float
     symmetry: int
     """P over the pair's normal force: 4 (quarter model), 2 (half) or 1."""
+    master: tuple[float, float] | None
+    """The master's (E, nu); None for a rigid plane."""
+    e_star: float
+    """Hertz's E* (:func:`effective_modulus`)."""
     force: float
     """P, the total force of the whole sphere."""
     a: float
@@ -162,6 +187,8 @@ class Hertz3dComparison:
     """The contact's centre (reference configuration)."""
     normal: np.ndarray
     """The plane's unit normal (the contact axis' direction, into the sphere)."""
+    axis_source: str
+    """Where the normal comes from (the rigid plane, or the master face and its flatness)."""
     misfit: float
     """rms distance of the fitted points from the sphere, over R."""
     tau_hertz: float
@@ -231,9 +258,39 @@ def _contact(result: Result, step: int, pair: int) -> tuple[Step, ContactOutput]
     if missing:
         raise HertzError(f"{result.path}: step {st.step}, pair {pair + 1}: no {' and no '.join(missing)} "
                          "(post hertz3d needs the nominal pressure and each point's reference area)")
-    if c.rigid_point is None or c.rigid_normal is None or len(c.rigid_normal) != 3:
+    if c.master == "rigid" and (c.rigid_point is None or c.rigid_normal is None or len(c.rigid_normal) != 3):
         raise HertzError(f"{result.path}: pair {c.slave} -> {c.master} is not pressed on a rigid plane")
     return st, c
+
+
+def contact_plane(result: Result, c: ContactOutput) -> tuple[np.ndarray, np.ndarray, str]:
+    """``(point, unit normal, source)`` of the flat the sphere presses on: the rigid
+    plane's, or a body master's contact face (its bulk volume's ``zeta = 1``, reference
+    configuration) at the active points' ``xi_master``: the mean of its unit normals
+    there weighted by the points' forces, and the force-weighted mean of those points.
+    HertzError when the master is not a solid or its face is not flat over the zone
+    (:data:`FLAT_TOLERANCE`)."""
+    if c.rigid_normal is not None and c.rigid_point is not None:
+        n = np.asarray(c.rigid_normal, dtype=float)
+        return np.asarray(c.rigid_point, dtype=float), n / np.linalg.norm(n), "the rigid plane's normal"
+    master = result.body(c.master)
+    if not isinstance(master.bulk, Volume) or c.xi_master is None:
+        raise HertzError(f"{result.path}: the master {c.master!r} is not a solid with xi_master")
+    active = c.active
+    xi = np.asarray(c.xi_master, dtype=float).reshape(len(active), -1)[active]  # (n, 2) stored flat
+    x, jac = jacobian(master.bulk, xi[:, 0], xi[:, 1], np.ones(len(xi)))
+    normals = np.cross(jac[:, :, 0], jac[:, :, 1])  # outward at zeta = 1 of a right-handed volume
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    w = np.asarray(c.p_n_nominal, dtype=float)[active] * np.asarray(c.area_ref, dtype=float)[active]
+    w = w if w.sum() > 0 else np.ones(len(w))
+    n = w @ normals
+    n /= np.linalg.norm(n)
+    spread = float(np.arccos(np.clip(normals @ n, -1.0, 1.0)).max())
+    if spread > FLAT_TOLERANCE:
+        raise HertzError(f"{result.path}: the contact face of the master {c.master!r} is not flat over the "
+                         f"zone (its normals turn by {spread:.2g} rad, allowed {FLAT_TOLERANCE:g}); post "
+                         "hertz3d compares a sphere on a flat")
+    return w @ x / w.sum(), n, f"the master face's normal (reference, flat to {spread:.1g} rad)"
 
 
 def subsurface_shear(result: Result, st: Step, body: str, centre: np.ndarray, normal: np.ndarray,
@@ -269,27 +326,35 @@ def subsurface_shear(result: Result, st: Step, body: str, centre: np.ndarray, no
 
 def hertz3d_comparison(result: Result, step: int = -1, pair: int = 0, radius: float | None = None,
                        youngs_modulus: float | None = None, poisson_ratio: float | None = None,
-                       symmetry: int | None = None) -> Hertz3dComparison:
+                       symmetry: int | None = None, master_youngs_modulus: float | None = None,
+                       master_poisson_ratio: float | None = None) -> Hertz3dComparison:
     """Compare contact pair ``pair`` (0-based) at ``step`` of a 3D result with Hertz's
     point contact (module docstring). R: the sphere fitted to the slave points near the
-    contact unless ``radius``; E and nu: the slave body's unless given; ``symmetry``: P
-    over the pair's normal force (None: from the active points' azimuths). HertzError
-    when the pair is not a sphere on a rigid plane or has nothing to compare."""
+    contact unless ``radius``; E and nu: the slave body's unless given, and for a body
+    master its own (``master_youngs_modulus``, ``master_poisson_ratio``); ``symmetry``:
+    P over the pair's normal force (None: from the active points' azimuths). HertzError
+    when the pair is not a sphere on a flat or has nothing to compare."""
     st, c = _contact(result, step, pair)
-    n = np.asarray(c.rigid_normal, dtype=float)
-    n = n / np.linalg.norm(n)
     active = c.active
+    if not active.any():
+        raise HertzError(f"{result.path}: no point of {c.slave} -> {c.master} is in contact at step {st.step}")
+    plane, n, axis_source = contact_plane(result, c)
     normal_force = abs(float(c.force @ n))
-    if not active.any() or normal_force <= 0:
+    if normal_force <= 0:
         raise HertzError(f"{result.path}: no point of {c.slave} -> {c.master} is in contact at step {st.step}")
     sphere, r_fit, misfit = fit_sphere(c, n)
-    if misfit > CIRCLE_TOLERANCE or (sphere - c.rigid_point) @ n <= 0:
+    if misfit > CIRCLE_TOLERANCE or (sphere - plane) @ n <= 0:
         raise HertzError(f"{result.path}: the contact face of {c.slave!r} is not a sphere pressing on "
                          f"the plane (its reference points near the contact are {misfit:.2g} of the "
                          f"radius off the best sphere, allowed {CIRCLE_TOLERANCE:g})")
     body = result.body(c.slave)
     e = float(youngs_modulus if youngs_modulus is not None else body.youngs_modulus)
     nu = float(poisson_ratio if poisson_ratio is not None else body.poisson_ratio)
+    master = None
+    if c.master != "rigid":
+        mb = result.body(c.master)
+        master = (float(master_youngs_modulus if master_youngs_modulus is not None else mb.youngs_modulus),
+                  float(master_poisson_ratio if master_poisson_ratio is not None else mb.poisson_ratio))
     big_r = float(radius) if radius is not None else r_fit
     centre = sphere - r_fit * n
     rel = c.x_ref - centre
@@ -298,7 +363,7 @@ def hertz3d_comparison(result: Result, step: int = -1, pair: int = 0, radius: fl
     e1, e2 = _axis_frame(n)
     factor = symmetry or symmetry_factor(np.arctan2(radial[active] @ e2, radial[active] @ e1))
     force = factor * normal_force
-    a, p0 = sphere_reference(force, e, nu, big_r)
+    a, p0 = sphere_reference(force, e, nu, big_r, master)
     p = np.asarray(c.p_n_nominal, dtype=float)
     err = disc_error(r, p, c.area_ref, active, a, p0)
     on = p > 0
@@ -312,8 +377,9 @@ def hertz3d_comparison(result: Result, step: int = -1, pair: int = 0, radius: fl
               else f"sphere fit to the slave face's reference points, misfit {misfit:.1g} R")
     order = np.argsort(r, kind="stable")
     return Hertz3dComparison(radius=big_r, youngs_modulus=e, poisson_ratio=nu, symmetry=factor,
+                             master=master, e_star=effective_modulus(e, nu, master),
                              force=force, a=a, p0=p0, error=err, a_fit=a_fit, p0_fit=p0_fit,
-                             centre=centre, normal=n, misfit=misfit, tau_hertz=tau_h,
+                             centre=centre, normal=n, axis_source=axis_source, misfit=misfit, tau_hertz=tau_h,
                              depth_hertz=depth_h, shear=shear, shear_note=note, r=r[order],
                              p=p[order], source=str(result.path), step=st.step,
                              time=float(st.time), radius_source=source)
@@ -332,6 +398,14 @@ def format_hertz3d(h: Hertz3dComparison) -> str:
             f"L2 = {h.error.l2:.3%}  fit: a {h.a_error:+.2%}, p0 {h.p0_error:+.2%}{shear}")
 
 
+def _e_star_text(h: Hertz3dComparison) -> str:
+    if h.master is None:
+        return f"E* = E/(1-nu^2) = {h.e_star:.6g} (rigid flat)"
+    e, nu = h.master
+    return (f"on the master's E = {e:.6g}, nu = {nu:.6g}: E* = 1/((1-nu^2)/E + (1-nu_m^2)/E_m) = "
+            f"{h.e_star:.6g} (an elastic flat, a half-space)")
+
+
 def hertz3d_report(h: Hertz3dComparison) -> list[str]:
     """The lines ``python -m post hertz3d`` prints."""
     e = h.error
@@ -340,9 +414,8 @@ def hertz3d_report(h: Hertz3dComparison) -> list[str]:
              "  measure: reference configuration, p_n_nominal (force per reference area) at "
              "x_ref, weighted by area_ref",
              f"  sphere: R = {h.radius:.6g} ({h.radius_source}); E = {h.youngs_modulus:.6g}, "
-             f"nu = {h.poisson_ratio:.6g}, E* = E/(1-nu^2) = "
-             f"{h.youngs_modulus / (1 - h.poisson_ratio**2):.6g} (rigid flat)",
-             f"  contact centre ({c}), axis along the plane's normal; r = distance from the axis",
+             f"nu = {h.poisson_ratio:.6g}, " + _e_star_text(h),
+             f"  contact centre ({c}), axis along {h.axis_source}; r = distance from the axis",
              f"  P = {h.force:.6g} = {h.symmetry} x the pair's normal force ({MODELS[h.symmetry]})",
              f"  analytic: a = (3PR/(4E*))^(1/3) = {h.a:.6g} (a/R = {h.a / h.radius:.4g}), "
              f"p0 = 3P/(2 pi a^2) = {h.p0:.6g}",

@@ -5,7 +5,7 @@ Subcommands:
   geometry3d   a spec of 3D bodies (TOML) -> geometry file of volumes and case file
   cases        write cases/<scene>/geometry.h5 and every study's namelist
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
-  hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane (issue 42)
+  hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane or a block (issue 42)
   ironing3d    the 3D ironing scene: a rigid sphere pressed into a slab and slid (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       a result: its case refined at the contact zone; a case: the splipy dump
@@ -133,10 +133,9 @@ def _write_scene3d(command: str, write: Callable[[], Any], dofs: Callable[[str, 
                    same: str, closing: str) -> int:
     """Run a 3D scene's writer ``write()`` (``(geometry, cases, geometry written)``); a
     refusal is one line on stderr naming ``python -m pre COMMAND`` and exit code 2. Print
-    what was written, each case's DOFs (``dofs(mesh, layout)``) and ``closing``."""
+    what was written, each case's DOFs (``dofs(mesh, layout)``: body -> DOFs) and ``closing``."""
     from .files import OutputError
     from .hertz import HertzCaseError
-
     try:
         geometry, cases, fresh = write()
     except (HertzCaseError, OutputError, OSError) as err:
@@ -145,21 +144,26 @@ def _write_scene3d(command: str, write: Callable[[], Any], dofs: Callable[[str, 
     print(f"wrote {geometry}" if fresh else f"kept {geometry} (the same {same})")
     for case in cases:
         mesh, layout = case.stem.split("-", 1)
-        print(f"wrote {case}: {dofs(mesh, layout)['total']} DOFs")
+        each = dofs(mesh, layout)
+        parts = f" ({', '.join(f'{name} {n}' for name, n in each.items())})" if len(each) > 1 else ""
+        print(f"wrote {case}: {sum(each.values())} DOFs{parts}")
     print(closing)
     return 0
 
 
 def _cmd_hertz3d(args: argparse.Namespace) -> int:
-    from .hertz3d import Ball, case_dofs, write_hertz3d
+    from .hertz3d import Ball, body_dofs, write_hertz3d
 
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
-                poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material)
+                poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material,
+                master=args.master, block_size=args.block_size, block_cell=args.block_cell,
+                block_youngs_modulus=args.block_youngs_modulus, block_poisson_ratio=args.block_poisson_ratio)
     return _write_scene3d(
         "hertz3d", lambda: write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
                                          n_steps=args.steps, method=args.method,
                                          penalty_normal=args.penalty_normal),
-        lambda mesh, layout: case_dofs(ball, mesh, layout), "ball",
+        lambda mesh, layout: body_dofs(ball, mesh, layout),
+        "ball" if ball.master == "rigid" else "ball and block",
         f"expected contact radius a = sqrt(R d) = {ball.half_width:.6g} "
         f"(a/R = {ball.half_width / ball.radius:.4g}; Hertz for the approach d, an estimate)")
 
@@ -172,7 +176,7 @@ def _cmd_ironing3d(args: argparse.Namespace) -> int:
         "ironing3d", lambda: write_ironing3d(iron, args.mesh, args.layout, args.out, force=args.force,
                                              steps=args.steps, n_gauss=args.n_gauss or None,
                                              penalty_normal=args.penalty_normal),
-        lambda mesh, layout: case_dofs(iron, mesh, layout), "die",
+        lambda mesh, layout: {"slab": case_dofs(iron, mesh, layout)["total"]}, "die",
         f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
 
 
@@ -288,7 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_hertz)
 
     s = sub.add_parser("hertz3d", help="the 3D Hertz scene: a quarter hemisphere (ball octant) "
-                                       "pressed on a rigid plane; geometry.h5 and a case per mesh "
+                                       "pressed on a rigid plane or an elastic block; geometry.h5 and a case per mesh "
                                        "and layout")
     s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml (not cases/: voiga "
                                "cannot run 3D contact yet)")
@@ -306,6 +310,18 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--method", default="mortar", help="&contact method (default mortar, voiga's on solids)")
     s.add_argument("--penalty-normal", type=float, default=None,
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
+    s.add_argument("--master", default="rigid", choices=("rigid", "block"),
+                   help="rigid: the rigid plane z = -R (default); block: an elastic block "
+                        "[0, L] x [0, L] x [-R - H, -R] under the ball, its bottom fixed")
+    s.add_argument("--block-size", type=float, default=1.0,
+                   help="--master block: L = H over R (default 1, ten contact radii)")
+    s.add_argument("--block-cell", type=float, default=1.3,
+                   help="--master block: its top cells over the ball's fine ones (default 1.3: "
+                        "comparable, not matching)")
+    s.add_argument("--block-youngs-modulus", type=float, default=None,
+                   help="--master block: the block's E (default: the ball's)")
+    s.add_argument("--block-poisson-ratio", type=float, default=None,
+                   help="--master block: the block's nu (default: the ball's)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_hertz3d)
 

@@ -23,7 +23,20 @@ sphere, the surface element as long as the fine ones (:func:`pre.meshes.hertz_et
 ``a_est = sqrt(R d)`` is Hertz's half-width for a sphere whose approach to the plane is
 d (a sphere on a rigid flat: ``d = a^2 / R``); the top face's d also holds the
 compression of the hemisphere itself, so the run's a is somewhat smaller.
-"""
+
+Master ``block`` (``--master block``; issue 42's "sphere on an elastic block"): instead of
+the rigid plane, a second body ``block``, the box ``[0, L] x [0, L] x [-R - H, -R]``
+(:func:`pre.solids.box`; L = H = ``block_size`` R, default :data:`BLOCK_SIZE`), the
+quarter of a half-space under the ball with the same symmetry faces (``symmetry_x``
+x = 0 with ``fix_x``, ``symmetry_y`` y = 0 with ``fix_y``), its ``bottom`` fixed in z,
+its ``top`` (z = -R) the master face of ``&contact slave = 'ball', master = 'block'``;
+the ball's material unless given, the ball's layout. Its knots are graded toward the
+contact point (0, 0, -R) as the ball's (:func:`block_knots`): along x and y cells
+``block_cell`` (default :data:`BLOCK_CELL`) times the ball's fine ones over the ball's
+fine zone ``R sin(theta_c)``, then the ball's ``rest`` count growing to L; along z the
+ball's ``radial`` count growing from that size at the top to the bottom. The two
+contact faces do not match (a mortar integral over the ball's cells crosses the
+block's kinks)."""
 
 from __future__ import annotations
 
@@ -39,7 +52,7 @@ from .h5io import write_geometry
 from .hertz import Cylinder, HertzCaseError, write_shared_geometry
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import knotted_body_group, solid_dofs
-from .solids import ball_octant
+from .solids import ball_octant, box
 from .volume import Volume, check_volume
 
 SOLID_METHOD = "mortar"
@@ -51,6 +64,19 @@ BODY = "ball"
 CONTACT_FACE = "outer"
 """The sphere face (rho = R) of :func:`pre.solids.ball_octant`."""
 MATERIALS = ("linear", "neo-hookean")
+MASTERS = ("rigid", "block")
+"""``--master``: the rigid plane z = -R, or the elastic block under it."""
+BLOCK = "block"
+BLOCK_FACE = "top"
+BLOCK_FACES = {"left": "symmetry_x", "front": "symmetry_y"}
+"""The block's faces: :data:`pre.solids.BOX_FACES` with x = 0 and y = 0 renamed as the ball's."""
+BLOCK_SIZE = 1.0
+"""L = H over R: ten contact radii (a/R = 0.1), where the block's finite size changes the
+pressure by less than the meshes can show (docs/verification.md, "Contact on faces")."""
+BLOCK_CELL = 1.3
+"""The block's top cells under the zone over the ball's fine cells: comparable, not
+matching (within the ball's fine zone no block knot comes within 2 % of a cell of a
+ball knot line on any mesh; 1.2, 1.33, 1.4 or 0.8 put some within 1 %)."""
 
 MESHES: dict[str, tuple[int, int, int]] = {
     "m1": (5, 5, 5),
@@ -74,12 +100,40 @@ class Ball(Cylinder):
     the values and their ranges are :class:`pre.hertz.Cylinder`'s, plus the material law."""
 
     material: str = "linear"
+    master: str = "rigid"
+    """:data:`MASTERS`: the rigid plane or the block."""
+    block_size: float = BLOCK_SIZE
+    """The block's L = H over R."""
+    block_cell: float = BLOCK_CELL
+    """The block's top cells over the ball's fine ones (:data:`BLOCK_CELL`)."""
+    block_youngs_modulus: float | None = None
+    """The block's E (None: the ball's)."""
+    block_poisson_ratio: float | None = None
+    """The block's nu (None: the ball's)."""
 
     def check(self) -> None:
         """HertzCaseError naming the first value out of range."""
         super().check()
         if self.material not in MATERIALS:
             raise HertzCaseError(f"material {self.material!r} must be one of {', '.join(MATERIALS)}")
+        if self.master not in MASTERS:
+            raise HertzCaseError(f"master {self.master!r} must be one of {', '.join(MASTERS)}")
+        if not (math.isfinite(self.block_size) and 0.25 <= self.block_size <= 100):
+            raise HertzCaseError(f"block size {self.block_size!r} must be from 0.25 to 100 (L = H over R)")
+        if not (math.isfinite(self.block_cell) and 0.25 <= self.block_cell <= 4):
+            raise HertzCaseError(f"block cell {self.block_cell!r} must be from 0.25 to 4 (over the ball's)")
+        e, nu = self.block_material
+        if not (math.isfinite(e) and e > 0):
+            raise HertzCaseError(f"block youngs modulus {e!r} must be > 0")
+        if not (math.isfinite(nu) and -1.0 < nu < 0.5):
+            raise HertzCaseError(f"block poisson ratio {nu!r} must be in (-1, 0.5)")
+
+    @property
+    def block_material(self) -> tuple[float, float]:
+        """The block's ``(E, nu)``: the given ones, else the ball's."""
+        e = self.youngs_modulus if self.block_youngs_modulus is None else self.block_youngs_modulus
+        nu = self.poisson_ratio if self.block_poisson_ratio is None else self.block_poisson_ratio
+        return float(e), float(nu)
 
     @property
     def half_width(self) -> float:
@@ -88,8 +142,14 @@ class Ball(Cylinder):
 
 
 def ball_geometry(ball: Ball) -> dict[str, Volume]:
-    """The body of the scene: the ball octant of radius R, faces of :data:`pre.solids.BALL_FACES`."""
-    return {BODY: ball_octant(ball.radius)}
+    """The bodies of the scene: the ball octant of radius R (faces of
+    :data:`pre.solids.BALL_FACES`) and, for the master ``block``, the block (faces
+    :data:`BLOCK_FACES`)."""
+    bodies = {BODY: ball_octant(ball.radius)}
+    if ball.master == BLOCK:
+        r, side = float(ball.radius), float(ball.block_size) * float(ball.radius)
+        bodies[BLOCK] = box((0.0, side), (0.0, side), (-r - side, -r), faces=BLOCK_FACES)
+    return bodies
 
 
 def ball_knots(ball: Ball, mesh: str) -> dict[str, list[float]]:
@@ -105,46 +165,92 @@ def ball_knots(ball: Ball, mesh: str) -> dict[str, list[float]]:
     return {"knots_xi": angle, "knots_eta": list(angle), "knots_zeta": [float(k) for k in rho]}
 
 
+def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, list[float]]:
+    """The block's ``knots_xi``, ``knots_eta`` (x and y over L), ``knots_zeta`` (z over H,
+    1 at the top) on mesh ``mesh`` (module docstring): cells ``cell`` (default the
+    ball's ``block_cell``) times the ball's
+    fine arc ``R theta_c / fine`` over at least the ball's fine zone ``R sin(theta_c)``
+    along x and y, then ``rest`` cells growing to L; ``radial`` cells across, growing
+    from that size at the top (:func:`pre.meshes.hertz_eta_knots`)."""
+    if mesh not in MESHES:
+        raise HertzCaseError(f"mesh {mesh!r}: one of {', '.join(MESHES)}")
+    fine, rest, radial = MESHES[mesh]
+    theta_c = hertz_theta_c(ball.half_width / ball.radius)
+    side = float(ball.block_size) * float(ball.radius)
+    h = (ball.block_cell if cell is None else cell) * ball.radius * theta_c / fine
+    n_fine = math.ceil(ball.radius * math.sin(theta_c) / h - 1e-9)
+    if n_fine * h > side / 2 or radial * h >= side:
+        raise HertzCaseError(f"block size {ball.block_size:g} R is too small for the contact zone on {mesh}: "
+                             f"its cells span {n_fine * h:g} along the top (at most half the block, "
+                             f"{side / 2:g}) and {radial * h:g} in depth (less than {side:g})")
+    along = [x / side for x in graded_angles(n_fine * h, n_fine, rest, sweep=side)]
+    depth = hertz_eta_knots(radial, h / side, thickness=1.0)
+    return {"knots_xi": along, "knots_eta": list(along), "knots_zeta": [float(k) for k in depth]}
+
+
+def _solid_group(name: str, vol: Volume, knots: dict[str, list[float]], layout: str, face: str,
+                 material: str, youngs_modulus: float, poisson_ratio: float) -> dict[str, Any]:
+    """A ``&body`` of the scene with explicit knots (:func:`pre.solid_case.knotted_body_group`:
+    the contact face is ``zeta = 1`` of both volumes)."""
+    spec = {"name": name, "layout": layout, "contact_face": face, "material": material,
+            "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio}
+    try:
+        return knotted_body_group(spec, vol, knots)
+    except ValueError as err:
+        raise HertzCaseError(str(err)) from None
+
+
 def ball_case(ball: Ball, mesh: str, layout: str, n_steps: int | None = None,
               method: str = SOLID_METHOD, penalty_normal: float | None = None) -> dict[str, Any]:
     """The namelist groups of the case ``mesh``, ``layout`` (module docstring).
     ``penalty_normal``: None leaves it to voiga (automatic)."""
     ball.check()
-    knots = ball_knots(ball, mesh)
-    vol = ball_geometry(ball)[BODY]
-    spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE, "material": ball.material,
-            "youngs_modulus": ball.youngs_modulus, "poisson_ratio": ball.poisson_ratio}
-    try:
-        body = knotted_body_group(spec, vol, knots)
-    except ValueError as err:
-        raise HertzCaseError(str(err)) from None
+    vols = ball_geometry(ball)
+    bodies = [_solid_group(BODY, vols[BODY], ball_knots(ball, mesh), layout, CONTACT_FACE, ball.material,
+                           ball.youngs_modulus, ball.poisson_ratio)]
     if n_steps is not None and n_steps < 1:
         raise HertzCaseError(f"steps {n_steps} must be >= 1")
     contact: dict[str, Any] = {"slave": BODY, "master": "rigid",
                                "rigid_point": [0.0, 0.0, -float(ball.radius)],
                                "rigid_normal": [0.0, 0.0, 1.0], "method": method}
+    dirichlet = [{"body": BODY, "face": "top", "fix_z": True, "uz": -float(ball.indentation)},
+                 {"body": BODY, "face": "symmetry_x", "fix_x": True},
+                 {"body": BODY, "face": "symmetry_y", "fix_y": True}]
+    on = ""
+    if ball.master == BLOCK:
+        e, nu = ball.block_material
+        bodies.append(_solid_group(BLOCK, vols[BLOCK], block_knots(ball, mesh), layout, BLOCK_FACE,
+                                   ball.material, e, nu))
+        contact = {"slave": BODY, "master": BLOCK, "method": method}
+        dirichlet += [{"body": BLOCK, "face": "bottom", "fix_z": True},
+                      {"body": BLOCK, "face": "symmetry_x", "fix_x": True},
+                      {"body": BLOCK, "face": "symmetry_y", "fix_y": True}]
+        on = f", on a block L = H = {ball.block_size * ball.radius:g}, E = {e:g}, nu = {nu:g}"
     if penalty_normal is not None:
         if not (isinstance(penalty_normal, (int, float)) and 0 < penalty_normal < math.inf):
             raise HertzCaseError(f"penalty_normal {penalty_normal!r} must be > 0")
         contact["penalty_normal"] = float(penalty_normal)
     title = (f"hertz3d {mesh} {layout}: ball octant R = {ball.radius:g}, E = {ball.youngs_modulus:g}, "
-             f"nu = {ball.poisson_ratio:g}, {ball.material}, indentation {ball.indentation:g}")
+             f"nu = {ball.poisson_ratio:g}, {ball.material}, indentation {ball.indentation:g}{on}")
     return {"case": {"title": title, "scene": SCENE, "mesh": mesh, "layout": layout,
-                     "geometry": GEOMETRY_FILE, "output": f"{case_stem(mesh, layout)}.h5", "n_bodies": 1},
-            "body": [body],
+                     "geometry": GEOMETRY_FILE, "output": f"{case_stem(mesh, layout)}.h5",
+                     "n_bodies": len(bodies)},
+            "body": bodies,
             "solver": {"n_steps": int(n_steps or HERTZ_STEPS)},
-            "dirichlet": [
-                {"body": BODY, "face": "top", "fix_z": True, "uz": -float(ball.indentation)},
-                {"body": BODY, "face": "symmetry_x", "fix_x": True},
-                {"body": BODY, "face": "symmetry_y", "fix_y": True},
-            ],
+            "dirichlet": dirichlet,
             "contact": [contact],
             "output": {"fields": ["stress"], "samples": FIELD_SAMPLES, "every": 0}}
 
 
 def case_dofs(ball: Ball, mesh: str, layout: str) -> dict[str, int]:
-    """The DOFs of a case (:func:`pre.solid_case.solid_dofs`)."""
+    """The ball's DOFs in a case (:func:`pre.solid_case.solid_dofs`)."""
     return solid_dofs(ball_case(ball, mesh, layout)["body"][0], ball_geometry(ball)[BODY])
+
+
+def body_dofs(ball: Ball, mesh: str, layout: str) -> dict[str, int]:
+    """Body name -> its total DOFs in a case (the ball, and the block for that master)."""
+    vols = ball_geometry(ball)
+    return {b["name"]: solid_dofs(b, vols[b["name"]])["total"] for b in ball_case(ball, mesh, layout)["body"]}
 
 
 def write_hertz3d(ball: Ball, meshes: Sequence[str], layouts: Sequence[str], out: str | Path,
@@ -166,7 +272,8 @@ def write_hertz3d(ball: Ball, meshes: Sequence[str], layouts: Sequence[str], out
     def geometry_file(path: Path) -> None:
         write_geometry(path, SCENE, bodies, generator="voiga pre (python -m pre hertz3d)")
 
-    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other="another ball")
+    other = "another ball" if ball.master == "rigid" else "another ball or block"
+    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other=other)
     for case, text in zip(cases, texts.values(), strict=True):
         write_text(case, text)
     return geometry, cases, fresh

@@ -18,8 +18,10 @@ from scipy.integrate import quad
 from post.__main__ import main
 from post.hertz import HertzError
 from post.hertz3d import (
+    FLAT_TOLERANCE,
     axis_shear,
     axis_stresses,
+    effective_modulus,
     hertz3d_comparison,
     max_subsurface_shear,
     sphere_reference,
@@ -29,8 +31,8 @@ from post.reader import read_result
 from post.summary import summary_lines
 from pre.h5io import write_volume
 from pre.meshes import arc_parameter
-from pre.solids import ball_octant
-from pre.volume import jacobian
+from pre.solids import ball_octant, box
+from pre.volume import Volume, jacobian
 
 E, NU, R = 1.0, 0.3, 1.0
 A = 0.1
@@ -38,6 +40,8 @@ A = 0.1
 E_STAR = E / (1 - NU**2)
 P = 4 * E_STAR * A**3 / (3 * R)
 P0 = 3 * P / (2 * math.pi * A**2)
+BLOCK = box((0.0, 1.0), (0.0, 1.0), (-2.0, -R))
+"""The master of the block tests: its top z = -R, parameters (x, y)."""
 
 
 def surface_points(n: int = 40, angle: float = 2.2 * A) -> tuple[np.ndarray, np.ndarray]:
@@ -59,42 +63,58 @@ def hertz_p(r: np.ndarray, a: float = A, p0: float = P0) -> np.ndarray:
     return p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None))
 
 
-def write_result(path: Path, x_ref: np.ndarray, p: np.ndarray, area: np.ndarray | None,
-                 force_z: float, stress: dict[str, np.ndarray] | None = None) -> Path:
-    """A converged one-step result of the ball octant (the coarse volume as the bulk, one
-    element, no layer) with one rigid-plane contact pair and, with ``stress``
-    (``xi``, ``eta``, ``zeta``, ``stress`` (n, 6)), the body's sampled stress."""
-    vol = ball_octant(R)
+def _write_body(f: h5py.File, name: str, vol: Volume, offset: int, youngs_modulus: float = E,
+                poisson_ratio: float = NU) -> int:
+    """``/bodies/<name>``: the coarse volume as the bulk, one element, no layer; its DOFs."""
     ncp = vol.weights.size
+    b = f.create_group(f"bodies/{name}")
+    b.attrs.update({"material": "linear", "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
+                    "dof_offset": offset})
+    b["control_points"] = vol.control_points.reshape(-1, 3)
+    b["weights"] = vol.weights.reshape(-1)
+    b["elements/ptr"] = np.array([1, ncp + 1])
+    b["elements/conn"] = np.arange(1, ncp + 1)
+    b["elements/range"] = np.array([[0.0, 1.0, 0.0, 1.0, 0.0, 1.0]])
+    b["elements/vo"] = np.array([0])
+    write_volume(b.create_group("bulk"), vol)
+    return 3 * ncp
+
+
+def write_result(path: Path, x_ref: np.ndarray, p: np.ndarray, area: np.ndarray | None,
+                 force_z: float, stress: dict[str, np.ndarray] | None = None,
+                 master: tuple[Volume, float, float] | None = None) -> Path:
+    """A converged one-step result of the ball octant (the coarse volume as the bulk, one
+    element, no layer) with one contact pair and, with ``stress`` (``xi``, ``eta``,
+    ``zeta``, ``stress`` (n, 6)), the body's sampled stress. The master: the rigid plane
+    z = -R, or with ``master = (volume, E, nu)`` the body ``block`` (its contact face
+    ``zeta = 1``; each point's ``xi_master`` its x and y, the parameters of
+    :data:`BLOCK`'s top)."""
+    vol = ball_octant(R)
     n = len(p)
     with h5py.File(path, "w") as f:
+        dofs = _write_body(f, "ball", vol, 0)
+        if master is not None:
+            dofs += _write_body(f, "block", master[0], dofs, master[1], master[2])
         f.attrs.update({"status": "converged", "dimension": 3, "n_steps_done": 1, "n_steps_planned": 1,
-                        "n_dofs": 3 * ncp, "title": "hertz3d synthetic", "scene": "hertz3d",
+                        "n_dofs": dofs, "title": "hertz3d synthetic", "scene": "hertz3d",
                         "units": "mm, N", "warnings": ""})
-        b = f.create_group("bodies/ball")
-        b.attrs.update({"material": "linear", "youngs_modulus": E, "poisson_ratio": NU, "dof_offset": 0})
-        b["control_points"] = vol.control_points.reshape(-1, 3)
-        b["weights"] = vol.weights.reshape(-1)
-        b["elements/ptr"] = np.array([1, ncp + 1])
-        b["elements/conn"] = np.arange(1, ncp + 1)
-        b["elements/range"] = np.array([[0.0, 1.0, 0.0, 1.0, 0.0, 1.0]])
-        b["elements/vo"] = np.array([0])
-        write_volume(b.create_group("bulk"), vol)
         s = f.create_group("steps/000001")
         s.attrs.update({"step": 1, "time": 1.0, "iterations": 1})
-        s["displacement"] = np.zeros(3 * ncp)
+        s["displacement"] = np.zeros(dofs)
         c = s.create_group("contact/1")
-        c.attrs.update({"slave": "ball", "master": "rigid", "penalty_normal": 100.0, "friction": 0.0,
-                        "method": "gpts"})
+        c.attrs.update({"slave": "ball", "master": "rigid" if master is None else "block",
+                        "penalty_normal": 100.0, "friction": 0.0, "method": "gpts"})
         c["force"] = np.array([0.0, 0.0, force_z])
         c["x_ref"], c["x"] = x_ref, x_ref
-        c["xi_slave"], c["xi_master"] = np.zeros((n, 2)), np.zeros((n, 2))
+        c["xi_slave"] = np.zeros((n, 2))
+        c["xi_master"] = np.zeros((n, 2)) if master is None else x_ref[:, :2].copy()
         c["gap"], c["p_t"] = np.zeros(n), np.zeros(n)
         c["p_n"], c["p_n_nominal"] = p, p
         c["state"] = (p > 0).astype(np.int32)
         if area is not None:
             c["area_ref"] = area
-        c["rigid_point"], c["rigid_normal"] = np.array([0.0, 0.0, -R]), np.array([0.0, 0.0, 1.0])
+        if master is None:
+            c["rigid_point"], c["rigid_normal"] = np.array([0.0, 0.0, -R]), np.array([0.0, 0.0, 1.0])
         if stress is not None:
             g = s.create_group("fields/ball")
             g.attrs.update({"samples": 3, "components": "xx yy zz xy yz xz"})
@@ -229,3 +249,80 @@ def test_without_area_ref(points, tmp_path: Path, capsys: pytest.CaptureFixture[
         hertz3d_comparison(read_result(path))
     assert main(["hertz3d", str(path), "--no-figure"]) == 2
     assert "area_ref" in capsys.readouterr().err
+
+
+def test_effective_modulus() -> None:
+    """E* of a sphere on a rigid flat and on an elastic one (Johnson, eq. 4.22)."""
+    assert effective_modulus(E, NU) == pytest.approx(E_STAR)
+    assert effective_modulus(E, NU, (E, NU)) == pytest.approx(E_STAR / 2)
+    assert effective_modulus(2.0, 0.25, (3.0, 0.0)) == pytest.approx(1 / (0.9375 / 2 + 1 / 3))
+    assert effective_modulus(E, NU, (1e12, 0.3)) == pytest.approx(E_STAR, rel=1e-11)
+
+
+def test_block_master(points, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # noqa: ANN001
+    """A body master: the axis is its flat face's normal (z), E* that of both bodies
+    (the master's E and nu from the result, or given); the exact pressure of that E*
+    has no error, the rigid E* would miss."""
+    x, area, r = points
+    e_m, nu_m = 2.0, 0.2
+    e_star = 1 / ((1 - NU**2) / E + (1 - nu_m**2) / e_m)
+    force = 4 * e_star * A**3 / (3 * R)
+    p0 = 3 * force / (2 * math.pi * A**2)
+    path = write_result(tmp_path / "block.h5", x, hertz_p(r, A, p0), area, force / 4,
+                        master=(BLOCK, e_m, nu_m))
+    h = hertz3d_comparison(read_result(path))
+    assert h.master == (e_m, nu_m) and h.e_star == pytest.approx(e_star)
+    np.testing.assert_allclose(h.normal, [0.0, 0.0, 1.0], atol=1e-14)
+    np.testing.assert_allclose(h.centre, [0.0, 0.0, -R], atol=1e-10)
+    assert "master face" in h.axis_source
+    assert (h.a, h.p0) == pytest.approx((A, p0), rel=1e-9) and h.error.l2 < 1e-9
+    assert main(["hertz3d", str(path), "--no-figure"]) == 0
+    out = capsys.readouterr().out
+    assert f"E* = 1/((1-nu^2)/E + (1-nu_m^2)/E_m) = {e_star:.6g}" in out and "E = 2, nu = 0.2" in out
+    # the master's material given: a stiffer master, a smaller a for the same P
+    assert main(["hertz3d", str(path), "--no-figure", "--master-youngs-modulus", "1e9",
+                 "--master-poisson-ratio", "0.3"]) == 0
+    out = capsys.readouterr().out
+    stiff = hertz3d_comparison(read_result(path), master_youngs_modulus=1e9, master_poisson_ratio=0.3)
+    assert stiff.e_star == pytest.approx(E_STAR, rel=1e-8) and stiff.a < A and stiff.error.l2 > 0.05
+    assert f"{stiff.e_star:.6g}" in out
+    # summary: the same comparison
+    assert "L2 = 0.000%" in summary_lines(read_result(path))[-1]
+
+
+def test_a_curved_master_is_refused(points, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # noqa: ANN001
+    """Hertz's sphere on a flat: a master whose face turns by more than FLAT_TOLERANCE
+    over the zone (here a ball's sphere under the points) is refused, naming it."""
+    x, area, r = points
+    curved = ball_octant(2.0, centre=(0.0, 0.0, -R - 2.0))
+    path = write_result(tmp_path / "curved.h5", x, hertz_p(r), area, P / 4, master=(curved, E, NU))
+    with pytest.raises(HertzError, match="not flat"):
+        hertz3d_comparison(read_result(path))
+    assert main(["hertz3d", str(path), "--no-figure"]) == 2
+    assert "not flat" in capsys.readouterr().err and FLAT_TOLERANCE < 0.01
+
+
+def test_voiga_ball_on_block(voiga: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``pre hertz3d --master block`` m1 N2 run by voiga (about 2 s): it converges, the
+    pair's force along z is the integral of the nominal pressure to the tilt of the
+    dented block's normals, and ``post hertz3d`` compares it with the E* of both bodies
+    (m1 N2: 12.2 %, docs/verification.md, "Contact on faces")."""
+    import subprocess
+
+    from pre.__main__ import main as pre_main
+
+    assert pre_main(["hertz3d", str(tmp_path), "--master", "block", "--mesh", "m1", "--layout", "N2"]) == 0
+    run = subprocess.run([str(voiga), "m1-N2.nml", "--quiet"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=600)
+    assert run.returncode == 0, run.stdout + run.stderr
+    result = read_result(tmp_path / "m1-N2.h5")
+    c = result.steps[-1].contact[0]
+    assert (c.slave, c.master, c.rigid_normal) == ("ball", "block", None)
+    total = float(np.sum(c.p_n_nominal * c.area_ref))
+    assert c.force[2] <= total <= 1.002 * c.force[2]
+    h = hertz3d_comparison(result)
+    assert h.e_star == pytest.approx(1 / (2 * (1 - NU**2)), rel=1e-12) and h.symmetry == 4
+    np.testing.assert_allclose(h.normal, [0.0, 0.0, 1.0], atol=1e-12)
+    assert h.error.l2 < 0.15 and abs(h.a_error) < 0.2
+    assert main(["hertz3d", str(tmp_path / "m1-N2.h5"), "--no-figure"]) == 0
+    assert "E_m) = 0.549451" in capsys.readouterr().out

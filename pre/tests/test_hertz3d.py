@@ -5,6 +5,7 @@ files parse and name the faces the geometry has."""
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import re
@@ -19,7 +20,11 @@ from splipy import Surface
 
 from pre.__main__ import main
 from pre.h5io import read_volumes
+from pre.hertz import HertzCaseError
 from pre.hertz3d import (
+    BLOCK,
+    BLOCK_CELL,
+    BLOCK_FACE,
     BODY,
     CONTACT_FACE,
     LAYOUTS,
@@ -28,6 +33,8 @@ from pre.hertz3d import (
     ball_case,
     ball_geometry,
     ball_knots,
+    block_knots,
+    body_dofs,
     case_dofs,
 )
 from pre.meshes import arc_angle
@@ -240,3 +247,180 @@ def test_voiga_check_counts_the_same_dofs(mesh: str, layouts: list[str], tmp_pat
                              text=True, timeout=300)
         assert run.returncode == 0, run.stdout + run.stderr
         assert f"dofs all total={case_dofs(Ball(), mesh, layout)['total']}" in run.stdout.splitlines()
+
+
+# --- the ball on an elastic block (--master block) ---------------------------------------
+
+RIGID_M1_N2_SHA256 = "3dd2e7b051441d60ba0b6ceb2d725716984e87729b8603b6ebf46ccbc75d8880"
+"""The rigid scene's m1-N2.nml as written before the block master was added."""
+
+
+def _ball_y_knots(ball: Ball, mesh: str) -> np.ndarray:
+    """y of the ball's knot lines along the sphere's edge on x = 0 (eta = 0): R sin of the
+    angle from the lowest point."""
+    return ball.radius * np.sin(arc_angle(np.array(ball_knots(ball, mesh)["knots_xi"])))
+
+
+def test_the_block() -> None:
+    """The block is the box [0, L]^2 x [-R - H, -R] under the ball's lowest point, with
+    the ball's symmetry faces and its top as the contact face (zeta = 1)."""
+    ball = Ball(radius=2.0, master="block", block_size=0.75)
+    vols = ball_geometry(ball)
+    assert list(vols) == [BODY, BLOCK]
+    vol = vols[BLOCK]
+    check_volume(BLOCK, vol)
+    np.testing.assert_allclose(vol.control_points.reshape(-1, 3).min(0), [0.0, 0.0, -3.5])
+    np.testing.assert_allclose(vol.control_points.reshape(-1, 3).max(0), [1.5, 1.5, -2.0])
+    assert vol.faces == {"xi0": "symmetry_x", "xi1": "right", "eta0": "symmetry_y", "eta1": "back",
+                         "zeta0": "bottom", "zeta1": BLOCK_FACE}
+    assert list(ball_geometry(Ball())) == [BODY]
+
+
+@pytest.mark.parametrize("mesh", list(MESHES))
+def test_the_block_knots_are_graded_and_do_not_match(mesh: str) -> None:
+    """Along x and y the block's top cells are BLOCK_CELL times the ball's fine arc over
+    at least the ball's fine zone, then grow to L; across they grow from that size at
+    the top; near the contact no block knot lies on a ball knot line."""
+    ball = Ball(master="block")
+    fine, rest, radial = MESHES[mesh]
+    knots = block_knots(ball, mesh)
+    assert knots["knots_xi"] == knots["knots_eta"]
+    x = np.concatenate([[0.0], knots["knots_xi"], [1.0]]) * ball.block_size * ball.radius
+    sizes = np.diff(x)
+    theta_c = math.asin(1.5 * ball.half_width / ball.radius)
+    h = BLOCK_CELL * ball.radius * theta_c / fine
+    n_fine = math.ceil(ball.radius * math.sin(theta_c) / h)  # over the ball's fine zone, then rest
+    assert len(sizes) == n_fine + rest and (n_fine - 1) * h < ball.radius * math.sin(theta_c) <= n_fine * h
+    np.testing.assert_allclose(sizes[:n_fine + 1], h, rtol=1e-9)  # the growth starts at h
+    assert np.all(np.diff(sizes) >= -1e-15) and sizes[-1] > 2 * h
+    z = np.concatenate([[0.0], knots["knots_zeta"], [1.0]])
+    assert len(z) - 1 == radial and 1.0 - z[-2] == pytest.approx(h / ball.block_size, rel=1e-9)
+    assert np.all(np.diff(np.diff(z)) < 0)
+    ball_y = _ball_y_knots(ball, mesh)
+    zone = x[(x > 0) & (x <= ball.radius * math.sin(theta_c))]
+    gaps = np.abs(zone[:, None] - ball_y[None, :]).min(axis=1)
+    assert gaps.min() > 0.02 * h  # not matching (1.3: 13 ball cells are 10 of the block's, m4 comes closest)
+
+
+def test_the_block_case() -> None:
+    """Two bodies, the block's faces fixed as the ball's symmetry faces and its bottom in
+    z, contact ball -> block with no rigid plane; the block takes the ball's material
+    unless given."""
+    groups = ball_case(Ball(master="block"), "m2", "NN2.2", method="gpts", penalty_normal=500.0)
+    assert groups["case"]["n_bodies"] == 2 and [b["name"] for b in groups["body"]] == [BODY, BLOCK]
+    block = groups["body"][1]
+    assert block["contact_face"] == BLOCK_FACE and (block["layer_degree"], block["layer_elevations"]) == (2, 2)
+    assert (block["material"], block["youngs_modulus"], block["poisson_ratio"]) == ("linear", 1.0, 0.3)
+    assert groups["contact"] == [{"slave": BODY, "master": BLOCK, "method": "gpts", "penalty_normal": 500.0}]
+    fixed = [(d["body"], d["face"], [k for k in ("fix_x", "fix_y", "fix_z") if d.get(k)])
+             for d in groups["dirichlet"]]
+    assert fixed[3:] == [(BLOCK, "bottom", ["fix_z"]), (BLOCK, "symmetry_x", ["fix_x"]),
+                         (BLOCK, "symmetry_y", ["fix_y"])]
+    assert all("uz" not in d for d in groups["dirichlet"][3:])
+    faces = set(ball_geometry(Ball(master="block"))[BLOCK].faces.values())
+    assert {d["face"] for d in groups["dirichlet"][3:]} <= faces
+    other = ball_case(Ball(master="block", block_youngs_modulus=3.0, block_poisson_ratio=0.2), "m1", "N2")
+    assert (other["body"][1]["youngs_modulus"], other["body"][1]["poisson_ratio"]) == (3.0, 0.2)
+    assert "on a block L = H = 1, E = 3, nu = 0.2" in other["case"]["title"]
+
+
+@pytest.mark.parametrize("layout", ["N2", "NN2.2"])
+def test_block_dofs(layout: str) -> None:
+    """The block's DOFs: formats.md's formula for a box (no coarse interior knots)."""
+    ball = Ball(master="block")
+    for mesh in MESHES:
+        dofs = body_dofs(ball, mesh, layout)
+        assert dofs[BODY] == case_dofs(Ball(), mesh, layout)["total"]
+        k = block_knots(ball, mesh)
+        n1, n3 = len(k["knots_xi"]) + 1, len(k["knots_zeta"]) + 1
+        bulk = 3 * (n1 + 2) ** 2 * (n3 + 1)
+        top = 3 * (2 + 3 * n1) ** 2 if layout == "NN2.2" else 3 * (n1 + 2) ** 2
+        assert dofs[BLOCK] == bulk + top
+
+
+def test_rigid_cases_are_unchanged(tmp_path: Path) -> None:
+    """--master rigid (the default) writes what the scene wrote before the block: one
+    body, the rigid plane, the same bytes as the Ball's defaults."""
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert main(["hertz3d", str(a), "--mesh", "m1", "m3", "--layout", "N2", "NN2.2"]) == 0
+    assert main(["hertz3d", str(b), "--mesh", "m1", "m3", "--layout", "N2", "NN2.2", "--master", "rigid",
+                 "--block-size", "3"]) == 0
+    for stem in ("m1-N2", "m1-NN2.2", "m3-N2", "m3-NN2.2"):
+        text = (a / f"{stem}.nml").read_text()
+        assert text == (b / f"{stem}.nml").read_text()
+        assert "block" not in text and "n_bodies = 1" in text
+    assert (a / "geometry.h5").read_bytes() == (b / "geometry.h5").read_bytes()
+    assert hashlib.sha256((a / "m1-N2.nml").read_bytes()).hexdigest() == RIGID_M1_N2_SHA256
+
+
+def test_the_block_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "blk"
+    assert main(["hertz3d", str(out), "--master", "block", "--mesh", "m1", "--layout", "N2", "NN2.2"]) == 0
+    printed = capsys.readouterr().out
+    for layout in ("N2", "NN2.2"):
+        dofs = body_dofs(Ball(master="block"), "m1", layout)
+        assert f"{sum(dofs.values())} DOFs (ball {dofs[BODY]}, block {dofs[BLOCK]})" in printed
+    _, volumes = read_volumes(out / "geometry.h5")
+    assert list(volumes) == [BODY, BLOCK]
+    nml = f90nml.read(str(out / "m1-N2.nml"))
+    for group, value in nml.items():
+        for entry in value if isinstance(value, list) else [value]:
+            assert set(entry) <= NAMELISTS[group], (group, set(entry) - NAMELISTS[group])
+    assert (nml["contact"]["slave"], nml["contact"]["master"], nml["contact"]["method"]) == (BODY, BLOCK, "mortar")
+    # a rigid scene in the same folder: another geometry, refused
+    assert main(["hertz3d", str(out), "--mesh", "m2", "--layout", "N2"]) == 2
+    assert "another ball" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad, says", [(["--block-size", "0.1"], "block size"),
+                                       (["--block-youngs-modulus", "-1"], "block youngs"),
+                                       (["--block-poisson-ratio", "0.5"], "block poisson"),
+                                       (["--master", "wall"], None)])
+def test_bad_block_values(bad: list[str], says: str | None, tmp_path: Path,
+                          capsys: pytest.CaptureFixture[str]) -> None:
+    if says is None:
+        with pytest.raises(SystemExit):
+            main(["hertz3d", str(tmp_path / "x"), *bad])
+        return
+    assert main(["hertz3d", str(tmp_path / "x"), "--master", "block", *bad]) == 2
+    assert says in capsys.readouterr().err
+    assert not (tmp_path / "x").exists() or not list((tmp_path / "x").glob("*.nml"))
+
+
+def test_voiga_check_counts_the_block(tmp_path: Path) -> None:
+    """``voiga CASE --check`` of the block scene (contact between the solids included)
+    counts the DOFs :func:`body_dofs` gives, per body and in all."""
+    voiga = _voiga()
+    if voiga is None:
+        if os.environ.get("CI"):
+            pytest.fail("voiga binary not found (build it or set VOIGA_BIN)")
+        pytest.skip("voiga binary not found (build it or set VOIGA_BIN)")
+    assert main(["hertz3d", str(tmp_path), "--master", "block", "--mesh", "m1", "--layout", "N2", "NN2.2"]) == 0
+    for layout in ("N2", "NN2.2"):
+        run = subprocess.run([str(voiga), f"m1-{layout}.nml", "--check"], cwd=tmp_path, capture_output=True,
+                             text=True, timeout=300)
+        assert run.returncode == 0, run.stdout + run.stderr
+        dofs = body_dofs(Ball(master="block"), "m1", layout)
+        lines = run.stdout.splitlines()
+        for name, n in dofs.items():
+            assert any(line.startswith(f"dofs {name} ") and f"total={n}" in line for line in lines), lines
+        assert f"dofs all total={sum(dofs.values())}" in lines
+
+
+def test_block_cell_option(tmp_path: Path) -> None:
+    """--block-cell sets the block's top cells over the ball's fine ones."""
+    assert main(["hertz3d", str(tmp_path), "--master", "block", "--block-cell", "0.77", "--mesh", "m2",
+                 "--layout", "N2"]) == 0
+    nml = f90nml.read(str(tmp_path / "m2-N2.nml"))
+    h = 0.77 * math.asin(0.15) / MESHES["m2"][0]
+    assert nml["body"][1]["knots_xi"][0] == pytest.approx(h, rel=1e-12)
+    assert block_knots(Ball(master="block", block_cell=0.77), "m2") == block_knots(Ball(master="block"), "m2", 0.77)
+    assert main(["hertz3d", str(tmp_path / "x"), "--master", "block", "--block-cell", "5"]) == 2
+    # a block too small for the zone's cells: refused, not graded backwards
+    with pytest.raises(HertzCaseError, match="too small"):
+        block_knots(Ball(master="block", block_size=0.25, indentation=0.05), "m1")
+    with pytest.raises(HertzCaseError, match="too small"):
+        block_knots(Ball(master="block", block_size=0.25, block_cell=4.0), "m1")
+    for size, cell in [(0.5, 1.3), (2.0, 4.0), (100.0, 0.25)]:
+        k = np.diff([0.0, *block_knots(Ball(master="block", block_size=size, block_cell=cell), "m4")["knots_xi"], 1.0])
+        assert np.all(k > 0)
