@@ -578,14 +578,12 @@ contains
         end associate
     end function mortar_step_limit
 
-    !> How deep a control point may close in one Newton step without being limited:
-    !> on a face, the deepest mean penetration -g_A / D_A, at the accepted iterate or
-    !> after the step, of the control points active at the accepted iterate (a point
-    !> closing no deeper carries no more penalty force than those the tangent already
-    !> holds); 0 on an edge, and before any is active.
-    !> On a face the zone's edge crosses hundreds of control points over a load step,
-    !> at as many different fractions of it: limiting every step to the first crossing
-    !> took 22 Newton iterations for the first step of hertz3d m2 NN2.2.
+    !> How deep a control point may close in one Newton step without being limited: on
+    !> a face, the deepest mean penetration -g_A / D_A (before or after the step) of the
+    !> points active at the accepted iterate (closing no deeper adds no more penalty force
+    !> than the tangent holds); 0 on an edge. A face's zone edge crosses hundreds of
+    !> control points per step: the first crossing's limit took hertz3d m2 NN2.2 57
+    !> Newton iterations, this 32.
     pure real(dp) function face_depth(self) result(depth)
         class(mortar_pair_t), intent(in) :: self
         integer :: a
