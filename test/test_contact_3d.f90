@@ -138,6 +138,17 @@ contains
                 deallocate (u)
             end do
         end do
+        ! the pattern's master ranges start from the reference projections: on a finer
+        ! master (12 x 8 cells) a slave cell is not coupled with all of it
+        c%bodies(2)%layout = layout3(2, [12, 8, 1], 0, 0, 'top')
+        call new_discretization(discs(2), unit_box(-1.0_dp), box_faces, c%bodies(2)%layout, '', error)
+        if (allocated(error)) return
+        call scene_model(c, discs, model, error)
+        if (allocated(error)) return
+        associate (pair => model%pairs(1)%pair)
+            call check(error, all(pair%mhi - pair%mlo + 1 < size(pair%master%all_dofs())/3), &
+                       'no slave cell coupled with the whole master face')
+        end associate
     end subroutine test_tangent_fd_deformable
 
     !> Coulomb friction on the tangent plane: every point in contact at the last

@@ -316,3 +316,16 @@ def test_face_away_from_the_plane_warns(voiga_bin: Path, tmp_path: Path) -> None
     res = run(voiga_bin, case, "--check")
     assert "faces away from it: the slave's contact_face = 'top'" in res.stderr, res.stderr
     assert "choose the face that faces it" in res.stderr
+
+
+def test_mortar_closing_steps_on_a_face(voiga_bin: Path, tmp_path: Path) -> None:
+    """hertz3d m1 NN2.2 (mortar): a Newton step may close control points as deep as the
+    active ones are, so the zone's edge crossing many of them per load step does not
+    cut every step to its first crossing (25 Newton iterations; 39 when it did)."""
+    out = tmp_path / "h"
+    subprocess.run(["python3", "-m", "pre", "hertz3d", str(out), "--mesh", "m1", "--layout", "NN2.2"],
+                   check=True, capture_output=True, cwd=Path(__file__).resolve().parents[2])
+    res = run(voiga_bin, out / "m1-NN2.2.nml")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out / "m1-NN2.2.h5") as f:
+        assert int(f.attrs["newton_iterations"]) <= 30
