@@ -473,8 +473,8 @@ contains
         real(dp), intent(in) :: b(:, :)
         real(dp), intent(out) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
-        real(dp), allocatable :: y(:, :)
-        integer :: info
+        real(dp), allocatable :: y(:, :), dy(:, :)
+        integer :: info, q, j
         call self%chol%solve_columns(a, b, x, error)
         if (allocated(error) .or. size(self%c) == 0) return
         y = x(self%c, :)
@@ -483,7 +483,13 @@ contains
             call fatal_error(error, 'bulk update: dense solve failed (info '//str(info)//')')
             return
         end if
-        x = x - matmul(self%z(:, self%zcol(self%c)), matmul(self%d, y))
+        ! column by column from the kept columns (no gathered copy of Z_C per solve)
+        dy = matmul(self%d, y)
+        do j = 1, size(x, 2)
+            do q = 1, size(self%c)
+                x(:, j) = x(:, j) - dy(q, j)*self%z(:, self%zcol(self%c(q)))
+            end do
+        end do
     end subroutine lazy_solve
 
     pure logical function bulk_has_determinant(self)

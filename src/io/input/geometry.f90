@@ -150,10 +150,8 @@ contains
         g = '/bodies/'//trim(name)
         call read_degree(h5, 'body', name, g, 3, degree, where, error)
         if (allocated(error)) return
-        do d = 1, 3
-            call h5%read(g//'/knots_'//trim(directions(d)), knots(d)%u, error, max_knots)
-            if (allocated(error)) return
-        end do
+        call read_knot_vectors(h5, g, knots, error)
+        if (allocated(error)) return
         call h5%read(g//'/control_points', cp, error, 3_int64*max_points)
         if (allocated(error)) return
         call h5%read(g//'/weights', w, error, int(max_points, int64))
@@ -172,14 +170,8 @@ contains
             call validate_knots(knots(d)%u, degree(d), size(w, d), where//'knots_'//trim(directions(d)), error)
             if (allocated(error)) return
         end do
-        if (.not. all(ieee_is_finite(cp))) then
-            call fatal_error(error, where//'control_points must be finite', error_code%input)
-            return
-        end if
-        if (.not. all(w > 0.0_dp .and. ieee_is_finite(w))) then
-            call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
-            return
-        end if
+        call check_net(reshape(cp, [size(cp)]), reshape(w, [size(w)]), where, error)
+        if (allocated(error)) return
         patch = new_patch(degree, knots, shape(w), reshape(cp, [3, size(w)]), reshape(w, [size(w)]))
         call check_map(patch, volume_samples, where, error)
         if (allocated(error)) return
@@ -257,10 +249,8 @@ contains
         g = '/surfaces/'//trim(name)
         call read_degree(h5, 'surface', name, g, 2, degree, where, error)
         if (allocated(error)) return
-        do d = 1, 2
-            call h5%read(g//'/knots_'//trim(directions(d)), knots(d)%u, error, max_knots)
-            if (allocated(error)) return
-        end do
+        call read_knot_vectors(h5, g, knots, error)
+        if (allocated(error)) return
         call h5%read(g//'/control_points', cp, error, 3_int64*max_points)
         if (allocated(error)) return
         call h5%read(g//'/weights', w, error, int(max_points, int64))
@@ -274,14 +264,38 @@ contains
             call validate_knots(knots(d)%u, degree(d), size(w, d), where//'knots_'//trim(directions(d)), error)
             if (allocated(error)) return
         end do
+        call check_net(reshape(cp, [size(cp)]), reshape(w, [size(w)]), where, error)
+        if (.not. allocated(error)) patch = new_patch(degree, knots, shape(w), reshape(cp, [3, size(w)]), &
+                                                      reshape(w, [size(w)]))
+    end subroutine read_surface
+
+    !> The knot vectors `knots_xi`, `knots_eta` (, `knots_zeta`) of the spline in group
+    !> `g`, one per entry of `knots`.
+    subroutine read_knot_vectors(h5, g, knots, error)
+        type(h5file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: g
+        type(knots_t), intent(inout) :: knots(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: directions(3) = ['xi  ', 'eta ', 'zeta']
+        integer :: d
+        do d = 1, size(knots)
+            call h5%read(g//'/knots_'//trim(directions(d)), knots(d)%u, error, max_knots)
+            if (allocated(error)) return
+        end do
+    end subroutine read_knot_vectors
+
+    !> A control net's points finite and weights finite and positive (`where` begins
+    !> the message).
+    pure subroutine check_net(cp, w, where, error)
+        real(dp), intent(in) :: cp(:), w(:)
+        character(len=*), intent(in) :: where
+        type(error_t), allocatable, intent(out) :: error
         if (.not. all(ieee_is_finite(cp))) then
             call fatal_error(error, where//'control_points must be finite', error_code%input)
         else if (.not. all(w > 0.0_dp .and. ieee_is_finite(w))) then
             call fatal_error(error, where//'weights must be finite and > 0', error_code%input)
-        else
-            patch = new_patch(degree, knots, shape(w), reshape(cp, [3, size(w)]), reshape(w, [size(w)]))
         end if
-    end subroutine read_surface
+    end subroutine check_net
 
     !> The `n` degrees of the spline in group `g` (a `what` called `name`: 'body' or
     !> 'curve'), each in 1..20; `where` begins the messages about it.
