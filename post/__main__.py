@@ -17,6 +17,8 @@ Subcommands:
                  force's F_x, F_z) and its oscillation over the sliding phase (and a figure)
   cattaneo       a cylinder pressed and sheared against Cattaneo-Mindlin's stick zone;
                  --halfplane: the incremental half-plane reference for a rigid flat
+  cattaneo3d     a sphere pressed and sheared (3D result) against Cattaneo-Mindlin's
+                 circular stick zone and traction
   study          a parameter study from a study file (docs/studies.md): derived cases
                  run on Dask, one table (CSV, markdown, Parquet) and figures
   sweep          the committed cases as a study without changes (the same engine)
@@ -285,6 +287,24 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
     print("\n".join(hertz3d_report(h)))
     if not args.no_figure:
         print(hertz3d_figure(result, h, args.out, args.output))
+    return 0
+
+
+def _cmd_cattaneo3d(args: argparse.Namespace) -> int:
+    from .cattaneo3d import cattaneo3d_comparison, cattaneo3d_report
+    from .hertz import HertzError
+
+    try:
+        result = _read(args.result, "cattaneo3d")
+        if not result.steps:
+            print(f"python -m post cattaneo3d: {args.result} has no converged step (status "
+                  f"{result.status!r})", file=sys.stderr)
+            return 1
+        cm = cattaneo3d_comparison(result, step=args.step, friction=args.friction)
+    except (HertzError, OSError, KeyError, ValueError, StopIteration) as err:
+        print(f"python -m post cattaneo3d: {args.result}: {err or 'no such step'}", file=sys.stderr)
+        return 2
+    print("\n".join(cattaneo3d_report(cm)))
     return 0
 
 
@@ -702,6 +722,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--partial", action="store_true",
                    help="compare the last written step of a run that has not converged")
     s.set_defaults(func=_cmd_hertz3d)
+
+    s = sub.add_parser("cattaneo3d", help="a sphere pressed and sheared (3D result) against Cattaneo-Mindlin: "
+                                          "stick radius, traction along Q (docs/cattaneo3d.md)")
+    s.add_argument("result", help="result file (.h5) of dimension 3 (the scene of pre cattaneo3d)")
+    s.add_argument("--step", type=int, default=-1,
+                   help="step number (>= 1) or -k for the k-th last (default: -1)")
+    s.add_argument("--friction", type=_positive, default=None,
+                   help="mu (default: the pair's at that step, from the result)")
+    s.set_defaults(func=_cmd_cattaneo3d)
 
     s = sub.add_parser("ironing", help="an ironing run's force history and its oscillation over the "
                                        "sliding phase (2D: die reactions; 3D: contact force)")

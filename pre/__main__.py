@@ -7,6 +7,7 @@ Subcommands:
   hertz        a Hertz case for any cylinder (radius, E, nu, indentation; mesh, layout)
   hertz3d      the 3D Hertz scene: a ball octant pressed on a rigid plane or a block (issue 42)
   ironing3d    the 3D ironing scene: a rigid sphere pressed into a slab and slid (issue 42)
+  cattaneo3d   the 3D Cattaneo-Mindlin scene: a half ball pressed on a rigid plane, sheared (issue 42)
   cattaneo     a Cattaneo-Mindlin case (a half cylinder pressed, then sheared)
   refine       a result: its case refined at the contact zone; a case: the splipy dump
   plot-layout  draw a body's control nets and contact basis functions
@@ -180,6 +181,19 @@ def _cmd_ironing3d(args: argparse.Namespace) -> int:
         f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
 
 
+def _cmd_cattaneo3d(args: argparse.Namespace) -> int:
+    from .cattaneo3d import HalfBall, case_dofs, write_cattaneo3d
+
+    ball = HalfBall(youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
+                    indentation=args.indentation, friction=args.friction, target=args.target,
+                    shear=args.shear, press_steps=args.steps[0], shear_steps=args.steps[1], method=args.method)
+    return _write_scene3d(
+        "cattaneo3d", lambda: write_cattaneo3d(ball, args.mesh, args.layout, args.out, force=args.force),
+        lambda mesh, layout: case_dofs(ball, mesh, layout), "half ball",
+        f"expected contact radius sqrt(R d) = {ball.half_width:.4g}; the plane moves {ball.plane_shear:.4g} "
+        f"along x in the shear phase")
+
+
 def _cmd_refine(args: argparse.Namespace) -> int:
     if not args.input.endswith(".nml"):
         return _refine_zone(args)
@@ -339,6 +353,25 @@ def build_parser() -> argparse.ArgumentParser:
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_ironing3d)
+
+    s = sub.add_parser("cattaneo3d", help="the 3D Cattaneo-Mindlin scene: a half ball pressed on a rigid "
+                                          "plane without friction, then sheared with it (docs/cattaneo3d.md)")
+    s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml")
+    s.add_argument("--mesh", nargs="+", default=["m1"], help="mesh levels m1 .. m4 (default m1)")
+    s.add_argument("--layout", nargs="+", default=["N2"], help="solid layouts, e.g. N2 NN2.2 (default N2)")
+    s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
+    s.add_argument("--poisson-ratio", type=float, default=0.3, help="nu in (-1, 0.5) (default 0.3)")
+    s.add_argument("--indentation", type=float, default=0.01, help="the press d, 0 < d < R/10 (default 0.01)")
+    s.add_argument("--friction", type=float, default=0.3, help="Coulomb's mu in the shear (default 0.3)")
+    s.add_argument("--target", type=float, default=0.5,
+                   help="Q/(mu P) the shear aims at, in (0, 1) (default 0.5)")
+    s.add_argument("--shear", type=float, default=None,
+                   help="the plane's move along x (default: the estimate for --target)")
+    s.add_argument("--steps", type=int, nargs=2, default=(10, 10), metavar=("PRESS", "SHEAR"),
+                   help="steps of the press and shear phases (default 10 10)")
+    s.add_argument("--method", default=None, help="&contact method (default: none written, voiga's)")
+    s.add_argument("--force", action="store_true", help="overwrite existing files")
+    s.set_defaults(func=_cmd_cattaneo3d)
 
     s = sub.add_parser("cattaneo", help="a Cattaneo-Mindlin case: a half cylinder pressed onto a "
                                         "rigid flat, its mirror image or a block, then sheared")

@@ -212,6 +212,45 @@ def ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(BALL_FACES, faces))
 
 
+HALF_SHELL_FACES = {"symmetry_y": "xi0", "top": "xi1", "end_xneg": "eta0", "end_xpos": "eta1",
+                    "inner": "zeta0", "outer": "zeta1"}
+"""Face labels of a half ball shell (:func:`half_ball_shell`): ``symmetry_y`` the plane
+y = y_c, ``top`` the plane z = z_c, ``end_xneg`` and ``end_xpos`` the cones about the x
+axis at x < x_c and x > x_c, ``inner`` the inner sphere, ``outer`` the sphere (the
+contact face)."""
+
+
+def half_ball_shell(radius: float, inner: float, cone: float, centre: Point = (0.0, 0.0, 0.0),
+                    faces: dict[str, str] | None = None) -> Volume:
+    """The half ``y >= y_c, z <= z_c`` of the lower hemisphere of the shell ``inner <=
+    |x - centre| <= radius`` within ``cone`` degrees (< 90) of the plane x = x_c, in
+    spherical coordinates about the x axis as :func:`ball_octant`: xi along phi from -90
+    degrees (the plane y = y_c) to 0 (the plane z = z_c), eta along theta from 90 + cone
+    to 90 - cone degrees (x from negative to positive), zeta along rho from ``inner`` to
+    ``radius``. Exact: the tensor product of a quarter arc, one rational quadratic arc of
+    2 cone degrees (weights ``(1, cos(cone), 1)``) and a line; degrees (2, 2, 1), right-handed,
+    nothing collapses. The lowest point ``centre - (0, 0, radius)`` is the middle of the
+    edge ``xi = 0, zeta = 1`` (eta = 1/2) of the sphere face: a half model of a ball pressed
+    and sheared along x keeps its contact away from every edge but the symmetry plane's.
+    Faces :data:`HALF_SHELL_FACES`."""
+    radius, inner, cone = float(radius), float(inner), float(cone)
+    if not (0.0 < inner < radius and 0.0 < cone < 90.0):
+        raise ValueError(f"half ball shell: need 0 < inner < radius and 0 < cone < 90 degrees, got "
+                         f"inner {inner}, radius {radius}, cone {cone}")
+    t = math.radians(cone)
+    phi = np.array([[0.0, -1.0], [1.0, -1.0], [1.0, 0.0]])  # (cos, sin) polygon, -90 .. 0 degrees
+    theta = np.array([[-math.sin(t), math.cos(t)], [0.0, 1.0 / math.cos(t)], [math.sin(t), math.cos(t)]])
+    cp = np.zeros((2, 3, 3, 3))
+    for k, rho in enumerate((inner, radius)):
+        for j in range(3):
+            cp[k, j, :, 0] = rho * theta[j, 0]
+            cp[k, j, :, 1:] = rho * theta[j, 1] * phi
+    cp += np.asarray(centre, dtype=float)
+    w_phi, w_theta = np.array([1.0, math.sqrt(0.5), 1.0]), np.array([1.0, math.cos(t), 1.0])
+    weights = np.broadcast_to(np.outer(w_theta, w_phi), (2, 3, 3)).copy()
+    return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(HALF_SHELL_FACES, faces))
+
+
 def _clockwise(patch: Patch, name: str) -> bool:
     """``patch`` checked (:func:`pre.geometry.check_patch`); whether it runs clockwise
     (det J < 0, as the annular sectors, xi along the arcs and eta outwards)."""
