@@ -139,8 +139,10 @@ contains
             end do
         end do
         ! the pattern's master ranges start from the reference projections: on a finer
-        ! master (12 x 8 cells) a slave cell is not coupled with all of it
-        c%bodies(2)%layout = layout3(2, [12, 8, 1], 0, 0, 'top')
+        ! master (40 x 8 cells) a slave cell is not coupled with all of it, and its range
+        ! is a rectangle of the master's grid, not the band of whole rows between its
+        ! corners (fewer control points than that band)
+        c%bodies(2)%layout = layout3(2, [40, 8, 1], 0, 0, 'top')
         call new_discretization(discs(2), unit_box(-1.0_dp), box_faces, c%bodies(2)%layout, '', error)
         if (allocated(error)) return
         call scene_model(c, discs, model, error)
@@ -148,6 +150,9 @@ contains
         associate (pair => model%pairs(1)%pair)
             call check(error, all(pair%mhi - pair%mlo + 1 < size(pair%master%all_dofs())/3), &
                        'no slave cell coupled with the whole master face')
+            if (allocated(error)) return
+            call check(error, sum([(size(pair%range_ids(j)), j=1, size(pair%mlo))]) < sum(pair%mhi - pair%mlo + 1), &
+                       'the ranges are rectangles of the master grid, narrower than bands of rows')
         end associate
     end subroutine test_tangent_fd_deformable
 

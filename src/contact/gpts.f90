@@ -221,10 +221,12 @@ contains
         class(gpts_pair_t), intent(in) :: self
         integer, intent(in) :: b
         integer, intent(in) :: mdofs(:)
-        integer, allocatable :: dofs(:)
+        integer, allocatable :: dofs(:), ids(:)
+        integer :: i, c
         allocate (dofs(0))
-        if (self%mlo(b) <= self%mhi(b)) &
-            dofs = [self%element_dofs(b), mdofs(self%nsd*(self%mlo(b) - 1) + 1:self%nsd*self%mhi(b))]
+        if (self%mlo(b) > self%mhi(b)) return
+        ids = self%range_ids(b)
+        dofs = [self%element_dofs(b), [((mdofs(self%nsd*(ids(i) - 1) + c), c=1, self%nsd), i=1, size(ids))]]
     end function gpts_block_dofs
 
     !> With friction: a stick anchor per slave point (`anchor`).

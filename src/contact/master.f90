@@ -55,6 +55,10 @@ module voiga_contact_master
         procedure(project_interface), deferred :: project
         !> Every DOF the master may couple to (for the stiffness pattern); default: none.
         procedure :: all_dofs => master_no_dofs
+        !> Control points per row of the master's numbering when they form a grid (a
+        !> face: n_xi), else 0 (one row: an edge). The pair's pattern ranges are
+        !> rectangles of that grid, not bands of whole rows.
+        procedure :: grid_width => master_grid_width
         procedure :: prepare => master_prepare
         procedure :: move => master_move
         !> What a step's contact output records of it; default: nothing (a
@@ -91,6 +95,13 @@ contains
         allocate (dofs(0))
         if (self%deformable) dofs = [integer ::]   ! (a deformable master overrides this)
     end function master_no_dofs
+
+    !> One row (an edge or a rigid master): 0.
+    pure integer function master_grid_width(self) result(width)
+        class(contact_master_t), intent(in) :: self
+        width = 0
+        if (self%deformable) width = 0   ! (a face master overrides this)
+    end function master_grid_width
 
     !> Update whatever the master's search needs for the configuration `u` (called
     !> once per evaluation of a pair, before its projections). Default: nothing.

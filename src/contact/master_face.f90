@@ -28,6 +28,7 @@ module voiga_contact_master_face
     contains
         procedure :: project => face_project
         procedure :: all_dofs => face_all_dofs
+        procedure :: grid_width => face_grid_width
         procedure :: prepare => face_prepare
     end type face_master_t
 
@@ -158,6 +159,12 @@ contains
         end associate
         call new_surface_search(self%search, patch)
     end subroutine face_prepare
+
+    !> The face's control points per row (its numbering runs xi fastest).
+    pure integer function face_grid_width(self) result(width)
+        class(face_master_t), intent(in) :: self
+        width = self%surf%n_xi
+    end function face_grid_width
 
     pure function face_all_dofs(self) result(dofs)
         class(face_master_t), intent(in) :: self

@@ -416,7 +416,7 @@ contains
         do e = self%node_first(b), self%node_last(b)
             lo = min(lo, self%slave%spans(e) - p)
             hi = max(hi, self%slave%spans(e))
-            if (self%mlo(e) <= self%mhi(e)) used(self%mlo(e):self%mhi(e)) = .true.
+            used(self%range_ids(e)) = .true.
         end do
         dofs = reshape(self%slave%dofs(:, lo:hi), [2*(hi - lo + 1)])
         dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
@@ -438,7 +438,7 @@ contains
             ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
             if (.not. any(ids == b)) cycle
             used(ids) = .true.
-            if (self%mlo(e) <= self%mhi(e)) mused(self%mlo(e):self%mhi(e)) = .true.
+            mused(self%range_ids(e)) = .true.
         end do
         dofs = reshape(self%slave%dofs(:, pack([(e, e=1, size(used))], used)), [3*count(used)])
         dofs = [dofs, pack(mdofs, reshape(spread(mused, 1, 3), [size(mdofs)]))]

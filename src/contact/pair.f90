@@ -135,10 +135,13 @@ module voiga_contact_pair
         real(dp) :: force(3) = 0.0_dp
         !> Counters: active point evaluations, of which frictional.
         integer(i8) :: n_evaluations = 0, n_friction = 0
-        !> Deformable master: the master control points [mlo(e), mhi(e)] each slave
-        !> element e is coupled with in the stiffness pattern (empty: lo > hi;
-        !> initially the whole master).
+        !> Deformable master: the master control points each slave element e is coupled
+        !> with in the stiffness pattern (`range_ids`): the rectangle of the master's grid
+        !> (`mwidth` control points per row) with corners mlo(e) and mhi(e), or on an
+        !> edge (mwidth = 0) the range [mlo(e), mhi(e)]; empty: lo > hi; initially the
+        !> whole master.
         integer, allocatable :: mlo(:), mhi(:)
+        integer :: mwidth = 0
         !> Set by an evaluation with a stiffness in which an active point projected
         !> outside its element's range (the range was widened, the point's
         !> stiffness not added: the pattern must be rebuilt and the tangent
@@ -200,6 +203,7 @@ module voiga_contact_pair
         procedure :: projection_error => pair_projection_error
         procedure :: fit_pattern => pair_fit_pattern
         procedure :: element_dofs => pair_element_dofs
+        procedure :: range_ids => pair_range_ids
         procedure :: wanted_ranges => pair_wanted_ranges
         !> The slave points of slave element e (first and last index) and the slave
         !> element of point k: `n_gauss` per element in element order unless a method
@@ -275,6 +279,13 @@ module voiga_contact_pair
             integer, intent(in) :: e
             integer, allocatable :: dofs(:)
         end function pair_element_dofs
+
+        !> The master control points of slave element `e`'s range (`mlo`, `mhi`).
+        pure module function pair_range_ids(self, e) result(ids)
+            class(contact_pair_t), intent(in) :: self
+            integer, intent(in) :: e
+            integer, allocatable :: ids(:)
+        end function pair_range_ids
 
         !> The master ranges each slave element should be coupled with, from the last
         !> evaluation: the control points of the projections of its points that are
@@ -364,7 +375,10 @@ contains
         allocate (self%mlo(ne), self%mhi(ne))
         self%mlo = 1
         self%mhi = 0
-        if (allocated(self%master)) self%mhi = size(self%master%all_dofs())/self%nsd
+        if (allocated(self%master)) then
+            self%mhi = size(self%master%all_dofs())/self%nsd
+            self%mwidth = self%master%grid_width()
+        end if
         self%gap_tol = 1.0e-12_dp*norm2(maxval(self%slave%x0, dim=2) - minval(self%slave%x0, dim=2))
         call shared_history(self)
         call self%setup_history()

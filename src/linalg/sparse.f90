@@ -14,6 +14,10 @@ module voiga_linalg_sparse
     implicit none
     private
 
+    !> The pattern buffer's first size is at most this many entries per block entry
+    !> (`collect_columns`).
+    integer(i8), parameter :: guess_cap = 64_i8
+
     public :: csc_matrix_t, new_csc_pattern, pattern_positions, position_cache_t, consecutive_runs
 
     !> The positions in `values` of the last element `add_cached` was given (its
@@ -215,6 +219,10 @@ contains
     !> of the elements touching j, each once by a marker) is
     !> `rows(colptr(j)+1 : colptr(j+1))`. Element overlaps make sum(size^2) a few
     !> times nnz, hence the initial guess of the buffer size; it grows when needed.
+    !> Dense contact blocks that overlap much more (a mortar node's block on a face
+    !> holds every DOF its weighted gap sees, and its neighbours' nearly the same)
+    !> would make that guess many times nnz: it is capped at `guess_cap` entries per
+    !> block entry.
     subroutine collect_columns(n, elem_ptr, elem_dofs, dof_ptr, dof_elems, sumsq, colptr, rows, &
                                error)
         integer, intent(in) :: n, elem_ptr(:), elem_dofs(:), dof_ptr(:), dof_elems(:)
@@ -228,7 +236,7 @@ contains
         integer :: e, q, p, i, j, st
         integer(i8) :: top, cap, bound
 
-        cap = max(int(n, i8) + sumsq/3, 16_i8)
+        cap = max(int(n, i8) + min(sumsq/3, guess_cap*size(elem_dofs, kind=i8)), 16_i8)
         allocate (rows(cap), stat=st)
         if (st /= 0) then
             call fatal_error(error, 'out of memory: the stiffness pattern needs '//str(int(cap/262144))//' MB')
