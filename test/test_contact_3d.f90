@@ -9,7 +9,7 @@ module test_contact_3d
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_layout, only: layout_t
     use voiga_contact_factory, only: contact_settings_t
-    use voiga_contact_law, only: state_stick, state_slip
+    use voiga_contact_law, only: contact_law_t, control_point_law3, state_stick, state_slip
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
     use voiga_contact_master_face, only: rigid_surface_t
@@ -43,6 +43,7 @@ contains
                     new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
                     new_unittest('contact_3d_mortar_friction_fd', test_mortar_friction_fd), &
                     new_unittest('contact_3d_mortar_friction_fd_deformable', test_mortar_friction_fd_deformable), &
+                    new_unittest('contact_3d_mortar_law_at_zero_pressure', test_law3_zero_pressure), &
                     new_unittest('rigid_surface_flat_is_the_plane', test_flat_surface), &
                     new_unittest('rigid_surface_tangent_fd', test_surface_fd), &
                     new_unittest('contact_3d_face_area', test_face_area), &
@@ -292,6 +293,28 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_mortar_friction_fd_deformable
+
+    !> A control point active with a gap just below gap_tol D_A has a pressure a round-off
+    !> below 0; with no committed traction and no slip (a node that just touched), its
+    !> trial traction is zero: it sticks with zero traction, not 0/0 (the m1 NN2.2 ironing
+    !> with mortar stopped there, "the residual is not finite"); with a trial traction it
+    !> slips at |t| = mu |p|, as on an edge.
+    subroutine test_law3_zero_pressure(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(contact_law_t) :: law
+        real(dp) :: p, t(3), ttr(3)
+        integer :: state
+        law = contact_law_t(eps_n=10.0_dp, eps_t=10.0_dp, mu=0.3_dp)
+        call control_point_law3(law, 1.0e-14_dp, 1.0_dp, [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                                1.0e-12_dp, p, t, state, ttr)
+        call check(error, p < 0.0_dp .and. state == state_stick .and. all(t == 0.0_dp), &
+                   'zero trial traction at p < 0: sticks with t = 0')
+        if (allocated(error)) return
+        call control_point_law3(law, 1.0e-14_dp, 1.0_dp, [1.0e-6_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                                1.0e-12_dp, p, t, state, ttr)
+        call check(error, state == state_slip .and. abs(norm2(t) - law%mu*abs(p)) <= 1.0e-15_dp*abs(p), &
+                   'a trial traction at p < 0 slips at mu |p|')
+    end subroutine test_law3_zero_pressure
 
     !> A perturbed state `u` (every DOF moved by up to `amplitude`) of the model's
     !> mortar pair and its committed friction history (`test_mortar_friction_fd`); with

@@ -78,7 +78,9 @@ contains
         if (law%mu <= 0.0_dp) return
         ttr = t_old - law%eps_t*ds_a/d_a
         size_tr = norm2(ttr)
-        if (size_tr <= law%mu*p .or. .not. law%return_map) then
+        ! (active at a gap just below gap_tol D_A, p is a round-off below 0: no trial
+        ! traction is then no slip direction either, it sticks)
+        if (size_tr <= law%mu*p .or. size_tr <= 0.0_dp .or. .not. law%return_map) then
             t = ttr
         else
             state = state_slip
