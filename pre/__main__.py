@@ -176,7 +176,7 @@ def _cmd_ironing3d(args: argparse.Namespace) -> int:
     return _write_scene3d(
         "ironing3d", lambda: write_ironing3d(iron, args.mesh, args.layout, args.out, force=args.force,
                                              steps=args.steps, n_gauss=args.n_gauss or None,
-                                             penalty_normal=args.penalty_normal),
+                                             penalty_normal=args.penalty_normal, method=args.method),
         lambda mesh, layout: {"slab": case_dofs(iron, mesh, layout)["total"]}, "die",
         f"expected contact radius sqrt(R d) = {iron.contact_radius:.4g}")
 
@@ -351,6 +351,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="&contact n_gauss per direction (default 0: none written, voiga's layer degree + 1)")
     s.add_argument("--penalty-normal", type=float, default=None,
                    help="&contact penalty_normal (default: none written, voiga's automatic one)")
+    s.add_argument("--method", default="gpts", choices=("gpts", "mortar"),
+                   help="&contact method (default gpts, the scene's reference)")
     s.add_argument("--force", action="store_true", help="overwrite existing files")
     s.set_defaults(func=_cmd_ironing3d)
 

@@ -11,9 +11,9 @@ touching the slab at (1, 0, 0).
 Loads: the slab's bottom fixed, ``uy = 0`` on its symmetry face y = 0 (``front``); the
 die moves down by the indentation d = 0.1 in :data:`PRESS_STEPS` steps, then along x by
 :data:`SLIDE` in :data:`SLIDE_STEPS` steps (``rigid_ux``, ``rigid_uz``, two load
-phases); GPTS contact (the only frictional method on faces) with voiga's default
-``n_gauss`` (the layer's degree + 1 points per direction of a slave cell; or the given
-one) and friction mu (0.3).
+phases); GPTS contact (the scene's reference; ``method='mortar'``, ``--method mortar``,
+for the mortar-type one) with voiga's default ``n_gauss`` (the layer's degree + 1 points
+per direction of a slave cell; or the given one) and friction mu (0.3).
 
 Mesh m<k> (:data:`MESHES`): uniform along x (``nx`` elements over the slab's length),
 across ``fine`` elements over the path's band ``0 <= y <= BAND`` and ``rest`` beyond,
@@ -126,16 +126,20 @@ def slab_knots(mesh: str) -> dict[str, list[float]]:
 
 
 def iron_case(iron: Iron, mesh: str, layout: str, steps: Sequence[int] | None = None,
-              n_gauss: int | None = DEFAULT_GAUSS, penalty_normal: float | None = None) -> dict[str, Any]:
+              n_gauss: int | None = DEFAULT_GAUSS, penalty_normal: float | None = None,
+              method: str = "gpts") -> dict[str, Any]:
     """The namelist groups of the case ``mesh``, ``layout`` (module docstring).
     ``steps``: (press, slide) steps; ``n_gauss`` and ``penalty_normal`` None leave them
-    to voiga (its n_gauss is the contact layer's degree + 1)."""
+    to voiga (its n_gauss is the contact layer's degree + 1); ``method`` the
+    ``&contact method``, 'gpts' or 'mortar' (both carry friction on faces)."""
     iron.check()
     press, slide = steps if steps is not None else (PRESS_STEPS, SLIDE_STEPS)
     if press < 1 or slide < 1:
         raise HertzCaseError(f"steps {press}, {slide} must be >= 1")
     if n_gauss is not None and n_gauss < 1:
         raise HertzCaseError(f"n_gauss {n_gauss} must be >= 1")
+    if method not in ("gpts", "mortar"):
+        raise HertzCaseError(f"method {method!r} must be 'gpts' or 'mortar'")
     knots = slab_knots(mesh)
     vol = scene_geometry()[BODY]
     spec = {"name": BODY, "layout": layout, "contact_face": CONTACT_FACE, "material": "neo-hookean",
@@ -144,7 +148,7 @@ def iron_case(iron: Iron, mesh: str, layout: str, steps: Sequence[int] | None = 
         body = knotted_body_group(spec, vol, knots)
     except ValueError as err:
         raise HertzCaseError(str(err)) from None
-    contact: dict[str, Any] = {"slave": BODY, "master": "rigid", "rigid_surface": DIE, "method": "gpts",
+    contact: dict[str, Any] = {"slave": BODY, "master": "rigid", "rigid_surface": DIE, "method": method,
                                "friction": float(iron.friction),
                                "rigid_ux": [0.0, SLIDE], "rigid_uz": [-iron.indentation] * 2}
     if n_gauss is not None:

@@ -9,8 +9,9 @@ module test_contact_3d
     use voiga_discretization_patch, only: discretization_t, new_discretization
     use voiga_discretization_layout, only: layout_t
     use voiga_contact_factory, only: contact_settings_t
-    use voiga_contact_law, only: state_stick, state_slip
+    use voiga_contact_law, only: contact_law_t, control_point_law3, state_stick, state_slip
     use voiga_contact_gpts, only: gpts_pair_t
+    use voiga_contact_mortar, only: mortar_pair_t
     use voiga_contact_master_face, only: rigid_surface_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
@@ -40,6 +41,9 @@ contains
                     new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
                     new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
                     new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
+                    new_unittest('contact_3d_mortar_friction_fd', test_mortar_friction_fd), &
+                    new_unittest('contact_3d_mortar_friction_fd_deformable', test_mortar_friction_fd_deformable), &
+                    new_unittest('contact_3d_mortar_law_at_zero_pressure', test_law3_zero_pressure), &
                     new_unittest('rigid_surface_flat_is_the_plane', test_flat_surface), &
                     new_unittest('rigid_surface_tangent_fd', test_surface_fd), &
                     new_unittest('contact_3d_face_area', test_face_area), &
@@ -50,12 +54,14 @@ contains
     !> The quarter ring (E = 1) whose outer cylinder r = 2 is the slave face, against
     !> the tilted plane through (1.9, 0, 0.5) whose obstacle lies beyond it (outward
     !> normal towards the ring): the cylinder's points near theta = 0 penetrate.
-    subroutine ring_on_plane(layout, model, error, mu)
+    subroutine ring_on_plane(layout, model, error, mu, method)
         type(layout_t), intent(in) :: layout
         type(model_t), intent(out) :: model
         type(error_t), allocatable, intent(out) :: error
         !> Coulomb's coefficient (default 0).
         real(dp), intent(in), optional :: mu
+        !> The contact method (default 'gpts').
+        character(len=*), intent(in), optional :: method
         type(scene_t) :: c
         type(discretization_t) :: discs(1)
         type(contact_settings_t) :: contact
@@ -63,6 +69,7 @@ contains
         contact%slave = 'ring'
         contact%master = 'rigid'
         contact%method = 'gpts'
+        if (present(method)) contact%method = method
         contact%rigid_point = [1.9_dp, 0.0_dp, 0.5_dp]
         contact%rigid_normal = [-1.0_dp, -0.2_dp, 0.1_dp]
         contact%point_components = 3
@@ -219,6 +226,145 @@ contains
         end select
         call contact_fd(model%pairs(1)%pair, u, want, 'friction '//label, error)
     end subroutine friction_fd
+
+    !> The mortar-type pair's Coulomb friction on a face (a traction vector per slave
+    !> control point, `mortar_faces.f90`): every point had a projection at the last
+    !> converged state `shift` behind its present one in both master coordinates, every
+    !> control point was in contact with a committed traction of 0.2 mu p_A in a direction
+    !> off the tangent plane; K against central differences when every control point
+    !> sticks (mu = 0.5, 1e-5) and slips (mu = 0.3, 0.05) on the ring against the tilted
+    !> plane (N2, NN3), and for control points that touched in this step (open at the
+    !> last converged state at mean gap 1e-3: only the slip after the touch counts).
+    subroutine test_mortar_friction_fd(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(layout_t) :: layouts(2)
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        integer :: il
+        layouts = [layout3(2, [2, 3, 2], 0, 0, 'outer'), layout3(2, [1, 2, 2], 3, 0, 'outer')]
+        do il = 1, 2
+            call ring_on_plane(layouts(il), model, error, 0.5_dp, 'mortar')
+            if (allocated(error)) return
+            call mortar_friction_state(model, 1.0e-3_dp, 1.0e-5_dp, u, error)
+            if (allocated(error)) return
+            call contact_fd(model%pairs(1)%pair, u, state_stick, 'mortar friction stick '//str(il), error)
+            if (allocated(error)) return
+            call ring_on_plane(layouts(il), model, error, 0.3_dp, 'mortar')
+            if (allocated(error)) return
+            call mortar_friction_state(model, 1.0e-3_dp, 0.05_dp, u, error)
+            if (allocated(error)) return
+            call contact_fd(model%pairs(1)%pair, u, state_slip, 'mortar friction slip '//str(il), error)
+            if (allocated(error)) return
+        end do
+        call ring_on_plane(layouts(2), model, error, 0.5_dp, 'mortar')
+        if (allocated(error)) return
+        call mortar_friction_state(model, 1.0e-3_dp, 1.0e-5_dp, u, error, touch=1.0e-3_dp)
+        if (allocated(error)) return
+        call contact_fd(model%pairs(1)%pair, u, state_stick, 'mortar friction touch', error)
+    end subroutine test_mortar_friction_fd
+
+    !> The two blocks of `test_tangent_fd_deformable` (N2 on 3 x 2 cells, mortar) with
+    !> friction: the master's tangents and curvature enter the slip and the projection
+    !> of the traction; stick and slip as in `test_mortar_friction_fd`.
+    subroutine test_mortar_friction_fd_deformable(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_t) :: c
+        type(discretization_t) :: discs(2)
+        type(contact_settings_t) :: contact
+        type(model_t) :: model
+        real(dp), allocatable :: u(:)
+        real(dp) :: mu(2), shift(2)
+        integer :: want(2), i
+        mu = [0.5_dp, 0.3_dp]
+        shift = [1.0e-5_dp, 0.05_dp]
+        want = [state_stick, state_slip]
+        do i = 1, 2
+            c%bodies = [body_settings('upper', 'linear', 1.0_dp, layout3(2, [2, 2, 1], 0, 0, 'bottom')), &
+                        body_settings('lower', 'linear', 1.0_dp, layout3(2, [3, 2, 1], 0, 0, 'top'))]
+            contact%slave = 'upper'
+            contact%master = 'lower'
+            contact%method = 'mortar'
+            contact%friction = mu(i)
+            c%contact = [contact]
+            call new_discretization(discs(1), unit_box(-0.02_dp), box_faces, c%bodies(1)%layout, '', error)
+            if (allocated(error)) return
+            call new_discretization(discs(2), unit_box(-1.0_dp), box_faces, c%bodies(2)%layout, '', error)
+            if (allocated(error)) return
+            call scene_model(c, discs, model, error)
+            if (allocated(error)) return
+            call mortar_friction_state(model, 2.0e-3_dp, shift(i), u, error)
+            if (allocated(error)) return
+            call contact_fd(model%pairs(1)%pair, u, want(i), 'mortar friction blocks '//str(i), error)
+            if (allocated(error)) return
+        end do
+    end subroutine test_mortar_friction_fd_deformable
+
+    !> A control point active with a gap just below gap_tol D_A has a pressure a round-off
+    !> below 0; with no committed traction and no slip (a node that just touched), its
+    !> trial traction is zero: it sticks with zero traction, not 0/0 (the m1 NN2.2 ironing
+    !> with mortar stopped there, "the residual is not finite"); with a trial traction it
+    !> slips at |t| = mu |p|, as on an edge.
+    subroutine test_law3_zero_pressure(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(contact_law_t) :: law
+        real(dp) :: p, t(3), ttr(3)
+        integer :: state
+        law = contact_law_t(eps_n=10.0_dp, eps_t=10.0_dp, mu=0.3_dp)
+        call control_point_law3(law, 1.0e-14_dp, 1.0_dp, [0.0_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                                1.0e-12_dp, p, t, state, ttr)
+        call check(error, p < 0.0_dp .and. state == state_stick .and. all(t == 0.0_dp), &
+                   'zero trial traction at p < 0: sticks with t = 0')
+        if (allocated(error)) return
+        call control_point_law3(law, 1.0e-14_dp, 1.0_dp, [1.0e-6_dp, 0.0_dp, 0.0_dp], [0.0_dp, 0.0_dp, 0.0_dp], &
+                                1.0e-12_dp, p, t, state, ttr)
+        call check(error, state == state_slip .and. abs(norm2(t) - law%mu*abs(p)) <= 1.0e-15_dp*abs(p), &
+                   'a trial traction at p < 0 slips at mu |p|')
+    end subroutine test_law3_zero_pressure
+
+    !> A perturbed state `u` (every DOF moved by up to `amplitude`) of the model's
+    !> mortar pair and its committed friction history (`test_mortar_friction_fd`); with
+    !> `touch`, every control point open at the last converged state at that mean gap.
+    subroutine mortar_friction_state(model, amplitude, shift, u, error, touch)
+        type(model_t), intent(inout) :: model
+        real(dp), intent(in) :: amplitude, shift
+        real(dp), allocatable, intent(out) :: u(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(dp), intent(in), optional :: touch
+        type(lcg_t) :: rng
+        real(dp), allocatable :: r(:), p(:)
+        integer :: j
+        allocate (u(model%ndof), r(model%ndof))
+        do j = 1, size(u)
+            u(j) = amplitude*(2.0_dp*rng%uniform() - 1.0_dp)
+        end do
+        r = 0.0_dp
+        call model%pairs(1)%pair%evaluate(u, r, error)
+        if (allocated(error)) return
+        select type (pair => model%pairs(1)%pair)
+        type is (mortar_pair_t)
+            call check(error, pair%h_traction_yz(2) > 0, 'a traction vector per control point')
+            if (allocated(error)) return
+            associate (h => pair%hist%field)
+                h(pair%h_active)%last = 1.0_dp
+                h(pair%h_xi)%last = pair%out%xi_m - shift
+                h(pair%h_eta)%last = pair%out%eta_m - shift
+                h(pair%h_node_active)%last = 1.0_dp
+                p = pair%law%mu*pair%law%eps_n*max(0.0_dp, -pair%last%g/max(pair%last%d, tiny(1.0_dp)))
+                h(pair%h_traction)%last = 0.12_dp*p
+                h(pair%h_traction_yz(1))%last = -0.1_dp*p
+                h(pair%h_traction_yz(2))%last = 0.09_dp*p
+                if (present(touch)) then
+                    h(pair%h_node_active)%last = 0.0_dp
+                    h(pair%h_node_gap)%last = touch
+                    h(pair%h_traction)%last = 0.0_dp
+                    h(pair%h_traction_yz(1))%last = 0.0_dp
+                    h(pair%h_traction_yz(2))%last = 0.0_dp
+                end if
+            end associate
+        class default
+            call check(error, .false., 'a mortar pair')
+        end select
+    end subroutine mortar_friction_state
 
     !> A flat rigid NURBS surface (the plane z = 0.02 as a bilinear patch over
     !> [-1, 2]^2, its normal +z) acts as the rigid plane through the same point: the

@@ -62,6 +62,8 @@ def test_the_case_names_the_die_and_the_phases(tmp_path: Path) -> None:
     assert nml["body"]["layer_degree"] == 2 and nml["body"]["layer_elevations"] == 2
     assert nml["body"]["contact_face"] == "top"
     assert iron_case(Iron(), "m1", "N2", n_gauss=2)["contact"][0]["n_gauss"] == 2
+    assert main(["ironing3d", str(tmp_path / "m"), "--method", "mortar"]) == 0
+    assert f90nml.read(tmp_path / "m" / "m1-N2.nml")["contact"]["method"] == "mortar"
 
 
 def test_existing_files_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -79,3 +81,10 @@ def test_existing_files_are_refused(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_bad_values_are_refused(iron: Iron, mesh: str, message: str) -> None:
     with pytest.raises(HertzCaseError, match=message):
         iron_case(iron, mesh, "N2")
+
+
+def test_only_the_face_methods_are_written() -> None:
+    """'gpts' and 'mortar' carry friction on faces; voiga refuses the others there."""
+    assert iron_case(Iron(), "m1", "N2", method="mortar")["contact"][0]["method"] == "mortar"
+    with pytest.raises(HertzCaseError, match="method 'alm'"):
+        iron_case(Iron(), "m1", "N2", method="alm")

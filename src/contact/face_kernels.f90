@@ -7,8 +7,9 @@
 !> law's parameters, the history and the output are the pairs' (docs/theory.md,
 !> section 7, "Faces").
 !>
-!> Friction: GPTS only (Coulomb on the tangent plane, `coulomb3`); a frictional
-!> mortar pair on a face is refused where the case is read.
+!> Friction: Coulomb on the tangent plane, per point for GPTS (`coulomb3`), per
+!> control point for the mortar-type pair (`mortar_friction_point3` gives a point's
+!> share; the law is `control_point_law3`).
 !>
 !> Local DOFs of a point: the slave point's functions first (3 per function), then
 !> the master's (none for a rigid master), as in `voiga_contact_kinematics`.
@@ -21,7 +22,7 @@ module voiga_contact_face_kernels
     implicit none
     private
 
-    public :: gpts_point3, mortar_point3
+    public :: gpts_point3, mortar_point3, mortar_friction_point3
 
 contains
 
@@ -157,6 +158,49 @@ contains
             end do
         end do
     end subroutine mortar_point3
+
+    !> The mortar-type point on a face with friction: as `mortar_point3`, with the
+    !> interpolated tangential traction `tbar` [3] projected onto the master's tangent
+    !> plane at the point, t = pbar n + (I - n n^T) tbar, both held fixed in `k` (the
+    !> normal and the projector turning); and the vectors from which the pair forms the
+    !> coupling through the control points: `gn` = G^T n [nd], `gp` = G^T (I - n n^T)
+    !> [nd, 3], and (`slip`: the point had a projection at the last converged state) its
+    !> slip vector `s` = dxi^alpha m_alpha [3] (`dxi` [2] = xi_m - xi_m,last in both
+    !> master coordinates) and `ms` = d s / du [3, nd]; `tt` the projected traction [3].
+    pure subroutine mortar_friction_point3(w0, sp, mp, pbar, tbar, dxi, slip, r, k, gn, gp, s, ms, tt)
+        real(dp), intent(in) :: w0, pbar, tbar(3), dxi(2)
+        type(surface_point_t), intent(in) :: sp
+        type(master_point_t), intent(in) :: mp
+        logical, intent(in) :: slip
+        real(dp), intent(out) :: r(:), k(:, :), gn(:), gp(:, :), s(3), ms(:, :), tt(3)
+        real(dp) :: gm(3, size(r)), dm(3, size(r), 2), dmt(3, size(r), 2), c(size(r), 2), dn(3, size(r)), &
+                    dda(size(r)), dt(3, size(r)), t(3), n(3), g, da, tn
+        integer :: a, b
+        call face_linearization(sp, mp, 1.0_dp, g, da, gm, dm, c, gn, dn, dda, dmt)
+        n = mp%n
+        tn = dot_product(n, tbar)
+        tt = tbar - tn*n
+        t = pbar*n + tt
+        do a = 1, size(r)
+            r(a) = -w0*dot_product(t, gm(:, a))
+            gp(a, :) = gm(:, a) - n*dot_product(n, gm(:, a))
+            ! d t at fixed pbar, tbar: pbar dn - (n . tbar) dn - n (dn . tbar)
+            dt(:, a) = (pbar - tn)*dn(:, a) - n*dot_product(dn(:, a), tbar)
+        end do
+        do a = 1, size(r)
+            do b = 1, size(r)
+                k(b, a) = -w0*dot_product(gm(:, b), dt(:, a)) &
+                          + w0*(dot_product(dm(:, b, 1), t)*c(a, 1) + dot_product(dm(:, b, 2), t)*c(a, 2))
+            end do
+        end do
+        s = 0.0_dp
+        ms = 0.0_dp
+        if (.not. slip) return
+        s = dxi(1)*mp%a + dxi(2)*mp%b
+        do a = 1, size(r)
+            ms(:, a) = mp%a*c(a, 1) + mp%b*c(a, 2) + dxi(1)*dmt(:, a, 1) + dxi(2)*dmt(:, a, 2)
+        end do
+    end subroutine mortar_friction_point3
 
     !> The kinematics of a slave point `sp` and its projection `mp` on a face and
     !> their linearization by the local DOFs (m_alpha the master tangents,

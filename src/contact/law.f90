@@ -8,7 +8,7 @@ module voiga_contact_law
     implicit none
     private
 
-    public :: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
+    public :: contact_law_t, control_point_law, control_point_law3, state_inactive, state_stick, state_slip
 
     !> Contact states of a slave point or control point.
     integer, parameter :: state_inactive = 0, state_stick = 1, state_slip = 2
@@ -54,5 +54,38 @@ contains
             end if
         end if
     end subroutine control_point_law
+
+    !> `control_point_law` on a face: the weighted slip `ds_a`, the committed traction
+    !> `t_old` and the traction `t` are vectors [3] (Cartesian components; the tangent
+    !> plane's, up to the master's curvature over the node's support: the points project
+    !> it onto theirs), and the return map is radial, onto the disc |t| <= mu p.
+    pure subroutine control_point_law3(law, g_a, d_a, ds_a, t_old, gap_tol, p, t, state, ttr)
+        type(contact_law_t), intent(in) :: law
+        real(dp), intent(in) :: g_a, d_a, ds_a(3), t_old(3), gap_tol
+        real(dp), intent(out) :: p, t(3)
+        integer, intent(out) :: state
+        !> Trial tangential traction [3] (0 when open).
+        real(dp), intent(out) :: ttr(3)
+        real(dp) :: size_tr
+        p = 0.0_dp
+        t = 0.0_dp
+        ttr = 0.0_dp
+        state = state_inactive
+        if (d_a <= 0.0_dp .or. g_a >= gap_tol*d_a) return
+        p = -law%eps_n*g_a/d_a
+        state = state_stick
+        ! (a phase without friction: no tangential traction, as on an edge)
+        if (law%mu <= 0.0_dp) return
+        ttr = t_old - law%eps_t*ds_a/d_a
+        size_tr = norm2(ttr)
+        ! (active at a gap just below gap_tol D_A, p is a round-off below 0: no trial
+        ! traction is then no slip direction either, it sticks)
+        if (size_tr <= law%mu*p .or. size_tr <= 0.0_dp .or. .not. law%return_map) then
+            t = ttr
+        else
+            state = state_slip
+            t = law%mu*p*ttr/size_tr
+        end if
+    end subroutine control_point_law3
 
 end module voiga_contact_law

@@ -9,9 +9,9 @@
 !> p(xi) = sum_A N_A(xi) p_A. Friction: per control point, the tangential traction
 !> t_A is the state variable, with an elastic predictor on the weighted increment
 !> of slip ds_A = int N_A (xi_m - xi_m,last) |a_m| dA0 and a return map onto
-!> |t_A| <= mu p_A (`voiga_contact_law`). The integrals use the reference length
-!> dA0 of the slave edge (nominal tractions); the residual at a point is
-!> r = -w0 G^T (p n + t t_hat), as in `voiga_contact_gpts`.
+!> |t_A| <= mu p_A (`voiga_contact_law`; on a face t_A is a vector, `mortar_faces.f90`).
+!> The integrals use the reference length dA0 of the slave edge (nominal tractions);
+!> the residual at a point is r = -w0 G^T (p n + t t_hat), as in `voiga_contact_gpts`.
 !>
 !> Step control (`step_limit`): a Newton step that closes an open control point,
 !> or reverses the trial traction of a slipping one, is shortened to the first
@@ -67,6 +67,9 @@ module voiga_contact_mortar
         !> interpolated linearly from there, vanished: only its slip after that
         !> counts (`touch_factors`).
         integer :: h_traction = 0, h_node_gap = 0, h_node_active = 0
+        !> On a face, the traction is a vector (`mortar_faces.f90`): `traction` its x
+        !> component, these its y and z ('traction_y', 'traction_z'; 0 on an edge).
+        integer :: h_traction_yz(2) = 0
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
         type(mortar_snapshot_t) :: last, accepted
@@ -112,6 +115,27 @@ module voiga_contact_mortar
         real(dp), allocatable :: f_a(:), ds_raw(:), df_a(:)
     end type mortar_work_t
 
+    interface
+        !> A face with friction: the laws, points and coupling with a tangential traction
+        !> vector per control point (`mortar_faces.f90`, after `mortar_project`).
+        module subroutine face_friction(self, r, wk, add)
+            class(mortar_pair_t), intent(inout) :: self
+            real(dp), intent(inout) :: r(:)
+            type(mortar_work_t), intent(inout) :: wk
+            procedure(add_matrix), optional :: add
+        end subroutine face_friction
+        !> Node b's pattern block on a face (`block_dofs`).
+        pure module function face_block_dofs(self, b, mdofs) result(dofs)
+            class(mortar_pair_t), intent(in) :: self
+            integer, intent(in) :: b, mdofs(:)
+            integer, allocatable :: dofs(:)
+        end function face_block_dofs
+        !> The multiplier basis on a face (`setup_multipliers`).
+        pure module subroutine face_multipliers(self)
+            class(mortar_pair_t), intent(inout) :: self
+        end subroutine face_multipliers
+    end interface
+
 contains
 
     pure function mortar_method_name(self) result(name)
@@ -148,6 +172,12 @@ contains
                 trial_gap = huge(1.0_dp)
                 where (wk%g_a < huge(1.0_dp) .and. wk%d_a > 0.0_dp) trial_gap = wk%g_a/wk%d_a
             end associate
+        end if
+        if (self%h_traction_yz(1) > 0) then
+            ! (its snapshot has no trial traction: no reversal limit on a face)
+            call face_friction(self, r, wk, add)
+            self%last = mortar_snapshot_t(wk%g_a, wk%d_a, spread(0.0_dp, 1, size(wk%g_a)), wk%st_a)
+            return
         end if
         call self%control_laws(wk%g_a, wk%d_a, wk%ds_a, wk%p_a, wk%t_a, wk%st_a, wk%t_tr)
         if (self%h_node_active > 0) self%hist%field(self%h_node_active)%trial = flag_value(wk%st_a /= state_inactive)
@@ -258,7 +288,7 @@ contains
                 if (.not. allocated(rl)) allocate (rl(nd), kl(nd, nd))
                 allocate (vec%gn(nd), vec%gt(nd), vec%m(nd))
                 if (self%slave%npar > 1) then
-                    ! a face (frictionless: refused with friction where the case is read)
+                    ! a face without friction (with it: `face_friction`)
                     call mortar_point3(wk%w0(k), sp, mp, pbar, rl, kl, vec%gn)
                     vec%gt = 0.0_dp
                     vec%m = 0.0_dp
@@ -422,28 +452,6 @@ contains
         dofs = [dofs, pack(mdofs, reshape(spread(used, 1, 2), [size(mdofs)]))]
     end function mortar_block_dofs
 
-    !> Node b's block on a face: the DOFs of the control points of every cell whose
-    !> functions include the node's, then the master ranges of those cells (`mdofs`:
-    !> the master's DOFs, 3 per control point; none for a rigid master).
-    pure function face_block_dofs(self, b, mdofs) result(dofs)
-        class(mortar_pair_t), intent(in) :: self
-        integer, intent(in) :: b, mdofs(:)
-        integer, allocatable :: dofs(:), ids(:)
-        logical :: used(size(self%slave%cps)), mused(size(mdofs)/3)
-        integer :: e, nu
-        nu = size(self%slave%spans)
-        used = .false.
-        mused = .false.
-        do e = self%node_first(b), self%node_last(b)
-            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
-            if (.not. any(ids == b)) cycle
-            used(ids) = .true.
-            mused(self%range_ids(e)) = .true.
-        end do
-        dofs = reshape(self%slave%dofs(:, pack([(e, e=1, size(used))], used)), [3*count(used)])
-        dofs = [dofs, pack(mdofs, reshape(spread(mused, 1, 3), [size(mdofs)]))]
-    end function face_block_dofs
-
     !> The multiplier basis; with friction the shared history and a tangential
     !> traction per node.
     pure subroutine mortar_setup_history(self)
@@ -455,6 +463,9 @@ contains
         call self%hist%add('traction', n, self%h_traction)
         call self%hist%add('node_gap', n, self%h_node_gap, initial=huge(1.0_dp))
         call self%hist%add('node_active', n, self%h_node_active, flags=.true.)
+        if (self%slave%npar < 2) return
+        call self%hist%add('traction_y', n, self%h_traction_yz(1))
+        call self%hist%add('traction_z', n, self%h_traction_yz(2))
     end subroutine mortar_setup_history
 
     !> The multiplier basis at the slave points and the supports of its nodes: the
@@ -506,32 +517,6 @@ contains
             end do
         end do
     end subroutine setup_multipliers
-
-    !> The multiplier basis on a face: the slave face's functions at each point (as
-    !> `setup` computed them), and each node's support as the range of cells (flat,
-    !> xi fastest) from its first to its last.
-    pure subroutine face_multipliers(self)
-        class(mortar_pair_t), intent(inout) :: self
-        integer :: k, e, ne, a, nu
-        integer, allocatable :: ids(:)
-        ne = n_elements(self%slave)
-        nu = size(self%slave%spans)
-        allocate (self%point_nodes(size(self%slave_basis, 1), size(self%xi)), &
-                  self%node_first(size(self%slave%cps)), self%node_last(size(self%slave%cps)))
-        do k = 1, size(self%xi)
-            self%point_nodes(:, k) = face_ids(self%slave, [self%span(k), self%span_eta(k)])
-        end do
-        self%point_values = self%slave_basis(:, 1, :)
-        self%node_first = huge(1)
-        self%node_last = 0
-        do e = 1, ne
-            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
-            do a = 1, size(ids)
-                self%node_first(ids(a)) = min(self%node_first(ids(a)), e)
-                self%node_last(ids(a)) = max(self%node_last(ids(a)), e)
-            end do
-        end do
-    end subroutine face_multipliers
 
     !> A control point was in contact at the last converged state (friction only).
     pure logical function mortar_contact_last(self)

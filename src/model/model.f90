@@ -199,8 +199,6 @@ contains
         end if
         settings = inp
         if (.not. inp%method_given) settings%method = default_method(trim(inp%master) == 'rigid', self%nsd)
-        ! (on solids friction is GPTS's only so far: a frictional pair that names no method)
-        if (.not. inp%method_given .and. self%nsd == 3 .and. inp%friction > 0.0_dp) settings%method = 'gpts'
         call new_contact_pair(slot%pair, settings, slave, master, [ib, im], plane_modulus(self, ib, im), &
                               self%ndof, error)
     end subroutine new_pair

@@ -1,9 +1,11 @@
-"""Contact on a solid's face (issue 42, first step: frictionless GPTS and mortar against
-a rigid plane) through the command line. A box pressed onto a rigid plane by a uniform
-pressure on its top carries that pressure uniformly (the contact patch test against a
-rigid flat, which every method must pass); the sphere of `pre hertz3d` runs and its
-result reads in `post hertz3d` with its contact force equal to the integral of the
-pressure; what is not implemented on faces yet is refused with its cause named."""
+"""Contact on a solid's face (issue 42: GPTS and mortar, with and without friction)
+through the command line. A box pressed onto a rigid plane by a uniform pressure on its
+top carries that pressure uniformly (the contact patch test against a rigid flat, which
+every method must pass), and slid along the plane carries mu times it (both methods; a
+mortar run cut and continued with --restart reproduces the uncut one); the sphere of
+`pre hertz3d` runs and its result reads in `post hertz3d` with its contact force equal to
+the integral of the pressure; what is not implemented on faces yet is refused with its
+cause named."""
 from __future__ import annotations
 
 import subprocess
@@ -108,7 +110,7 @@ def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(("contact", "message"), [
-    (PLANE + ", method = 'mortar', friction = 0.3", "friction on solids is implemented for method = 'gpts' only"),
+    (PLANE + ", method = 'alm', friction = 0.3", "method = 'alm' is not implemented for solids yet"),
     (PLANE + ", method = 'segment'", "method = 'segment' is not implemented for solids yet"),
     (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
     (", rigid_point = 0.0, 0.0", "rigid_point needs 3 components"),
@@ -231,13 +233,15 @@ def test_blocks_non_matching_faces(voiga_bin: Path, tmp_path: Path) -> None:
     assert spreads["mortar", 9] < spreads["mortar", 6] < spreads["mortar", 3] < 0.02
 
 
-def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path) -> None:
-    """Coulomb friction on the tangent plane (GPTS, the method a frictional pair on a
-    solid takes): the box pressed by 0.01 (phase 1), then the plane slid 0.05 along x
-    under it (phase 2). Every point ends slipping, the friction force approaches
-    mu F_N along the sliding direction and the transverse one (from the press's
-    lateral expansion, held by friction) dies out."""
-    case = box_case(tmp_path, PLANE + ", friction = 0.3, rigid_ux = 0.0, 0.05")
+@pytest.mark.parametrize("method", ["gpts", "mortar", ""])
+def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) -> None:
+    """Coulomb friction on the tangent plane, GPTS and mortar (per control point; the
+    default on a solid, with friction as without): the box pressed by 0.01 (phase 1),
+    then the plane slid 0.05 along x under it (phase 2). Every point ends slipping, the
+    friction force approaches mu F_N along the sliding direction and the transverse one
+    (from the press's lateral expansion, held by friction) dies out."""
+    given = f", method = '{method}'" if method else ""
+    case = box_case(tmp_path, PLANE + given + ", friction = 0.3, rigid_ux = 0.0, 0.05")
     text = case.read_text().replace("n_steps = 2", "n_steps = 2, 4").replace("p = 0.01", "p = 0.01, 0.01")
     case.write_text(text)
     res = run(voiga_bin, case)
@@ -248,6 +252,40 @@ def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path) -> None:
     assert abs(fz - 0.02) < 1e-12
     assert abs(fx / fz - 0.3) < 1e-5 and abs(fy / fz) < 1e-3
     assert c["p_t"].shape == (c["p_n"].size, 3)
+    with h5py.File(tmp_path / "box.h5") as f:
+        assert f["steps/000006/contact/1"].attrs["method"].decode().strip() == (method or "mortar")
+
+
+def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path) -> None:
+    """The sliding box with mortar cut after step 4 (sliding, every control point
+    carrying a traction vector: the history's `traction`, `traction_y`, `traction_z`)
+    and continued with --restart: the same contact forces, tractions and displacements
+    as the run that was not cut."""
+    import shutil
+
+    case = box_case(tmp_path, PLANE + ", method = 'mortar', friction = 0.3, rigid_ux = 0.0, 0.05")
+    case.write_text(case.read_text().replace("n_steps = 2", "n_steps = 2, 4").replace("p = 0.01", "p = 0.01, 0.01"))
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    full, partial = tmp_path / "full.h5", tmp_path / "box.h5"
+    shutil.copy(partial, full)
+    with h5py.File(partial, "r+") as f:
+        history = f["steps/000004/contact/1/history"]
+        assert {"traction", "traction_y", "traction_z", "eta_last"} <= set(history)
+        assert np.abs(history["traction"][()]).max() > 0.0
+        for k in list(f["steps"]):
+            if int(k) > 4:
+                del f["steps"][k]
+        f.attrs["n_steps_done"] = np.int32(4)
+        f.attrs["status"] = np.bytes_("interrupted")
+    res = run(voiga_bin, case, "--restart", str(partial))
+    assert res.returncode == 0, res.stderr
+    with h5py.File(full) as a, h5py.File(partial) as b:
+        assert b.attrs["status"] == b"converged" and int(b.attrs["n_steps_done"]) == 6
+        for k in a["steps"]:
+            for name in ("displacement", "contact/1/force", "contact/1/p_t", "contact/1/p_n"):
+                np.testing.assert_allclose(b["steps"][k][name][()], a["steps"][k][name][()], rtol=0, atol=1e-12,
+                                           err_msg=f"{k} {name}")
 
 
 INDENT = """&case

@@ -95,8 +95,8 @@ contains
 
     !> A rigid master's point and normal have `nsd` components (or none given: the
     !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
-    !> solids contact is, so far, frictionless GPTS or mortar against a rigid plane
-    !> (issue 42: the rest is refused here, naming what is missing).
+    !> solids contact is, so far, GPTS or mortar, with or without friction (issue 42: the
+    !> other methods are refused here, naming what is missing).
     subroutine check_contact_dimension(c, nsd, where, error)
         type(contact_settings_t), intent(in) :: c
         integer, intent(in) :: nsd
@@ -119,9 +119,6 @@ contains
             if (c%method_given .and. all(trim(c%method) /= [character(len=6) :: 'gpts', 'mortar'])) then
                 what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
                        "'mortar' or 'gpts'"
-            else if (c%friction > 0.0_dp .and. c%method_given .and. trim(c%method) /= 'gpts') then
-                what = 'friction on solids is implemented for method = ''gpts'' only so far (issue 42); '// &
-                       'give method = ''gpts'' or friction = 0'
             end if
         end if
         if (allocated(what)) call fatal_error(error, where//what, error_code%input)
