@@ -25,7 +25,7 @@ export PY_MISSING := import importlib.util as u, sys; sys.exit(any(u.find_spec(m
 PY_PINNED := $(shell sed -n 's/^\([A-Za-z0-9_.-]*==[^ #]*\).*/\1/p' requirements.txt)
 export PY_OTHER_VERSION := import importlib.metadata as m, sys; sys.exit(any(m.version(n) != v for n, v in (a.split('==') for a in sys.argv[1:])))
 
-.PHONY: all deps build run test lint test-fortran test-python clean bench paper stress regress attack
+.PHONY: all deps build run test lint test-fortran test-python clean bench paper paper3d stress regress attack
 
 all: build
 
@@ -129,6 +129,17 @@ paper: build
 	@status=0; \
 	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post study cases/studies/paper.toml --out $(PAPER_OUT) $(PAPER_ARGS) || status=$$?; \
 	$(PYTHON) -m post figures --results $(PAPER_OUT) --out docs/validation || status=$$?; \
+	exit $$status
+
+## paper3d: what VO buys in 3D (docs/validation-3d.md): the study cases/studies/paper3d.toml
+## (the committed hertz3d and ironing3d cases; about 20 CPU minutes) into PAPER3D_OUT, then
+## its figures and accuracy/cost tables in docs/validation/3d; fails if a case fails.
+## PAPER3D_ARGS e.g. --scenes hertz3d --meshes m1 m2
+PAPER3D_OUT ?= results3d
+paper3d: build
+	@status=0; \
+	VOIGA_BIN=$(CURDIR)/$(VOIGA) $(PYTHON) -m post study cases/studies/paper3d.toml --out $(PAPER3D_OUT) $(PAPER3D_ARGS) || status=$$?; \
+	$(PYTHON) -m post figures --results $(PAPER3D_OUT) --out docs/validation/3d || status=$$?; \
 	exit $$status
 
 ## regress: every committed case and every converging hard case, compared per step with

@@ -9,6 +9,12 @@
   extras), and the relative L2 error of the normalised pressure p/p_max against the
   reference run (N2 on m6).
 - rings: relative L2 errors of p_N and p_T against the reference run (N2, finer mesh).
+- hertz3d (a sphere on a flat, :mod:`post.hertz3d`): against Hertz's point contact in
+  the reference configuration: the relative L2 error of the nominal pressure over the
+  contact disc, the fitted contact radius and peak, the largest pointwise deviation
+  over p0 and the sampled largest subsurface shear (docs/validation-3d.md).
+- ironing in 3D (ironing3d, :mod:`post.ironing3d`): the 2D measure on the contact
+  pair's resultant, F_x along the path (suffix ``t``) and F_z (suffix ``n``).
 
 A study may also name measures read from the result file (:func:`file_measure`).
 """
@@ -128,6 +134,34 @@ def hertz_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     return out
 
 
+def hertz3d_measures(res: Result) -> dict[str, float]:
+    """A 3D sphere-on-a-flat result against Hertz's point contact
+    (:func:`post.hertz3d.hertz3d_comparison`; the last step, the first contact pair):
+    ``l2_analytic`` (relative L2 of the pressure over the disc), ``a_err`` and
+    ``p0_err`` (the fit p^2 = p0^2 (1 - r^2/a^2) over the analytic a and p0, minus 1),
+    ``abs_a_err`` (|a_err|: the half-width error the accuracy/cost table ranks),
+    ``maxdev_analytic`` (the largest |p - p_H| / p0), ``force`` (P of the whole
+    sphere), ``a`` (Hertz's a for P) and, when the result holds the sampled stress,
+    ``tau_err`` (the largest sampled shear below the contact over Hertz's, minus 1)."""
+    from .hertz3d import hertz3d_comparison
+
+    h = hertz3d_comparison(res)
+    out = {"force": h.force, "a": h.a, "l2_analytic": h.error.l2, "a_err": h.a_error,
+           "abs_a_err": abs(h.a_error), "p0_err": h.p0_error, "maxdev_analytic": abs(h.error.max_deviation)}
+    if h.shear is not None:
+        out["tau_err"] = h.shear.tau_max / h.tau_hertz - 1.0
+    return out
+
+
+def ironing3d_measures(res: Result) -> dict[str, float]:
+    """The oscillation measures of a 3D ironing result (:func:`post.ironing3d.ironing_forces`:
+    the 2D study's ``amp``, ``osc``, ``mean``, ``raw_amp`` and ``spread`` of F_x, suffix
+    ``_t``, and of F_z, suffix ``_n``, and ``ratio`` = |mean F_x / mean F_z|)."""
+    from .ironing3d import ironing_forces
+
+    return dict(ironing_forces(res).measures)
+
+
 def rings_measures(res: Result, ref: Result | None = None) -> dict[str, float]:
     """L2 errors of p_N and p_T against the reference run (profiles along current x)."""
     if ref is None or not res.steps or not res.steps[-1].contact:
@@ -152,9 +186,11 @@ def measures_for(scene: str, res: Result, ref: Result | None = None) -> dict[str
         return {}
     try:
         if scene.startswith("ironing"):
-            return ironing_measures(res)
+            return ironing_measures(res) if res.dimension == 2 else ironing3d_measures(res)
         if scene == "hertz":
             return hertz_measures(res, ref)
+        if scene == "hertz3d":
+            return hertz3d_measures(res)
         if scene == "rings":
             return rings_measures(res, ref)
     except (ValueError, IndexError) as err:
@@ -224,5 +260,6 @@ def file_measure(path: Path, expr: str) -> float:
     return float(value.reshape(()))
 
 
-__all__ = ["detrended_amplitude", "file_measure", "fit_hertz", "hertz_measures", "ironing_measures",
-           "measures_for", "parse_file_measure", "profile_error", "rings_measures"]
+__all__ = ["detrended_amplitude", "file_measure", "fit_hertz", "hertz3d_measures", "hertz_measures",
+           "ironing3d_measures", "ironing_measures", "measures_for", "parse_file_measure", "profile_error",
+           "rings_measures"]

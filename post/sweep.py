@@ -180,7 +180,8 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
     name and the value of every variable the study changes), DOFs, iterations, cuts,
     seconds, status, the scene's measures and the ``measures`` named by the study
     (column -> :func:`post.measures.file_measure`); ironing amplitudes as % of N2 on the
-    same mesh with the same changes; the cost (repeats, CPU and wall seconds: median,
+    same mesh with the same changes (2D: px_pct_n2, py_pct_n2; 3D: t_pct_n2, n_pct_n2);
+    the cost (repeats, CPU and wall seconds: median,
     lo, hi; :func:`post.cost.cost_columns`) and the median CPU time normalised by the
     scene's most expensive run's (``time_norm``, the paper's Eq. 36; by the wall time
     when a run of the scene has no CPU time). ``failures``: label -> (exit code,
@@ -204,12 +205,18 @@ def summarize(runs: list[Run], measures: dict[str, str] | None = None,
     else:
         rows = [_row(task) for task in tasks]
     for run, row in zip(runs, rows, strict=True):
-        if str(row["scene"]).startswith("ironing") and "amp_px" in row:
+        if not str(row["scene"]).startswith("ironing"):
+            continue
+        # 2D: the die's Px, Py; 3D: the pair's F_x (t), F_z (n)
+        for tangential, normal, names in (("amp_px", "amp_py", ("px_pct_n2", "py_pct_n2")),
+                                          ("amp_t", "amp_n", ("t_pct_n2", "n_pct_n2"))):
+            if tangential not in row:
+                continue
             n2 = [r for u, r in zip(runs, rows, strict=True) if u.scene == run.scene and u.mesh == run.mesh
-                  and u.layout == "N2" and u.changes == run.changes and "amp_px" in r]
+                  and u.layout == "N2" and u.changes == run.changes and tangential in r]
             if n2:
-                row["px_pct_n2"] = 100.0 * float(row["amp_px"]) / float(n2[0]["amp_px"])
-                row["py_pct_n2"] = 100.0 * float(row["amp_py"]) / float(n2[0]["amp_py"])
+                row[names[0]] = 100.0 * float(row[tangential]) / float(n2[0][tangential])
+                row[names[1]] = 100.0 * float(row[normal]) / float(n2[0][normal])
     for scene in {str(r["scene"]) for r in rows}:
         timed = [r for r in rows if r["scene"] == scene and "wall_s" in r]
         key = "cpu_s" if all("cpu_s" in r for r in timed) else "wall_s"

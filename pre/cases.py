@@ -80,6 +80,19 @@ STUDIES["rings"] = ([(f"m{k}", lay) for k in range(1, 4) for lay in ["N2", "N4",
 RINGS_REF_MESH = "m4"
 """The rings reference (file ``ref-N2.nml``) is N2 on m4 (x8 along the arcs)."""
 
+STUDIES_3D: dict[str, list[tuple[str, str]]] = {
+    "hertz3d": [(f"m{k}", lay) for k in range(1, 4) for lay in ["N2", "N3", "NN2.1", "NN2.2"]]
+    + [("m4", "N2")],
+    "ironing3d": [(f"m{k}", lay) for k in range(1, 4) for lay in ["N2", "NN2.1", "NN2.2"]]
+    + [(f"m{k}", "N3") for k in range(1, 3)],
+}
+"""scene -> [(mesh, layout)] of the 3D study (``make paper3d``, docs/validation-3d.md),
+committed under cases/<scene>/ as ``python -m pre hertz3d`` and ``python -m pre ironing3d``
+write them with their defaults. Chosen so that the study runs in about 20 minutes of CPU
+on this machine: every layout on m1 to m3; N2 on hertz3d m4 too (32 s), where uniform
+order meets NN2.2 on m2; N3 on ironing3d only on m1 and m2 (m1 N3 takes 36 s of CPU
+against NN2.2's 30 s and oscillates 16 times more)."""
+
 
 def case_stem(mesh: str, layout: str) -> str:
     """File stem ``<mesh>-<layout>``."""
@@ -327,6 +340,30 @@ def write_cases(out: str | Path) -> list[Path]:
         path = out / rel
         write_text(path, to_namelist_text(groups))
         written.append(path)
+    return written + write_cases_3d(out)
+
+
+def write_cases_3d(out: str | Path) -> list[Path]:
+    """Write the 3D study's scenes (:data:`STUDIES_3D`) under ``out``: each scene's
+    ``geometry.h5`` and case namelists, by the writers of ``python -m pre hertz3d`` and
+    ``python -m pre ironing3d`` with their default values (the cases there are
+    overwritten; the geometry file is kept when its bytes are the same)."""
+    from .hertz3d import Ball, write_hertz3d
+    from .ironing3d import Iron, write_ironing3d
+
+    writers = {"hertz3d": lambda meshes, layouts, folder: write_hertz3d(Ball(), meshes, layouts, folder,
+                                                                       force=True),
+               "ironing3d": lambda meshes, layouts, folder: write_ironing3d(Iron(), meshes, layouts, folder,
+                                                                           force=True)}
+    written: list[Path] = []
+    for scene, runs in STUDIES_3D.items():
+        folder = Path(out) / scene
+        by_mesh: dict[str, list[str]] = {}
+        for mesh, layout in runs:
+            by_mesh.setdefault(mesh, []).append(layout)
+        for mesh, layouts in by_mesh.items():
+            geometry, cases, _ = writers[scene]([mesh], layouts, folder)
+            written += [p for p in (geometry, *cases) if p not in written]
     return written
 
 
