@@ -252,6 +252,10 @@ def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) 
     assert abs(fz - 0.02) < 1e-12
     assert abs(fx / fz - 0.3) < 1e-5 and abs(fy / fz) < 1e-3
     assert c["p_t"].shape == (c["p_n"].size, 3)
+    # every point carries mu p_n: GPTS exactly; mortar's interpolated control-point vectors
+    # up to their directions' spread (the transverse slip's 2e-3 of the sliding one: 6e-8)
+    ratio = np.linalg.norm(c["p_t"], axis=1) / c["p_n"]
+    assert np.all(ratio <= 0.3 * (1 + 1e-12)) and np.all(ratio >= 0.3 * (1 - 1e-6))
     with h5py.File(tmp_path / "box.h5") as f:
         assert f["steps/000006/contact/1"].attrs["method"].decode().strip() == (method or "mortar")
 
