@@ -29,7 +29,17 @@ from pathlib import Path
 import numpy as np
 
 from .ball_mesh import BallMesh, ball_octant, flat_block, flat_grid
-from .ball_pressure import NU, RADIUS, E, interpolated_points, measure, nodal_force_points, penalty_points
+from .ball_pressure import (
+    NU,
+    RADIUS,
+    E,
+    interpolated_points,
+    measure,
+    nodal_force_points,
+    penalty_nodal_points,
+    penalty_points,
+    projected_points,
+)
 from .run import Workdir
 
 UZ = -0.01
@@ -163,10 +173,12 @@ def run_kratos(py: Path, w: Workdir, mesh: BallMesh, method: str = "alm", solver
     active = np.array([r["active"] for r in res["slave"]]) & ~np.isin(ids, ball["top"])
     pts = nodal_force_points(ball["nodes"], ball["surface"], ids, fz, active)
     faces = measure(interpolated_points(ball["nodes"], ball["surface"], pts, ids), res["reaction"])
+    nodal = measure(pts, res["reaction"])
     return {"code": "kratos", "mesh": mesh.name, "method": method, "solver": solver,
             "dofs": info["dofs"], "elements": info["elements"], "wall": wall,
-            "iterations": int(sum(res["iterations"])), **measure(pts, res["reaction"]),
-            "l2_faces": faces["l2"]}
+            "iterations": int(sum(res["iterations"])), **faces, "l2_nodes": nodal["l2"],
+            "nodal_force": nodal["contact_force"],
+            "measure": "nodal force / nodal area, interpolated at the faces' points"}
 
 
 def _lines(ids, per_line: int = 12) -> list[str]:
@@ -261,10 +273,21 @@ def run_ccx(exe: str, w: Workdir, mesh: BallMesh, element: str = "C3D20R",
     faces = ball["surface"]
     if np.isnan(u[faces]).any():
         raise RuntimeError(f"ccx {stem}: displacements of slave nodes missing in the .dat")
-    pts = penalty_points(ball["nodes"], np.nan_to_num(u), faces, penalty * E / RADIUS)
-    return {"code": "ccx", "mesh": mesh.name, "method": f"{element} K {penalty:g}", "solver": "spooles",
-            "dofs": info["dofs"], "elements": info["elements"], "wall": wall,
-            "iterations": iterations(proc.stdout), **measure(pts, rf)}
+    u = np.nan_to_num(u)
+    slope = penalty * E / RADIUS
+    law = measure(penalty_points(ball["nodes"], u, faces, slope), rf)
+    out = {"code": "ccx", "mesh": mesh.name, "method": f"{element} K {penalty:g}", "solver": "spooles",
+           "dofs": info["dofs"], "elements": info["elements"], "wall": wall,
+           "iterations": iterations(proc.stdout), "l2_law": law["l2"]}
+    if faces.shape[1] != 4:  # quadratic faces: no nodal areas; the Gram matrix's nodal pressures
+        proj = projected_points(ball["nodes"], faces, penalty_points(ball["nodes"], u, faces, slope))
+        return {**out, **measure(proj, rf), "l2_nodes": float("nan"),
+                "measure": "nodal forces -> nodal pressures by the faces' Gram matrix, interpolated"}
+    pts = penalty_nodal_points(ball["nodes"], u, faces, slope)
+    nodes = np.unique(faces)
+    return {**out, **measure(interpolated_points(ball["nodes"], faces, pts, nodes), rf),
+            "l2_nodes": measure(pts, rf)["l2"],
+            "measure": "nodal force / nodal area, interpolated at the faces' points"}
 
 
 def short_name(r: dict) -> str:

@@ -16,9 +16,13 @@ conversions, one per kind of output:
 - :func:`penalty_points` (CalculiX's surface-to-surface penalty): ``K x overclosure`` at
   the Gauss points of every slave face from the nodal displacements, the law the penalty
   applies, per reference area (times the face's current over reference Jacobian).
-  Points: the Gauss points (2 x 2 on a bilinear face, 3 x 3 on a quadratic one);
-  weights: Gauss weight x reference Jacobian. This is also right for quadratic faces,
-  whose corner nodes take negative shares of a pressure.
+  Points: 3 x 3 Gauss points of every face; weights: Gauss weight x reference Jacobian.
+  This is also right for quadratic faces, whose corner nodes take negative shares of a
+  pressure. On bilinear faces (C3D8I) :func:`penalty_nodal_points` also gives the nodal
+  measure: the law's consistent nodal forces over the nodal areas, as for Kratos. On
+  quadratic faces (C3D20R) :func:`projected_points` turns the nodal forces into nodal
+  pressures with the faces' Gram matrix instead (the L2 projection of the law's pressure
+  onto the faces' shape functions).
 
 The flat is the plane z = -R (its normal +z, into the ball) and the axis the z axis
 through the contact point (0, 0, -R): r = sqrt(x^2 + y^2) of the reference position.
@@ -142,13 +146,57 @@ def interpolated_points(x: np.ndarray, faces: np.ndarray, nodal: Points, nodes: 
 def penalty_points(x: np.ndarray, u: np.ndarray, faces: np.ndarray, slope: float) -> Points:
     """CalculiX's conversion (module docstring): reference node positions ``x`` (N, 3),
     displacements ``u`` (N, 3), slave faces (F, 4 or 8), contact slope K (pressure per
-    overclosure) of the linear pressure-overclosure law against the flat z = -R."""
-    n_gauss = 2 if faces.shape[1] == 4 else 3
-    ref, jac0, _ = face_points(x, faces, n_gauss)
-    cur, jac, _ = face_points(x + u, faces, n_gauss)
-    _, w = gauss_square(n_gauss)
+    overclosure) of the linear pressure-overclosure law against the flat z = -R; at
+    3 x 3 Gauss points of every face."""
+    ref, jac0, _ = face_points(x, faces, 3)
+    cur, jac, _ = face_points(x + u, faces, 3)
+    _, w = gauss_square(3)
     p = slope * np.clip(FLAT_Z - cur[..., 2], 0.0, None) * jac / jac0
     return Points(ref.reshape(-1, 3), p.ravel(), (jac0 * w).ravel())
+
+
+def penalty_nodal_points(x: np.ndarray, u: np.ndarray, faces: np.ndarray, slope: float) -> Points:
+    """CalculiX's nodal conversion on bilinear faces: the penalty law's consistent nodal
+    forces ``f_i = integral of N_i p`` (:func:`penalty_points`' points) over the nodal
+    areas, at the faces' nodes, as :func:`nodal_force_points` for Kratos."""
+    if faces.shape[1] != 4:
+        raise ValueError("nodal forces per nodal area need bilinear faces")
+    pts = penalty_points(x, u, faces, slope)
+    _, _, N = face_points(x, faces, 3)
+    f = np.zeros(len(x))
+    np.add.at(f, faces, np.einsum("fg,gn->fn", (pts.p * pts.w).reshape(len(faces), -1), N))
+    nodes = np.unique(faces)
+    return nodal_force_points(x, faces, nodes, -f[nodes], f[nodes] > 0)
+
+
+def projected_points(x: np.ndarray, faces: np.ndarray, law: Points) -> Points:
+    """The pressure of ``law`` (at :func:`penalty_points`' 3 x 3 points of every face)
+    projected in L2 onto the faces' shape functions (``M p = f``, M the faces' Gram
+    matrix ``integral N_i N_j``, f the consistent nodal forces ``integral N_i p``) and
+    interpolated back at those points: on quadratic faces the nodal pressure that the
+    nodal forces define (a corner's N_i integrates to a negative area, so f_i / A_i,
+    the lumped form of the same system, does not exist). Only the faces with pressure at
+    a point take part (the others' nodes get none): a projection over the whole sphere
+    rings with small pressures out to its edge."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.linalg import spsolve
+    _, _, N = face_points(x, faces, 3)
+    w_all = law.w.reshape(len(faces), -1)  # (F, g): Gauss weight x reference Jacobian
+    p_all = law.p.reshape(len(faces), -1)
+    on = (p_all > 0).any(axis=1)
+    f = np.zeros(len(x))
+    np.add.at(f, faces[on], np.einsum("fg,gn->fn", p_all[on] * w_all[on], N))
+    m = np.einsum("fg,gi,gj->fij", w_all[on], N, N)
+    rows = np.repeat(faces[on][:, :, None], faces.shape[1], axis=2)
+    cols = np.repeat(faces[on][:, None, :], faces.shape[1], axis=1)
+    nodes = np.unique(faces[on])
+    index = -np.ones(len(x), dtype=int)
+    index[nodes] = np.arange(len(nodes))
+    gram = coo_matrix((m.ravel(), (index[rows].ravel(), index[cols].ravel())),
+                      shape=(len(nodes), len(nodes))).tocsc()
+    p = np.zeros(len(x))
+    p[nodes] = spsolve(gram, f[nodes])
+    return Points(law.x, np.clip(np.einsum("fn,gn->fg", p[faces], N).ravel(), 0.0, None), law.w)
 
 
 def measure(points: Points, quarter_force: float) -> dict:
