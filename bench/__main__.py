@@ -1,6 +1,6 @@
 """``python3 -m bench``: voiga performance figures, all measured in this one run.
 
-Sections (``--only 1,2,...``):
+Sections (``--only 1,2,...``; 1 to 8 unless given):
   1  time per Newton iteration by stage (hertz m3 N2 / NN2.2, ironing m1 NN2.2 short)
   2  NNp against Np on the same mesh (wall time and time per iteration)
   3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
@@ -199,7 +199,8 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", default="1,2,3,4,5,6,7,8,9", help="comma-separated sections")
+    ap.add_argument("--only", default="1,2,3,4,5,6,7,8",
+                    help="comma-separated sections (9 only when named: 15 to 30 minutes)")
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")

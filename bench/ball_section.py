@@ -172,10 +172,10 @@ def section_ball(w: Workdir, voiga_runs: str = VOIGA_RUNS, peer_runs: str = PEER
                       f"{row['ratio']:6.1f}")
             else:
                 print(head + "no voiga run this accurate")
-    print("L2: voiga's post hertz3d; the peers' nodal contact force over its nodal area, interpolated "
-          "over the faces at 3 x 3 points\n(voiga's control-point pressure p_A = force / D_A, "
-          "interpolated); C3D20R: K x overclosure at those points (no nodal\nareas: a quadratic "
-          "face's corners take negative shares); L2 nodes: at the nodes only, weights the nodal areas")
+    print("L2: voiga's post hertz3d (control-point pressures p_A = force / D_A interpolated at its "
+          "points); the peers' nodal\ncontact force over its nodal area interpolated over the faces "
+          "at 3 x 3 points (C3D20R: the penalty law's nodal\nforces turned into nodal pressures by "
+          "the faces' Gram matrix); L2 nodes: at the nodes only, weights the nodal areas")
     print("wall: the whole process, fastest of the repeats (OMP_NUM_THREADS=1; ccx also "
           "CCX_NPROC_*=1); DOFs: 3 x the ball's nodes;\nNewton: iterations over the five steps "
           "(ccx: its log's); P: the total force (4 x the quarter's)")

@@ -226,6 +226,23 @@ def test_penalty_nodal_points_of_a_uniform_overclosure() -> None:
         bpr.penalty_nodal_points(q["nodes"], np.zeros_like(q["nodes"]), q["top"], 1e4)
 
 
+def test_projected_points_keep_a_uniform_pressure() -> None:
+    """The Gram-matrix projection of a uniform pressure over part of the flat's faces (the
+    quadratic ones, whose corner shares are negative, and the bilinear ones) gives that
+    pressure back at the loaded faces' points, and none at the faces away from them."""
+    for quadratic in (False, True):
+        f = bm.flat_block(bm.flat_grid(MESH), quadratic)
+        u = np.zeros_like(f["nodes"])
+        law = bpr.penalty_points(f["nodes"], u, f["top"], 1e4)
+        centre = f["nodes"][f["top"]].mean(axis=1)
+        loaded = np.repeat(np.hypot(centre[:, 0], centre[:, 1]) < 0.1, 9)
+        law = bpr.Points(law.x, np.where(loaded, 0.07, 0.0), law.w)
+        proj = bpr.projected_points(f["nodes"], f["top"], law)
+        assert proj.p[loaded] == pytest.approx(0.07, rel=1e-9)
+        far = np.repeat(np.hypot(centre[:, 0], centre[:, 1]) > 0.25, 9)
+        assert (proj.p[far] == 0).all()
+
+
 def test_interpolated_points() -> None:
     """Nodal pressures interpolated inside the faces: a uniform one stays uniform."""
     m = bm.ball_octant(MESH, False)
