@@ -40,6 +40,8 @@ from .ball_pressure import (
     penalty_points,
     projected_points,
 )
+from .kratos import _block, _sub
+from .kratos import fix as fixed
 from .run import Workdir
 
 UZ = -0.01
@@ -48,23 +50,6 @@ CCX_PENALTY = 1e4
 """Contact slope K over E / R of the CalculiX runs: the issue's earlier runs' 1e4; the
 law's compliance p0 / K (p0 about 0.07 E) is 1e-3 of the indentation."""
 CCX_ELEMENTS = ("C3D20R", "C3D8I")
-
-
-def fixed(part: str, constrained: list[bool], value: list) -> dict:
-    return {"python_module": "assign_vector_variable_process", "kratos_module": "KratosMultiphysics",
-            "Parameters": {"model_part_name": f"Structure.{part}", "variable_name": "DISPLACEMENT",
-                           "interval": [0.0, "End"], "constrained": constrained, "value": value}}
-
-
-def _block(name: str, rows: list[str]) -> list[str]:
-    return [f"Begin {name}", *rows, f"End {name.split()[0]}"]
-
-
-def _sub(name: str, nodes=(), elems=(), conds=()) -> list[str]:
-    body = (_block("SubModelPartNodes", [str(int(i)) for i in nodes])
-            + _block("SubModelPartElements", [str(int(i)) for i in elems])
-            + _block("SubModelPartConditions", [str(int(i)) for i in conds]))
-    return [f"Begin SubModelPart {name}", *body, "End SubModelPart"]
 
 
 def kratos_model(mesh: BallMesh) -> dict:
