@@ -90,7 +90,7 @@ def write_mdpa(path: Path, mesh: BallMesh) -> dict:
 
 def kratos_parameters(stem: str, method: str, solver: str) -> dict:
     """The analysis: static, nonlinear (contact), five steps, Kratos's contact criterion."""
-    from .kratos import MORTAR, SOLVER_SETTINGS
+    from .kratos import MORTAR, analysis_settings, contact_process
     mortar, process, _ = MORTAR[method]
     props = {"model_part_name": "Structure.Ball", "properties_id": 1,
              "Material": {"constitutive_law": {"name": "LinearElastic3DLaw"},
@@ -101,20 +101,7 @@ def kratos_parameters(stem: str, method: str, solver: str) -> dict:
     return {
         "materials": {"properties": [props, flat]},
         "parameters": {
-            "problem_data": {"problem_name": stem, "parallel_type": "OpenMP", "echo_level": 0,
-                             "start_time": 0.0, "end_time": 1.0},
-            "solver_settings": {
-                "model_part_name": "Structure", "domain_size": 3, "solver_type": "Static",
-                "echo_level": 0, "analysis_type": "non_linear",
-                "model_import_settings": {"input_type": "mdpa", "input_filename": stem},
-                "material_import_settings": {"materials_filename": "materials.json"},
-                "contact_settings": {"mortar_type": mortar},
-                "time_stepping": {"time_step": 1.0 / N_STEPS},
-                "convergence_criterion": "contact_residual_criterion",
-                "displacement_relative_tolerance": 1e-6, "displacement_absolute_tolerance": 1e-12,
-                "residual_relative_tolerance": 1e-6, "residual_absolute_tolerance": 1e-12,
-                "max_iteration": 30,
-                "linear_solver_settings": {"solver_type": solver, **SOLVER_SETTINGS.get(solver, {})}},
+            **analysis_settings(stem, mortar, solver, domain_size=3, n_steps=N_STEPS),
             "processes": {
                 "constraints_process_list": [
                     fixed("Flat", [True, True, True], [0.0, 0.0, 0.0]),
@@ -122,13 +109,7 @@ def kratos_parameters(stem: str, method: str, solver: str) -> dict:
                     fixed("Y0", [False, True, False], [0.0, 0.0, 0.0]),
                     fixed("Top", [False, False, True], [0.0, 0.0, f"{UZ}*t"])],
                 "loads_process_list": [],
-                "contact_process_list": [{
-                    "python_module": process,
-                    "kratos_module": "KratosMultiphysics.ContactStructuralMechanicsApplication",
-                    "Parameters": {"model_part_name": "Structure",
-                                   "contact_model_part": {"0": ["Slave", "Master"]},
-                                   "assume_master_slave": {"0": ["Slave"]},
-                                   "contact_type": "Frictionless"}}]},
+                "contact_process_list": [contact_process(process)]},
             "output_processes": {}}}
 
 
@@ -211,29 +192,14 @@ def write_ccx(path: Path, mesh: BallMesh, element: str, penalty: float = CCX_PEN
 def parse_dat(path: Path, n_nodes: int) -> tuple[np.ndarray, float]:
     """The last printed displacements (N, 3; NaN where not printed) and the last total
     force along z of the top face."""
+    from .ccx_sphere import dat_tables
     u = np.full((n_nodes, 3), np.nan)
-    rf = float("nan")
-    mode = None
-    for line in path.read_text().splitlines():
-        s = line.strip()
-        if s.startswith("displacements"):
-            mode = "u"
-            continue
-        if s.startswith("total force"):
-            mode = "rf"
-            continue
-        parts = s.split()
-        if not parts:
-            continue
-        try:
-            vals = [float(v) for v in parts]
-        except ValueError:
-            mode = None
-            continue
-        if mode == "u" and len(vals) == 4 and int(vals[0]) <= n_nodes:
+    tables = dat_tables(path, ("displacements", "total force"))
+    for vals in tables["displacements"]:
+        if len(vals) == 4 and int(vals[0]) <= n_nodes:
             u[int(vals[0]) - 1] = vals[1:]
-        elif mode == "rf" and len(vals) >= 3:
-            rf = vals[2]
+    totals = [v for v in tables["total force"] if len(v) >= 3]
+    rf = totals[-1][2] if totals else float("nan")
     return u, rf
 
 
