@@ -29,10 +29,14 @@ from .run import ROOT, Run, Workdir, header, solve
 
 VOIGA_RUNS = "m1:N2,m2:N2,m3:N2,m1:NN2.2,m2:NN2.2,m3:NN2.2"
 PEER_RUNS = ("kratos:alm:amgcl:6x4x3x5,kratos:alm:amgcl:8x5x3x6,kratos:alm:amgcl:12x6x4x8,"
-             "kratos:alm:amgcl:16x8x5x10,ccx:C3D20R:4x3x2x3,ccx:C3D20R:6x4x3x5,ccx:C3D8I:8x5x3x6,ccx:C3D8I:12x6x4x8")
+             "kratos:alm:amgcl:16x8x5x10,ccx:C3D20R:4x3x2x3:1e3,ccx:C3D20R:6x4x3x5:1e3,ccx:C3D8I:8x5x3x6,"
+             "ccx:C3D8I:12x6x4x8")
 """The peers' default runs: four Kratos meshes (4,212 to 37,350 DOFs), CalculiX's C3D20R
 on two (5,190 and 15,846) and C3D8I on two (7,338 and 17,631): each within a few minutes
-on one thread (C3D20R 6x4x3x5 is the slowest: 42 Newton iterations of SPOOLES). The
+on one thread. C3D20R with the contact slope 1e3 E/R, C3D8I with 1e4 (each the better of
+the two: C3D20R 6x4x3x5 6.5 % at 1e3 against 10.8 % at 1e4, its faces' pressure
+alternating from node to node under the stiffer law; C3D8I 8x5x3x6 9.6 % at 1e3, 9.3 %
+at 1e4, 9.2 % at 1e5 in 1.4 times the time, docs/performance-solids.md). The
 syntax: code:method:solver:mesh (Kratos: alm or penalty, amgcl or sparse_lu) and
 code:element:mesh[:penalty] (CalculiX); meshes :class:`bench.ball_mesh.BallMesh`."""
 
