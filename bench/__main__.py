@@ -1,6 +1,6 @@
 """``python3 -m bench``: voiga performance figures, all measured in this one run.
 
-Sections (``--only 1,2,...``):
+Sections (``--only 1,2,...``; 1 to 8 unless given):
   1  time per Newton iteration by stage (hertz m3 N2 / NN2.2, ironing m1 NN2.2 short)
   2  NNp against Np on the same mesh (wall time and time per iteration)
   3  NN2.2 against N2 at comparable accuracy on hertz (wall time, Hertz errors)
@@ -14,6 +14,10 @@ Sections (``--only 1,2,...``):
   8  voiga on the same shell (exact NURBS octant, degrees 2-4), and with section 7 in the
      same run: each CalculiX run against the fastest voiga run at its stress error or
      below, the pair re-timed interleaved
+  9  the 3D Hertz sphere in one run: voiga (pre hertz3d, N2 / NN2.2), Kratos (3D mortar,
+     trilinear hexahedra; skipped if pip cannot install it) and CalculiX (C3D20R, C3D8I,
+     surface-to-surface penalty), the same L2 of the nominal pressure for all, the runs
+     interleaved; every peer run against the fastest voiga run at equal or better error
 
 Runs go to a scratch directory (default build/bench); every ratio compares runs made
 here, interleaved and best of --repeat, never against figures from another run.
@@ -195,7 +199,8 @@ def section_scaling(w: Workdir, repeat: int, levels: int, solvers: list[str],
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m bench", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", default="1,2,3,4,5,6,7,8", help="comma-separated sections")
+    ap.add_argument("--only", default="1,2,3,4,5,6,7,8",
+                    help="comma-separated sections (9 only when named: 15 to 30 minutes)")
     ap.add_argument("--repeat", type=int, default=2, help="runs per small case (best taken)")
     ap.add_argument("--levels", type=int, default=7,
                     help="largest hertz mesh of section 4 (m7 ~ 1.1e5 DOFs, m8 ~ 4.4e5)")
@@ -232,6 +237,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sphere-voiga-meshes", default=None,
                     help="section 8: p:n per run, degree p and n elements per direction "
                          "(default bench.voiga_sphere.MESHES)")
+    ap.add_argument("--ball-voiga", default=None,
+                    help="section 9: voiga's mesh:layout runs (default bench.ball_section.VOIGA_RUNS)")
+    ap.add_argument("--ball-peers", default=None,
+                    help="section 9: kratos:alm|penalty:SOLVER:MESH and ccx:C3D20R|C3D8I:MESH[:PENALTY] "
+                         "runs, MESH fine x rest x outer x radial (default bench.ball_section.PEER_RUNS)")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
     only = {s.strip() for s in args.only.split(",")}
@@ -270,6 +280,10 @@ def main(argv: list[str] | None = None) -> int:
         from .voiga_sphere import section_voiga_sphere
         figures["sphere_voiga"] = section_voiga_sphere(w, args.sphere_voiga_meshes or VOIGA_MESHES,
                                                        figures.get("sphere_calculix"), args.repeat)
+    if "9" in only:
+        from .ball_section import PEER_RUNS, VOIGA_RUNS, section_ball
+        figures["hertz3d"] = section_ball(w, args.ball_voiga or VOIGA_RUNS, args.ball_peers or PEER_RUNS,
+                                          args.repeat)
     total = time.perf_counter() - t0
     print(f"\nbench: done in {total:.0f} s")
     path = args.json or (w.path / "bench.json")

@@ -248,20 +248,17 @@ def write_input(path: Path, mesh: dict, shell: LameShell = SHELL, solver: str = 
     path.write_text("\n".join(out) + "\n")
 
 
-def parse_dat(path: Path, n_nodes: int, n_elements: int) -> tuple[np.ndarray, np.ndarray]:
-    """The last step's nodal displacements (n_nodes, 3) and integration-point stresses
-    (n_elements, 8, 3, 3) of a .dat written by :func:`write_input`'s *NODE PRINT and
-    *EL PRINT (stresses in the order xx, yy, zz, xy, xz, yz)."""
-    u = np.full((n_nodes, 3), np.nan)
-    s = np.full((n_elements, 8, 6), np.nan)
+def dat_tables(path: Path, heads: tuple[str, ...]) -> dict[str, list[list[float]]]:
+    """The rows of numbers under each block of a ccx .dat whose title starts with one of
+    ``heads`` ("displacements", "stresses", "total force", ...), the blocks of one title
+    merged in order (a later increment's row of a node comes after the earlier ones)."""
+    rows: dict[str, list[list[float]]] = {h: [] for h in heads}
     mode = None
     for line in path.read_text().splitlines():
         head = line.strip()
-        if head.startswith("displacements"):
-            mode = "u"
-            continue
-        if head.startswith("stresses"):
-            mode = "s"
+        title = next((h for h in heads if head.startswith(h)), None)
+        if title is not None:
+            mode = title
             continue
         parts = head.split()
         if not parts:
@@ -271,9 +268,23 @@ def parse_dat(path: Path, n_nodes: int, n_elements: int) -> tuple[np.ndarray, np
         except ValueError:
             mode = None
             continue
-        if mode == "u" and len(vals) == 4:
+        if mode is not None:
+            rows[mode].append(vals)
+    return rows
+
+
+def parse_dat(path: Path, n_nodes: int, n_elements: int) -> tuple[np.ndarray, np.ndarray]:
+    """The last step's nodal displacements (n_nodes, 3) and integration-point stresses
+    (n_elements, 8, 3, 3) of a .dat written by :func:`write_input`'s *NODE PRINT and
+    *EL PRINT (stresses in the order xx, yy, zz, xy, xz, yz)."""
+    u = np.full((n_nodes, 3), np.nan)
+    s = np.full((n_elements, 8, 6), np.nan)
+    tables = dat_tables(path, ("displacements", "stresses"))
+    for vals in tables["displacements"]:
+        if len(vals) == 4:
             u[int(vals[0]) - 1] = vals[1:]
-        elif mode == "s" and len(vals) == 8:
+    for vals in tables["stresses"]:
+        if len(vals) == 8:
             s[int(vals[0]) - 1, int(vals[1]) - 1] = vals[2:]
     if np.isnan(u).any() or np.isnan(s).any():
         raise ValueError(f"{path}: incomplete displacements or stresses")

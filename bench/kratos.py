@@ -193,38 +193,52 @@ at 1e-10 (234 s), where sparse_lu gives 0.66 %; on m5 x2 and m6 x1 it agrees wit
 sparse_lu to 2e-6."""
 
 
-def parameters(stem: str, method: str, stiffness: float, solver: str) -> dict:
-    mortar, process, _ = MORTAR[method]
+def analysis_settings(stem: str, mortar: str, solver: str, domain_size: int = 2,
+                      n_steps: int = N_STEPS) -> dict:
+    """``problem_data`` and ``solver_settings`` of a static contact analysis of
+    ``n_steps`` steps over t = 0 to 1 (shared by section 6 and the 3D sphere's section 9):
+    Kratos's contact residual criterion, tolerances 1e-6 relative, 1e-12 absolute."""
     return {
         "problem_data": {"problem_name": stem, "parallel_type": "OpenMP", "echo_level": 0,
                          "start_time": 0.0, "end_time": 1.0},
         "solver_settings": {
-            "model_part_name": "Structure", "domain_size": 2, "solver_type": "Static",
+            "model_part_name": "Structure", "domain_size": domain_size, "solver_type": "Static",
             "echo_level": 0, "analysis_type": "non_linear",
             "model_import_settings": {"input_type": "mdpa", "input_filename": stem},
             "material_import_settings": {"materials_filename": "materials.json"},
             "contact_settings": {"mortar_type": mortar},
-            "time_stepping": {"time_step": 1.0 / N_STEPS},
+            "time_stepping": {"time_step": 1.0 / n_steps},
             "convergence_criterion": "contact_residual_criterion",
             "displacement_relative_tolerance": 1e-6, "displacement_absolute_tolerance": 1e-12,
             "residual_relative_tolerance": 1e-6, "residual_absolute_tolerance": 1e-12,
             "max_iteration": 30,
             "linear_solver_settings": {"solver_type": solver,
-                                       **SOLVER_SETTINGS.get(solver, {})}},
+                                       **SOLVER_SETTINGS.get(solver, {})}}}
+
+
+def contact_process(process: str, **extra) -> dict:
+    """Frictionless mortar contact of the sub-model parts Slave (the slave) and Master;
+    ``extra``: more of the process's parameters."""
+    return {"python_module": process,
+            "kratos_module": "KratosMultiphysics.ContactStructuralMechanicsApplication",
+            "Parameters": {"model_part_name": "Structure",
+                           "contact_model_part": {"0": ["Slave", "Master"]},
+                           "assume_master_slave": {"0": ["Slave"]},
+                           "contact_type": "Frictionless", **extra}}
+
+
+def parameters(stem: str, method: str, stiffness: float, solver: str) -> dict:
+    mortar, process, _ = MORTAR[method]
+    return {
+        **analysis_settings(stem, mortar, solver),
         "processes": {
             "constraints_process_list": [
                 fix("Block", [True, True, True], [0.0, 0.0, 0.0]),
                 fix("Symmetry", [True, False, True], [0.0, 0.0, 0.0]),
                 fix("Top", [False, True, True], [0.0, f"{UY}*t", 0.0])],
             "loads_process_list": [],
-            "contact_process_list": [{
-                "python_module": process,
-                "kratos_module": "KratosMultiphysics.ContactStructuralMechanicsApplication",
-                "Parameters": {"model_part_name": "Structure",
-                               "contact_model_part": {"0": ["Slave", "Master"]},
-                               "assume_master_slave": {"0": ["Slave"]},
-                               "contact_type": "Frictionless",
-                               "advance_ALM_parameters": {"stiffness_factor": stiffness}}}]},
+            "contact_process_list": [contact_process(
+                process, advance_ALM_parameters={"stiffness_factor": stiffness})]},
         "output_processes": {}}
 
 

@@ -4,10 +4,12 @@ This file is executed by the Python of Kratos's own virtual environment
 (build/kratos-venv), not imported by the bench: it needs only KratosMultiphysics and the
 standard library. ``python kratos_driver.py job.json`` reads the analysis parameters
 (``parameters``) and the node ids to report (``slave_nodes``, ``top_nodes``) from the job
-file, runs the analysis in the job's directory and writes ``result.json`` there: the
-reference coordinates, displacements and contact variables of the slave nodes, the total
-reaction on the top cut, the Newton iterations per step and the seconds spent in the
-analysis (import and set-up excluded).
+file (``dimension``: 2, the default, or 3 for the sphere of section 9; ``reaction``: the
+variable summed over the top nodes, REACTION_Y unless given), runs the analysis in the
+job's directory and writes ``result.json`` there: the reference coordinates,
+displacements and contact variables of the slave nodes, the total reaction on the top
+cut, the Newton iterations per step and the seconds spent in the analysis (import and
+set-up excluded).
 """
 
 from __future__ import annotations
@@ -56,15 +58,18 @@ def main(job_path: str) -> int:
     analysis.Run()
     seconds = time.perf_counter() - t0
     part = model["Structure"]
+    dim = int(job.get("dimension", 2))
     slave = []
     for i in job["slave_nodes"]:
         n = part.GetNode(i)
         row = {"id": i, "x0": n.X0, "y0": n.Y0,
                "ux": n.GetSolutionStepValue(KM.DISPLACEMENT_X),
                "uy": n.GetSolutionStepValue(KM.DISPLACEMENT_Y), "active": n.Is(KM.ACTIVE)}
+        if dim == 3:
+            row.update(z0=n.Z0, uz=n.GetSolutionStepValue(KM.DISPLACEMENT_Z))
         for name in job["contact_variables"]:
             row[name] = nodal(n, name)
-        row["force"] = [0.0, 0.0]
+        row["force"] = [0.0] * dim
         slave.append(row)
     # nodal forces of the elements on the slave nodes (the contact force they balance)
     index = {r["id"]: r for r in slave}
@@ -76,12 +81,13 @@ def main(job_path: str) -> int:
         elem.CalculateRightHandSide(rhs, part.ProcessInfo)
         for k, i in enumerate(ids):
             if i in index:
-                index[i]["force"][0] += rhs[2 * k]
-                index[i]["force"][1] += rhs[2 * k + 1]
-    reaction = sum(part.GetNode(i).GetSolutionStepValue(KM.REACTION_Y) for i in job["top_nodes"])
+                for c in range(dim):
+                    index[i]["force"][c] += rhs[dim * k + c]
+    var = KM.KratosGlobals.GetVariable(job.get("reaction", "REACTION_Y"))
+    reaction = sum(part.GetNode(i).GetSolutionStepValue(var) for i in job["top_nodes"])
     info = part.ProcessInfo
     out = {"initial_penalty": info[KM.INITIAL_PENALTY], "scale_factor": info[KM.SCALE_FACTOR],
-           "seconds": seconds, "iterations": analysis.iterations, "reaction_y": reaction,
+           "seconds": seconds, "iterations": analysis.iterations, "reaction_y": reaction, "reaction": reaction,
            "slave": slave, "time": part.ProcessInfo[KM.TIME]}
     (Path(job_path).parent / "result.json").write_text(json.dumps(out))
     return 0
