@@ -14,6 +14,7 @@
 !> - the master cells its image can touch: those of the projections of 3 x 3 points
 !>   of the cell, one cell more on each side, and a ghost cell beyond each edge of
 !>   the master that range reaches (the part of the slave cell that sees no master);
+!>   a cell farther from the master than it is wide is not cut;
 !> - each master node (breakpoint pair) mapped into the slave cell's parameters where
 !>   the master's normal line through it meets the slave cell's surface (its
 !>   polynomial piece, continued beyond the cell): the closest-point projection
@@ -215,10 +216,11 @@ contains
         real(dp), allocatable :: p(:, :, :), poly(:, :)
         real(dp) :: area, total, cell_area
         integer :: rng(2, 2), i, j, k, n_pieces
-        logical :: ok
+        logical :: ok, far
         pcs%whole = .true.
         allocate (pcs%tri(2, 3, 0))
-        rng = master_range(m, u, slave, span, lo, hi)
+        call master_range(m, u, slave, span, lo, hi, rng, far)
+        if (far) return
         call mapped_nodes(m, slave, span, lo, hi, rng, p, ok)
         if (.not. ok) return
         cell_area = product(hi - lo)
@@ -243,23 +245,30 @@ contains
         pcs%whole = n_pieces <= 1 .or. abs(total - cell_area) > tile_tol*cell_area
     end function cell_pieces
 
-    !> The master cells [first, last] per direction [2 (first, last), 2 (u, v)] the
-    !> slave cell can touch: those of the projections of 3 x 3 points of it, one more on
-    !> each side, and the ghost cell (0 or the number of cells + 1) beyond a master edge
-    !> that range reaches.
-    pure function master_range(m, u, slave, span, lo, hi) result(rng)
+    !> The master cells [first, last] per direction `rng` [2 (first, last), 2 (u, v)]
+    !> the slave cell can touch: those of the projections of 3 x 3 points of it, one
+    !> more on each side, and the ghost cell (0 or the number of cells + 1) beyond a
+    !> master edge that range reaches. `far`: every point is farther from the master
+    !> than the points' box is wide (as the pattern's ranges count a point near): the
+    !> cell keeps the tensor rule until a converged state finds it near (cutting a cell
+    !> far from the master costs the mapping of every master node its wide range holds).
+    pure subroutine master_range(m, u, slave, span, lo, hi, rng, far)
         class(face_master_t), intent(in) :: m
         real(dp), intent(in) :: u(:), lo(2), hi(2)
         type(nurbs_patch_t), intent(in) :: slave
         integer, intent(in) :: span(2)
-        integer :: rng(2, 2)
+        integer, intent(out) :: rng(2, 2)
+        logical, intent(out) :: far
         type(master_point_t) :: mp
-        real(dp) :: x(3), d1(3, 2), d2(3, 3)
+        real(dp) :: x(3), d1(3, 2), d2(3, 3), xlo(3), xhi(3), nearest
         integer :: a, b, c(2), n(2)
         logical :: found, converged
         n = [size(m%search%breaks_u), size(m%search%breaks_v)] - 1
         rng(1, :) = huge(1)
         rng(2, :) = -huge(1)
+        xlo = huge(1.0_dp)
+        xhi = -huge(1.0_dp)
+        nearest = huge(1.0_dp)
         do b = 0, 2
             do a = 0, 2
                 call surface_derivatives(slave, lo + 0.5_dp*[a, b]*(hi - lo), span, x, d1, d2)
@@ -267,13 +276,17 @@ contains
                 c = [cell_of(m%search%breaks_u, mp%xi), cell_of(m%search%breaks_v, mp%eta)]
                 rng(1, :) = min(rng(1, :), c)
                 rng(2, :) = max(rng(2, :), c)
+                xlo = min(xlo, x)
+                xhi = max(xhi, x)
+                nearest = min(nearest, norm2(x - mp%x))
             end do
         end do
+        far = nearest > norm2(xhi - xlo)
         rng(1, :) = max(1, rng(1, :) - 1)
         rng(2, :) = min(n, rng(2, :) + 1)
         where (rng(1, :) == 1) rng(1, :) = 0
         where (rng(2, :) == n) rng(2, :) = n + 1
-    end function master_range
+    end subroutine master_range
 
     !> The cell (1 .. size(breaks) - 1) holding `t` (clamped).
     pure integer function cell_of(breaks, t) result(i)
