@@ -13,6 +13,7 @@ module test_contact_3d
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_master_face, only: rigid_surface_t, face_master_t
     use voiga_contact_segment_faces, only: segment_face_pair_t, default_face_segment_points
+    use voiga_contact_pair, only: history_item_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
@@ -42,6 +43,7 @@ contains
                     new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
                     new_unittest('segment_faces_pieces', test_segment_pieces), &
                     new_unittest('segment_faces_tangent_fd_curved', test_segment_curved), &
+                    new_unittest('segment_faces_history', test_segment_history), &
                     new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
                     new_unittest('rigid_surface_flat_is_the_plane', test_flat_surface), &
                     new_unittest('rigid_surface_tangent_fd', test_surface_fd), &
@@ -388,6 +390,55 @@ contains
             call check(error, .false., 'a segment pair on faces')
         end select
     end subroutine test_segment_pieces
+
+    !> Segment on faces, a restart: the points of a pair segmented at a perturbed state
+    !> (`history`) set on a pair fresh from the reference state (`set_history`) give it
+    !> the same points, weights and cells; a history with a point outside its cell is
+    !> refused.
+    subroutine test_segment_history(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: refused
+        type(model_t) :: a, b
+        type(lcg_t) :: rng
+        type(history_item_t), allocatable :: items(:)
+        real(dp), allocatable :: u(:), r(:)
+        integer :: j, i
+        call pressed_blocks('segment', 0, a, error)
+        if (allocated(error)) return
+        call pressed_blocks('segment', 0, b, error)
+        if (allocated(error)) return
+        allocate (u(a%ndof), r(a%ndof), source=0.0_dp)
+        do j = 1, size(u)
+            u(j) = 2.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+        end do
+        call a%pairs(1)%pair%evaluate(u, r, error)
+        if (allocated(error)) return
+        call a%pairs(1)%pair%commit()
+        items = a%pairs(1)%pair%history()
+        call b%pairs(1)%pair%set_history(items, error)
+        if (allocated(error)) return
+        select type (pa => a%pairs(1)%pair)
+        type is (segment_face_pair_t)
+            select type (pb => b%pairs(1)%pair)
+            type is (segment_face_pair_t)
+                call check(error, size(pb%xi) == size(pa%xi) .and. size(pa%xi) /= 6*pa%n_gauss**2, &
+                           'the segmented number of points')
+                if (allocated(error)) return
+                call check(error, all(pb%xi == pa%xi) .and. all(pb%eta == pa%eta) .and. all(pb%w == pa%w) .and. &
+                           all(pb%elem == pa%elem) .and. all(pb%first == pa%first), 'the same points')
+                if (allocated(error)) return
+                call check(error, size(pb%out) == size(pa%xi) .and. size(pb%point_nodes, 2) == size(pa%xi), &
+                           'output and multiplier basis per point')
+                if (allocated(error)) return
+            end select
+        end select
+        i = findloc([(items(j)%name == 'point_eta', j=1, size(items))], .true., dim=1)
+        items(i)%values(1) = 2.0_dp
+        call b%pairs(1)%pair%set_history(items, refused)
+        call check(error, allocated(refused), 'a point outside its cell is refused')
+        if (allocated(error)) return
+        call check(error, index(refused%message, 'outside its cell') > 0, 'the message names it: '//refused%message)
+    end subroutine test_segment_history
 
     !> The master cell (i, j) of the parameters (xi, eta).
     pure function master_cell(m, xi, eta) result(cell)
