@@ -41,11 +41,10 @@ module voiga_contact_segment_faces
     use voiga_element_quadrature, only: gauss_legendre
     use voiga_nurbs_patch, only: nurbs_patch_t, knots_t, new_patch, cross
     use voiga_nurbs_projection, only: surface_derivatives
-    use voiga_contact_surface, only: contact_surface_t, face_basis, face_ids, n_elements
+    use voiga_contact_surface, only: contact_surface_t, surface_point_t, face_basis, face_ids, n_elements
     use voiga_contact_master, only: master_point_t
     use voiga_contact_master_face, only: face_master_t
     use voiga_contact_pair, only: history_item_t
-    use voiga_contact_surface, only: surface_point_t
     use voiga_contact_history, only: flag_value
     use voiga_contact_segment, only: segment_pair_t, interpolated_output
     implicit none
@@ -337,11 +336,13 @@ contains
         end do
     end subroutine mapped_nodes
 
-    !> The point `reach` beyond `edge` on the ray from `inner` through it.
+    !> The point `reach` beyond `edge` on the ray from `inner` through it (`edge` if
+    !> they coincide: a collapsed master edge; its ghost has no area).
     pure function beyond(edge, inner, reach) result(q)
         real(dp), intent(in) :: edge(2), inner(2), reach
         real(dp) :: q(2)
-        q = edge + reach*(edge - inner)/norm2(edge - inner)
+        q = edge
+        if (norm2(edge - inner) > 0.0_dp) q = edge + reach*(edge - inner)/norm2(edge - inner)
     end function beyond
 
     !> The parameters `s` [2] where the line x + t n meets the slave cell's surface
