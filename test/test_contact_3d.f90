@@ -12,7 +12,9 @@ module test_contact_3d
     use voiga_contact_law, only: contact_law_t, control_point_law3, state_stick, state_slip
     use voiga_contact_gpts, only: gpts_pair_t
     use voiga_contact_mortar, only: mortar_pair_t
-    use voiga_contact_master_face, only: rigid_surface_t
+    use voiga_contact_master_face, only: rigid_surface_t, face_master_t
+    use voiga_contact_segment_faces, only: segment_face_pair_t, default_face_segment_points
+    use voiga_contact_pair, only: history_item_t
     use voiga_contact_master_rigid, only: rigid_line_t, new_rigid_line
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: ring_block, layout3, scene_t, scene_model, body_settings, lcg_t
@@ -40,6 +42,9 @@ contains
         testsuite = [ &
                     new_unittest('contact_3d_tangent_fd', test_tangent_fd), &
                     new_unittest('contact_3d_tangent_fd_deformable', test_tangent_fd_deformable), &
+                    new_unittest('segment_faces_pieces', test_segment_pieces), &
+                    new_unittest('segment_faces_tangent_fd_curved', test_segment_curved), &
+                    new_unittest('segment_faces_history', test_segment_history), &
                     new_unittest('contact_3d_friction_tangent_fd', test_friction_fd), &
                     new_unittest('contact_3d_mortar_friction_fd', test_mortar_friction_fd), &
                     new_unittest('contact_3d_mortar_friction_fd_deformable', test_mortar_friction_fd_deformable), &
@@ -110,10 +115,11 @@ contains
     !> Two blocks, the upper one's bottom face (slave) pressed 0.02 into the lower
     !> one's top face (master), non-matching, at a perturbed state (every DOF moved by
     !> up to 2e-3, so both faces are curved and the master's tangents and curvature
-    !> enter): K of the pair against central differences, GPTS and mortar, N2 and NN3.
+    !> enter): K of the pair against central differences, GPTS, mortar and segment (on
+    !> the reference state's segments), N2 and NN3.
     subroutine test_tangent_fd_deformable(error)
         type(error_t), allocatable, intent(out) :: error
-        character(len=6), parameter :: methods(2) = [character(len=6) :: 'gpts', 'mortar']
+        character(len=7), parameter :: methods(3) = [character(len=7) :: 'gpts', 'mortar', 'segment']
         type(scene_t) :: c
         type(discretization_t) :: discs(2)
         type(contact_settings_t) :: contact
@@ -121,7 +127,7 @@ contains
         type(lcg_t) :: rng
         real(dp), allocatable :: u(:)
         integer :: im, iq, j
-        do im = 1, 2
+        do im = 1, size(methods)
             do iq = 0, 3, 3
                 c%bodies = [body_settings('upper', 'linear', 1.0_dp, layout3(2, [2, 2, 1], iq, 0, 'bottom')), &
                             body_settings('lower', 'linear', 1.0_dp, layout3(2, [3, 2, 1], 0, 0, 'top'))]
@@ -455,6 +461,189 @@ contains
             call check(error, .not. surface, 'the surface was asked for, not the plane')
         end select
     end subroutine box_on_rigid
+
+    !> The upper block (2 x 2 cells, layer `iq`) pressed 0.02 into the lower one (3 x 2
+    !> cells), non-matching, with `method`.
+    subroutine pressed_blocks(method, iq, model, error)
+        character(len=*), intent(in) :: method
+        integer, intent(in) :: iq
+        type(model_t), intent(out) :: model
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_t) :: c
+        type(discretization_t) :: discs(2)
+        type(contact_settings_t) :: contact
+        c%bodies = [body_settings('upper', 'linear', 1.0_dp, layout3(2, [2, 2, 1], iq, 0, 'bottom')), &
+                    body_settings('lower', 'linear', 1.0_dp, layout3(2, [3, 2, 1], 0, 0, 'top'))]
+        contact%slave = 'upper'
+        contact%master = 'lower'
+        contact%method = method
+        c%contact = [contact]
+        call new_discretization(discs(1), unit_box(-0.02_dp), box_faces, c%bodies(1)%layout, '', error)
+        if (allocated(error)) return
+        call new_discretization(discs(2), unit_box(-1.0_dp), box_faces, c%bodies(2)%layout, '', error)
+        if (allocated(error)) return
+        call scene_model(c, discs, model, error)
+    end subroutine pressed_blocks
+
+    !> Segment on faces, the flat pressed blocks: the default points per direction
+    !> (exact for N_A N_B: 5 for degree 2 on both), every slave cell's weights add up to
+    !> its parameter area (its pieces tile it), the cells cut by the master's cell
+    !> boundaries have more points than n_gauss^2, and the n_gauss^2 points of each
+    !> triangle (or whole cell) project into one master cell: no master kink inside
+    !> a piece.
+    subroutine test_segment_pieces(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        real(dp), allocatable :: u(:), r(:)
+        integer :: e, k, k0, ng, nu, n_split, cell(2), cell0(2)
+        call pressed_blocks('segment', 0, model, error)
+        if (allocated(error)) return
+        allocate (u(model%ndof), r(model%ndof), source=0.0_dp)
+        call model%pairs(1)%pair%evaluate(u, r, error)
+        if (allocated(error)) return
+        select type (pair => model%pairs(1)%pair)
+        type is (segment_face_pair_t)
+            select type (m => pair%master)
+            class is (face_master_t)
+                ng = pair%n_gauss
+                call check(error, ng, default_face_segment_points([2, 2], [2, 2]), 'default points per direction')
+                if (allocated(error)) return
+                call check(error, ng, 5, 'default points per direction for degree 2')
+                if (allocated(error)) return
+                nu = size(pair%slave%spans)
+                n_split = 0
+                do e = 1, size(pair%first) - 1
+                    associate (rng => pair%point_range(e), ci => modulo(e - 1, nu) + 1, cj => (e - 1)/nu + 1)
+                        ! the weights: the cell's parameter area to round-off (1e-13)
+                        call check(error, sum(pair%w(rng(1):rng(2))), &
+                                   (pair%slave%breaks(ci + 1) - pair%slave%breaks(ci))* &
+                                   (pair%slave%breaks_eta(cj + 1) - pair%slave%breaks_eta(cj)), &
+                                   'cell '//str(e)//': the pieces tile it', rel=1.0e-13_dp)
+                        if (allocated(error)) return
+                        call check(error, mod(rng(2) - rng(1) + 1, ng*ng), 0, 'n_gauss^2 points per piece')
+                        if (allocated(error)) return
+                        if (rng(2) - rng(1) + 1 > ng*ng) n_split = n_split + 1
+                        do k0 = rng(1), rng(2), ng*ng
+                            cell0 = master_cell(m, pair%out(k0)%xi_m, pair%out(k0)%eta_m)
+                            do k = k0 + 1, k0 + ng*ng - 1
+                                cell = master_cell(m, pair%out(k)%xi_m, pair%out(k)%eta_m)
+                                call check(error, all(cell == cell0), 'cell '//str(e)//', point '//str(k)// &
+                                           ': the points of a piece project into one master cell')
+                                if (allocated(error)) return
+                            end do
+                        end do
+                    end associate
+                end do
+                ! 2 x 2 on 3 x 2: the master's boundary at x = 1/3 crosses slave cell 1, 2/3 cell 2
+                call check(error, n_split, size(pair%first) - 1, 'every slave cell is cut')
+            end select
+        class default
+            call check(error, .false., 'a segment pair on faces')
+        end select
+    end subroutine test_segment_pieces
+
+    !> Segment on faces, a restart: the points of a pair segmented at a perturbed state
+    !> (`history`) set on a pair fresh from the reference state (`set_history`) give it
+    !> the same points, weights and cells; a history with a point outside its cell is
+    !> refused.
+    subroutine test_segment_history(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: refused
+        type(model_t) :: a, b
+        type(lcg_t) :: rng
+        type(history_item_t), allocatable :: items(:)
+        real(dp), allocatable :: u(:), r(:)
+        integer :: j, i
+        call pressed_blocks('segment', 0, a, error)
+        if (allocated(error)) return
+        call pressed_blocks('segment', 0, b, error)
+        if (allocated(error)) return
+        allocate (u(a%ndof), r(a%ndof), source=0.0_dp)
+        do j = 1, size(u)
+            u(j) = 2.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+        end do
+        call a%pairs(1)%pair%evaluate(u, r, error)
+        if (allocated(error)) return
+        call a%pairs(1)%pair%commit()
+        items = a%pairs(1)%pair%history()
+        call b%pairs(1)%pair%set_history(items, error)
+        if (allocated(error)) return
+        select type (pa => a%pairs(1)%pair)
+        type is (segment_face_pair_t)
+            select type (pb => b%pairs(1)%pair)
+            type is (segment_face_pair_t)
+                call check(error, size(pb%xi) == size(pa%xi) .and. size(pa%xi) /= 6*pa%n_gauss**2, &
+                           'the segmented number of points')
+                if (allocated(error)) return
+                call check(error, all(pb%xi == pa%xi) .and. all(pb%eta == pa%eta) .and. all(pb%w == pa%w) .and. &
+                           all(pb%elem == pa%elem) .and. all(pb%first == pa%first), 'the same points')
+                if (allocated(error)) return
+                call check(error, size(pb%out) == size(pa%xi) .and. size(pb%point_nodes, 2) == size(pa%xi), &
+                           'output and multiplier basis per point')
+                if (allocated(error)) return
+            end select
+        end select
+        i = findloc([(items(j)%name == 'point_eta', j=1, size(items))], .true., dim=1)
+        items(i)%values(1) = 2.0_dp
+        call b%pairs(1)%pair%set_history(items, refused)
+        call check(error, allocated(refused), 'a point outside its cell is refused')
+        if (allocated(error)) return
+        call check(error, index(refused%message, 'outside its cell') > 0, 'the message names it: '//refused%message)
+    end subroutine test_segment_history
+
+    !> The master cell (i, j) of the parameters (xi, eta).
+    pure function master_cell(m, xi, eta) result(cell)
+        type(face_master_t), intent(in) :: m
+        real(dp), intent(in) :: xi, eta
+        integer :: cell(2)
+        cell = [count(m%search%breaks_u(2:size(m%search%breaks_u) - 1) <= xi) + 1, &
+                count(m%search%breaks_v(2:size(m%search%breaks_v) - 1) <= eta) + 1]
+    end function master_cell
+
+    !> Segment on curved faces: the pressed blocks at a perturbed state (every DOF moved
+    !> by up to 2e-3), segmented there (a commit after an evaluation), N2 and NN3 on the
+    !> slave: the pieces still tile every cell, and K of the pair against central
+    !> differences on those points.
+    subroutine test_segment_curved(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(model_t) :: model
+        type(lcg_t) :: rng
+        real(dp), allocatable :: u(:), r(:)
+        real(dp) :: total, area
+        integer :: iq, j, e
+        do iq = 0, 3, 3
+            call pressed_blocks('segment', iq, model, error)
+            if (allocated(error)) return
+            allocate (u(model%ndof), r(model%ndof), source=0.0_dp)
+            do j = 1, size(u)
+                u(j) = 2.0e-3_dp*(2.0_dp*rng%uniform() - 1.0_dp)
+            end do
+            call model%pairs(1)%pair%evaluate(u, r, error)
+            if (allocated(error)) return
+            call model%pairs(1)%pair%commit()
+            select type (pair => model%pairs(1)%pair)
+            type is (segment_face_pair_t)
+                area = (pair%slave%breaks(size(pair%slave%breaks)) - pair%slave%breaks(1))* &
+                       (pair%slave%breaks_eta(size(pair%slave%breaks_eta)) - pair%slave%breaks_eta(1))
+                total = sum(pair%w)
+                call check(error, total, area, 'curved, layer '//char(48 + iq)//': the pieces tile the face', &
+                           rel=1.0e-12_dp)
+                if (allocated(error)) return
+                e = size(pair%xi)
+                call check(error, e > n_elements_of(pair)*pair%n_gauss**2, 'curved: cells are cut')
+                if (allocated(error)) return
+            end select
+            call contact_fd(model%pairs(1)%pair, u, state_stick, 'segment curved blocks, layer '//char(48 + iq), &
+                            error)
+            if (allocated(error)) return
+            deallocate (u, r)
+        end do
+    end subroutine test_segment_curved
+
+    pure integer function n_elements_of(pair) result(n)
+        type(segment_face_pair_t), intent(in) :: pair
+        n = size(pair%first) - 1
+    end function n_elements_of
 
     !> The surface over [-1, 2]^2 of degree `p` (1 or 2) at z = `z0`, its middle control
     !> point raised by `rise` (degree 2: a bump into the box above), normal +z.

@@ -16,6 +16,7 @@ module voiga_contact_factory
     use voiga_contact_mortar, only: mortar_pair_t
     use voiga_contact_alm, only: alm_pair
     use voiga_contact_segment, only: segment_pair_t
+    use voiga_contact_segment_faces, only: segment_face_pair_t
     implicit none
     private
 
@@ -42,7 +43,8 @@ module voiga_contact_factory
     !> constraints per face cell lock against the ~1 control point a cell adds: on the
     !> Hertz sphere its pressure scatters by up to the peak pressure with the automatic
     !> penalty, the mortar-type one's by 16 % at the coarsest mesh (docs/verification.md,
-    !> "Contact on faces"); segment is not implemented on faces yet.
+    !> "Contact on faces"). Segment passes the patch test on non-matching faces too, at
+    !> several times mortar's points (docs/verification-faces.md).
     character(len=*), parameter :: default_face = 'mortar'
 
     !> One contact pair (`&contact`; docs/formats.md).
@@ -132,7 +134,7 @@ contains
         integer, intent(in) :: bodies(2), ndof
         real(dp), intent(in) :: e_star
         type(error_t), allocatable, intent(out) :: error
-        call new_method(pair, settings, error)
+        call new_method(pair, settings, slave%npar, error)
         if (allocated(error)) return
         call build_pair(pair, settings, slave, master, bodies, e_star, ndof, error)
     end subroutine new_contact_pair
@@ -179,10 +181,12 @@ contains
         pair%n_friction = 0
     end subroutine build_pair
 
-    !> An empty pair of the method `settings%method`, with the method's own settings.
-    subroutine new_method(pair, settings, error)
+    !> An empty pair of the method `settings%method`, with the method's own settings,
+    !> for a slave edge (`npar` = 1) or face (2).
+    subroutine new_method(pair, settings, npar, error)
         class(contact_pair_t), allocatable, intent(out) :: pair
         type(contact_settings_t), intent(in) :: settings
+        integer, intent(in) :: npar
         type(error_t), allocatable, intent(out) :: error
         select case (trim(settings%method))
         case ('gpts')
@@ -192,7 +196,11 @@ contains
         case ('alm')
             pair = alm_pair(settings%tolerance)
         case ('segment')
-            allocate (segment_pair_t :: pair)
+            if (npar > 1) then
+                allocate (segment_face_pair_t :: pair)
+            else
+                allocate (segment_pair_t :: pair)
+            end if
         case default
             call fatal_error(error, "unknown contact method '"//trim(settings%method)//"'", error_code%input)
         end select

@@ -40,6 +40,8 @@ module voiga_contact_segment
     private
 
     public :: segment_pair_t, segment_points, default_segment_points
+    !> For the face pair (`voiga_contact_segment_faces`), which segments as this one does.
+    public :: interpolated_output
 
     !> Two cuts (or a cut and an element end) closer than this fraction of their
     !> slave element are one: a segment that short adds nothing to the integrals.
