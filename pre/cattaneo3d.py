@@ -36,14 +36,13 @@ from pathlib import Path
 from typing import Any
 
 from .cases import GEOMETRY_FILE, case_stem, to_namelist_text
-from .files import write_text
 from .h5io import write_geometry
-from .hertz import HertzCaseError, write_shared_geometry
+from .hertz import HertzCaseError, write_scene3d_folder
 from .hertz3d import MESHES, _solid_group
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import solid_dofs
 from .solids import half_ball_shell
-from .volume import Volume, check_volume
+from .volume import Volume
 
 SCENE = "cattaneo3d"
 BODY = "ball"
@@ -177,17 +176,9 @@ def write_cattaneo3d(ball: HalfBall, meshes: Sequence[str], layouts: Sequence[st
     Existing case files, or a geometry file of another ball, are refused (HertzCaseError,
     nothing written) unless ``force``. Returns ``(geometry, cases, geometry written)``."""
     texts = {case_stem(m, lay): to_namelist_text(ball_case(ball, m, lay)) for m in meshes for lay in layouts}
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    cases = [folder / f"{stem}.nml" for stem in texts]
     bodies = ball_geometry(ball)
-    for name, vol in bodies.items():
-        check_volume(name, vol)
 
     def geometry_file(path: Path) -> None:
         write_geometry(path, SCENE, bodies, generator="voiga pre (python -m pre cattaneo3d)")
 
-    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other="another half ball")
-    for case, text in zip(cases, texts.values(), strict=True):
-        write_text(case, text)
-    return geometry, cases, fresh
+    return write_scene3d_folder(out, texts, bodies, geometry_file, force, "another half ball")

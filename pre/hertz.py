@@ -57,6 +57,7 @@ from .meshes import (
     mesh_level,
 )
 from .scenes import HERTZ, annular_sector
+from .volume import check_volume
 
 MAX_INDENTATION = 0.1
 """Largest indentation d / R accepted (exclusive): beyond it a / R > 0.3 and the
@@ -256,6 +257,25 @@ def write_shared_geometry(folder: Path, write: Callable[[Path], None], cases: li
     finally:
         tmp.unlink(missing_ok=True)
     return geometry, not same
+
+
+def write_scene3d_folder(out: str | Path, texts: dict[str, str], bodies: dict[str, Any],
+                         geometry_file: Callable[[Path], None], force: bool = False,
+                         other: str = "another scene") -> tuple[Path, list[Path], bool]:
+    """The 3D scenes' writer: ``out/<stem>.nml`` for every ``texts`` (stem -> namelist
+    text) after the shared ``out/geometry.h5`` (``geometry_file(path)`` writes it;
+    :func:`write_shared_geometry`), each of ``bodies`` checked first
+    (:func:`pre.volume.check_volume`). Refused as that function refuses. Returns
+    ``(geometry, cases, geometry written)``."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    cases = [folder / f"{stem}.nml" for stem in texts]
+    for name, vol in bodies.items():
+        check_volume(name, vol)
+    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other=other)
+    for case, text in zip(cases, texts.values(), strict=True):
+        write_text(case, text)
+    return geometry, cases, fresh
 
 
 def write_hertz_case(cyl: Cylinder, mesh: str, layout: str, out: str | Path,

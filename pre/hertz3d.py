@@ -47,13 +47,12 @@ from pathlib import Path
 from typing import Any
 
 from .cases import GEOMETRY_FILE, HERTZ_STEPS, case_stem, to_namelist_text
-from .files import write_text
 from .h5io import write_geometry
-from .hertz import Cylinder, HertzCaseError, write_shared_geometry
+from .hertz import Cylinder, HertzCaseError, write_scene3d_folder
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import knotted_body_group, solid_dofs
 from .solids import ball_octant, box
-from .volume import Volume, check_volume
+from .volume import Volume
 
 SOLID_METHOD = "mortar"
 """The contact method the cases name: voiga's default on solids (GPTS's n_gauss^2
@@ -262,18 +261,10 @@ def write_hertz3d(ball: Ball, meshes: Sequence[str], layouts: Sequence[str], out
     written)``."""
     texts = {case_stem(m, lay): to_namelist_text(ball_case(ball, m, lay, **options))
              for m in meshes for lay in layouts}
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    cases = [folder / f"{stem}.nml" for stem in texts]
     bodies = ball_geometry(ball)
-    for name, vol in bodies.items():
-        check_volume(name, vol)
 
     def geometry_file(path: Path) -> None:
         write_geometry(path, SCENE, bodies, generator="voiga pre (python -m pre hertz3d)")
 
     other = "another ball" if ball.master == "rigid" else "another ball or block"
-    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other=other)
-    for case, text in zip(cases, texts.values(), strict=True):
-        write_text(case, text)
-    return geometry, cases, fresh
+    return write_scene3d_folder(out, texts, bodies, geometry_file, force, other)

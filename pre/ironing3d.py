@@ -30,14 +30,13 @@ from pathlib import Path
 from typing import Any
 
 from .cases import GEOMETRY_FILE, case_stem, to_namelist_text
-from .files import write_text
 from .h5io import write_geometry
-from .hertz import HertzCaseError, write_shared_geometry
+from .hertz import HertzCaseError, write_scene3d_folder
 from .meshes import geometric_sizes
 from .rigid_surfaces import add_surfaces, sphere_cap
 from .solid_case import knotted_body_group, solid_dofs
 from .solids import box
-from .volume import Volume, check_volume
+from .volume import Volume
 
 SCENE = "ironing3d"
 BODY = "slab"
@@ -185,19 +184,11 @@ def write_ironing3d(iron: Iron, meshes: Sequence[str], layouts: Sequence[str], o
     cases, geometry written)``."""
     texts = {case_stem(m, lay): to_namelist_text(iron_case(iron, m, lay, **options))
              for m in meshes for lay in layouts}
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    cases = [folder / f"{stem}.nml" for stem in texts]
     bodies = scene_geometry()
-    for name, vol in bodies.items():
-        check_volume(name, vol)
     die = sphere_cap(iron.radius, (START, 0.0, iron.radius), CAP_HALF_ANGLE)
 
     def geometry_file(path: Path) -> None:
         write_geometry(path, SCENE, bodies, generator="voiga pre (python -m pre ironing3d)")
         add_surfaces(str(path), {DIE: die})
 
-    geometry, fresh = write_shared_geometry(folder, geometry_file, cases, force, other="another die")
-    for case, text in zip(cases, texts.values(), strict=True):
-        write_text(case, text)
-    return geometry, cases, fresh
+    return write_scene3d_folder(out, texts, bodies, geometry_file, force, "another die")
