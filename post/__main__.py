@@ -301,8 +301,8 @@ def _cmd_cattaneo3d(args: argparse.Namespace) -> int:
                   f"{result.status!r})", file=sys.stderr)
             return 1
         cm = cattaneo3d_comparison(result, step=args.step, friction=args.friction)
-    except (HertzError, OSError, KeyError, ValueError, StopIteration) as err:
-        print(f"python -m post cattaneo3d: {args.result}: {err or 'no such step'}", file=sys.stderr)
+    except (HertzError, OSError, KeyError, ValueError) as err:
+        print(f"python -m post cattaneo3d: {args.result}: {err}", file=sys.stderr)
         return 2
     print("\n".join(cattaneo3d_report(cm)))
     return 0

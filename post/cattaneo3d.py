@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .hertz import HertzError
+from .hertz import HertzError, contact_pair
 from .hertz3d import Hertz3dComparison, hertz3d_comparison
 from .reader import Result
 from .stickslip import cattaneo_mindlin
@@ -88,8 +88,7 @@ def cattaneo3d_comparison(result: Result, step: int = -1, pair: int = 0,
     """Compare contact pair ``pair`` (0-based) at ``step`` of a 3D result with
     Cattaneo-Mindlin (module docstring); mu the pair's at that step unless ``friction``."""
     h = hertz3d_comparison(result, step=step, pair=pair)
-    st = result.steps[step] if step < 0 else next(s for s in result.steps if s.step == step)
-    c = st.contact[pair]
+    st, c = contact_pair(result, step, pair)
     mu = float(friction) if friction is not None else _friction(result, c.attrs, float(st.time))
     if not mu > 0:
         raise Cattaneo3dError(f"{result.path}: step {h.step}: the pair has no friction (mu = {mu:g})")
