@@ -44,6 +44,7 @@ import warnings
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from .reader import Result
     from .study import Study
 
 
@@ -262,15 +263,24 @@ def _cmd_hertz(args: argparse.Namespace) -> int:
     return code
 
 
+def _read_stepped(path: str, command: str) -> Result | None:
+    """The result at ``path`` (:func:`_read`), or None after saying on stderr that it has
+    no converged step."""
+    result = _read(path, command)
+    if not result.steps:
+        print(f"python -m post {command}: {path} has no converged step (status {result.status!r})",
+              file=sys.stderr)
+        return None
+    return result
+
+
 def _cmd_hertz3d(args: argparse.Namespace) -> int:
     from .hertz import HertzError
     from .hertz3d import hertz3d_comparison, hertz3d_figure, hertz3d_report
 
     try:
-        result = _read(args.result, "hertz3d")
-        if not result.steps:
-            print(f"python -m post hertz3d: {args.result} has no converged step (status "
-                  f"{result.status!r})", file=sys.stderr)
+        result = _read_stepped(args.result, "hertz3d")
+        if result is None:
             return 1
         if not result.converged and not args.partial:
             print(f"python -m post hertz3d: {args.result}: the run has not converged (status "
@@ -295,10 +305,8 @@ def _cmd_cattaneo3d(args: argparse.Namespace) -> int:
     from .hertz import HertzError
 
     try:
-        result = _read(args.result, "cattaneo3d")
-        if not result.steps:
-            print(f"python -m post cattaneo3d: {args.result} has no converged step (status "
-                  f"{result.status!r})", file=sys.stderr)
+        result = _read_stepped(args.result, "cattaneo3d")
+        if result is None:
             return 1
         cm = cattaneo3d_comparison(result, step=args.step, friction=args.friction)
     except (HertzError, OSError, KeyError, ValueError) as err:
