@@ -158,9 +158,11 @@ def _cmd_hertz3d(args: argparse.Namespace) -> int:
     ball = Ball(radius=args.radius, youngs_modulus=args.youngs_modulus,
                 poisson_ratio=args.poisson_ratio, indentation=args.indentation, material=args.material,
                 master=args.master, block_size=args.block_size, block_cell=args.block_cell,
-                block_youngs_modulus=args.block_youngs_modulus, block_poisson_ratio=args.block_poisson_ratio)
+                block_youngs_modulus=args.block_youngs_modulus, block_poisson_ratio=args.block_poisson_ratio,
+                grid=args.grid)
+    meshes = args.mesh or ["p3" if args.grid == "polar" else "m2"]
     return _write_scene3d(
-        "hertz3d", lambda: write_hertz3d(ball, args.mesh, args.layout, args.out, force=args.force,
+        "hertz3d", lambda: write_hertz3d(ball, meshes, args.layout, args.out, force=args.force,
                                          n_steps=args.steps, method=args.method,
                                          penalty_normal=args.penalty_normal),
         lambda mesh, layout: body_dofs(ball, mesh, layout),
@@ -310,9 +312,15 @@ def build_parser() -> argparse.ArgumentParser:
                                        "and layout")
     s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml (not cases/: voiga "
                                "cannot run 3D contact yet)")
-    s.add_argument("--mesh", nargs="+", default=["m2"], help="mesh levels m1 .. m4 (default m2)")
+    s.add_argument("--mesh", nargs="+", default=None,
+                   help="meshes: m1 .. m4 on the Cartesian grid (default m2), p1 .. p4 on the polar one "
+                        "(default p3)")
     s.add_argument("--layout", nargs="+", default=["NN2.2"],
                    help="solid layouts, e.g. N2 N3 NN2.1 NN2.2 (default NN2.2)")
+    s.add_argument("--grid", default="cartesian", choices=("cartesian", "polar"),
+                   help="the ball's parametrization: cartesian (about a horizontal axis; the contact "
+                        "at a regular corner) or polar (about the vertical axis through the contact: "
+                        "knot lines along the zone's edge, which it splits; default cartesian)")
     s.add_argument("--radius", type=float, default=1.0, help="ball radius R (default 1)")
     s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
     s.add_argument("--poisson-ratio", type=float, default=0.3, help="nu in (-1, 0.5) (default 0.3)")

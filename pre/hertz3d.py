@@ -21,8 +21,17 @@ Mesh m<k> (:data:`MESHES`): along both angles, ``fine`` elements uniform in angl
 (:func:`pre.meshes.arc_parameter_exact`); radially ``radial`` elements graded toward the
 sphere, the surface element as long as the fine ones (:func:`pre.meshes.hertz_eta_knots`).
 ``a_est = sqrt(R d)`` is Hertz's half-width for a sphere whose approach to the plane is
-d (a sphere on a rigid flat: ``d = a^2 / R``); the top face's d also holds the
-compression of the hemisphere itself, so the run's a is somewhat smaller.
+d (a sphere on a rigid flat: ``d = a^2 / R``); the runs' a is 1.8 % larger at d = 0.01 R
+(0.4 % at 0.000625 R).
+
+Grid ``polar`` (``--grid polar``, meshes p<k> of :data:`POLAR_MESHES`): the same octant
+in spherical coordinates about the vertical axis through the lowest point
+(:func:`pre.solids.polar_ball_octant`), whose theta knot lines are circles about the
+contact: theta graded as above with the spans at the expected edge (0.9 to 1.1 a_est)
+split, :data:`PHI_ELEMENTS` along phi, rho as above. The Cartesian grid's error falls
+only like the zone cells' size, the rate of a square-root edge that no knot line follows
+(docs/verification-faces.md); the polar grid resolves the edge as the 2D scene's
+``--edge-refine`` does. The lowest point is then on the collapsed face ``axis``.
 
 Master ``block`` (``--master block``; issue 42's "sphere on an elastic block"): instead of
 the rigid plane, a second body ``block``, the box ``[0, L] x [0, L] x [-R - H, -R]``
@@ -48,10 +57,10 @@ from typing import Any
 
 from .cases import GEOMETRY_FILE, HERTZ_STEPS, case_stem, to_namelist_text
 from .h5io import write_geometry
-from .hertz import Cylinder, HertzCaseError, write_scene3d_folder
+from .hertz import EDGE_BAND, Cylinder, HertzCaseError, split_spans, write_scene3d_folder
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import knotted_body_group, solid_dofs
-from .solids import ball_octant, box
+from .solids import ball_octant, box, polar_ball_octant
 from .volume import Volume
 
 SOLID_METHOD = "mortar"
@@ -86,6 +95,26 @@ MESHES: dict[str, tuple[int, int, int]] = {
 """Mesh -> (fine, rest, radial) elements: along each angle ``fine`` over the contact
 zone and ``rest`` beyond, radially ``radial`` (NN2.2: about 5,700 to 60,000 DOFs)."""
 
+GRIDS = ("cartesian", "polar")
+"""``--grid``: the ball in spherical coordinates about a horizontal axis
+(:func:`pre.solids.ball_octant`, meshes :data:`MESHES`) or about the vertical one through
+the contact point (:func:`pre.solids.polar_ball_octant`, meshes :data:`POLAR_MESHES`)."""
+
+POLAR_MESHES: dict[str, tuple[int, int, int, int]] = {
+    "p1": (10, 10, 10, 2),
+    "p2": (16, 10, 12, 4),
+    "p3": (20, 10, 12, 4),
+    "p4": (30, 10, 12, 4),
+}
+"""Polar mesh -> (fine, rest, radial, edge): along theta ``fine`` elements over the
+contact zone, those overlapping :data:`pre.hertz.EDGE_BAND` of the expected a split into
+``edge``, and ``rest`` beyond; radially ``radial``; :data:`PHI_ELEMENTS` along the
+azimuth (NN2.2: about 5,000 to 13,000 DOFs)."""
+PHI_ELEMENTS = 2
+"""Elements along the azimuth of a polar mesh. One would do for this scene: the basis
+along phi holds cos and sin exactly (the geometry's rational arc), so the axisymmetric
+solution is in the space; two keep the mesh from depending on that."""
+
 LAYOUTS: tuple[str, ...] = ("N2", "N3", "NN2.1", "NN2.2")
 """The layouts of the study (any solid layout is accepted)."""
 
@@ -100,6 +129,8 @@ class Ball(Cylinder):
 
     material: str = "linear"
     master: str = "rigid"
+    grid: str = "cartesian"
+    """:data:`GRIDS`: the ball's parametrization, and the meshes it takes."""
     """:data:`MASTERS`: the rigid plane or the block."""
     block_size: float = BLOCK_SIZE
     """The block's L = H over R."""
@@ -117,6 +148,8 @@ class Ball(Cylinder):
             raise HertzCaseError(f"material {self.material!r} must be one of {', '.join(MATERIALS)}")
         if self.master not in MASTERS:
             raise HertzCaseError(f"master {self.master!r} must be one of {', '.join(MASTERS)}")
+        if self.grid not in GRIDS:
+            raise HertzCaseError(f"grid {self.grid!r} must be one of {', '.join(GRIDS)}")
         if not (math.isfinite(self.block_size) and 0.25 <= self.block_size <= 100):
             raise HertzCaseError(f"block size {self.block_size!r} must be from 0.25 to 100 (L = H over R)")
         if not (math.isfinite(self.block_cell) and 0.25 <= self.block_cell <= 4):
@@ -144,24 +177,46 @@ def ball_geometry(ball: Ball) -> dict[str, Volume]:
     """The bodies of the scene: the ball octant of radius R (faces of
     :data:`pre.solids.BALL_FACES`) and, for the master ``block``, the block (faces
     :data:`BLOCK_FACES`)."""
-    bodies = {BODY: ball_octant(ball.radius)}
+    bodies = {BODY: (polar_ball_octant if ball.grid == "polar" else ball_octant)(ball.radius)}
     if ball.master == BLOCK:
         r, side = float(ball.radius), float(ball.block_size) * float(ball.radius)
         bodies[BLOCK] = box((0.0, side), (0.0, side), (-r - side, -r), faces=BLOCK_FACES)
     return bodies
 
 
+def mesh_counts(ball: Ball, mesh: str) -> tuple[int, int, int]:
+    """``(fine, rest, radial)`` of mesh ``mesh`` of the ball's grid (HertzCaseError
+    naming the grid's meshes if it has none of that name)."""
+    table: dict[str, tuple[int, ...]] = dict(POLAR_MESHES) if ball.grid == "polar" else dict(MESHES)
+    if mesh not in table:
+        raise HertzCaseError(f"mesh {mesh!r}: the {ball.grid} grid's meshes are {', '.join(table)}")
+    fine, rest, radial = table[mesh][:3]
+    return fine, rest, radial
+
+
 def ball_knots(ball: Ball, mesh: str) -> dict[str, list[float]]:
     """``knots_xi``, ``knots_eta``, ``knots_zeta`` of mesh ``mesh`` (module docstring):
-    both angles graded alike from the lowest point (xi along phi, eta along theta, each
-    starting there), rho graded toward the sphere."""
-    if mesh not in MESHES:
-        raise HertzCaseError(f"mesh {mesh!r}: one of {', '.join(MESHES)}")
-    fine, rest, radial = MESHES[mesh]
+    on the Cartesian grid both angles graded alike from the lowest point (xi along phi,
+    eta along theta, each starting there), on the polar grid theta so and split at the
+    expected edge (:func:`polar_theta_knots`), phi uniform; rho graded toward the sphere."""
+    fine, rest, radial = mesh_counts(ball, mesh)
     theta_c = hertz_theta_c(ball.half_width / ball.radius)
     angle = [arc_parameter_exact(a) for a in graded_angles(theta_c, fine, rest)]
-    rho = hertz_eta_knots(radial, theta_c / fine, thickness=1.0)
-    return {"knots_xi": angle, "knots_eta": list(angle), "knots_zeta": [float(k) for k in rho]}
+    rho = [float(k) for k in hertz_eta_knots(radial, theta_c / fine, thickness=1.0)]
+    if ball.grid == "polar":
+        return {"knots_xi": [k / PHI_ELEMENTS for k in range(1, PHI_ELEMENTS)],
+                "knots_eta": polar_theta_knots(angle, ball.half_width / ball.radius, POLAR_MESHES[mesh][3]),
+                "knots_zeta": rho}
+    return {"knots_xi": angle, "knots_eta": list(angle), "knots_zeta": rho}
+
+
+def polar_theta_knots(knots: list[float], half_width: float, edge: int) -> list[float]:
+    """The graded theta knots of a polar mesh with every span that overlaps
+    :data:`pre.hertz.EDGE_BAND` times ``half_width`` (a / R) split into ``edge``: the
+    zone's edge, a circle about the lowest point, runs along these knot lines, and the
+    band holds the runs' a (1.8 % above sqrt(R d) at d = 0.01 R, 0.4 % at 0.000625 R)."""
+    t0, t1 = (arc_parameter_exact(math.asin(f * half_width)) for f in EDGE_BAND)
+    return split_spans(knots, [(t0, t1)], edge)
 
 
 def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, list[float]]:
@@ -171,9 +226,7 @@ def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, l
     fine arc ``R theta_c / fine`` over at least the ball's fine zone ``R sin(theta_c)``
     along x and y, then ``rest`` cells growing to L; ``radial`` cells across, growing
     from that size at the top (:func:`pre.meshes.hertz_eta_knots`)."""
-    if mesh not in MESHES:
-        raise HertzCaseError(f"mesh {mesh!r}: one of {', '.join(MESHES)}")
-    fine, rest, radial = MESHES[mesh]
+    fine, rest, radial = mesh_counts(ball, mesh)
     theta_c = hertz_theta_c(ball.half_width / ball.radius)
     side = float(ball.block_size) * float(ball.radius)
     h = (ball.block_cell if cell is None else cell) * ball.radius * theta_c / fine
@@ -229,7 +282,8 @@ def ball_case(ball: Ball, mesh: str, layout: str, n_steps: int | None = None,
         if not (isinstance(penalty_normal, (int, float)) and 0 < penalty_normal < math.inf):
             raise HertzCaseError(f"penalty_normal {penalty_normal!r} must be > 0")
         contact["penalty_normal"] = float(penalty_normal)
-    title = (f"hertz3d {mesh} {layout}: ball octant R = {ball.radius:g}, E = {ball.youngs_modulus:g}, "
+    grid = ", polar grid" if ball.grid == "polar" else ""
+    title = (f"hertz3d {mesh} {layout}: ball octant{grid} R = {ball.radius:g}, E = {ball.youngs_modulus:g}, "
              f"nu = {ball.poisson_ratio:g}, {ball.material}, indentation {ball.indentation:g}{on}")
     return {"case": {"title": title, "scene": SCENE, "mesh": mesh, "layout": layout,
                      "geometry": GEOMETRY_FILE, "output": f"{case_stem(mesh, layout)}.h5",

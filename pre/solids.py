@@ -16,6 +16,10 @@ the control points themselves (the tests compare each with the same body built b
 - :func:`shell_octant`: the octant x, y, z >= 0 of a thick spherical shell: xi along
   the longitude, eta from the equator to the pole (the face ``eta = 1`` collapses onto
   the z axis), zeta from the inner to the outer sphere.
+- :func:`ball_octant`, :func:`polar_ball_octant`: a quarter of the lower hemisphere of a
+  ball, in spherical coordinates about a horizontal axis (its lowest point a regular
+  corner) or about the vertical one (knot lines circles about its lowest point);
+  :func:`half_ball_shell`: a half of it, hollow, sheared along x.
 - :func:`extrude`, :func:`revolve`: a 2D body (:class:`pre.nurbs.Patch`, z = 0) swept
   along z or about an axis in its plane: xi along the sweep (backwards for a clockwise
   patch, so that the volume is right-handed), ``(eta, zeta)`` the
@@ -210,6 +214,44 @@ def ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
     w = np.array([1.0, w45, 1.0])
     weights = np.broadcast_to(np.outer(w, w), (2, 3, 3)).copy()
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(BALL_FACES, faces))
+
+
+POLAR_BALL_FACES = {"symmetry_y": "xi0", "symmetry_x": "xi1", "axis": "eta0", "top": "eta1",
+                    "centre": "zeta0", "outer": "zeta1"}
+"""Face labels of a polar ball octant (:func:`polar_ball_octant`): ``symmetry_y`` the
+plane y = y_c, ``symmetry_x`` the plane x = x_c, ``axis`` the face collapsed onto the
+axis x = x_c, y = y_c below the centre, ``top`` the plane z = z_c, ``centre`` the face
+collapsed onto the centre, ``outer`` the sphere (the contact face)."""
+
+
+def polar_ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
+                      faces: dict[str, str] | None = None) -> Volume:
+    """The octant ``x >= x_c, y >= y_c, z <= z_c`` of the ball ``|x - centre| <= radius``,
+    as :func:`ball_octant` but in spherical coordinates about the vertical axis through
+    its lowest point, ``(x, y) = rho sin(theta) (cos(phi), sin(phi))``, ``z = -rho
+    cos(theta)``: xi along phi from 0 (the plane y = y_c) to 90 degrees (x = x_c), eta
+    along theta from 0 (the axis) to 90 degrees (the plane z = z_c), zeta along rho. Its
+    knot lines of eta are circles about the lowest point ``centre - (0, 0, radius)``, so
+    a contact zone about that point has its edge along a knot line, where a Cartesian
+    grid cuts the edge at every angle (the 3D Hertz scene's ``--grid polar``). The face
+    ``eta = 0`` collapses onto the axis (so the lowest point is a collapsed edge of the
+    sphere face: the coincident control points there are separate unknowns, held
+    together by the stiffness only) and ``zeta = 0`` onto the centre. Degrees (2, 2, 1),
+    3 x 3 x 2 control points, right-handed; faces :data:`POLAR_BALL_FACES`."""
+    radius = float(radius)
+    if not radius > 0:
+        raise ValueError(f"polar ball octant: need radius > 0, got {radius}")
+    w45 = math.sqrt(0.5)
+    phi = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])  # (cos, sin) polygon, 0 .. 90 degrees
+    theta = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])  # (sin, cos) polygon, 0 .. 90 degrees
+    cp = np.zeros((2, 3, 3, 3))
+    for j in range(3):
+        cp[1, j, :, :2] = radius * theta[j, 0] * phi
+        cp[1, j, :, 2] = -radius * theta[j, 1]
+    cp += np.asarray(centre, dtype=float)
+    w = np.array([1.0, w45, 1.0])
+    weights = np.broadcast_to(np.outer(w, w), (2, 3, 3)).copy()
+    return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(POLAR_BALL_FACES, faces))
 
 
 HALF_SHELL_FACES = {"symmetry_y": "xi0", "top": "xi1", "end_xneg": "eta0", "end_xpos": "eta1",

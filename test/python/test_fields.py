@@ -299,7 +299,7 @@ def test_hertz_m4_half_space_values(hertz_m4: Path) -> None:
 def test_fields_at_a_degenerate_point_of_the_map(run, tmp_path: Path, shape: str) -> None:
     """A solid half-disc (its centre a corner of 180 degrees, det dX/dxi = 0 there) and a
     polygon half-disc (two such corners) moved as a whole: every sample, those at the
-    degenerate points included (taken 1e-6 inside their element), has zero stress. At
+    degenerate points included (taken 1 % of the way into their element), has zero stress. At
     det = 0 the gradient divided by zero and the step failed as an inverted element."""
     from pre.geometry import annular_sector, polygon
 
@@ -323,9 +323,8 @@ def test_fields_at_a_degenerate_point_of_the_map(run, tmp_path: Path, shape: str
     fields = step.fields["disc"]
     assert len(fields["von_mises"]) == 6 * 4 * 9
     # round-off of u (|u| 0.2, 2e-16 relative) is amplified by the inverse Jacobian, about
-    # 1/nudge = 1e6 at a sample taken 1e-6 from a degenerate point: 1e-8 there, 1e-12 elsewhere
+    # 1/nudge = 100 at a sample taken 1 % of the way in from a degenerate point
     stress = np.abs(fields["stress"]).max(axis=1)
-    assert stress.max() < 1e-8, stress.max()
-    assert np.sort(stress)[-9] < 1e-12, np.sort(stress)[-12:]
+    assert stress.max() < 1e-12, np.sort(stress)[-12:]
     np.testing.assert_allclose(step.displacement.reshape(-1, 2), [[0.1, -0.2]] * (step.displacement.size // 2),
                                atol=1e-12)
