@@ -20,7 +20,7 @@ from splipy import Surface
 
 from pre.__main__ import main
 from pre.h5io import read_volumes
-from pre.hertz import HertzCaseError
+from pre.hertz import EDGE_BAND, HertzCaseError
 from pre.hertz3d import (
     BLOCK,
     BLOCK_CELL,
@@ -29,6 +29,8 @@ from pre.hertz3d import (
     CONTACT_FACE,
     LAYOUTS,
     MESHES,
+    PHI_ELEMENTS,
+    POLAR_MESHES,
     Ball,
     ball_case,
     ball_geometry,
@@ -39,7 +41,7 @@ from pre.hertz3d import (
 )
 from pre.meshes import arc_angle
 from pre.namelists import NAMELISTS
-from pre.solids import ball_octant
+from pre.solids import ball_octant, polar_ball_octant
 from pre.tests.test_hertz_case import _voiga
 from pre.volume import check_volume, enclosed_volume, evaluate, jacobian, jacobian_grid, volume_to_splipy
 
@@ -424,3 +426,121 @@ def test_block_cell_option(tmp_path: Path) -> None:
     for size, cell in [(0.5, 1.3), (2.0, 4.0), (100.0, 0.25)]:
         k = np.diff([0.0, *block_knots(Ball(master="block", block_size=size, block_cell=cell), "m4")["knots_xi"], 1.0])
         assert np.all(k > 0)
+
+
+# --- the polar grid (--grid polar) ----------------------------------------------------------
+
+POLAR = Ball(grid="polar")
+
+
+@pytest.mark.parametrize("radius", [1.0, 2.5])
+def test_the_polar_ball_is_exact(radius: float) -> None:
+    """The polar octant is the same ball octant: its sphere face on the sphere, its faces
+    the same planes, its axis face collapsed onto the vertical axis below the centre, the
+    lowest point the whole edge eta = 0 of the sphere face, the volume pi R^3 / 6."""
+    vol = polar_ball_octant(radius)
+    check_volume(BODY, vol)
+    xi, eta = _random()
+    sphere = evaluate(vol, xi, eta, np.ones_like(xi))
+    assert np.abs(np.linalg.norm(sphere, axis=1) - radius).max() < 1e-12 * radius
+    inside = evaluate(vol, xi, eta, RNG.random(len(xi)))
+    assert inside[:, 0].min() >= 0 and inside[:, 1].min() >= 0 and inside[:, 2].max() <= 0
+    zero, one, zeta = np.zeros_like(xi), np.ones_like(xi), RNG.random(len(xi))
+    assert np.abs(evaluate(vol, zero, eta, zeta)[:, 1]).max() < 1e-15      # symmetry_y: y = 0
+    assert np.abs(evaluate(vol, one, eta, zeta)[:, 0]).max() < 1e-15       # symmetry_x: x = 0
+    assert np.abs(evaluate(vol, xi, zero, zeta)[:, :2]).max() < 1e-15      # axis: x = y = 0
+    assert np.abs(evaluate(vol, xi, one, zeta)[:, 2]).max() < 1e-15        # top: z = 0
+    assert np.abs(evaluate(vol, xi, eta, zero)).max() < 1e-15              # centre
+    assert vol.faces == {"xi0": "symmetry_y", "xi1": "symmetry_x", "eta0": "axis", "eta1": "top",
+                         "zeta0": "centre", "zeta1": CONTACT_FACE}
+    np.testing.assert_allclose(evaluate(vol, xi, zero, one), [[0.0, 0.0, -radius]] * len(xi), atol=1e-15)
+    assert enclosed_volume(vol) == pytest.approx(math.pi * radius**3 / 6, rel=1e-12)
+
+
+@pytest.mark.parametrize("mesh", list(POLAR_MESHES))
+def test_polar_knot_lines_are_circles_about_the_contact(mesh: str) -> None:
+    """On the sphere face every theta knot line is a circle about the vertical axis through
+    the lowest point (constant distance from it, constant height), and the spans over
+    0.9 .. 1.1 a_est are ``edge`` times finer than the fine ones: the zone's edge runs
+    along knot lines that resolve it."""
+    knots = ball_knots(POLAR, mesh)
+    vol = ball_geometry(POLAR)[BODY]
+    phi = np.linspace(0.0, 1.0, 17)
+    radii = []
+    for t in knots["knots_eta"]:
+        x = evaluate(vol, phi, np.full_like(phi, t), np.ones_like(phi))
+        r = np.hypot(x[:, 0], x[:, 1])
+        assert np.ptp(r) < 1e-13 and np.ptp(x[:, 2]) < 1e-13
+        radii.append(r[0])
+    r = np.concatenate([[0.0], radii])
+    sizes = np.diff(np.arcsin(np.minimum(r, 1.0)))  # arc angle of each span from the lowest point
+    fine, _, _, edge = POLAR_MESHES[mesh]
+    theta_c = math.asin(1.5 * POLAR.half_width / POLAR.radius)
+    lo, hi = (math.asin(f * POLAR.half_width) for f in EDGE_BAND)
+    inside = (np.arcsin(r[1:]) > lo) & (np.arcsin(r[:-1]) < hi)
+    assert inside.sum() >= 2 * edge
+    # split into equal parameter spans of the rational arc: equal angles within 0.2 %
+    np.testing.assert_allclose(sizes[inside], theta_c / fine / edge, rtol=2e-3)
+    assert sizes[~inside][: int(np.argmax(inside))].max() == pytest.approx(theta_c / fine, rel=1e-9)
+    assert knots["knots_xi"] == [k / PHI_ELEMENTS for k in range(1, PHI_ELEMENTS)]
+
+
+@pytest.mark.parametrize("mesh", list(POLAR_MESHES))
+def test_polar_det_j_is_positive_at_every_gauss_point(mesh: str) -> None:
+    """det J > 0 at the Gauss points of every element of the polar meshes, those along the
+    collapsed axis (det J ~ the distance from it) included."""
+    vol = ball_geometry(POLAR)[BODY]
+    knots = ball_knots(POLAR, mesh)
+    x, _ = np.polynomial.legendre.leggauss(3)
+    pts = []
+    for d in ("xi", "eta", "zeta"):
+        breaks = np.concatenate([[0.0], knots[f"knots_{d}"], [1.0]])
+        pts.append(np.concatenate([0.5 * (a + b) + 0.5 * (b - a) * x for a, b in pairwise(breaks)]))
+    det = np.linalg.det(jacobian_grid(vol, *pts)[1])
+    assert det.min() > 0 and det.min() > 1e-10 * det.max()
+
+
+def test_polar_cases_and_meshes_per_grid(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--grid polar`` writes the polar octant and its p meshes (default p3), the same faces
+    and loads as the Cartesian grid; a mesh of the other grid is refused naming the grid's
+    meshes; the polar meshes' DOFs grow from p1 to p4."""
+    out = tmp_path / "p"
+    assert main(["hertz3d", str(out), "--grid", "polar", "--layout", "N2"]) == 0
+    assert f"{case_dofs(POLAR, 'p3', 'N2')['total']} DOFs" in capsys.readouterr().out
+    _, volumes = read_volumes(out / "geometry.h5")
+    np.testing.assert_array_equal(volumes[BODY].control_points, polar_ball_octant(1.0).control_points)
+    nml = f90nml.read(str(out / "p3-N2.nml"))
+    assert {d["face"] for d in nml["dirichlet"]} == {"top", "symmetry_x", "symmetry_y"}
+    assert "polar grid" in nml["case"]["title"]
+    assert main(["hertz3d", str(tmp_path / "q"), "--grid", "polar", "--mesh", "m1"]) == 2
+    assert "polar grid's meshes are p1, p2, p3, p4" in capsys.readouterr().err
+    assert main(["hertz3d", str(tmp_path / "r"), "--mesh", "p1"]) == 2
+    assert "cartesian grid's meshes are m1" in capsys.readouterr().err
+    with pytest.raises(HertzCaseError, match="grid 'radial'"):
+        Ball(grid="radial").check()
+    dofs = [case_dofs(POLAR, m, "NN2.2")["total"] for m in POLAR_MESHES]
+    assert dofs == sorted(dofs) and dofs[-1] < 20000
+
+
+@pytest.mark.parametrize("layout", ["N2", "NN2.2"])
+def test_polar_dof_counts_against_splipy(layout: str) -> None:
+    """The polar p1's counts are those of splipy's k-refinement of the polar volume."""
+    body = ball_case(POLAR, "p1", layout)["body"][0]
+    vol = ball_geometry(POLAR)[BODY]
+    spline = volume_to_splipy(vol)
+    spline.raise_order(*(body["degree_xi"] - q for q in vol.degree))
+    new = [body[f"knots_{d}"] for d in ("xi", "eta", "zeta")]
+    for d, k in enumerate(new):
+        spline.insert_knot(k, direction=d)
+    n = list(spline.shape)
+    interface = 3 * n[0] * n[1]
+    if body["layer_degree"]:
+        face = Surface(*volume_to_splipy(vol).bases[:2], volume_to_splipy(vol).controlpoints[:, :, -1],
+                       rational=True, raw=True)
+        face.raise_order(*(body["layer_degree"] - q for q in vol.degree[:2]))
+        for d, k in enumerate(new[:2]):
+            face.insert_knot(k, direction=d)
+        face.raise_order(body["layer_elevations"], body["layer_elevations"])
+        interface = 3 * face.shape[0] * face.shape[1]
+    assert case_dofs(POLAR, "p1", layout) == {"interface": interface, "bulk": 3 * n[0] * n[1] * (n[2] - 1),
+                                              "total": interface + 3 * n[0] * n[1] * (n[2] - 1)}

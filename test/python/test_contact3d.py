@@ -154,6 +154,33 @@ def test_hertz3d_runs_and_reads(voiga_bin: Path, tmp_path: Path) -> None:
     assert "relative L2 error of p" in post.stdout
 
 
+@pytest.mark.parametrize("indentation, tau_tol", [(0.01, 0.05), (0.000625, 0.01)])
+def test_hertz3d_polar_grid_meets_hertz(voiga_bin: Path, tmp_path: Path, indentation: float,
+                                        tau_tol: float) -> None:
+    """`pre hertz3d --grid polar` p4 N2 (9,576 DOFs), knot lines along the zone's edge: the
+    final pressure within 1 % (L2) of Hertz and the fitted half-width within 0.5 %, issue
+    42's line that the Cartesian grids miss (2.2 % at 60,000 DOFs); measured 0.47 % and
+    +0.05 % at a/R = 0.10, 0.41 % and +0.07 % at 0.025 (0.41 to 0.87 % in between; p2
+    gives 0.83 % at 0.10 but 1.6 % at 0.025). The subsurface shear is sampled on the collapsed axis (1 % into
+    its elements, where 1e-6 gave 14 p0) and its largest value is Hertz's within 5 % at
+    a/R = 0.10 and 1 % at 0.025: the finite ball's departure, -3.6 %, -1.4 %, -0.1 % at
+    a/R = 0.10, 0.05, 0.025 on p4, not the mesh's (radial refinement leaves it)."""
+    from post.hertz3d import hertz3d_comparison
+    from post.reader import read_result
+
+    out = tmp_path / "p"
+    subprocess.run(["python3", "-m", "pre", "hertz3d", str(out), "--grid", "polar", "--mesh", "p4", "--layout",
+                    "N2", "--indentation", str(indentation)],
+                   check=True, capture_output=True, cwd=Path(__file__).resolve().parents[2])
+    res = run(voiga_bin, out / "p4-N2.nml")
+    assert res.returncode == 0, res.stderr
+    h = hertz3d_comparison(read_result(out / "p4-N2.h5"))
+    assert h.error.l2 < 0.01, h.error
+    assert abs(h.a_error) < 0.005, h.a_error
+    assert h.shear is not None and h.shear.axis_samples > 10, h.shear_note
+    assert abs(h.shear.tau_max / h.tau_hertz - 1.0) < tau_tol, (h.shear.tau_max, h.tau_hertz)
+
+
 BLOCKS = """&case
   title = 'blocks', geometry = 'geometry.h5', output = 'blocks.h5', n_bodies = 2
 /
