@@ -31,7 +31,10 @@ contact: theta graded as above with the spans at the expected edge (0.9 to 1.1 a
 split, :data:`PHI_ELEMENTS` along phi, rho as above. The Cartesian grid's error falls
 only like the zone cells' size, the rate of a square-root edge that no knot line follows
 (docs/verification-faces.md); the polar grid resolves the edge as the 2D scene's
-``--edge-refine`` does. The lowest point is then on the collapsed face ``axis``.
+``--edge-refine`` does. The lowest point is then on the collapsed face ``axis``. With
+``--master block`` the block is then the quarter cylinder of radius L about the same
+axis (:func:`pre.solids.polar_quarter_cylinder`, faces named as the box's), its r knots
+the box's x knots split over the same band, :data:`PHI_ELEMENTS` along its angle.
 
 Master ``block`` (``--master block``; issue 42's "sphere on an elastic block"): instead of
 the rigid plane, a second body ``block``, the box ``[0, L] x [0, L] x [-R - H, -R]``
@@ -60,7 +63,7 @@ from .h5io import write_geometry
 from .hertz import EDGE_BAND, Cylinder, HertzCaseError, split_spans, write_scene3d_folder
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import knotted_body_group, solid_dofs
-from .solids import ball_octant, box, polar_ball_octant
+from .solids import ball_octant, box, polar_ball_octant, polar_quarter_cylinder
 from .volume import Volume
 
 SOLID_METHOD = "mortar"
@@ -180,7 +183,8 @@ def ball_geometry(ball: Ball) -> dict[str, Volume]:
     bodies = {BODY: (polar_ball_octant if ball.grid == "polar" else ball_octant)(ball.radius)}
     if ball.master == BLOCK:
         r, side = float(ball.radius), float(ball.block_size) * float(ball.radius)
-        bodies[BLOCK] = box((0.0, side), (0.0, side), (-r - side, -r), faces=BLOCK_FACES)
+        bodies[BLOCK] = (polar_quarter_cylinder(side, (-r - side, -r)) if ball.grid == "polar" else
+                         box((0.0, side), (0.0, side), (-r - side, -r), faces=BLOCK_FACES))
     return bodies
 
 
@@ -236,8 +240,13 @@ def block_knots(ball: Ball, mesh: str, cell: float | None = None) -> dict[str, l
                              f"its cells span {n_fine * h:g} along the top (at most half the block, "
                              f"{side / 2:g}) and {radial * h:g} in depth (less than {side:g})")
     along = [x / side for x in graded_angles(n_fine * h, n_fine, rest, sweep=side)]
-    depth = hertz_eta_knots(radial, h / side, thickness=1.0)
-    return {"knots_xi": along, "knots_eta": list(along), "knots_zeta": [float(k) for k in depth]}
+    depth = [float(k) for k in hertz_eta_knots(radial, h / side, thickness=1.0)]
+    if ball.grid == "polar":  # xi along r = xi L, the same split at the expected edge as the ball's
+        a = ball.half_width / side
+        along = split_spans(along, [(EDGE_BAND[0] * a, EDGE_BAND[1] * a)], POLAR_MESHES[mesh][3])
+        return {"knots_xi": along, "knots_eta": [k / PHI_ELEMENTS for k in range(1, PHI_ELEMENTS)],
+                "knots_zeta": depth}
+    return {"knots_xi": along, "knots_eta": list(along), "knots_zeta": depth}
 
 
 def _solid_group(name: str, vol: Volume, knots: dict[str, list[float]], layout: str, face: str,

@@ -254,6 +254,36 @@ def polar_ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(POLAR_BALL_FACES, faces))
 
 
+DISC_FACES = {"axis": "xi0", "rim": "xi1", "symmetry_y": "eta0", "symmetry_x": "eta1",
+              "bottom": "zeta0", "top": "zeta1"}
+"""Face labels of a polar quarter cylinder (:func:`polar_quarter_cylinder`): ``axis`` the
+face collapsed onto the axis, ``rim`` the cylinder, ``symmetry_y``/``symmetry_x`` the
+planes y = y_c / x = x_c, ``bottom``/``top`` z = z0 / z1 (``top``: the contact face)."""
+
+
+def polar_quarter_cylinder(radius: float, z: Sequence[float], centre: Sequence[float] = (0.0, 0.0),
+                           faces: dict[str, str] | None = None) -> Volume:
+    """The quarter ``x >= x_c, y >= y_c`` of the solid cylinder ``|(x, y) - centre| <=
+    radius``, ``z0 <= z <= z1``, in cylindrical coordinates: xi along the distance r from
+    the axis (degree 1: the face ``xi = 0`` collapses onto the axis), eta along the angle
+    from 0 (the plane y = y_c) to 90 degrees (one exact rational arc), zeta along z. Its
+    knot lines of xi on the top face are circles about the axis, as a polar ball's
+    (:func:`polar_ball_octant`): the elastic half-space under it in the 3D Hertz scene's
+    polar grid. Right-handed; faces :data:`DISC_FACES`."""
+    radius = float(radius)
+    z0, z1 = _pair(z, "z")
+    if not radius > 0:
+        raise ValueError(f"polar quarter cylinder: need radius > 0, got {radius}")
+    phi = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])  # (cos, sin) polygon, 0 .. 90 degrees
+    cp = np.zeros((2, 3, 2, 3))
+    for k, zk in enumerate((z0, z1)):
+        cp[k, :, 1, :2] = radius * phi
+        cp[k, :, :, :2] += np.asarray(centre, dtype=float)
+        cp[k, :, :, 2] = zk
+    weights = np.broadcast_to(np.array([1.0, math.sqrt(0.5), 1.0])[None, :, None], (2, 3, 2)).copy()
+    return Volume((1, 2, 1), ONE, ARC, ONE, cp, weights, _named(DISC_FACES, faces))
+
+
 HALF_SHELL_FACES = {"symmetry_y": "xi0", "top": "xi1", "end_xneg": "eta0", "end_xpos": "eta1",
                     "inner": "zeta0", "outer": "zeta1"}
 """Face labels of a half ball shell (:func:`half_ball_shell`): ``symmetry_y`` the plane

@@ -544,3 +544,29 @@ def test_polar_dof_counts_against_splipy(layout: str) -> None:
         interface = 3 * face.shape[0] * face.shape[1]
     assert case_dofs(POLAR, "p1", layout) == {"interface": interface, "bulk": 3 * n[0] * n[1] * (n[2] - 1),
                                               "total": interface + 3 * n[0] * n[1] * (n[2] - 1)}
+
+
+def test_the_polar_block() -> None:
+    """``--grid polar --master block``: the block is the quarter cylinder of radius L about
+    the contact's axis, its top (z = -R) the contact face, its faces named as the box's;
+    its r knots are the box's x knots with the band 0.9 .. 1.1 a_est split as the ball's,
+    so its knot lines too are circles about the axis."""
+    ball = Ball(master="block", grid="polar", block_size=0.75, radius=2.0)
+    vol = ball_geometry(ball)[BLOCK]
+    check_volume(BLOCK, vol)
+    assert enclosed_volume(vol) == pytest.approx(math.pi * 1.5**2 / 4 * 1.5, rel=1e-12)
+    xi, eta = _random()
+    top = evaluate(vol, xi, eta, np.ones_like(xi))
+    np.testing.assert_allclose(top[:, 2], -2.0, atol=1e-15)
+    np.testing.assert_allclose(np.hypot(top[:, 0], top[:, 1]), 1.5 * xi, rtol=1e-12)  # r = xi L
+    assert set(vol.faces.values()) >= {"symmetry_x", "symmetry_y", "bottom", BLOCK_FACE}
+    for mesh in POLAR_MESHES:
+        polar = block_knots(ball, mesh)
+        assert polar["knots_eta"] == [k / PHI_ELEMENTS for k in range(1, PHI_ELEMENTS)]
+        r = np.concatenate([[0.0], polar["knots_xi"], [1.0]]) * 1.5
+        a = ball.half_width
+        inside = (r[1:] > EDGE_BAND[0] * a) & (r[:-1] < EDGE_BAND[1] * a)
+        assert inside.sum() >= POLAR_MESHES[mesh][3]
+        h = BLOCK_CELL * ball.radius * math.asin(1.5 * a / ball.radius) / POLAR_MESHES[mesh][0]
+        np.testing.assert_allclose(np.diff(r)[inside], h / POLAR_MESHES[mesh][3], rtol=1e-9)
+        assert len(polar["knots_zeta"]) == POLAR_MESHES[mesh][2] - 1
