@@ -188,9 +188,11 @@ def _cmd_cattaneo3d(args: argparse.Namespace) -> int:
 
     ball = HalfBall(youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
                     indentation=args.indentation, friction=args.friction, target=args.target,
-                    shear=args.shear, press_steps=args.steps[0], shear_steps=args.steps[1], method=args.method)
+                    shear=args.shear, press_steps=args.steps[0], shear_steps=args.steps[1], method=args.method,
+                    grid=args.grid)
+    meshes = args.mesh or ["p1" if args.grid == "polar" else "m1"]
     return _write_scene3d(
-        "cattaneo3d", lambda: write_cattaneo3d(ball, args.mesh, args.layout, args.out, force=args.force),
+        "cattaneo3d", lambda: write_cattaneo3d(ball, meshes, args.layout, args.out, force=args.force),
         lambda mesh, layout: case_dofs(ball, mesh, layout), "half ball",
         f"expected contact radius sqrt(R d) = {ball.half_width:.4g}; the plane moves {ball.plane_shear:.4g} "
         f"along x in the shear phase")
@@ -367,8 +369,13 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("cattaneo3d", help="the 3D Cattaneo-Mindlin scene: a half ball pressed on a rigid "
                                           "plane without friction, then sheared with it (docs/cattaneo3d.md)")
     s.add_argument("out", help="folder for geometry.h5 and <mesh>-<layout>.nml")
-    s.add_argument("--mesh", nargs="+", default=["m1"], help="mesh levels m1 .. m4 (default m1)")
+    s.add_argument("--mesh", nargs="+", default=None,
+                   help="meshes: m1 .. m4 on the Cartesian grid (default m1), p1 .. p4 on the polar one "
+                        "(default p1)")
     s.add_argument("--layout", nargs="+", default=["N2"], help="solid layouts, e.g. N2 NN2.2 (default N2)")
+    s.add_argument("--grid", default="cartesian", choices=("cartesian", "polar"),
+                   help="cartesian: the half shell (default); polar: the half ball about the vertical axis "
+                        "through the contact, knot lines along the contact's and the stick zone's edges")
     s.add_argument("--youngs-modulus", type=float, default=1.0, help="E (default 1)")
     s.add_argument("--poisson-ratio", type=float, default=0.3, help="nu in (-1, 0.5) (default 0.3)")
     s.add_argument("--indentation", type=float, default=0.01, help="the press d, 0 < d < R/10 (default 0.01)")

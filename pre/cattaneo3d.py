@@ -37,11 +37,11 @@ from typing import Any
 
 from .cases import GEOMETRY_FILE, case_stem, to_namelist_text
 from .h5io import write_geometry
-from .hertz import HertzCaseError, write_scene3d_folder
-from .hertz3d import MESHES, _solid_group
+from .hertz import EDGE_BAND, HertzCaseError, split_spans, write_scene3d_folder
+from .hertz3d import GRIDS, MESHES, POLAR_MESHES, _solid_group
 from .meshes import arc_parameter_exact, graded_angles, hertz_eta_knots, hertz_theta_c
 from .solid_case import solid_dofs
-from .solids import half_ball_shell
+from .solids import half_ball_shell, polar_half_ball
 from .volume import Volume
 
 SCENE = "cattaneo3d"
@@ -51,6 +51,9 @@ INNER = 0.05
 """Inner radius of the shell over R (the 2D scenes' hole)."""
 CONE = 60.0
 """The body spans theta = 90 +- CONE degrees about the x axis (|x| <= R sin(CONE))."""
+PHI_ELEMENTS = 4
+"""Elements along each quarter of phi on the polar grid: the shear's field varies as cos 2
+phi, which the geometry's rational arc does not hold exactly (the press's does)."""
 BODY_COMPLIANCE = 1.0
 """The ball's own tangential compliance beyond the contact's, times G R (see
 :meth:`HalfBall.shear_for`): the half shell's top held, measured from the plane's move and
@@ -74,6 +77,8 @@ class HalfBall:
     shear_steps: int = 10
     method: str | None = None
     """``&contact method`` (None: voiga's default on solids)."""
+    grid: str = "cartesian"
+    """:data:`pre.hertz3d.GRIDS`: the half shell, or the polar half ball (module docstring)."""
 
     def check(self) -> None:
         """HertzCaseError naming the first value out of range."""
@@ -93,6 +98,8 @@ class HalfBall:
             raise HertzCaseError(f"target Q/(mu P) {self.target:g} must be in (0, 1) (1: gross slip)")
         if self.shear is not None and not (math.isfinite(self.shear) and self.shear > 0):
             raise HertzCaseError(f"shear {self.shear!r} must be > 0")
+        if self.grid not in GRIDS:
+            raise HertzCaseError(f"grid {self.grid!r} must be one of {', '.join(GRIDS)}")
         if self.press_steps < 1 or self.shear_steps < 1:
             raise HertzCaseError("press and shear steps must be >= 1")
 
@@ -121,8 +128,10 @@ class HalfBall:
 def ball_knots(ball: HalfBall, mesh: str) -> dict[str, list[float]]:
     """``knots_xi`` (phi), ``knots_eta`` (theta, symmetric about the lowest point),
     ``knots_zeta`` (rho) of mesh ``mesh`` (module docstring)."""
+    if ball.grid == "polar":
+        return polar_knots(ball, mesh)
     if mesh not in MESHES:
-        raise HertzCaseError(f"mesh {mesh!r}: one of {', '.join(MESHES)}")
+        raise HertzCaseError(f"mesh {mesh!r}: the cartesian grid's meshes are {', '.join(MESHES)}")
     fine, rest, radial = MESHES[mesh]
     theta_c = hertz_theta_c(ball.half_width / ball.radius)
     phi = [arc_parameter_exact(a) for a in graded_angles(theta_c, fine, rest)]
@@ -135,8 +144,31 @@ def ball_knots(ball: HalfBall, mesh: str) -> dict[str, list[float]]:
     return {"knots_xi": phi, "knots_eta": theta, "knots_zeta": [float(k) for k in rho]}
 
 
+def polar_knots(ball: HalfBall, mesh: str) -> dict[str, list[float]]:
+    """The knots of a polar mesh (:data:`pre.hertz3d.POLAR_MESHES`): :data:`PHI_ELEMENTS`
+    uniform along each quarter of phi (the C0 knot at 90 degrees kept once); theta graded
+    as the 3D Hertz scene's with the spans over :data:`pre.hertz.EDGE_BAND` of both
+    expected edges, the contact's a = sqrt(R d) and the stick zone's c = a (1 -
+    target)^(1/3), split into ``edge``; rho graded toward the sphere."""
+    if mesh not in POLAR_MESHES:
+        raise HertzCaseError(f"mesh {mesh!r}: the polar grid's meshes are {', '.join(POLAR_MESHES)}")
+    fine, rest, radial, edge = POLAR_MESHES[mesh]
+    a = ball.half_width / ball.radius
+    theta_c = hertz_theta_c(a)
+    theta = [arc_parameter_exact(t) for t in graded_angles(theta_c, fine, rest)]
+    bands = [tuple(arc_parameter_exact(math.asin(f * r)) for f in EDGE_BAND)
+             for r in (a, a * (1.0 - ball.target) ** (1.0 / 3.0))]
+    n = 2 * PHI_ELEMENTS
+    return {"knots_xi": [k / n for k in range(1, n) if 2 * k != n],
+            "knots_eta": split_spans(theta, bands, edge),
+            "knots_zeta": [float(k) for k in hertz_eta_knots(radial, theta_c / fine, thickness=1.0)]}
+
+
 def ball_geometry(ball: HalfBall) -> dict[str, Volume]:
-    """The scene's one body (:func:`pre.solids.half_ball_shell`)."""
+    """The scene's one body (:func:`pre.solids.half_ball_shell`, or
+    :func:`pre.solids.polar_half_ball` on the polar grid)."""
+    if ball.grid == "polar":
+        return {BODY: polar_half_ball(ball.radius)}
     return {BODY: half_ball_shell(ball.radius, INNER * ball.radius, CONE)}
 
 
@@ -147,12 +179,14 @@ def ball_case(ball: HalfBall, mesh: str, layout: str) -> dict[str, Any]:
     body = _solid_group(BODY, vol, ball_knots(ball, mesh), layout, CONTACT_FACE, "linear",
                         ball.youngs_modulus, ball.poisson_ratio)
     d, s, r = float(ball.indentation), ball.plane_shear, float(ball.radius)
+    symmetry = ["symmetry_y", "symmetry_y_back"] if ball.grid == "polar" else ["symmetry_y"]
     contact: dict[str, Any] = {"slave": BODY, "master": "rigid", "rigid_point": [0.0, 0.0, -r],
                                "rigid_normal": [0.0, 0.0, 1.0], "friction": [0.0, float(ball.friction)],
                                "rigid_ux": [0.0, s]}
     if ball.method is not None:
         contact["method"] = ball.method
-    title = (f"cattaneo3d {mesh} {layout}: half ball R = {r:g}, E = {ball.youngs_modulus:g}, "
+    grid = " (polar grid)" if ball.grid == "polar" else ""
+    title = (f"cattaneo3d {mesh} {layout}: half ball{grid} R = {r:g}, E = {ball.youngs_modulus:g}, "
              f"nu = {ball.poisson_ratio:g}, pressed {d:g} without friction, sheared {s:.4g} with mu = "
              f"{ball.friction:g}")
     return {"case": {"title": title, "scene": SCENE, "mesh": mesh, "layout": layout,
@@ -161,7 +195,7 @@ def ball_case(ball: HalfBall, mesh: str, layout: str) -> dict[str, Any]:
             "solver": {"n_steps": [int(ball.press_steps), int(ball.shear_steps)]},
             "dirichlet": [{"body": BODY, "face": "top", "fix_x": True, "fix_y": True, "fix_z": True,
                            "ux": [0.0, 0.0], "uy": [0.0, 0.0], "uz": [-d, -d]},
-                          {"body": BODY, "face": "symmetry_y", "fix_y": True}],
+                          *({"body": BODY, "face": f, "fix_y": True} for f in symmetry)],
             "contact": [contact]}
 
 

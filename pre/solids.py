@@ -254,6 +254,39 @@ def polar_ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
     return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(POLAR_BALL_FACES, faces))
 
 
+POLAR_HALF_FACES = {"symmetry_y": "xi0", "symmetry_y_back": "xi1", "axis": "eta0", "top": "eta1",
+                    "centre": "zeta0", "outer": "zeta1"}
+"""Face labels of a polar half ball (:func:`polar_half_ball`): ``symmetry_y`` and
+``symmetry_y_back`` the halves x >= x_c and x <= x_c of the plane y = y_c, ``axis``,
+``top``, ``centre`` and ``outer`` as the polar ball octant's."""
+HALF_TURN = np.array([0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0])
+"""Knots of two rational quadratic quarter arcs (a C0 knot between them)."""
+
+
+def polar_half_ball(radius: float, centre: Point = (0.0, 0.0, 0.0),
+                    faces: dict[str, str] | None = None) -> Volume:
+    """The half ``y >= y_c, z <= z_c`` of the lower hemisphere of the ball ``|x - centre|
+    <= radius``, in the polar ball octant's coordinates (:func:`polar_ball_octant`) with
+    phi from 0 to 180 degrees (two exact quarter arcs, the knot between them on the
+    plane x = x_c): the knot lines of eta are half circles about the lowest point, for a
+    contact sheared along x (the 3D Cattaneo-Mindlin scene's ``--grid polar``). Degrees
+    (2, 2, 1), 5 x 3 x 2 control points, right-handed; the faces ``eta = 0`` (the axis)
+    and ``zeta = 0`` (the centre) collapse; faces :data:`POLAR_HALF_FACES`."""
+    radius = float(radius)
+    if not radius > 0:
+        raise ValueError(f"polar half ball: need radius > 0, got {radius}")
+    w45 = math.sqrt(0.5)
+    phi = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [-1.0, 1.0], [-1.0, 0.0]])  # 0 .. 180 degrees
+    theta = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])  # (sin, cos) polygon, 0 .. 90 degrees
+    cp = np.zeros((2, 3, 5, 3))
+    for j in range(3):
+        cp[1, j, :, :2] = radius * theta[j, 0] * phi
+        cp[1, j, :, 2] = -radius * theta[j, 1]
+    cp += np.asarray(centre, dtype=float)
+    weights = np.broadcast_to(np.outer([1.0, w45, 1.0], [1.0, w45, 1.0, w45, 1.0]), (2, 3, 5)).copy()
+    return Volume((2, 2, 1), HALF_TURN, ARC, ONE, cp, weights, _named(POLAR_HALF_FACES, faces))
+
+
 DISC_FACES = {"axis": "xi0", "rim": "xi1", "symmetry_y": "eta0", "symmetry_x": "eta1",
               "bottom": "zeta0", "top": "zeta1"}
 """Face labels of a polar quarter cylinder (:func:`polar_quarter_cylinder`): ``axis`` the

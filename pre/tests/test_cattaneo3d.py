@@ -13,11 +13,22 @@ import numpy as np
 import pytest
 
 from pre.__main__ import main
-from pre.cattaneo3d import BODY, CONE, INNER, HalfBall, ball_case, ball_geometry, ball_knots, write_cattaneo3d
-from pre.hertz import HertzCaseError
+from pre.cattaneo3d import (
+    BODY,
+    CONE,
+    INNER,
+    PHI_ELEMENTS,
+    HalfBall,
+    ball_case,
+    ball_geometry,
+    ball_knots,
+    write_cattaneo3d,
+)
+from pre.hertz import EDGE_BAND, HertzCaseError
+from pre.hertz3d import POLAR_MESHES
 from pre.meshes import arc_angle
-from pre.solids import half_ball_shell
-from pre.volume import check_volume, jacobian
+from pre.solids import half_ball_shell, polar_half_ball
+from pre.volume import check_volume, enclosed_volume, jacobian
 
 
 def test_half_shell_is_exact_and_right_handed() -> None:
@@ -94,3 +105,46 @@ def test_cli_writes_cases_and_refuses_to_overwrite(tmp_path: Path, capsys: pytes
     assert (tmp_path / "m1-N2.nml").read_bytes() == before
     assert write_cattaneo3d(HalfBall(shear=1e-3), ["m1"], ["N2"], tmp_path, force=True)[1][0].exists()
     assert INNER < 1
+
+
+def test_polar_half_ball_is_exact_and_right_handed() -> None:
+    """The polar half ball: its sphere face on the sphere, y >= 0, z <= 0, det J > 0 inside,
+    the plane y = 0 in two faces (x >= 0 and x <= 0), the lowest point the edge eta = 0."""
+    vol = polar_half_ball(2.0)
+    check_volume("ball", vol)
+    rng = np.random.default_rng(4)
+    xi, eta = rng.random(50), rng.random(50)
+    x, jac = jacobian(vol, xi, eta, np.ones(50))
+    assert np.allclose(np.linalg.norm(x, axis=1), 2.0, rtol=1e-13)
+    assert np.all(x[:, 1] >= -1e-14) and np.all(x[:, 2] <= 1e-14)
+    assert np.all(np.linalg.det(jacobian(vol, xi, eta, rng.random(50))[1]) > 0)
+    for end, sign in ((0.0, 1.0), (1.0, -1.0)):
+        side, _ = jacobian(vol, np.full(50, end), eta, rng.random(50))
+        assert np.abs(side[:, 1]).max() < 1e-14 and np.all(sign * side[:, 0] >= -1e-14)
+    low, _ = jacobian(vol, xi, np.zeros(50), np.ones(50))
+    assert np.allclose(low, [0.0, 0.0, -2.0], atol=1e-14)
+    assert enclosed_volume(vol) == pytest.approx(2.0 * math.pi * 8.0 / 6.0, rel=1e-12)
+
+
+def test_polar_knots_split_both_edges() -> None:
+    """On the polar grid theta's spans over 0.9 .. 1.1 of both expected edges (a, and the
+    stick zone's c = a (1 - target)^(1/3)) are split; phi's C0 knot at 90 degrees is not
+    inserted again (it would cut the body); the symmetry plane's two faces are held in y."""
+    ball = HalfBall(grid="polar")
+    knots = ball_knots(ball, "p2")
+    assert 0.5 not in knots["knots_xi"] and len(knots["knots_xi"]) == 2 * PHI_ELEMENTS - 2
+    theta = np.concatenate([[0.0], arc_angle(np.array(knots["knots_eta"])), [math.pi / 2]])
+    sizes = np.diff(theta)
+    a = ball.half_width / ball.radius
+    for r in (a, a * (1 - ball.target) ** (1 / 3)):
+        lo, hi = (math.asin(f * r) for f in EDGE_BAND)
+        inside = (theta[1:] > lo) & (theta[:-1] < hi)
+        assert inside.sum() >= 2 * POLAR_MESHES["p2"][3]
+        assert sizes[inside].max() < 0.3 * sizes[: int(np.argmax(inside))].max()
+    case = ball_case(ball, "p2", "N2")
+    assert [d["face"] for d in case["dirichlet"] if d.get("fix_y") and not d.get("fix_z")] == \
+        ["symmetry_y", "symmetry_y_back"]
+    with pytest.raises(HertzCaseError, match="polar grid's meshes"):
+        ball_knots(ball, "m1")
+    with pytest.raises(HertzCaseError, match="cartesian grid's meshes"):
+        ball_knots(HalfBall(), "p1")
