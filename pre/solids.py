@@ -238,20 +238,29 @@ def polar_ball_octant(radius: float, centre: Point = (0.0, 0.0, 0.0),
     sphere face: the coincident control points there are separate unknowns, held
     together by the stiffness only) and ``zeta = 0`` onto the centre. Degrees (2, 2, 1),
     3 x 3 x 2 control points, right-handed; faces :data:`POLAR_BALL_FACES`."""
+    w45 = math.sqrt(0.5)
+    cp, weights = _polar_net(radius, centre, np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
+                             np.array([1.0, w45, 1.0]), "polar ball octant")
+    return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(POLAR_BALL_FACES, faces))
+
+
+def _polar_net(radius: float, centre: Point, phi: np.ndarray, w_phi: np.ndarray,
+               what: str) -> tuple[np.ndarray, np.ndarray]:
+    """Control points (2, 3, n, 3) and weights of a ball in spherical coordinates about
+    the vertical axis through its lowest point: the azimuth's (cos, sin) polygon ``phi``
+    (n, 2) with its weights ``w_phi``, times the polar angle's quarter arc from the axis
+    (theta 0 .. 90 degrees) and a line from the centre to the sphere."""
     radius = float(radius)
     if not radius > 0:
-        raise ValueError(f"polar ball octant: need radius > 0, got {radius}")
-    w45 = math.sqrt(0.5)
-    phi = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])  # (cos, sin) polygon, 0 .. 90 degrees
+        raise ValueError(f"{what}: need radius > 0, got {radius}")
     theta = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])  # (sin, cos) polygon, 0 .. 90 degrees
-    cp = np.zeros((2, 3, 3, 3))
+    cp = np.zeros((2, 3, len(phi), 3))
     for j in range(3):
         cp[1, j, :, :2] = radius * theta[j, 0] * phi
         cp[1, j, :, 2] = -radius * theta[j, 1]
     cp += np.asarray(centre, dtype=float)
-    w = np.array([1.0, w45, 1.0])
-    weights = np.broadcast_to(np.outer(w, w), (2, 3, 3)).copy()
-    return Volume((2, 2, 1), ARC, ARC, ONE, cp, weights, _named(POLAR_BALL_FACES, faces))
+    w_theta = np.array([1.0, math.sqrt(0.5), 1.0])
+    return cp, np.broadcast_to(np.outer(w_theta, w_phi), (2, 3, len(phi))).copy()
 
 
 POLAR_HALF_FACES = {"symmetry_y": "xi0", "symmetry_y_back": "xi1", "axis": "eta0", "top": "eta1",
@@ -272,18 +281,9 @@ def polar_half_ball(radius: float, centre: Point = (0.0, 0.0, 0.0),
     contact sheared along x (the 3D Cattaneo-Mindlin scene's ``--grid polar``). Degrees
     (2, 2, 1), 5 x 3 x 2 control points, right-handed; the faces ``eta = 0`` (the axis)
     and ``zeta = 0`` (the centre) collapse; faces :data:`POLAR_HALF_FACES`."""
-    radius = float(radius)
-    if not radius > 0:
-        raise ValueError(f"polar half ball: need radius > 0, got {radius}")
     w45 = math.sqrt(0.5)
     phi = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [-1.0, 1.0], [-1.0, 0.0]])  # 0 .. 180 degrees
-    theta = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])  # (sin, cos) polygon, 0 .. 90 degrees
-    cp = np.zeros((2, 3, 5, 3))
-    for j in range(3):
-        cp[1, j, :, :2] = radius * theta[j, 0] * phi
-        cp[1, j, :, 2] = -radius * theta[j, 1]
-    cp += np.asarray(centre, dtype=float)
-    weights = np.broadcast_to(np.outer([1.0, w45, 1.0], [1.0, w45, 1.0, w45, 1.0]), (2, 3, 5)).copy()
+    cp, weights = _polar_net(radius, centre, phi, np.array([1.0, w45, 1.0, w45, 1.0]), "polar half ball")
     return Volume((2, 2, 1), HALF_TURN, ARC, ONE, cp, weights, _named(POLAR_HALF_FACES, faces))
 
 

@@ -43,7 +43,7 @@ from pre.meshes import arc_angle
 from pre.namelists import NAMELISTS
 from pre.solids import ball_octant, polar_ball_octant
 from pre.tests.test_hertz_case import _voiga
-from pre.volume import check_volume, enclosed_volume, evaluate, jacobian, jacobian_grid, volume_to_splipy
+from pre.volume import Volume, check_volume, enclosed_volume, evaluate, jacobian, jacobian_grid, volume_to_splipy
 
 RNG = np.random.default_rng(42)
 DOF_RANGE = (4000, 70000)
@@ -54,9 +54,9 @@ def _random(n: int = 200) -> tuple[np.ndarray, np.ndarray]:
     return RNG.random(n), RNG.random(n)
 
 
-@pytest.mark.parametrize("radius", [1.0, 2.5])
-def test_the_ball_is_exact(radius: float) -> None:
-    vol = ball_octant(radius)
+def _in_the_octant(vol: Volume, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Checks the volume, that its sphere face is on the sphere and that it lies in the
+    ball's octant x, y >= 0, z <= 0; returns the random (xi, eta) it drew."""
     check_volume(BODY, vol)
     xi, eta = _random()
     sphere = evaluate(vol, xi, eta, np.ones_like(xi))
@@ -64,6 +64,13 @@ def test_the_ball_is_exact(radius: float) -> None:
     inside = evaluate(vol, xi, eta, RNG.random(len(xi)))
     assert np.linalg.norm(inside, axis=1).max() <= radius * (1 + 1e-12)
     assert inside[:, 0].min() >= 0 and inside[:, 1].min() >= 0 and inside[:, 2].max() <= 0
+    return xi, eta
+
+
+@pytest.mark.parametrize("radius", [1.0, 2.5])
+def test_the_ball_is_exact(radius: float) -> None:
+    vol = ball_octant(radius)
+    xi, eta = _in_the_octant(vol, radius)
     zero, one = np.zeros_like(xi), np.ones_like(xi)
     zeta = RNG.random(len(xi))
     # the symmetry faces and the top are planes, the collapsed faces a line and a point
@@ -87,19 +94,23 @@ def test_the_contact_corner_is_regular() -> None:
     assert abs(j[1, 0]) > 1 and abs(j[0, 1]) > 1 and j[2, 2] == pytest.approx(-1.0)
 
 
-@pytest.mark.parametrize("mesh", list(MESHES))
-def test_det_j_is_positive_at_every_gauss_point(mesh: str) -> None:
-    """Over the refined mesh, det J > 0 at the Gauss points (degree + 1 = 3 per
-    direction) of every element, the ones next to the collapsed faces included."""
-    ball = Ball()
-    vol = ball_geometry(ball)[BODY]
-    knots = ball_knots(ball, mesh)
+def _gauss_det(vol: Volume, knots: dict[str, list[float]]) -> np.ndarray:
+    """det J at the Gauss points (3 per direction) of every element of ``vol`` refined
+    by ``knots``."""
     x, _ = np.polynomial.legendre.leggauss(3)
     pts = []
     for d in ("xi", "eta", "zeta"):
         breaks = np.concatenate([[0.0], knots[f"knots_{d}"], [1.0]])
         pts.append(np.concatenate([0.5 * (a + b) + 0.5 * (b - a) * x for a, b in pairwise(breaks)]))
-    det = np.linalg.det(jacobian_grid(vol, *pts)[1])
+    return np.linalg.det(jacobian_grid(vol, *pts)[1])
+
+
+@pytest.mark.parametrize("mesh", list(MESHES))
+def test_det_j_is_positive_at_every_gauss_point(mesh: str) -> None:
+    """Over the refined mesh, det J > 0 at the Gauss points (degree + 1 = 3 per
+    direction) of every element, the ones next to the collapsed faces included."""
+    ball = Ball()
+    det = _gauss_det(ball_geometry(ball)[BODY], ball_knots(ball, mesh))
     assert det.min() > 0
     assert det.min() > 1e-10 * det.max()
 
@@ -439,12 +450,7 @@ def test_the_polar_ball_is_exact(radius: float) -> None:
     the same planes, its axis face collapsed onto the vertical axis below the centre, the
     lowest point the whole edge eta = 0 of the sphere face, the volume pi R^3 / 6."""
     vol = polar_ball_octant(radius)
-    check_volume(BODY, vol)
-    xi, eta = _random()
-    sphere = evaluate(vol, xi, eta, np.ones_like(xi))
-    assert np.abs(np.linalg.norm(sphere, axis=1) - radius).max() < 1e-12 * radius
-    inside = evaluate(vol, xi, eta, RNG.random(len(xi)))
-    assert inside[:, 0].min() >= 0 and inside[:, 1].min() >= 0 and inside[:, 2].max() <= 0
+    xi, eta = _in_the_octant(vol, radius)
     zero, one, zeta = np.zeros_like(xi), np.ones_like(xi), RNG.random(len(xi))
     assert np.abs(evaluate(vol, zero, eta, zeta)[:, 1]).max() < 1e-15      # symmetry_y: y = 0
     assert np.abs(evaluate(vol, one, eta, zeta)[:, 0]).max() < 1e-15       # symmetry_x: x = 0
@@ -489,14 +495,7 @@ def test_polar_knot_lines_are_circles_about_the_contact(mesh: str) -> None:
 def test_polar_det_j_is_positive_at_every_gauss_point(mesh: str) -> None:
     """det J > 0 at the Gauss points of every element of the polar meshes, those along the
     collapsed axis (det J ~ the distance from it) included."""
-    vol = ball_geometry(POLAR)[BODY]
-    knots = ball_knots(POLAR, mesh)
-    x, _ = np.polynomial.legendre.leggauss(3)
-    pts = []
-    for d in ("xi", "eta", "zeta"):
-        breaks = np.concatenate([[0.0], knots[f"knots_{d}"], [1.0]])
-        pts.append(np.concatenate([0.5 * (a + b) + 0.5 * (b - a) * x for a, b in pairwise(breaks)]))
-    det = np.linalg.det(jacobian_grid(vol, *pts)[1])
+    det = _gauss_det(ball_geometry(POLAR)[BODY], ball_knots(POLAR, mesh))
     assert det.min() > 0 and det.min() > 1e-10 * det.max()
 
 
