@@ -269,9 +269,10 @@ contains
         call contact_fd(model%pairs(1)%pair, u, state_stick, 'mortar friction touch', error)
     end subroutine test_mortar_friction_fd
 
-    !> The two blocks of `test_tangent_fd_deformable` (N2 on 3 x 2 cells, mortar) with
-    !> friction: the master's tangents and curvature enter the slip and the projection
-    !> of the traction; stick and slip as in `test_mortar_friction_fd`.
+    !> The two blocks of `test_tangent_fd_deformable` (N2 on 3 x 2 cells) with friction,
+    !> mortar and segment (its points cut at the master's cells): the master's tangents
+    !> and curvature enter the slip and the projection of the traction; stick and slip
+    !> as in `test_mortar_friction_fd`.
     subroutine test_mortar_friction_fd_deformable(error)
         type(error_t), allocatable, intent(out) :: error
         type(scene_t) :: c
@@ -280,16 +281,18 @@ contains
         type(model_t) :: model
         real(dp), allocatable :: u(:)
         real(dp) :: mu(2), shift(2)
-        integer :: want(2), i
+        integer :: want(2), i, im
+        character(len=7), parameter :: methods(2) = [character(len=7) :: 'mortar', 'segment']
         mu = [0.5_dp, 0.3_dp]
         shift = [1.0e-5_dp, 0.05_dp]
         want = [state_stick, state_slip]
+        do im = 1, 2
         do i = 1, 2
             c%bodies = [body_settings('upper', 'linear', 1.0_dp, layout3(2, [2, 2, 1], 0, 0, 'bottom')), &
                         body_settings('lower', 'linear', 1.0_dp, layout3(2, [3, 2, 1], 0, 0, 'top'))]
             contact%slave = 'upper'
             contact%master = 'lower'
-            contact%method = 'mortar'
+            contact%method = methods(im)
             contact%friction = mu(i)
             c%contact = [contact]
             call new_discretization(discs(1), unit_box(-0.02_dp), box_faces, c%bodies(1)%layout, '', error)
@@ -300,8 +303,9 @@ contains
             if (allocated(error)) return
             call mortar_friction_state(model, 2.0e-3_dp, shift(i), u, error)
             if (allocated(error)) return
-            call contact_fd(model%pairs(1)%pair, u, want(i), 'mortar friction blocks '//str(i), error)
+            call contact_fd(model%pairs(1)%pair, u, want(i), trim(methods(im))//' friction blocks '//str(i), error)
             if (allocated(error)) return
+        end do
         end do
     end subroutine test_mortar_friction_fd_deformable
 
@@ -347,7 +351,7 @@ contains
         call model%pairs(1)%pair%evaluate(u, r, error)
         if (allocated(error)) return
         select type (pair => model%pairs(1)%pair)
-        type is (mortar_pair_t)
+        class is (mortar_pair_t)
             call check(error, pair%h_traction_yz(2) > 0, 'a traction vector per control point')
             if (allocated(error)) return
             associate (h => pair%hist%field)

@@ -46,7 +46,9 @@ module voiga_contact_segment_faces
     use voiga_contact_master_face, only: face_master_t
     use voiga_contact_pair, only: history_item_t
     use voiga_contact_history, only: flag_value
+    use voiga_contact_law, only: state_inactive
     use voiga_contact_segment, only: segment_pair_t, interpolated_output
+    use voiga_contact_clip, only: clip_to_rectangle, signed_area, rectangle_rule, triangle_rule
     implicit none
     private
 
@@ -139,10 +141,33 @@ contains
                 self%hist%field(self%h_active)%last(k) = flag_value(found)
             end if
             if (found) call interpolated_output(self, k)
+            if (found .and. self%h_traction > 0) call traction_output(self, k, mp%n)
         end do
         self%warm = warm
         call self%hist%reset_trial()
     end subroutine resegment
+
+    !> A new point's traction vector (`interpolated_output` gives the pressure): the
+    !> committed control-point vectors (Cartesian, history `traction`, `traction_y`,
+    !> `traction_z`) interpolated there and projected on the master's tangent plane
+    !> (normal `n`), as the face mortar evaluation makes it.
+    pure subroutine traction_output(self, k, n)
+        class(segment_face_pair_t), intent(inout) :: self
+        integer, intent(in) :: k
+        real(dp), intent(in) :: n(3)
+        real(dp) :: tbar(3)
+        associate (nodes => self%point_nodes(:, k), phi => self%point_values(:, k), out => self%out(k), &
+                   h => self%hist%field)
+            if (out%state == state_inactive) return
+            tbar = [dot_product(phi, h(self%h_traction)%last(nodes)), &
+                    dot_product(phi, h(self%h_traction_yz(1))%last(nodes)), &
+                    dot_product(phi, h(self%h_traction_yz(2))%last(nodes))]
+            tbar = tbar - dot_product(n, tbar)*n
+            out%pt0 = norm2(tbar)
+            out%pt = out%pt0/out%stretch
+            out%tt = tbar/out%stretch
+        end associate
+    end subroutine traction_output
 
     !> The segmented quadrature of the slave face at `u` (`prepare`d master): per
     !> slave cell (xi fastest) its pieces (`cell_pieces`) and their points:
@@ -374,99 +399,6 @@ contains
             end if
         end do
     end subroutine line_meets_surface
-
-    !> The part of the quadrilateral `q` [2, 4] inside the rectangle [lo, hi]
-    !> (Sutherland-Hodgman against its four half-planes) [2, vertices].
-    pure function clip_to_rectangle(q, lo, hi) result(poly)
-        real(dp), intent(in) :: q(:, :), lo(2), hi(2)
-        real(dp), allocatable :: poly(:, :)
-        integer :: a
-        poly = q
-        do a = 1, 2
-            poly = clip_half(poly, a, lo(a), 1.0_dp)
-            poly = clip_half(poly, a, hi(a), -1.0_dp)
-        end do
-    end function clip_to_rectangle
-
-    !> The part of `poly` [2, n] where side (x_a - c) >= 0.
-    pure function clip_half(poly, a, c, side) result(out)
-        real(dp), intent(in) :: poly(:, :), c, side
-        integer, intent(in) :: a
-        real(dp), allocatable :: out(:, :)
-        real(dp) :: d0, d1, pt(2)
-        integer :: k, n
-        n = size(poly, 2)
-        allocate (out(2, 0))
-        do k = 1, n
-            associate (p0 => poly(:, k), p1 => poly(:, modulo(k, n) + 1))
-                d0 = side*(p0(a) - c)
-                d1 = side*(p1(a) - c)
-                if (d0 >= 0.0_dp) out = reshape([out, p0], [2, size(out, 2) + 1])
-                if ((d0 >= 0.0_dp) .neqv. (d1 >= 0.0_dp)) then
-                    pt = p0 + d0/(d0 - d1)*(p1 - p0)
-                    ! exactly on the line (no round-off across it)
-                    pt(a) = c
-                    out = reshape([out, pt], [2, size(out, 2) + 1])
-                end if
-            end associate
-        end do
-    end function clip_half
-
-    !> The signed area of the polygon `poly` [2, n] (positive counterclockwise).
-    pure real(dp) function signed_area(poly) result(area)
-        real(dp), intent(in) :: poly(:, :)
-        integer :: k, n
-        n = size(poly, 2)
-        area = 0.0_dp
-        do k = 1, n
-            area = area + poly(1, k)*poly(2, modulo(k, n) + 1) - poly(2, k)*poly(1, modulo(k, n) + 1)
-        end do
-        area = 0.5_dp*area
-    end function signed_area
-
-    !> The tensor rule (`gx`, `gw` on [0, 1]) on the rectangle [lo, hi]: points `px`
-    !> [2, n^2] and weights `pw` [n^2].
-    pure subroutine rectangle_rule(lo, hi, gx, gw, px, pw)
-        real(dp), intent(in) :: lo(2), hi(2), gx(:), gw(:)
-        real(dp), allocatable, intent(out) :: px(:, :), pw(:)
-        integer :: i, j, k, n
-        n = size(gx)
-        allocate (px(2, n*n), pw(n*n))
-        k = 0
-        do j = 1, n
-            do i = 1, n
-                k = k + 1
-                px(:, k) = lo + [gx(i), gx(j)]*(hi - lo)
-                pw(k) = gw(i)*gw(j)*product(hi - lo)
-            end do
-        end do
-    end subroutine rectangle_rule
-
-    !> The collapsed Gauss rule on each triangle of `tri` [2, 3, triangles]: with s, t
-    !> the rule's points on [0, 1], x = v1 + s (v2 - v1) + s t (v3 - v2), weight
-    !> w_s w_t s |det(v2 - v1, v3 - v2)|. A monomial of total degree d becomes one of
-    !> degree d + 1 in s (the Jacobian's s) and d in t: exact for d <= 2 n - 2.
-    pure subroutine triangle_rule(tri, gx, gw, px, pw)
-        real(dp), intent(in) :: tri(:, :, :), gx(:), gw(:)
-        real(dp), allocatable, intent(out) :: px(:, :), pw(:)
-        real(dp) :: det
-        integer :: i, j, k, it, n
-        n = size(gx)
-        allocate (px(2, n*n*size(tri, 3)), pw(n*n*size(tri, 3)))
-        k = 0
-        do it = 1, size(tri, 3)
-            associate (v1 => tri(:, 1, it), v2 => tri(:, 2, it), v3 => tri(:, 3, it))
-                det = abs((v2(1) - v1(1))*(v3(2) - v2(2)) - (v2(2) - v1(2))*(v3(1) - v2(1)))
-                do j = 1, n
-                    do i = 1, n
-                        k = k + 1
-                        px(:, k) = v1 + gx(i)*(v2 - v1) + gx(i)*gx(j)*(v3 - v2)
-                        pw(k) = gw(i)*gw(j)*gx(i)*det
-                    end do
-                end do
-            end associate
-        end do
-    end subroutine triangle_rule
 
     !> Make `xi`, `eta`, `w`, `elem` the pair's points: spans, slave functions (the
     !> multiplier basis), cell ranges, output records and per-point history.

@@ -113,8 +113,6 @@ def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
 @pytest.mark.parametrize(("contact", "message"), [
     (PLANE + ", method = 'alm', friction = 0.3", "method = 'alm' is not implemented for solids yet"),
     (PLANE + ", method = 'alm'", "method = 'alm' is not implemented for solids yet"),
-    (PLANE + ", method = 'segment', friction = 0.3",
-     "friction with method = 'segment' on solids is not implemented yet"),
     (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
     (", rigid_point = 0.0, 0.0", "rigid_point needs 3 components"),
     (", rigid_curve = 'arc'", "in a solid case use rigid_surface"),
@@ -291,10 +289,11 @@ def test_blocks_non_matching_faces(voiga_bin: Path, tmp_path: Path) -> None:
     assert spreads["segment", 0] <= 1e-6 and spreads["segment", 3] <= 1e-6
 
 
-@pytest.mark.parametrize("method", ["gpts", "mortar", ""])
+@pytest.mark.parametrize("method", ["gpts", "mortar", "segment", ""])
 def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) -> None:
-    """Coulomb friction on the tangent plane, GPTS and mortar (per control point; the
-    default on a solid, with friction as without): the box pressed by 0.01 (phase 1),
+    """Coulomb friction on the tangent plane, GPTS, mortar (per control point; the
+    default on a solid, with friction as without) and segment (mortar's law on points
+    cut at the master's cells): the box pressed by 0.01 (phase 1),
     then the plane slid 0.05 along x under it (phase 2). Every point ends slipping, the
     friction force approaches mu F_N along the sliding direction and the transverse one
     (from the press's lateral expansion, held by friction) dies out."""
@@ -318,14 +317,16 @@ def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) 
         assert f["steps/000006/contact/1"].attrs["method"].decode().strip() == (method or "mortar")
 
 
-def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path) -> None:
-    """The sliding box with mortar cut after step 4 (sliding, every control point
+@pytest.mark.parametrize("method", ["mortar", "segment"])
+def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path, method: str) -> None:
+    """The sliding box with mortar (and segment: its points and their friction history
+    re-cut at every converged state) cut after step 4 (sliding, every control point
     carrying a traction vector: the history's `traction`, `traction_y`, `traction_z`)
     and continued with --restart: the same contact forces, tractions and displacements
     as the run that was not cut."""
     import shutil
 
-    case = box_case(tmp_path, PLANE + ", method = 'mortar', friction = 0.3, rigid_ux = 0.0, 0.05")
+    case = box_case(tmp_path, PLANE + f", method = '{method}', friction = 0.3, rigid_ux = 0.0, 0.05")
     case.write_text(case.read_text().replace("n_steps = 2", "n_steps = 2, 4").replace("p = 0.01", "p = 0.01, 0.01"))
     res = run(voiga_bin, case)
     assert res.returncode == 0, res.stderr

@@ -119,9 +119,6 @@ contains
             if (c%method_given .and. all(trim(c%method) /= [character(len=7) :: 'gpts', 'mortar', 'segment'])) then
                 what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
                        "'mortar', 'segment' or 'gpts'"
-            else if (c%friction > 0.0_dp .and. trim(c%method) == 'segment') then
-                what = 'friction with method = ''segment'' on solids is not implemented yet (issue 42: the '// &
-                       'segments on faces are frictionless); give friction = 0, or method = ''mortar'' or ''gpts'''
             end if
         end if
         if (allocated(what)) call fatal_error(error, where//what, error_code%input)
