@@ -25,6 +25,8 @@ module test_contact_3d
     private
 
     public :: collect_contact_3d
+    !> For the augmented Lagrangian's tests on faces (`test_alm_faces`).
+    public :: ring_on_plane, unit_box, box_faces
 
     !> The quarter ring's faces (`ring_block`): r = 1, r = 2, theta = 0, theta = 90 deg,
     !> z = 0, z = 1.

@@ -28,12 +28,19 @@
 !> is exact for a fixed active set of a linear problem, whatever the penalty. Why
 !> not multipliers as unknowns of the global system: the solvers, the stiffness
 !> pattern and the result file keep the displacement unknowns only.
+!>
+!> On a solid's face (issue 42) the same pair runs frictionless: one normal multiplier
+!> per control point of the slave face, the face's weighted gaps from the mortar pair's
+!> face path (`mortar_point3`), and as element size of the tolerance the longer chord
+!> across the middle of the cells of the control point's support (`face_sizes`). With
+!> friction a face's law is the mortar pair's traction vector per control point
+!> (`mortar_faces.f90`), which has no multiplier here: the input refuses it.
 module voiga_contact_alm
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: real_str
     use voiga_contact_law, only: control_point_law, state_inactive, state_stick, state_slip
-    use voiga_contact_surface, only: element_lengths
+    use voiga_contact_surface, only: element_lengths, face_ids
     use voiga_contact_pair, only: history_item_t, sparse_vector_t, constraint_set_t, automatic
     use voiga_contact_mortar, only: mortar_pair_t
     implicit none
@@ -182,11 +189,36 @@ contains
             allocate (self%tau(n))
             self%tau = 0.0_dp
         end if
+        if (self%slave%npar > 1) then
+            call face_sizes(self)
+            return
+        end if
         lengths = element_lengths(self%slave)
         do i = 1, n
             self%h(i) = maxval(lengths(self%node_first(i):self%node_last(i)))
         end do
     end subroutine alm_setup_history
+
+    !> On a face, each control point's reference size: the largest over the cells of
+    !> its support of the cell's longer chord across its middle. The longer, as an
+    !> edge's chord, is the cell's extent whatever its aspect: the cells of a polar
+    !> grid narrow to wedges at its collapsed axis, whose shorter chord (or the square
+    !> root of their area) would tighten the tolerance there for no accuracy. The
+    !> cells of a support come from their control points (`face_ids`): a node's range
+    !> of cells, flat from first to last, holds cells beside its support.
+    pure subroutine face_sizes(self)
+        class(alm_pair_t), intent(inout) :: self
+        real(dp), allocatable :: lengths(:)
+        integer, allocatable :: ids(:)
+        integer :: e, nu
+        lengths = element_lengths(self%slave, longest=.true.)
+        nu = size(self%slave%spans)
+        self%h = 0.0_dp
+        do e = 1, size(lengths)
+            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
+            self%h(ids) = max(self%h(ids), lengths(e))
+        end do
+    end subroutine face_sizes
 
     !> The step converged (the multipliers become the committed ones), a step is
     !> retried, or the history is set (a restart): the tangential multipliers go on

@@ -96,7 +96,7 @@ contains
     !> A rigid master's point and normal have `nsd` components (or none given: the
     !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
     !> solids contact is, so far, GPTS or mortar, with or without friction, or frictionless
-    !> segment (issue 42: the rest is refused here, naming what is missing).
+    !> segment or ALM (issue 42: the rest is refused here, naming what is missing).
     subroutine check_contact_dimension(c, nsd, where, error)
         type(contact_settings_t), intent(in) :: c
         integer, intent(in) :: nsd
@@ -116,9 +116,10 @@ contains
                    '(a surface of the geometry file)'
         end if
         if (nsd == 3 .and. .not. allocated(what)) then
-            if (c%method_given .and. all(trim(c%method) /= [character(len=7) :: 'gpts', 'mortar', 'segment'])) then
-                what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
-                       "'mortar', 'segment' or 'gpts'"
+            if (c%friction > 0.0_dp .and. trim(c%method) == 'alm') then
+                what = 'friction with method = ''alm'' on solids is not implemented yet (issue 42: the multipliers '// &
+                       'on faces are normal pressures only, a tangential traction vector per control point has '// &
+                       'none); give friction = 0, or method = ''mortar'' or ''gpts'''
             else if (c%friction > 0.0_dp .and. trim(c%method) == 'segment') then
                 what = 'friction with method = ''segment'' on solids is not implemented yet (issue 42: the '// &
                        'segments on faces are frictionless); give friction = 0, or method = ''mortar'' or ''gpts'''
