@@ -13,7 +13,7 @@ module test_alm_faces
     use voiga_contact_pair, only: contact_pair_t
     use voiga_model, only: model_t
     use voiga_test_fixtures, only: layout3, scene_t, scene_model, body_settings, lcg_t
-    use voiga_nurbs_patch, only: nurbs_patch_t
+    use voiga_text, only: str
     use test_contact, only: contact_fd
     use test_contact_3d, only: ring_on_plane, unit_box, box_faces
     implicit none
@@ -82,9 +82,34 @@ contains
             if (allocated(error)) return
             call contact_fd(model%pairs(1)%pair, u, state_stick, 'alm blocks, layer '//char(48 + iq), error)
             if (allocated(error)) return
+            call check_shift(model%pairs(1)%pair, error)
+            if (allocated(error)) return
             deallocate (u)
         end do
     end subroutine test_tangent_fd_deformable
+
+    !> At the last evaluation every active control point's pressure is the shifted law's,
+    !> p_A = lambda_A - eps_N g_A / D_A (the face's mortar path called the pair's laws).
+    subroutine check_shift(pair, error)
+        class(contact_pair_t), intent(in) :: pair
+        type(error_t), allocatable, intent(out) :: error
+        integer :: a
+        select type (pair)
+        type is (alm_pair_t)
+            call check(error, count(pair%state == state_stick) >= 3, 'at least 3 active control points')
+            if (allocated(error)) return
+            associate (lambda => pair%hist%field(pair%h_lambda)%trial)
+                do a = 1, size(pair%state)
+                    if (pair%state(a) /= state_stick) cycle
+                    call check(error, pair%p_last(a), lambda(a) - pair%law%eps_n*pair%g(a)/pair%d(a), &
+                               'p_A = lambda_A - eps_N g_A / D_A at control point '//str(a), rel=1.0e-12_dp)
+                    if (allocated(error)) return
+                end do
+            end associate
+        class default
+            call check(error, .false., 'the pair is an alm pair')
+        end select
+    end subroutine check_shift
 
     !> The constraint test's size of a control point on a face is the longer chord of the
     !> cells of its support: 3 x 2 cells on the unit square are 1/3 x 1/2, so every
