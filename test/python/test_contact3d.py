@@ -202,6 +202,7 @@ def test_hertz3d_polar_alm_any_penalty(voiga_bin: Path, tmp_path: Path) -> None:
 
     root = Path(__file__).resolve().parents[2]
     pressures = []
+    automatic = 0.0  # the automatic penalty, read from the first run's result
     for i, factor in enumerate([None, 0.1, 10.0]):
         out = tmp_path / f"h{i}"
         extra = [] if factor is None else ["--penalty-normal", repr(factor * automatic)]
@@ -418,6 +419,54 @@ def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path) -> None:
             for name in ("displacement", "contact/1/force", "contact/1/p_t", "contact/1/p_n"):
                 np.testing.assert_allclose(b["steps"][k][name][()], a["steps"][k][name][()], rtol=0, atol=1e-12,
                                            err_msg=f"{k} {name}")
+
+
+def test_alm_faces_restart(voiga_bin: Path, tmp_path: Path) -> None:
+    """`pre hertz3d --grid polar` p1 N2 with ALM cut after step 3 and continued with
+    --restart: the continued steps take the uncut run's Newton iterations and give its
+    displacements, pressures and multipliers (history `multiplier`, one per control
+    point of the face) to 1e-12. Here the multiplier step is exact from any start (a
+    linear problem with a fixed active set: zeroed multipliers gave the same to 1.5e-15),
+    so that alone does not show they are read back: a file without them is refused,
+    naming the dataset."""
+    import shutil
+
+    out = tmp_path / "h"
+    subprocess.run(["python3", "-m", "pre", "hertz3d", str(out), "--grid", "polar", "--mesh", "p1", "--layout",
+                    "N2", "--method", "alm"], check=True, capture_output=True, cwd=Path(__file__).resolve().parents[2])
+    case = out / "p1-N2.nml"
+    res = run(voiga_bin, case)
+    assert res.returncode == 0, res.stderr
+    full, partial = out / "full.h5", out / "p1-N2.h5"
+    shutil.copy(partial, full)
+    with h5py.File(partial, "r+") as f:
+        multiplier = f["steps/000003/contact/1/history/multiplier"][()]
+        assert multiplier.max() > 0.0 and np.count_nonzero(multiplier) < multiplier.size
+        for k in list(f["steps"]):
+            if int(k) > 3:
+                del f["steps"][k]
+        f.attrs["n_steps_done"] = np.int32(3)
+        f.attrs["status"] = np.bytes_("interrupted")
+    res = run(voiga_bin, case, "--restart", str(partial))
+    assert res.returncode == 0, res.stderr
+    with h5py.File(full) as a, h5py.File(partial) as b:
+        assert b.attrs["status"] == b"converged" and int(b.attrs["n_steps_done"]) == 5
+        for k in a["steps"]:
+            for name in ("displacement", "contact/1/force", "contact/1/p_n", "contact/1/history/multiplier"):
+                np.testing.assert_allclose(b["steps"][k][name][()], a["steps"][k][name][()], rtol=0, atol=1e-12,
+                                           err_msg=f"{k} {name}")
+            for name in ("iterations_total", "cuts"):
+                assert b["steps"][k].attrs[name] == a["steps"][k].attrs[name], (k, name)
+    shutil.copy(full, partial)
+    with h5py.File(partial, "r+") as f:
+        del f["steps/000003/contact/1/history/multiplier"]
+        for k in list(f["steps"]):
+            if int(k) > 3:
+                del f["steps"][k]
+        f.attrs["n_steps_done"] = np.int32(3)
+        f.attrs["status"] = np.bytes_("interrupted")
+    res = run(voiga_bin, case, "--restart", str(partial))
+    assert res.returncode != 0 and "steps/000003/contact/1/history/multiplier' is missing" in res.stderr, res.stderr
 
 
 INDENT = """&case
