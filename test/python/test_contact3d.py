@@ -1,9 +1,9 @@
-"""Contact on a solid's face (issue 42: GPTS and mortar, with and without friction, and
-frictionless segment, against a rigid plane or another solid) through the command line. A
-box pressed onto a rigid plane by a uniform pressure on its top carries that pressure
-uniformly (the contact patch test against a rigid flat, which every method must pass),
-and slid along the plane carries mu times it (both frictional methods; a mortar run cut
-and continued with --restart reproduces the uncut one); the sphere of `pre hertz3d` runs
+"""Contact on a solid's face (issue 42: GPTS, mortar and ALM, with and without friction,
+and frictionless segment, against a rigid plane or another solid) through the command
+line. A box pressed onto a rigid plane by a uniform pressure on its top carries that
+pressure uniformly (the contact patch test against a rigid flat, which every method must
+pass), and slid along the plane carries mu times it (the frictional methods; a mortar run
+cut and continued with --restart reproduces the uncut one); the sphere of `pre hertz3d` runs
 and its result reads in `post hertz3d` with its contact force equal to the integral of
 the pressure; what is not implemented on faces yet is refused with its cause named."""
 from __future__ import annotations
@@ -122,7 +122,6 @@ def test_default_normal_is_z(voiga_bin: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(("contact", "message"), [
-    (PLANE + ", method = 'alm', friction = 0.3", "friction with method = 'alm' on solids is not implemented yet"),
     (PLANE + ", method = 'segment', friction = 0.3",
      "friction with method = 'segment' on solids is not implemented yet"),
     (", rigid_point = 0.0, 0.0, 0.0, rigid_normal = 0.0, 1.0", "rigid_normal needs 3 components"),
@@ -362,10 +361,11 @@ def test_alm_blocks_any_penalty(voiga_bin: Path, tmp_path: Path) -> None:
     assert np.abs(u["mortar", 10.0] - u["mortar", 1.0e4]).max() > 1e-4
 
 
-@pytest.mark.parametrize("method", ["gpts", "mortar", ""])
+@pytest.mark.parametrize("method", ["gpts", "mortar", "alm", ""])
 def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) -> None:
-    """Coulomb friction on the tangent plane, GPTS and mortar (per control point; the
-    default on a solid, with friction as without): the box pressed by 0.01 (phase 1),
+    """Coulomb friction on the tangent plane, GPTS, mortar (per control point; the
+    default on a solid, with friction as without) and ALM (mortar's law with multiplier
+    references, `contact/alm_faces.f90`): the box pressed by 0.01 (phase 1),
     then the plane slid 0.05 along x under it (phase 2). Every point ends slipping, the
     friction force approaches mu F_N along the sliding direction and the transverse one
     (from the press's lateral expansion, held by friction) dies out."""
@@ -389,14 +389,16 @@ def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) 
         assert f["steps/000006/contact/1"].attrs["method"].decode().strip() == (method or "mortar")
 
 
-def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path) -> None:
-    """The sliding box with mortar cut after step 4 (sliding, every control point
-    carrying a traction vector: the history's `traction`, `traction_y`, `traction_z`)
+@pytest.mark.parametrize("method", ["mortar", "alm"])
+def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path, method: str) -> None:
+    """The sliding box with mortar or ALM cut after step 4 (sliding, every control point
+    carrying a traction vector: the history's `traction`, `traction_y`, `traction_z`;
+    ALM's tangential multipliers go on from them, its normal ones are `multiplier`)
     and continued with --restart: the same contact forces, tractions and displacements
     as the run that was not cut."""
     import shutil
 
-    case = box_case(tmp_path, PLANE + ", method = 'mortar', friction = 0.3, rigid_ux = 0.0, 0.05")
+    case = box_case(tmp_path, PLANE + f", method = '{method}', friction = 0.3, rigid_ux = 0.0, 0.05")
     case.write_text(case.read_text().replace("n_steps = 2", "n_steps = 2, 4").replace("p = 0.01", "p = 0.01, 0.01"))
     res = run(voiga_bin, case)
     assert res.returncode == 0, res.stderr

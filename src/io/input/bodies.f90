@@ -95,8 +95,8 @@ contains
 
     !> A rigid master's point and normal have `nsd` components (or none given: the
     !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
-    !> solids contact is, so far, GPTS or mortar, with or without friction, or frictionless
-    !> segment or ALM (issue 42: the rest is refused here, naming what is missing).
+    !> solids contact is, so far, GPTS, mortar or ALM, with or without friction, or frictionless
+    !> segment (issue 42: the rest is refused here, naming what is missing).
     subroutine check_contact_dimension(c, nsd, where, error)
         type(contact_settings_t), intent(in) :: c
         integer, intent(in) :: nsd
@@ -116,11 +116,7 @@ contains
                    '(a surface of the geometry file)'
         end if
         if (nsd == 3 .and. .not. allocated(what)) then
-            if (c%friction > 0.0_dp .and. trim(c%method) == 'alm') then
-                what = 'friction with method = ''alm'' on solids is not implemented yet (issue 42: the multipliers '// &
-                       'on faces are normal pressures only, a tangential traction vector per control point has '// &
-                       'none); give friction = 0, or method = ''mortar'' or ''gpts'''
-            else if (c%friction > 0.0_dp .and. trim(c%method) == 'segment') then
+            if (c%friction > 0.0_dp .and. trim(c%method) == 'segment') then
                 what = 'friction with method = ''segment'' on solids is not implemented yet (issue 42: the '// &
                        'segments on faces are frictionless); give friction = 0, or method = ''mortar'' or ''gpts'''
             end if
