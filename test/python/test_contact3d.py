@@ -389,6 +389,29 @@ def test_sliding_box_carries_mu_p(voiga_bin: Path, tmp_path: Path, method: str) 
         assert f["steps/000006/contact/1"].attrs["method"].decode().strip() == (method or "mortar")
 
 
+def test_alm_stick_with_symmetry_planes(voiga_bin: Path, tmp_path: Path) -> None:
+    """The box pressed with mu = 2 and ALM: every control point sticks, so the bottom
+    face does not spread (measured 7e-16; the penalty methods let it slip elastically by
+    t / eps_T: mortar 2.3e-4); one multiplier update per step, although the symmetry planes
+    fix 9 of the face's DOFs along sticking directions, which makes 9 of its 60
+    constraints dependent (`outer.f90`, `dependent`: the least-squares step)."""
+    slide = {}
+    for method in ("alm", "mortar"):
+        folder = tmp_path / method
+        folder.mkdir()
+        res = run(voiga_bin, box_case(folder, PLANE + f", method = '{method}', friction = 2.0"))
+        assert res.returncode == 0, res.stderr
+        c = last_contact(folder / "box.h5")
+        assert np.all(c["state"] == 1)
+        slide[method] = np.abs((c["x"] - c["x_ref"])[:, :2]).max()
+        if method == "alm":
+            with h5py.File(folder / "box.h5") as f:
+                assert int(f.attrs["multiplier_updates"]) == 2
+    # the constraints hold the weighted slips to 1e-6 of the cells' size (1/3 is below
+    # their longer chord)
+    assert slide["alm"] < 1e-6 / 3 and slide["mortar"] > 1e-5
+
+
 @pytest.mark.parametrize("method", ["mortar", "alm"])
 def test_mortar_friction_restart(voiga_bin: Path, tmp_path: Path, method: str) -> None:
     """The sliding box with mortar or ALM cut after step 4 (sliding, every control point
