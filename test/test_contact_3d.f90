@@ -25,6 +25,8 @@ module test_contact_3d
     private
 
     public :: collect_contact_3d
+    !> For the augmented Lagrangian's tests on faces (`test_alm_faces`).
+    public :: ring_on_plane, unit_box, box_faces, mortar_friction_state
 
     !> The quarter ring's faces (`ring_block`): r = 1, r = 2, theta = 0, theta = 90 deg,
     !> z = 0, z = 1.
@@ -332,7 +334,7 @@ contains
     end subroutine test_law3_zero_pressure
 
     !> A perturbed state `u` (every DOF moved by up to `amplitude`) of the model's
-    !> mortar pair and its committed friction history (`test_mortar_friction_fd`); with
+    !> mortar pair (or an extension's) and its committed friction history (`test_mortar_friction_fd`); with
     !> `touch`, every control point open at the last converged state at that mean gap.
     subroutine mortar_friction_state(model, amplitude, shift, u, error, touch)
         type(model_t), intent(inout) :: model

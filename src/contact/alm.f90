@@ -28,18 +28,26 @@
 !> is exact for a fixed active set of a linear problem, whatever the penalty. Why
 !> not multipliers as unknowns of the global system: the solvers, the stiffness
 !> pattern and the result file keep the displacement unknowns only.
+!>
+!> On a solid's face (issue 42) the same pair: one normal multiplier per control point
+!> of the slave face, the face's weighted gaps from the mortar pair's face path
+!> (`mortar_point3`), and as element size of the tolerance the longer chord across the
+!> middle of the cells of the control point's support (`face_sizes`). With friction the
+!> tangential multiplier is a vector, the reference of the mortar pair's traction vector
+!> per control point, and a sticking control point has two slip constraints on its
+!> tangent plane (`alm_faces.f90`).
 module voiga_contact_alm
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
     use voiga_text, only: real_str
     use voiga_contact_law, only: control_point_law, state_inactive, state_stick, state_slip
-    use voiga_contact_surface, only: element_lengths
+    use voiga_contact_surface, only: element_lengths, face_ids
     use voiga_contact_pair, only: history_item_t, sparse_vector_t, constraint_set_t, automatic
     use voiga_contact_mortar, only: mortar_pair_t
     implicit none
     private
 
-    public :: alm_pair_t, alm_pair, default_alm_tolerance, softening_factor
+    public :: alm_pair_t, alm_pair, default_alm_tolerance, softening_factor, tangent_frame
 
     !> Default constraint tolerance, relative to the slave element size: the mean
     !> weighted gap of an active control point and the mean weighted slip of a
@@ -69,6 +77,13 @@ module voiga_contact_alm
         !> Reference length of the slave elements in each control point's support
         !> (the largest) [slave edge control points].
         real(dp), allocatable :: h(:)
+        !> On a face with friction (`alm_faces.f90`) [3, slave face control points]: the
+        !> tangential multipliers (vectors, as the mortar pair's tractions), and at the
+        !> last evaluation the counted weighted slips, tractions, trial tractions and the
+        !> node normals; with a tangent, the columns of Q (-d r / d t_A) and the rows of
+        !> M (d ds_A / du) of the active control points [3, control points].
+        real(dp), allocatable :: tau3(:, :), ds3(:, :), t3(:, :), ttr3(:, :), n3(:, :)
+        type(sparse_vector_t), allocatable :: q3(:, :), m3(:, :)
     contains
         procedure :: method_name => alm_method_name
         procedure :: control_laws => alm_control_laws
@@ -82,7 +97,42 @@ module voiga_contact_alm
         procedure :: constraints => alm_constraints
         procedure :: update_multipliers => alm_update_multipliers
         procedure :: soften => alm_soften
+        procedure :: control_laws3 => alm_control_laws3
+        procedure :: keep_coupling3 => alm_keep_coupling3
     end type alm_pair_t
+
+    interface
+        !> `control_laws` on a face with friction (`alm_faces.f90`).
+        pure module subroutine alm_control_laws3(self, g_a, d_a, ds, n_a, p_a, t, st_a, t_tr)
+            class(alm_pair_t), intent(inout) :: self
+            real(dp), intent(inout) :: g_a(:)
+            real(dp), intent(in) :: d_a(:), ds(:, :), n_a(:, :)
+            real(dp), intent(out) :: p_a(:), t(:, :), t_tr(:, :)
+            integer, intent(out) :: st_a(:)
+        end subroutine alm_control_laws3
+        !> `keep_coupling` on a face with friction (`alm_faces.f90`).
+        pure module subroutine alm_keep_coupling3(self, a, blk, v, q, m)
+            class(alm_pair_t), intent(inout) :: self
+            integer, intent(in) :: a, blk(:)
+            real(dp), intent(in) :: v(:), q(:, :), m(:, :)
+        end subroutine alm_keep_coupling3
+        !> The active constraints of a face with friction (`constraints`).
+        pure module function face_constraints(self) result(set)
+            class(alm_pair_t), intent(in) :: self
+            type(constraint_set_t) :: set
+        end function face_constraints
+        !> The multiplier update of a face with friction (`update_multipliers`).
+        pure module subroutine face_update(self, delta)
+            class(alm_pair_t), intent(inout) :: self
+            real(dp), intent(in) :: delta(:)
+        end subroutine face_update
+        !> The largest tangential slip residual of the sticking control points of a face
+        !> with friction, relative to their sizes (`constraint_test`).
+        pure module function face_slip_residual(self) result(residual)
+            class(alm_pair_t), intent(in) :: self
+            real(dp) :: residual
+        end function face_slip_residual
+    end interface
 
 contains
 
@@ -178,15 +228,44 @@ contains
         self%state = state_inactive
         self%p_last = 0.0_dp
         self%t_last = 0.0_dp
-        if (self%law%mu > 0.0_dp) then
+        if (self%law%mu > 0.0_dp .and. self%slave%npar > 1) then
+            allocate (self%tau3(3, n), self%ds3(3, n), self%t3(3, n), self%ttr3(3, n), self%n3(3, n), &
+                      source=0.0_dp)
+            allocate (self%q3(3, n), self%m3(3, n))
+        else if (self%law%mu > 0.0_dp) then
             allocate (self%tau(n))
             self%tau = 0.0_dp
+        end if
+        if (self%slave%npar > 1) then
+            call face_sizes(self)
+            return
         end if
         lengths = element_lengths(self%slave)
         do i = 1, n
             self%h(i) = maxval(lengths(self%node_first(i):self%node_last(i)))
         end do
     end subroutine alm_setup_history
+
+    !> On a face, each control point's reference size: the largest over the cells of
+    !> its support of the cell's longer chord across its middle. The longer, as an
+    !> edge's chord, is the cell's extent whatever its aspect: the cells of a polar
+    !> grid narrow to wedges at its collapsed axis, whose shorter chord (or the square
+    !> root of their area) would tighten the tolerance there for no accuracy. The
+    !> cells of a support come from their control points (`face_ids`): a node's range
+    !> of cells, flat from first to last, holds cells beside its support.
+    pure subroutine face_sizes(self)
+        class(alm_pair_t), intent(inout) :: self
+        real(dp), allocatable :: lengths(:)
+        integer, allocatable :: ids(:)
+        integer :: e, nu
+        lengths = element_lengths(self%slave, longest=.true.)
+        nu = size(self%slave%spans)
+        self%h = 0.0_dp
+        do e = 1, size(lengths)
+            ids = face_ids(self%slave, [self%slave%spans(modulo(e - 1, nu) + 1), self%slave%spans_eta((e - 1)/nu + 1)])
+            self%h(ids) = max(self%h(ids), lengths(e))
+        end do
+    end subroutine face_sizes
 
     !> The step converged (the multipliers become the committed ones), a step is
     !> retried, or the history is set (a restart): the tangential multipliers go on
@@ -215,6 +294,10 @@ contains
     pure subroutine tau_from_traction(self)
         class(alm_pair_t), intent(inout) :: self
         if (allocated(self%tau)) self%tau = self%hist%field(self%h_traction)%last
+        if (.not. allocated(self%tau3)) return
+        self%tau3(1, :) = self%hist%field(self%h_traction)%last
+        self%tau3(2, :) = self%hist%field(self%h_traction_yz(1))%last
+        self%tau3(3, :) = self%hist%field(self%h_traction_yz(2))%last
     end subroutine tau_from_traction
 
     pure logical function alm_has_multipliers(self)
@@ -237,6 +320,7 @@ contains
             if (allocated(self%tau) .and. self%law%mu > 0.0_dp .and. self%state(a) == state_stick) &
                 residual = max(residual, abs(self%ds(a)/self%d(a))/self%h(a))
         end do
+        if (allocated(self%tau3)) residual = max(residual, face_slip_residual(self))
         satisfied = residual <= self%tolerance
     end subroutine alm_constraint_test
 
@@ -249,6 +333,10 @@ contains
         type(constraint_set_t) :: set
         integer, allocatable :: active(:), stick(:)
         integer :: j, a, n
+        if (allocated(self%tau3)) then
+            set = face_constraints(self)
+            return
+        end if
         active = pack([(a, a=1, size(self%state))], self%state /= state_inactive)
         allocate (stick(0))
         ! (a phase without friction has no tangential constraints)
@@ -279,6 +367,10 @@ contains
         class(alm_pair_t), intent(inout) :: self
         real(dp), intent(in) :: delta(:)
         integer :: a, j
+        if (allocated(self%tau3)) then
+            call face_update(self, delta)
+            return
+        end if
         j = 0
         associate (lambda => self%hist%field(self%h_lambda)%trial)
             do a = 1, size(self%state)
@@ -300,5 +392,18 @@ contains
             end if
         end do
     end subroutine alm_update_multipliers
+
+    !> An orthonormal frame [3, 2] of the plane normal to the unit vector `n`: the axis
+    !> least aligned with n made orthogonal to it, and n x that (as the rigid plane's).
+    pure function tangent_frame(n) result(e)
+        real(dp), intent(in) :: n(3)
+        real(dp) :: e(3, 2)
+        integer :: k
+        k = minloc(abs(n), dim=1)
+        e(:, 1) = -n(k)*n
+        e(k, 1) = e(k, 1) + 1.0_dp
+        e(:, 1) = e(:, 1)/norm2(e(:, 1))
+        e(:, 2) = [n(2)*e(3, 1) - n(3)*e(2, 1), n(3)*e(1, 1) - n(1)*e(3, 1), n(1)*e(2, 1) - n(2)*e(1, 1)]
+    end function tangent_frame
 
 end module voiga_contact_alm

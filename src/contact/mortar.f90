@@ -86,6 +86,9 @@ module voiga_contact_mortar
         procedure :: control_laws => mortar_control_laws
         !> Receives the coupling vectors of each active control point (default: no use).
         procedure :: keep_coupling => mortar_keep_coupling
+        !> On a face with friction, the same two (`mortar_faces.f90`).
+        procedure :: control_laws3 => mortar_control_laws3
+        procedure :: keep_coupling3 => mortar_keep_coupling3
     end type mortar_pair_t
 
     !> Per slave point: its derivative vectors over its local DOFs.
@@ -134,6 +137,21 @@ module voiga_contact_mortar
         pure module subroutine face_multipliers(self)
             class(mortar_pair_t), intent(inout) :: self
         end subroutine face_multipliers
+        !> `control_laws` on a face with friction: slips `ds`, node normals `n_a`,
+        !> tractions `t` and trial tractions `t_tr` are vectors [3, nodes].
+        pure module subroutine mortar_control_laws3(self, g_a, d_a, ds, n_a, p_a, t, st_a, t_tr)
+            class(mortar_pair_t), intent(inout) :: self
+            real(dp), intent(inout) :: g_a(:)
+            real(dp), intent(in) :: d_a(:), ds(:, :), n_a(:, :)
+            real(dp), intent(out) :: p_a(:), t(:, :), t_tr(:, :)
+            integer, intent(out) :: st_a(:)
+        end subroutine mortar_control_laws3
+        !> `keep_coupling` on a face with friction: `q` [nb, 3] = -d r / d t_A, `m` [3, nb].
+        pure module subroutine mortar_keep_coupling3(self, a, blk, v, q, m)
+            class(mortar_pair_t), intent(inout) :: self
+            integer, intent(in) :: a, blk(:)
+            real(dp), intent(in) :: v(:), q(:, :), m(:, :)
+        end subroutine mortar_keep_coupling3
     end interface
 
 contains

@@ -30,6 +30,9 @@ submodule(voiga_contact_mortar) voiga_contact_mortar_faces
     !> npts] the change of projection since the last converged state, and its vectors.
     type :: face_work_t
         real(dp), allocatable :: ds(:, :), ds_raw(:, :), t(:, :), t_tr(:, :), dxi(:, :)
+        !> Per node [3, nodes]: the N_A-weighted sum of the master normals at the points
+        !> with a projection, normalized (zero where none has one).
+        real(dp), allocatable :: n_a(:, :)
         type(face_vectors_t), allocatable :: vec(:)
     end type face_work_t
 
@@ -57,10 +60,15 @@ contains
         type(face_work_t), intent(out) :: fw
         real(dp) :: s(3)
         integer :: k, i, a
-        allocate (fw%ds_raw(3, size(wk%g_a)), fw%dxi(2, size(self%xi)), source=0.0_dp)
+        allocate (fw%ds_raw(3, size(wk%g_a)), fw%n_a(3, size(wk%g_a)), fw%dxi(2, size(self%xi)), source=0.0_dp)
         do k = 1, size(self%xi)
             associate (mp => wk%mps(k), nodes => self%point_nodes(:, k), phi => self%point_values(:, k))
                 self%hist%field(self%h_eta)%trial(k) = mp%eta
+                if (wk%valid(k)) then
+                    do i = 1, size(nodes)
+                        fw%n_a(:, nodes(i)) = fw%n_a(:, nodes(i)) + wk%w0(k)*phi(i)*mp%n
+                    end do
+                end if
                 if (.not. wk%slip(k)) cycle
                 fw%dxi(:, k) = [wk%dxi(k), mp%eta - self%hist%field(self%h_eta)%last(k)]
                 s = fw%dxi(1, k)*mp%a + fw%dxi(2, k)*mp%b
@@ -72,29 +80,40 @@ contains
         fw%ds = fw%ds_raw
         do a = 1, size(wk%g_a)
             fw%ds(:, a) = wk%f_a(a)*fw%ds_raw(:, a)
+            if (norm2(fw%n_a(:, a)) > 0.0_dp) fw%n_a(:, a) = fw%n_a(:, a)/norm2(fw%n_a(:, a))
         end do
     end subroutine face_slips
 
-    !> The law at every node (`control_point_law3`), the committed traction vector as
-    !> the reference; the tractions go to the history's trial values.
+    !> The laws at the nodes (`control_laws3`: an extension may shift the gaps and
+    !> change the tangential reference).
     pure subroutine face_laws(self, wk, fw)
         class(mortar_pair_t), intent(inout) :: self
         type(mortar_work_t), intent(inout) :: wk
         type(face_work_t), intent(inout) :: fw
-        integer :: a
         allocate (fw%t(3, size(wk%g_a)), fw%t_tr(3, size(wk%g_a)))
+        call self%control_laws3(wk%g_a, wk%d_a, fw%ds, fw%n_a, wk%p_a, fw%t, wk%st_a, fw%t_tr)
+    end subroutine face_laws
+
+    !> The law at every node (`control_point_law3`), the committed traction vector as
+    !> the reference; the tractions go to the history's trial values.
+    module procedure mortar_control_laws3
+        integer :: a
         associate (h => self%hist%field, i1 => self%h_traction, i2 => self%h_traction_yz(1), &
                    i3 => self%h_traction_yz(2))
-            do a = 1, size(wk%g_a)
-                call control_point_law3(self%law, wk%g_a(a), wk%d_a(a), fw%ds(:, a), &
-                                        [h(i1)%last(a), h(i2)%last(a), h(i3)%last(a)], self%gap_tol, wk%p_a(a), &
-                                        fw%t(:, a), wk%st_a(a), fw%t_tr(:, a))
-                h(i1)%trial(a) = fw%t(1, a)
-                h(i2)%trial(a) = fw%t(2, a)
-                h(i3)%trial(a) = fw%t(3, a)
+            do a = 1, size(g_a)
+                call control_point_law3(self%law, g_a(a), d_a(a), ds(:, a), &
+                                        [h(i1)%last(a), h(i2)%last(a), h(i3)%last(a)], self%gap_tol, p_a(a), &
+                                        t(:, a), st_a(a), t_tr(:, a))
+                h(i1)%trial(a) = t(1, a)
+                h(i2)%trial(a) = t(2, a)
+                h(i3)%trial(a) = t(3, a)
             end do
         end associate
-    end subroutine face_laws
+    end procedure mortar_control_laws3
+
+    !> No use of the coupling by default.
+    module procedure mortar_keep_coupling3
+    end procedure mortar_keep_coupling3
 
     !> Every point's interpolated traction (`mortar_friction_point3`): residual,
     !> resultant, output and (with `add`) geometric tangent; `miss`: a point fell
@@ -214,6 +233,7 @@ contains
                 kc(:, j) = kc(:, j) + self%law%eps_n/wk%d_a(a)*v*v(j)
             end do
             call add(blk, kc)
+            call self%keep_coupling3(a, blk, v, q, mm)
             at(blk) = 0
             deallocate (v, q, mm, kc)
         end do

@@ -372,9 +372,10 @@ contains
 
     !> The reference size of every element of the boundary: on an edge the chord
     !> between its ends, on a face the shorter of the chords across the cell's
-    !> middle; shape: [n_elements].
-    pure function element_lengths(self) result(h)
+    !> middle (with `longest`, the longer); shape: [n_elements].
+    pure function element_lengths(self, longest) result(h)
         type(contact_surface_t), intent(in) :: self
+        logical, intent(in), optional :: longest
         real(dp), allocatable :: h(:), u0(:)
         type(surface_point_t) :: pa, pb
         integer :: e, i, j, ni
@@ -386,6 +387,9 @@ contains
                 i = modulo(e - 1, ni) + 1
                 j = (e - 1)/ni + 1
                 h(e) = min(face_chord(i, j, 1), face_chord(i, j, 2))
+                if (present(longest)) then
+                    if (longest) h(e) = max(face_chord(i, j, 1), face_chord(i, j, 2))
+                end if
             end do
             return
         end if

@@ -4,7 +4,7 @@ module voiga_linalg_lapack
     implicit none
     private
 
-    public :: solve_spd, solve_general, band_factor, lu_factor, lu_solve, triangular_inverse
+    public :: solve_spd, solve_general, solve_least_squares, band_factor, lu_factor, lu_solve, triangular_inverse
 
     interface
         pure subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
@@ -20,6 +20,14 @@ module voiga_linalg_lapack
             real(dp), intent(inout) :: a(lda, *), b(ldb, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgesv
+        pure subroutine dgelss(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, info)
+            import :: dp
+            integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+            real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+            real(dp), intent(out) :: s(*), work(*)
+            real(dp), intent(in) :: rcond
+            integer, intent(out) :: rank, info
+        end subroutine dgelss
         pure subroutine dgetrf(m, n, a, lda, ipiv, info)
             import :: dp
             integer, intent(in) :: m, n, lda
@@ -76,6 +84,27 @@ contains
         integer :: ipiv(size(a, 1))
         call dgesv(size(a, 1), size(b, 2), a, size(a, 1), ipiv, b, size(b, 1), info)
     end subroutine solve_general
+
+    !> The least-squares solution of least norm of a x = b for a square `a` of any rank
+    !> (SVD, LAPACK dgelss): singular values below `rcond` times the largest count as
+    !> zero. On exit `b` holds x and `rank` the rank used; `a` is overwritten. `info` > 0:
+    !> the SVD did not converge.
+    pure subroutine solve_least_squares(a, b, rcond, rank, info)
+        !> shape: [n, n]
+        real(dp), intent(inout) :: a(:, :)
+        !> shape: [n, nrhs]
+        real(dp), intent(inout) :: b(:, :)
+        real(dp), intent(in) :: rcond
+        integer, intent(out) :: rank, info
+        real(dp) :: s(size(a, 1)), query(1)
+        real(dp), allocatable :: work(:)
+        integer :: n
+        n = size(a, 1)
+        call dgelss(n, n, size(b, 2), a, max(1, n), b, max(1, n), s, rcond, rank, query, -1, info)
+        if (info /= 0) return
+        allocate (work(max(1, int(query(1)))))
+        call dgelss(n, n, size(b, 2), a, max(1, n), b, max(1, n), s, rcond, rank, work, size(work), info)
+    end subroutine solve_least_squares
 
     !> LU factorization with partial pivoting of a square `a` (LAPACK dgetrf), kept
     !> for several `lu_solve`s. On exit `a` holds L and U, `ipiv` [n] the row

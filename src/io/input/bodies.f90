@@ -94,9 +94,9 @@ contains
     end subroutine check_dimensions
 
     !> A rigid master's point and normal have `nsd` components (or none given: the
-    !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case. On
-    !> solids contact is, so far, GPTS or mortar, with or without friction, or frictionless
-    !> segment (issue 42: the rest is refused here, naming what is missing).
+    !> origin, and the normal +y in 2D, +z in 3D: `rigid_normal_of`); rigid_uz only in a solid case,
+    !> rigid_curve only in a plane one, rigid_surface only in a solid one. Every method, with or
+    !> without friction, runs in both dimensions.
     subroutine check_contact_dimension(c, nsd, where, error)
         type(contact_settings_t), intent(in) :: c
         integer, intent(in) :: nsd
@@ -114,12 +114,6 @@ contains
         else if (nsd == 3 .and. len_trim(c%rigid_curve) > 0) then
             what = 'rigid_curve bounds a rigid obstacle of a plane case: in a solid case use rigid_surface '// &
                    '(a surface of the geometry file)'
-        end if
-        if (nsd == 3 .and. .not. allocated(what)) then
-            if (c%method_given .and. all(trim(c%method) /= [character(len=7) :: 'gpts', 'mortar', 'segment'])) then
-                what = "method = '"//trim(c%method)//"' is not implemented for solids yet (issue 42); use "// &
-                       "'mortar', 'segment' or 'gpts'"
-            end if
         end if
         if (allocated(what)) call fatal_error(error, where//what, error_code%input)
     end subroutine check_contact_dimension
