@@ -23,7 +23,7 @@ import sys
 from functools import partial
 from pathlib import Path
 
-from .ball_mesh import BallMesh
+from .ball_ogrid import parse_mesh
 from .ball_peers import CCX_ELEMENTS, CCX_PENALTY, run_ccx, run_kratos
 from .run import ROOT, Run, Workdir, header, solve
 
@@ -48,9 +48,9 @@ def parse_peers(spec: str) -> list[tuple]:
     for item in (s.strip() for s in spec.split(",") if s.strip()):
         parts = item.split(":")
         if parts[0] == "kratos" and len(parts) == 4 and parts[1] in ("alm", "penalty"):
-            out.append(("kratos", parts[1], parts[2], BallMesh.parse(parts[3])))
+            out.append(("kratos", parts[1], parts[2], parse_mesh(parts[3])))
         elif parts[0] == "ccx" and len(parts) in (3, 4) and parts[1] in CCX_ELEMENTS:
-            out.append(("ccx", parts[1], BallMesh.parse(parts[2]),
+            out.append(("ccx", parts[1], parse_mesh(parts[2]),
                         float(parts[3]) if len(parts) == 4 else CCX_PENALTY))
         else:
             raise SystemExit(f"bench: peer run {item!r}: expected kratos:alm|penalty:SOLVER:MESH "
