@@ -122,7 +122,7 @@ class OGridMesh:
         t = np.linspace(self.theta0, THETA_C, self.fine + 1)
         lo, hi = (math.asin(f * A_EST / RADIUS) for f in EDGE_BAND)
         out = [t[0]]
-        for t0, t1 in zip(t[:-1], t[1:]):
+        for t0, t1 in zip(t[:-1], t[1:], strict=True):
             n = self.edge if (t1 > lo and t0 < hi) else 1
             out.extend(t0 + (t1 - t0) * np.arange(1, n + 1) / n)
         return np.array(out)

@@ -59,21 +59,28 @@ def parse_peers(spec: str) -> list[tuple]:
 
 
 def voiga_cases(w: Workdir, runs: str) -> dict[str, Path]:
-    """``python -m pre hertz3d`` cases of ``runs`` (mesh:layout) in <work>/hertz3d."""
+    """``python -m pre hertz3d`` cases of ``runs`` (mesh:layout) in <work>/hertz3d: meshes
+    m<k> on the Cartesian grid, p<k> on the polar one (``--grid polar``, in
+    <work>/hertz3d-polar: each grid has its own geometry.h5)."""
     pairs = [tuple(s.strip().split(":")) for s in runs.split(",") if s.strip()]
-    meshes = sorted({m for m, _ in pairs})
-    layouts = sorted({lay for _, lay in pairs})
-    out = w.path / "hertz3d"
-    cmd = [sys.executable, "-m", "pre", "hertz3d", str(out), "--mesh", *meshes, "--layout", *layouts]
-    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.strip()[-400:]}")
     cases = {}
-    for mesh, layout in pairs:
-        path = out / f"{mesh}-{layout}.nml"
-        if not path.exists():
-            raise RuntimeError(f"pre hertz3d wrote no {path}")
-        cases[f"voiga {layout} {mesh}"] = path
+    for grid in ("cartesian", "polar"):
+        mine = [(m, lay) for m, lay in pairs if (m.startswith("p") == (grid == "polar"))]
+        if not mine:
+            continue
+        meshes = sorted({m for m, _ in mine})
+        layouts = sorted({lay for _, lay in mine})
+        out = w.path / ("hertz3d" if grid == "cartesian" else "hertz3d-polar")
+        cmd = [sys.executable, "-m", "pre", "hertz3d", str(out), "--grid", grid, "--mesh", *meshes,
+               "--layout", *layouts]
+        proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.strip()[-400:]}")
+        for mesh, layout in mine:
+            path = out / f"{mesh}-{layout}.nml"
+            if not path.exists():
+                raise RuntimeError(f"pre hertz3d wrote no {path}")
+            cases[f"voiga {layout} {mesh}"] = path
     return cases
 
 
