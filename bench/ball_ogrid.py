@@ -2,9 +2,9 @@
 near the contact on circles about the vertical axis through the contact point (0, 0, -R),
 the zone's edge r = a among them, as voiga's polar grid (``pre hertz3d --grid polar``).
 
-Spec ``o<core>x<fine>x<rest>x<radial>x<edge>``, e.g. ``o4x8x6x8x2`` (the peers' mesh in
-:data:`bench.ball_section.PEER_RUNS`: ``kratos:alm:amgcl:o4x8x6x8x2``,
-``ccx:C3D8I:o4x8x6x8x2``); :func:`parse_mesh` takes it or a :class:`BallMesh` spec.
+Spec ``o<core>x<fine>x<rest>x<radial>x<edge>``, e.g. ``o4x12x6x10x2``, in a peer run of
+:data:`bench.ball_section.PEER_RUNS` as ``kratos:alm:amgcl:o4x12x6x10x2`` or
+``ccx:C3D8I:o4x12x6x10x2:1e5``; :func:`parse_mesh` takes it or a :class:`BallMesh` spec.
 
 The blocks are :mod:`bench.ball_mesh`'s (a core cube ``[0, c] x [0, c] x [-c, 0]`` and
 three cube-sphere shells, a shell point ``((1 - w) c + w / |v|) v``), but the z shell (the
