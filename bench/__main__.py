@@ -238,10 +238,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="section 8: p:n per run, degree p and n elements per direction "
                          "(default bench.voiga_sphere.MESHES)")
     ap.add_argument("--ball-voiga", default=None,
-                    help="section 9: voiga's mesh:layout runs (default bench.ball_section.VOIGA_RUNS)")
+                    help="section 9: voiga's mesh:layout runs, m<k> Cartesian, p<k> polar grid "
+                         "(default bench.ball_section.VOIGA_RUNS)")
     ap.add_argument("--ball-peers", default=None,
                     help="section 9: kratos:alm|penalty:SOLVER:MESH and ccx:C3D20R|C3D8I:MESH[:PENALTY] "
-                         "runs, MESH fine x rest x outer x radial (default bench.ball_section.PEER_RUNS)")
+                         "runs, MESH fine x rest x outer x radial (cube-sphere) or "
+                         "o<core>x<fine>x<rest>x<radial>x<edge> (O-grid) (default bench.ball_section.PEER_RUNS)")
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = ap.parse_args(argv)
     only = {s.strip() for s in args.only.split(",")}

@@ -5,7 +5,8 @@ Problem (voiga's ``pre hertz3d``): the ball octant x, y >= 0, z <= 0 of R = 1, E
 nu = 0.3, small displacements; the top face z = 0 moves by u_z = -0.01 t (t = 0 to 1 in
 five steps, voiga's five), u_x = 0 on x = 0, u_y = 0 on y = 0; the flat z = -1 is a
 one-layer block of hexahedra (:func:`bench.ball_mesh.flat_block`) whose nodes are all
-fixed, its top face the master. Meshes: :mod:`bench.ball_mesh`.
+fixed, its top face the master. Meshes: :mod:`bench.ball_mesh` (cube-sphere) and
+:mod:`bench.ball_ogrid` (O-grid).
 
 - Kratos (:func:`run_kratos`): SmallDisplacementElement3D8N (trilinear), 3D mortar
   contact (``ALMContactFrictionless``, Kratos's augmented Lagrangian with its automatic
@@ -28,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .ball_mesh import BallMesh, ball_octant, flat_block, flat_grid
+from .ball_mesh import BallMesh, flat_block, flat_grid
+from .ball_ogrid import OGridMesh, octant
 from .ball_pressure import (
     NU,
     RADIUS,
@@ -54,14 +56,14 @@ alternates from node to node under 1e4)."""
 CCX_ELEMENTS = ("C3D20R", "C3D8I")
 
 
-def kratos_model(mesh: BallMesh) -> dict:
+def kratos_model(mesh: BallMesh | OGridMesh) -> dict:
     """The ball and the flat (linear hexahedra), as :func:`write_mdpa` writes them."""
-    ball = ball_octant(mesh, quadratic=False)
+    ball = octant(mesh, quadratic=False)
     flat = flat_block(flat_grid(mesh), quadratic=False)
     return {"ball": ball, "flat": flat}
 
 
-def write_mdpa(path: Path, mesh: BallMesh) -> dict:
+def write_mdpa(path: Path, mesh: BallMesh | OGridMesh) -> dict:
     """The Kratos model (1-based ids; the ball's nodes first) and what the run needs."""
     m = kratos_model(mesh)
     ball, flat = m["ball"], m["flat"]
@@ -115,7 +117,7 @@ def kratos_parameters(stem: str, method: str, solver: str) -> dict:
             "output_processes": {}}}
 
 
-def run_kratos(py: Path, w: Workdir, mesh: BallMesh, method: str = "alm", solver: str = "amgcl") -> dict:
+def run_kratos(py: Path, w: Workdir, mesh: BallMesh | OGridMesh, method: str = "alm", solver: str = "amgcl") -> dict:
     """One Kratos analysis (the whole process timed, one thread) and its measure."""
     from .kratos import DRIVER, MORTAR
     stem = f"ball-{mesh.name}-{method}-{solver}"
@@ -154,11 +156,11 @@ def _lines(ids, per_line: int = 12) -> list[str]:
     return [", ".join(str(v) for v in ids[i:i + per_line]) for i in range(0, len(ids), per_line)]
 
 
-def write_ccx(path: Path, mesh: BallMesh, element: str, penalty: float = CCX_PENALTY) -> dict:
+def write_ccx(path: Path, mesh: BallMesh | OGridMesh, element: str, penalty: float = CCX_PENALTY) -> dict:
     """The CalculiX input: the ball and the flat of ``element`` (C3D20R: quadratic,
     C3D8I: linear) and the contact pair; what the run needs to read it back."""
     quadratic = element.startswith("C3D20")
-    ball = ball_octant(mesh, quadratic)
+    ball = octant(mesh, quadratic)
     flat = flat_block(flat_grid(mesh), quadratic)
     nb, eb = len(ball["nodes"]), len(ball["elements"])
     out = ["*HEADING", f"hertz3d ball {mesh.name} {element}: ball octant on a rigid flat", "*NODE"]
@@ -205,7 +207,7 @@ def parse_dat(path: Path, n_nodes: int) -> tuple[np.ndarray, float]:
     return u, rf
 
 
-def run_ccx(exe: str, w: Workdir, mesh: BallMesh, element: str = "C3D20R",
+def run_ccx(exe: str, w: Workdir, mesh: BallMesh | OGridMesh, element: str = "C3D20R",
             penalty: float = CCX_PENALTY) -> dict:
     """One CalculiX analysis (the whole process timed, one thread) and its measure."""
     from .ccx import iterations

@@ -23,34 +23,48 @@ import sys
 from functools import partial
 from pathlib import Path
 
-from .ball_mesh import BallMesh
+from .ball_ogrid import parse_mesh
 from .ball_peers import CCX_ELEMENTS, CCX_PENALTY, run_ccx, run_kratos
 from .run import ROOT, Run, Workdir, header, solve
 
-VOIGA_RUNS = "m1:N2,m2:N2,m3:N2,m1:NN2.2,m2:NN2.2,m3:NN2.2"
+VOIGA_RUNS = ("m1:N2,m2:N2,m3:N2,m1:NN2.2,m2:NN2.2,m3:NN2.2,"
+              "p1:N2,p2:N2,p3:N2,p4:N2,p1:NN2.2,p2:NN2.2")
+"""voiga's default runs, mesh:layout: m<k> on the Cartesian grid, p<k> on the polar one
+(``pre hertz3d --grid polar``; knot lines on circles about the contact, split at the
+zone's edge)."""
 PEER_RUNS = ("kratos:alm:amgcl:6x4x3x5,kratos:alm:amgcl:8x5x3x6,kratos:alm:amgcl:12x6x4x8,"
              "kratos:alm:amgcl:16x8x5x10,ccx:C3D20R:4x3x2x3:1e3,ccx:C3D20R:6x4x3x5:1e3,ccx:C3D8I:8x5x3x6,"
-             "ccx:C3D8I:12x6x4x8")
-"""The peers' default runs: four Kratos meshes (4,212 to 37,350 DOFs), CalculiX's C3D20R
-on two (5,190 and 15,846) and C3D8I on two (7,338 and 17,631): each within a few minutes
-on one thread. C3D20R with the contact slope 1e3 E/R, C3D8I with 1e4 (each the better of
-the two: C3D20R 6x4x3x5 6.5 % at 1e3 against 10.8 % at 1e4, its faces' pressure
-alternating from node to node under the stiffer law; C3D8I 8x5x3x6 9.6 % at 1e3, 9.3 %
-at 1e4, 9.2 % at 1e5 in 1.4 times the time, docs/performance-solids.md). The
+             "ccx:C3D8I:12x6x4x8,"
+             "kratos:alm:amgcl:o4x8x6x8x2,kratos:alm:amgcl:o4x12x6x10x2,kratos:alm:amgcl:o4x24x6x14x1,"
+             "kratos:alm:amgcl:o6x20x6x12x2,ccx:C3D20R:o3x8x4x6x2:1e3,ccx:C3D8I:o4x12x6x10x2:1e5,"
+             "ccx:C3D8I:o6x20x6x12x2:1e5")
+"""The peers' default runs, each within a few minutes on one thread. On the cube-sphere
+meshes (:class:`bench.ball_mesh.BallMesh`): four Kratos meshes (4,212 to 37,350 DOFs),
+CalculiX's C3D20R on two (5,190 and 15,846) and C3D8I on two (7,338 and 17,631). C3D20R
+with the contact slope 1e3 E/R, C3D8I with 1e4 (each the better of the two: C3D20R
+6x4x3x5 6.5 % at 1e3 against 10.8 % at 1e4, its faces' pressure alternating from node to
+node under the stiffer law; C3D8I 8x5x3x6 9.6 % at 1e3, 9.3 % at 1e4, 9.2 % at 1e5 in 1.4
+times the time, docs/performance-solids.md). On the O-grid meshes
+(:class:`bench.ball_ogrid.OGridMesh`, rings on circles about the contact split at the
+zone's edge, as voiga's polar meshes): Kratos on four (7,806 to 27,831 DOFs), C3D20R on
+one (14,925) at 1e3 (o3x8x4x6x2 5.7 % at 3e2; o3x6x3x5x1 4.5 % at 1e3, 8.1 % at 3e3,
+17.5 % at 1e4), C3D8I on two (10,710 and 27,831) at 1e5 (o4x12x6x10x2 2.29 % at 1e4,
+2.09 % at 1e5 in 1.3 times the time); single runs, docs/performance-solids.md. The
 syntax: code:method:solver:mesh (Kratos: alm or penalty, amgcl or sparse_lu) and
-code:element:mesh[:penalty] (CalculiX); meshes :class:`bench.ball_mesh.BallMesh`."""
+code:element:mesh[:penalty] (CalculiX); a mesh ``fine x rest x outer x radial``
+(cube-sphere) or ``o<core>x<fine>x<rest>x<radial>x<edge>`` (O-grid)."""
 
 
 def parse_peers(spec: str) -> list[tuple]:
-    """``'kratos:alm:amgcl:8x5x3x6,ccx:C3D20R:6x4x3x5:1e4'`` -> [('kratos', 'alm',
-    'amgcl', BallMesh), ('ccx', 'C3D20R', BallMesh, 1e4)]."""
+    """``'kratos:alm:amgcl:8x5x3x6,ccx:C3D20R:o3x8x4x6x2:1e3'`` -> [('kratos', 'alm',
+    'amgcl', BallMesh), ('ccx', 'C3D20R', OGridMesh, 1e3)] (:func:`bench.ball_ogrid.parse_mesh`)."""
     out: list[tuple] = []
     for item in (s.strip() for s in spec.split(",") if s.strip()):
         parts = item.split(":")
         if parts[0] == "kratos" and len(parts) == 4 and parts[1] in ("alm", "penalty"):
-            out.append(("kratos", parts[1], parts[2], BallMesh.parse(parts[3])))
+            out.append(("kratos", parts[1], parts[2], parse_mesh(parts[3])))
         elif parts[0] == "ccx" and len(parts) in (3, 4) and parts[1] in CCX_ELEMENTS:
-            out.append(("ccx", parts[1], BallMesh.parse(parts[2]),
+            out.append(("ccx", parts[1], parse_mesh(parts[2]),
                         float(parts[3]) if len(parts) == 4 else CCX_PENALTY))
         else:
             raise SystemExit(f"bench: peer run {item!r}: expected kratos:alm|penalty:SOLVER:MESH "
@@ -59,21 +73,28 @@ def parse_peers(spec: str) -> list[tuple]:
 
 
 def voiga_cases(w: Workdir, runs: str) -> dict[str, Path]:
-    """``python -m pre hertz3d`` cases of ``runs`` (mesh:layout) in <work>/hertz3d."""
+    """``python -m pre hertz3d`` cases of ``runs`` (mesh:layout) in <work>/hertz3d: meshes
+    m<k> on the Cartesian grid, p<k> on the polar one (``--grid polar``, in
+    <work>/hertz3d-polar: each grid has its own geometry.h5)."""
     pairs = [tuple(s.strip().split(":")) for s in runs.split(",") if s.strip()]
-    meshes = sorted({m for m, _ in pairs})
-    layouts = sorted({lay for _, lay in pairs})
-    out = w.path / "hertz3d"
-    cmd = [sys.executable, "-m", "pre", "hertz3d", str(out), "--mesh", *meshes, "--layout", *layouts]
-    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.strip()[-400:]}")
     cases = {}
-    for mesh, layout in pairs:
-        path = out / f"{mesh}-{layout}.nml"
-        if not path.exists():
-            raise RuntimeError(f"pre hertz3d wrote no {path}")
-        cases[f"voiga {layout} {mesh}"] = path
+    for grid in ("cartesian", "polar"):
+        mine = [(m, lay) for m, lay in pairs if (m.startswith("p") == (grid == "polar"))]
+        if not mine:
+            continue
+        meshes = sorted({m for m, _ in mine})
+        layouts = sorted({lay for _, lay in mine})
+        out = w.path / ("hertz3d" if grid == "cartesian" else "hertz3d-polar")
+        cmd = [sys.executable, "-m", "pre", "hertz3d", str(out), "--grid", grid, "--mesh", *meshes,
+               "--layout", *layouts]
+        proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.strip()[-400:]}")
+        for mesh, layout in mine:
+            path = out / f"{mesh}-{layout}.nml"
+            if not path.exists():
+                raise RuntimeError(f"pre hertz3d wrote no {path}")
+            cases[f"voiga {layout} {mesh}"] = path
     return cases
 
 
