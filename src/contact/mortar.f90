@@ -19,12 +19,11 @@
 module voiga_contact_mortar
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_contact_surface, only: surface_point_t, surface_point
+    use voiga_contact_surface, only: surface_point_t, surface_point, face_ids, n_elements
     use voiga_contact_master, only: master_point_t
     use voiga_contact_law, only: contact_law_t, control_point_law, state_inactive, state_stick, state_slip
     use voiga_contact_mortar_kernels, only: mortar_point, node_touch_factors
     use voiga_contact_face_kernels, only: mortar_point3
-    use voiga_contact_surface, only: face_ids, n_elements
     use voiga_contact_pair, only: contact_pair_t, add_matrix
     use voiga_contact_history, only: flag_value
     implicit none
@@ -66,10 +65,9 @@ module voiga_contact_mortar
         !> A node that was open there touched in this step where its mean gap,
         !> interpolated linearly from there, vanished: only its slip after that
         !> counts (`touch_factors`).
-        integer :: h_traction = 0, h_node_gap = 0, h_node_active = 0
         !> On a face, the traction is a vector (`mortar_faces.f90`): `traction` its x
-        !> component, these its y and z ('traction_y', 'traction_z'; 0 on an edge).
-        integer :: h_traction_yz(2) = 0
+        !> component, `h_traction_yz` its y and z ('traction_y', 'traction_z'; 0 on an edge).
+        integer :: h_traction = 0, h_node_gap = 0, h_node_active = 0, h_traction_yz(2) = 0
         !> The control points at the last evaluation, and at the last accepted
         !> Newton iterate (`accept_iterate`).
         type(mortar_snapshot_t) :: last, accepted
@@ -87,8 +85,7 @@ module voiga_contact_mortar
         !> Receives the coupling vectors of each active control point (default: no use).
         procedure :: keep_coupling => mortar_keep_coupling
         !> On a face with friction, the same two (`mortar_faces.f90`).
-        procedure :: control_laws3 => mortar_control_laws3
-        procedure :: keep_coupling3 => mortar_keep_coupling3
+        procedure :: control_laws3 => mortar_control_laws3, keep_coupling3 => mortar_keep_coupling3
     end type mortar_pair_t
 
     !> Per slave point: its derivative vectors over its local DOFs.
