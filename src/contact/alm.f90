@@ -96,6 +96,8 @@ module voiga_contact_alm
         procedure :: constraint_test => alm_constraint_test
         procedure :: constraints => alm_constraints
         procedure :: update_multipliers => alm_update_multipliers
+        !> The normal multipliers' step (shared by the edge's and the face's update).
+        procedure, private :: normal_update => alm_normal_update
         procedure :: soften => alm_soften
         procedure :: control_laws3 => alm_control_laws3
         procedure :: keep_coupling3 => alm_keep_coupling3
@@ -360,17 +362,13 @@ contains
         end do
     end function alm_constraints
 
-    !> Update the multipliers: those of the active constraints (order of
-    !> `constraints`) by `delta` (lambda_A kept >= 0), the others from the law at the
-    !> last evaluation (lambda_A = 0 where A is open, tau_A = t_A where it slips).
-    pure subroutine alm_update_multipliers(self, delta)
+    !> Each active control point's lambda_A by its step in `delta` (kept >= 0), the open
+    !> ones' to 0; `j` the steps taken (the tangential ones follow in `delta`).
+    pure subroutine alm_normal_update(self, delta, j)
         class(alm_pair_t), intent(inout) :: self
         real(dp), intent(in) :: delta(:)
-        integer :: a, j
-        if (allocated(self%tau3)) then
-            call face_update(self, delta)
-            return
-        end if
+        integer, intent(out) :: j
+        integer :: a
         j = 0
         associate (lambda => self%hist%field(self%h_lambda)%trial)
             do a = 1, size(self%state)
@@ -382,6 +380,20 @@ contains
                 end if
             end do
         end associate
+    end subroutine alm_normal_update
+
+    !> Update the multipliers: those of the active constraints (order of
+    !> `constraints`) by `delta` (lambda_A kept >= 0), the others from the law at the
+    !> last evaluation (lambda_A = 0 where A is open, tau_A = t_A where it slips).
+    pure subroutine alm_update_multipliers(self, delta)
+        class(alm_pair_t), intent(inout) :: self
+        real(dp), intent(in) :: delta(:)
+        integer :: a, j
+        if (allocated(self%tau3)) then
+            call face_update(self, delta)
+            return
+        end if
+        call self%normal_update(delta, j)
         if (.not. allocated(self%tau)) return
         do a = 1, size(self%state)
             if (self%law%mu > 0.0_dp .and. self%state(a) == state_stick) then

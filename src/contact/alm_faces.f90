@@ -99,17 +99,7 @@ contains
     module procedure face_update
         real(dp) :: e(3, 2)
         integer :: a, j
-        j = 0
-        associate (lambda => self%hist%field(self%h_lambda)%trial)
-            do a = 1, size(self%state)
-                if (self%state(a) == state_inactive) then
-                    lambda(a) = 0.0_dp
-                else
-                    j = j + 1
-                    lambda(a) = max(0.0_dp, lambda(a) + delta(j))
-                end if
-            end do
-        end associate
+        call self%normal_update(delta, j)
         do a = 1, size(self%state)
             if (self%law%mu > 0.0_dp .and. self%state(a) == state_stick) then
                 e = tangent_frame(self%n3(:, a))
