@@ -8,10 +8,12 @@
 !> other line.
 module voiga_app_console
     use, intrinsic :: iso_fortran_env, only: output_unit
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use voiga_kinds, only: dp
     use voiga_text, only: str, fixed_str, real_str
     use voiga_error, only: error_t
     use voiga_model, only: model_t
+    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate
     use voiga_solver_records, only: cut_record_t, wall_seconds
     use voiga_solver_progress, only: progress_t, iteration_report_t, fixed_point_report_t, step_report_t
     implicit none
@@ -222,13 +224,34 @@ contains
             write (*, '(a,i0,a,i0,a,f8.4,a,i2,a,es9.2,a,f8.3,a)', advance='no') 'step ', rec%step, '/', &
                 report%n_steps, '  t=', rec%time, '  it=', rec%iterations, '  |r|=', report%residual, '  ', &
                 seconds, ' s'
-            if (rec%substeps > 1 .or. rec%cuts > 0) then
-                write (*, '(a,i0,a,i0)') '  substeps=', rec%substeps, ' cuts=', rec%cuts
-            else
-                write (*, '(a)') ''
-            end if
+            if (rec%substeps > 1 .or. rec%cuts > 0) write (*, '(a,i0,a,i0)', advance='no') &
+                '  substeps=', rec%substeps, ' cuts=', rec%cuts
+            write (*, '(a)') edge_errors(model)
         end associate
     end subroutine console_step_done
+
+    !> "  edge error 0.41%" per contact pair on an edge with a zone (the estimate of the
+    !> contact-zone indicator, docs/contact-accuracy.md; "unresolved" for a zone of too few
+    !> points), "" without one.
+    function edge_errors(model) result(text)
+        type(model_t), intent(in) :: model
+        character(len=:), allocatable :: text
+        type(zone_measure_t) :: zone
+        logical :: found
+        real(dp) :: e
+        integer :: k
+        text = ''
+        do k = 1, size(model%pairs)
+            call worst_of_pair(model, k, zone, found)
+            if (.not. found) cycle
+            e = zone_estimate(zone)
+            if (ieee_is_finite(e)) then
+                text = text//'  edge error '//fixed_str(100.0_dp*e, 2)//'%'
+            else
+                text = text//'  edge error unresolved'
+            end if
+        end do
+    end function edge_errors
 
     !> `voiga: warning: <text>` on stderr.
     subroutine console_warning(self, text)

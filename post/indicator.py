@@ -228,9 +228,45 @@ def _measure_edge(result: Result, c: ContactOutput, prof: _Profile, zone: tuple[
                        bracket=float(abs(s[j] - s[i])), half_width=float(w))
 
 
-def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure]:
+def _ratio(h: float, w: float) -> float:
+    """``h / w`` (inf for a zone of no width)."""
+    return h / w if w > 0 else math.inf
+
+
+def recorded_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure] | None:
+    """The zones voiga measured and wrote for pair ``pair`` at step ``step_index`` (its
+    ``accuracy`` group, the same quantities as :func:`measure_pair` computes), or None
+    when the file has none (written before voiga did, or a face)."""
+    st = result.steps[step_index]
+    c = st.contact[pair]
+    a = c.accuracy
+    if a is None:
+        return None
+    zones: list[ZoneMeasure] = []
+    owner = np.asarray(a.get("edge_zone", []), dtype=int).reshape(-1) - 1
+    for z in range(int(a["zones"])):
+        w = float(a["half_width"][z])
+        edges = [EdgeMeasure(xi=float(a["edge_xi"][e]), side=int(a["edge_side"][e]),
+                             h_tangent=float(a["edge_h_tangent"][e]), h_normal=float(a["edge_h_normal"][e]),
+                             ratio_tangent=_ratio(float(a["edge_h_tangent"][e]), w),
+                             ratio_normal=_ratio(float(a["edge_h_normal"][e]), w),
+                             raw=float(a["edge_raw"][e]), bracket=float(a["edge_bracket"][e]), half_width=w)
+                 for e in np.flatnonzero(owner == z)]
+        lo, hi = (float(v) for v in np.asarray(a["xi_range"]).reshape(-1, 2)[z])
+        zones.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step, time=st.time,
+                                 xi_range=(lo, hi), half_width=w,
+                                 elements_across=float(a["elements_across"][z]),
+                                 n_points=int(a["n_points"][z]), edges=edges))
+    return zones
+
+
+def measure_pair(result: Result, step_index: int, pair: int, computed: bool = False) -> list[ZoneMeasure]:
     """The zones of contact pair ``pair`` (0-based) at converged step ``step_index``
-    (an index into ``result.steps``)."""
+    (an index into ``result.steps``): those voiga wrote to the file, or (files without
+    them, or ``computed``) measured here from the slave points."""
+    recorded = None if computed else recorded_pair(result, step_index, pair)
+    if recorded is not None:
+        return recorded
     st = result.steps[step_index]
     c = st.contact[pair]
     order = np.argsort(c.xi_slave, kind="stable")
@@ -295,9 +331,11 @@ def indicator_lines(result: Result) -> list[str]:
     """The summary's lines: per pair the step with the largest estimate (and its zone),
     and a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`."""
     lines: list[str] = []
+    # voiga warns itself when it wrote the indicator (the file's warnings, post summary's)
+    own = any(c.accuracy is not None for st in result.steps for c in st.contact)
     for m in worst(measure(result)).values():
         lines.append("  accuracy: " + format_zone(m))
-        if m.estimate > WARN_ESTIMATE:
+        if m.estimate > WARN_ESTIMATE and not own:
             lines.append(f"warning: contact {m.slave} -> {m.master}: the mesh resolves the "
                          f"contact zone's edge poorly (estimated pressure error "
                          + (f"{m.estimate:.2%}" if math.isfinite(m.estimate) else "unbounded")

@@ -305,6 +305,9 @@ class ContactOutput:
     stretch: np.ndarray | None = None
     """(n,) current over reference length of the slave edge at each point; None in
     older files."""
+    accuracy: dict[str, Any] | None = None
+    """The contact-zone indicator voiga wrote (the ``accuracy`` group: its attributes and
+    datasets by name, docs/hdf5.md); None in files written before it and on faces."""
     area_ref: np.ndarray | None = None
     """(n,) a solid's slave points: the reference area each point integrates (Gauss
     weight x reference surface Jacobian); None where the file has none (plane bodies)."""
@@ -746,8 +749,16 @@ def _read_contact(g: h5py.Group, nsd: int) -> ContactOutput:
                          rigid_normal=vec("rigid_normal") if "rigid_normal" in g else None,
                          rigid_curve=read_curve(g["rigid_curve"]) if "rigid_curve" in g else None,
                          rigid_offset=vec("rigid_offset") if "rigid_offset" in g else None,
+                         accuracy=_read_accuracy(g["accuracy"]) if "accuracy" in g else None,
                          **{k: vec(k) for k in ("p_n_nominal", "p_t_nominal", "stretch", "area_ref")
                             if k in g})
+
+
+def _read_accuracy(g: h5py.Group) -> dict[str, Any]:
+    """The ``accuracy`` group of a pair at a step: attributes and datasets by name."""
+    out: dict[str, Any] = _attrs(g)
+    out.update({k: np.asarray(v[()]) for k, v in g.items()})
+    return out
 
 
 def read_result(path: str | Path, lazy: bool = False) -> Result:

@@ -15,7 +15,7 @@
 module voiga_model_checks
     use voiga_kinds, only: dp
     use voiga_error, only: error_t, fatal_error, error_code
-    use voiga_text, only: str, real_str, short_str
+    use voiga_text, only: str, real_str, short_str, fixed_str
     use voiga_model, only: model_t
     use voiga_discretization_patch, only: contact_name
     use voiga_contact_pair, only: contact_pair_t
@@ -29,6 +29,7 @@ module voiga_model_checks
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_contact_law, only: state_inactive
     use voiga_element_quadrature, only: gauss_legendre
+    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate, warn_estimate, min_points
     implicit none
     private
 
@@ -62,6 +63,10 @@ module voiga_model_checks
         logical, allocatable :: ever_active(:), deep_reported(:)
         !> Each pair's slave element lengths (computed once).
         type(lengths_t), allocatable :: slave(:)
+        !> Each pair's zone with the largest estimated edge error so far, and its step
+        !> (0: none yet).
+        type(zone_measure_t), allocatable :: worst(:)
+        integer, allocatable :: worst_step(:)
     contains
         procedure :: after_step => watch_after_step
         procedure :: at_end => watch_at_end
@@ -76,7 +81,8 @@ contains
         integer :: ip
         allocate (self%ever_active(size(model%pairs)), source=.false.)
         allocate (self%deep_reported(size(model%pairs)), source=.false.)
-        allocate (self%slave(size(model%pairs)))
+        allocate (self%slave(size(model%pairs)), self%worst(size(model%pairs)))
+        allocate (self%worst_step(size(model%pairs)), source=0)
         do ip = 1, size(model%pairs)
             self%slave(ip)%h = element_lengths(model%pairs(ip)%pair%slave)
         end do
@@ -423,6 +429,7 @@ contains
         integer :: ip, k
         allocate (list(0))
         do ip = 1, size(model%pairs)
+            call remember_worst(self, model, ip, step)
             associate (pair => model%pairs(ip)%pair)
                 if (any(pair%out%state /= state_inactive)) self%ever_active(ip) = .true.
                 if (self%deep_reported(ip)) cycle
@@ -450,6 +457,8 @@ contains
         integer :: ip
         allocate (list(0))
         do ip = 1, size(model%pairs)
+            if (self%worst_step(ip) > 0) call accuracy_warning(model%pairs(ip)%pair, self%worst(ip), &
+                                                               self%worst_step(ip), list)
             if (self%ever_active(ip)) cycle
             list = [list, warning_t(pair_label(model%pairs(ip)%pair)//'no point came into contact in '// &
                                     str(n_steps)//' steps: check the loads, the contact edges and the gap '// &
@@ -457,5 +466,49 @@ contains
                                     'no point came into contact')]
         end do
     end subroutine watch_at_end
+
+    !> Keep pair `ip`'s zone at `step` when its estimated edge error is the largest so far.
+    pure subroutine remember_worst(self, model, ip, step)
+        type(contact_watch_t), intent(inout) :: self
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: ip, step
+        type(zone_measure_t) :: zone
+        logical :: found
+        call worst_of_pair(model, ip, zone, found)
+        if (.not. found) return
+        if (self%worst_step(ip) > 0) then
+            if (.not. zone_estimate(zone) > zone_estimate(self%worst(ip))) return
+        end if
+        self%worst(ip) = zone
+        self%worst_step(ip) = step
+    end subroutine remember_worst
+
+    !> A pair whose largest estimated edge error (docs/contact-accuracy.md) exceeds
+    !> `warn_estimate`: the zone, where, and the remedy.
+    pure subroutine accuracy_warning(pair, zone, step, list)
+        class(contact_pair_t), intent(in) :: pair
+        type(zone_measure_t), intent(in) :: zone
+        integer, intent(in) :: step
+        type(warning_t), allocatable, intent(inout) :: list(:)
+        character(len=:), allocatable :: what
+        integer :: j
+        if (.not. zone_estimate(zone) > warn_estimate) return
+        if (zone%n_points < min_points) then
+            what = 'the contact zone is not resolved at step '//str(step)//' ('//str(zone%n_points)// &
+                   ' points in contact'
+        else
+            what = "the mesh resolves the contact zone's edge poorly: estimated pressure error "// &
+                   fixed_str(100.0_dp*zone_estimate(zone), 2)//' % at step '//str(step)//' (above '// &
+                   fixed_str(100.0_dp*warn_estimate, 1)//' %'
+            do j = 1, zone%n_edges
+                what = what//'; h/w '//fixed_str(zone%edges(j)%ratio_tangent, 3)//' along and '// &
+                       fixed_str(zone%edges(j)%ratio_normal, 3)//' across at xi = '//fixed_str(zone%edges(j)%xi, 4)
+            end do
+        end if
+        list = [list, warning_t(pair_label(pair)//what//', '//fixed_str(zone%elements_across, 1)// &
+                                ' slave elements across): refine the zone (python -m pre refine RESULT.h5, '// &
+                                'or post run CASE --adapt; docs/contact-accuracy.md)', &
+                                topic=pair_label(pair)//'an unresolved contact zone edge')]
+    end subroutine accuracy_warning
 
 end module voiga_model_checks

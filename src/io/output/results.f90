@@ -1,7 +1,6 @@
-!> The result file of a run (schema in docs/hdf5.md): metadata and the
-!> discretization first, then one group per converged step, written and flushed
-!> when the step converges, and a final status ('converged', 'failed: ...',
-!> 'interrupted'); the cuts of the adaptive stepping per step and for the run.
+!> The result file of a run (schema in docs/hdf5.md): metadata and the discretization first, then
+!> one group per converged step (its cuts, the contact zones' accuracy), written and flushed when
+!> it converges; the run's cuts and its final status ('converged', 'failed: ...', 'interrupted').
 !> Every write goes through `result_file_t`'s guards (what readers see, a second
 !> writer, a full disk: voiga_io_output_result_file). The writes of one step or record
 !> keep their first failure in the file (`h5file_t%check`), which the end of the
@@ -24,6 +23,7 @@ module voiga_io_output_results
     use voiga_model_loads, only: axis_names
     use voiga_model_fields, only: output_settings_t, field_samples_t
     use voiga_io_output_fields, only: write_fields, sample_bodies
+    use voiga_io_output_accuracy, only: write_accuracy
     use voiga_contact_master, only: master_output_t
     use voiga_contact_pair, only: contact_pair_t, pair_slot_t, history_item_t, contact_point_out_t
     use voiga_solver_records, only: step_record_t, cut_record_t, stage_names, solver_stats_t, n_cut_records
@@ -317,6 +317,7 @@ contains
         do k = 1, size(pairs)
             call write_contact(self%h5, g//'/contact/'//str(k), pairs(k)%pair, self%nsd)
         end do
+        if (present(model)) call write_accuracy(self%h5, g, model)
         if (present(model) .and. present(samples)) then
             if (allocated(samples)) call write_fields(self%h5, g, self%fields, model, samples)
         end if

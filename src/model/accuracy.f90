@@ -1,0 +1,465 @@
+!> How well the mesh resolves the edges of a contact zone: the indicator of
+!> docs/contact-accuracy.md, per contact pair and converged step, for the result file
+!> (`voiga_io_output_results`), the console's step line and the warning at the end of a
+!> run (`voiga_model_checks`). `post/indicator.py` computes the same from a result file
+!> (and reads these values when the file has them; a test compares the two).
+!>
+!> A zone is a run of slave points in contact with positive pressure, in slave-parameter
+!> order, measured on the slave's contact edge in the reference configuration: the slave
+!> elements it covers, and at each free edge (a zone reaching the first or last slave
+!> point ends at a symmetry cut or at the end of the edge, not at a free edge) the slave
+!> element's length and the surface row's thickness relative to the zone's half-width w,
+!> and an estimate of the relative L2 pressure error made there: near a free edge p^2 is
+!> smooth in the distance d into the zone (Hertz: exactly quadratic), so a least-squares
+!> fit of p^2 = c0 + c1 d + c2 d^2 to the points the mesh resolves (d between one edge
+!> element and `fit_band` w) continued to its root is the reference of the two edge
+!> elements; the L2 difference of the computed pressure from it there, relative to the
+!> zone's L2 norm and times `calibration`, is the estimate (docs/theory.md derives its
+!> order, docs/contact-accuracy.md calibrates it).
+!>
+!> Why only edges: a face's zone has a boundary curve instead of two points; the same
+!> measures are taken along its normal in the face, which is not built yet (a face pair
+!> has no zones here and its result group says so).
+module voiga_model_accuracy
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan, ieee_is_finite
+    use voiga_kinds, only: dp
+    use voiga_contact_pair, only: contact_pair_t
+    use voiga_contact_law, only: state_inactive
+    use voiga_discretization_patch, only: discretization_t
+    use voiga_nurbs_patch, only: patch_eval
+    use voiga_model, only: model_t
+    implicit none
+    private
+
+    public :: edge_measure_t, zone_measure_t, measure_zones, pair_zones, worst_of_pair, zone_estimate
+    public :: fit_band, calibration, warn_estimate, min_points
+
+    !> The fit of p^2 near an edge uses the points within this fraction of the zone's
+    !> half-width from the edge (and at least the two elements nearest it).
+    real(dp), parameter :: fit_band = 0.5_dp
+    !> Scales the raw estimate to the measured L2 error at the edges.
+    real(dp), parameter :: calibration = 0.65_dp
+    !> A pair whose estimated edge error exceeds this (0.5 %) is warned about.
+    real(dp), parameter :: warn_estimate = 0.005_dp
+    !> Fewer points in contact than this: the zone is not resolved at all.
+    integer, parameter :: min_points = 3
+
+    !> One free edge of a zone.
+    type :: edge_measure_t
+        !> Slave parameter of the edge: the fit's root when it lies between the last
+        !> point in contact and the first one out, else midway between them.
+        real(dp) :: xi = 0.0_dp
+        !> +1: the zone lies at smaller xi (the edge is its upper end); -1: larger.
+        integer :: side = 0
+        !> Reference length of the slave element holding the edge, and thickness of the
+        !> surface element row there; both over the zone's half-width.
+        real(dp) :: h_tangent = 0.0_dp, h_normal = 0.0_dp, ratio_tangent = 0.0_dp, ratio_normal = 0.0_dp
+        !> The uncalibrated estimate, and the reference distance between the points
+        !> that bracket the edge.
+        real(dp) :: raw = 0.0_dp, bracket = 0.0_dp
+    end type edge_measure_t
+
+    !> One zone of a pair at a step.
+    type :: zone_measure_t
+        !> Slave parameters of its first and last points in contact.
+        real(dp) :: xi_range(2) = 0.0_dp
+        !> w (half the length between two free edges, the whole from a cut to one).
+        real(dp) :: half_width = 0.0_dp
+        !> Slave elements covered (partly covered ones by their fraction).
+        real(dp) :: elements_across = 0.0_dp
+        integer :: n_points = 0, n_edges = 0
+        type(edge_measure_t) :: edges(2)
+    end type zone_measure_t
+
+    !> A pair's slave points in slave-parameter order: parameter, reference arc length,
+    !> nominal pressure, reference positions.
+    type :: profile_t
+        real(dp), allocatable :: xi(:), s(:), p(:), x0(:, :)
+        logical, allocatable :: on(:)
+    end type profile_t
+
+contains
+
+    !> Estimated relative L2 pressure error of `zone` made at its edges (the root of the
+    !> sum of its edges' squares; infinite for fewer than `min_points` points).
+    pure real(dp) function zone_estimate(zone) result(e)
+        type(zone_measure_t), intent(in) :: zone
+        if (zone%n_points < min_points) then
+            e = ieee_value(1.0_dp, ieee_positive_inf)
+        else
+            e = calibration*sqrt(sum(zone%edges(1:zone%n_edges)%raw**2))
+        end if
+    end function zone_estimate
+
+    !> The zones of pair `k` of `model` as it was last evaluated (none on a face).
+    pure function pair_zones(model, k) result(zones)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: k
+        type(zone_measure_t), allocatable :: zones(:)
+        associate (pair => model%pairs(k)%pair)
+            call measure_zones(pair, model%bodies(pair%slave_body)%disc, zones)
+        end associate
+    end function pair_zones
+
+    !> The zone of pair `k` of `model` with the largest estimate; `found` is false when
+    !> the pair has none (out of contact, or a face).
+    pure subroutine worst_of_pair(model, k, zone, found)
+        type(model_t), intent(in) :: model
+        integer, intent(in) :: k
+        type(zone_measure_t), intent(out) :: zone
+        logical, intent(out) :: found
+        type(zone_measure_t), allocatable :: zones(:)
+        zones = pair_zones(model, k)
+        found = size(zones) > 0
+        if (found) zone = zones(worst_zone(zones))
+    end subroutine worst_of_pair
+
+    !> The index of the zone with the largest estimate (0: none).
+    pure integer function worst_zone(zones) result(k)
+        type(zone_measure_t), intent(in) :: zones(:)
+        integer :: i
+        k = 0
+        do i = 1, size(zones)
+            if (k == 0) then
+                k = i
+            else if (zone_estimate(zones(i)) > zone_estimate(zones(k))) then
+                k = i
+            end if
+        end do
+    end function worst_zone
+
+    !> The zones of `pair` as it was last evaluated, on the slave discretization
+    !> `disc` (none on a face).
+    pure subroutine measure_zones(pair, disc, zones)
+        class(contact_pair_t), intent(in) :: pair
+        type(discretization_t), intent(in) :: disc
+        type(zone_measure_t), allocatable, intent(out) :: zones(:)
+        type(profile_t) :: prof
+        real(dp), allocatable :: breaks(:)
+        integer :: n, i, i0
+        allocate (zones(0))
+        if (pair%slave%npar /= 1 .or. size(pair%out) == 0) return
+        prof = profile(pair)
+        breaks = element_breaks(disc, 1)
+        n = size(prof%xi)
+        i = 1
+        do while (i <= n)
+            if (.not. prof%on(i)) then
+                i = i + 1
+                cycle
+            end if
+            i0 = i
+            do while (i < n)
+                if (.not. prof%on(i + 1)) exit
+                i = i + 1
+            end do
+            zones = [zones, measure_zone(prof, disc, breaks, i0, i)]
+            i = i + 1
+        end do
+    end subroutine measure_zones
+
+    !> The slave points of `pair` sorted by parameter (stable).
+    pure function profile(pair) result(prof)
+        class(contact_pair_t), intent(in) :: pair
+        type(profile_t) :: prof
+        integer, allocatable :: order(:)
+        integer :: n, i, j, k
+        n = size(pair%out)
+        order = [(i, i=1, n)]
+        ! insertion sort: the points come element by element, nearly sorted
+        do i = 2, n
+            k = order(i)
+            j = i - 1
+            do while (j >= 1)
+                if (pair%xi(order(j)) <= pair%xi(k)) exit
+                order(j + 1) = order(j)
+                j = j - 1
+            end do
+            order(j + 1) = k
+        end do
+        prof%xi = pair%xi(order)
+        prof%p = pair%out(order)%pn0
+        prof%x0 = reshape([(pair%out(order(i))%x0, i=1, n)], [3, n])
+        prof%on = pair%out(order)%state /= state_inactive .and. prof%p > 0.0_dp
+        allocate (prof%s(n))
+        prof%s(1) = 0.0_dp
+        do i = 2, n
+            prof%s(i) = prof%s(i - 1) + norm2(prof%x0(:, i) - prof%x0(:, i - 1))
+        end do
+    end function profile
+
+    !> The distinct element boundaries of `disc` in parametric direction `d`.
+    pure function element_breaks(disc, d) result(b)
+        type(discretization_t), intent(in) :: disc
+        integer, intent(in) :: d
+        real(dp), allocatable :: b(:), rest(:)
+        rest = [disc%elements%lo(d), disc%elements%hi(d)]
+        allocate (b(0))
+        do while (size(rest) > 0)
+            b = [b, minval(rest)]
+            rest = pack(rest, rest > b(size(b)))
+        end do
+    end function element_breaks
+
+    !> The zone of points i0..i1 of `prof`.
+    pure function measure_zone(prof, disc, breaks, i0, i1) result(zone)
+        type(profile_t), intent(in) :: prof
+        type(discretization_t), intent(in) :: disc
+        real(dp), intent(in) :: breaks(:)
+        integer, intent(in) :: i0, i1
+        type(zone_measure_t) :: zone
+        real(dp) :: s_lo, s_hi, xi_lo, xi_hi, w, norm
+        integer :: n, lo, hi
+        n = size(prof%xi)
+        s_lo = prof%s(1)
+        s_hi = prof%s(n)
+        xi_lo = breaks(1)
+        xi_hi = breaks(size(breaks))
+        if (i0 > 1) then
+            s_lo = 0.5_dp*(prof%s(i0) + prof%s(i0 - 1))
+            xi_lo = 0.5_dp*(prof%xi(i0) + prof%xi(i0 - 1))
+        end if
+        if (i1 < n) then
+            s_hi = 0.5_dp*(prof%s(i1) + prof%s(i1 + 1))
+            xi_hi = 0.5_dp*(prof%xi(i1) + prof%xi(i1 + 1))
+        end if
+        w = s_hi - s_lo
+        if (i0 > 1 .and. i1 < n) w = 0.5_dp*w
+        lo = max(i0 - 1, 1)
+        hi = min(i1 + 1, n)
+        norm = trapezoid(prof%p(lo:hi)**2, prof%s(lo:hi))
+        zone%xi_range = [prof%xi(i0), prof%xi(i1)]
+        zone%half_width = w
+        zone%elements_across = covered(breaks, xi_lo, xi_hi)
+        zone%n_points = i1 - i0 + 1
+        if (i0 > 1) call add_edge(zone, measure_edge(prof, disc, breaks, [i0, i1], i0, -1, w, norm))
+        if (i1 < n) call add_edge(zone, measure_edge(prof, disc, breaks, [i0, i1], i1, +1, w, norm))
+    end function measure_zone
+
+    pure subroutine add_edge(zone, edge)
+        type(zone_measure_t), intent(inout) :: zone
+        type(edge_measure_t), intent(in) :: edge
+        zone%n_edges = zone%n_edges + 1
+        zone%edges(zone%n_edges) = edge
+    end subroutine add_edge
+
+    !> The free edge of the zone `zone` (first, last point) after its point `i`
+    !> (`side` +1: its upper end, -1: its lower end); `w` its half-width, `norm` its
+    !> squared L2 norm.
+    pure function measure_edge(prof, disc, breaks, zone, i, side, w, norm) result(edge)
+        type(profile_t), intent(in) :: prof
+        type(discretization_t), intent(in) :: disc
+        real(dp), intent(in) :: breaks(:), w, norm
+        integer, intent(in) :: zone(2), i, side
+        type(edge_measure_t) :: edge
+        real(dp), allocatable :: d(:)
+        logical, allocatable :: mask(:)
+        real(dp) :: se, h, residual, root
+        integer :: j
+        j = i + side
+        edge%xi = 0.5_dp*(prof%xi(i) + prof%xi(j))
+        se = 0.5_dp*(prof%s(i) + prof%s(j))
+        h = element_size(prof, breaks, edge%xi)
+        d = side*(se - prof%s)
+        ! the zone's points, and those out of contact within two elements of the edge
+        allocate (mask(size(d)), source=.false.)
+        mask(zone(1):zone(2)) = .true.
+        mask = mask .or. (d < 0.0_dp .and. d > -2.0_dp*h)
+        call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root)
+        edge%bracket = abs(prof%s(j) - prof%s(i))
+        if (abs(root) <= edge%bracket) edge%xi = interpolate(se - side*root, prof%s, prof%xi)
+        edge%side = side
+        edge%h_tangent = h
+        edge%h_normal = normal_size(disc, edge%xi)
+        edge%ratio_tangent = ieee_value(1.0_dp, ieee_positive_inf)
+        edge%ratio_normal = edge%ratio_tangent
+        if (w > 0.0_dp) then
+            edge%ratio_tangent = h/w
+            edge%ratio_normal = edge%h_normal/w
+        end if
+        edge%raw = ieee_value(1.0_dp, ieee_positive_inf)
+        if (norm > 0.0_dp .and. ieee_is_finite(residual)) edge%raw = sqrt(residual/norm)
+    end function measure_edge
+
+    !> The squared L2 residual over the edge elements (d < 2 h) of the pressure `p` at
+    !> distances `d` into the zone from the least-squares fit p^2 = c0 + c1 d + c2 d^2
+    !> to the points with h <= d <= max(band, 2 h) (fewer than three such points: all
+    !> with p > 0), and the fit's edge (its largest root below the fitted points, -inf
+    !> when none); both NaN with fewer than three points to fit.
+    pure subroutine edge_residual(d, p, h, band, residual, root)
+        real(dp), intent(in) :: d(:), p(:), h, band
+        real(dp), intent(out) :: residual, root
+        logical :: fit(size(d)), near(size(d))
+        real(dp) :: c(3), ref(size(d))
+        fit = d >= h .and. d <= max(band, 2.0_dp*h) .and. p > 0.0_dp
+        if (count(fit) < 3) fit = p > 0.0_dp
+        if (count(fit) < 3) then
+            residual = ieee_value(1.0_dp, ieee_quiet_nan)
+            root = residual
+            return
+        end if
+        c = quadratic_fit(pack(d, fit), pack(p, fit)**2)
+        ref = sqrt(max(c(1) + c(2)*d + c(3)*d**2, 0.0_dp))
+        root = largest_root_below(c, minval(pack(d, fit)))
+        where (d < root) ref = 0.0_dp
+        near = d < 2.0_dp*h
+        residual = sorted_trapezoid(pack(d, near), pack(p - ref, near)**2)
+    end subroutine edge_residual
+
+    !> Least-squares coefficients c of c1 + c2 t + c3 t^2 ~ y (Householder QR of the
+    !> columns scaled to t / max |t|, so that the fit is as well conditioned as it can be).
+    pure function quadratic_fit(t, y) result(c)
+        real(dp), intent(in) :: t(:), y(:)
+        real(dp) :: c(3)
+        real(dp) :: a(size(t), 3), b(size(t)), v(size(t)), scale, alpha
+        integer :: k, m, j
+        m = size(t)
+        scale = maxval(abs(t))
+        if (scale <= 0.0_dp) scale = 1.0_dp
+        a(:, 1) = 1.0_dp
+        a(:, 2) = t/scale
+        a(:, 3) = (t/scale)**2
+        b = y
+        do k = 1, 3
+            alpha = -sign(norm2(a(k:m, k)), a(k, k))
+            v = 0.0_dp
+            v(k:m) = a(k:m, k)
+            v(k) = v(k) - alpha
+            if (norm2(v(k:m)) > 0.0_dp) then
+                v(k:m) = v(k:m)/norm2(v(k:m))
+                do j = k, 3
+                    a(k:m, j) = a(k:m, j) - 2.0_dp*v(k:m)*dot_product(v(k:m), a(k:m, j))
+                end do
+                b(k:m) = b(k:m) - 2.0_dp*v(k:m)*dot_product(v(k:m), b(k:m))
+            end if
+        end do
+        do k = 3, 1, -1
+            c(k) = (b(k) - dot_product(a(k, k + 1:3), c(k + 1:3)))/a(k, k)
+        end do
+        c = c/[1.0_dp, scale, scale**2]
+    end function quadratic_fit
+
+    !> The largest real root of c1 + c2 d + c3 d^2 below `start` (-inf when none).
+    pure real(dp) function largest_root_below(c, start) result(root)
+        real(dp), intent(in) :: c(3), start
+        real(dp) :: disc, q, r(2)
+        integer :: k
+        root = -ieee_value(1.0_dp, ieee_positive_inf)
+        if (c(3) == 0.0_dp) then
+            r = -c(1)/c(2)
+        else
+            disc = c(2)**2 - 4.0_dp*c(3)*c(1)
+            if (disc < 0.0_dp) return
+            q = -0.5_dp*(c(2) + sign(sqrt(disc), c(2)))
+            r(1) = q/c(3)
+            r(2) = r(1)
+            if (q /= 0.0_dp) r(2) = c(1)/q
+        end if
+        do k = 1, 2
+            if (r(k) < start) root = max(root, r(k))
+        end do
+    end function largest_root_below
+
+    !> The trapezoidal integral of `f` over the points `x` taken in ascending order.
+    pure real(dp) function sorted_trapezoid(x, f) result(total)
+        real(dp), intent(in) :: x(:), f(:)
+        real(dp) :: xs(size(x)), fs(size(x)), tx, tf
+        integer :: i, j
+        xs = x
+        fs = f
+        do i = 2, size(xs)
+            tx = xs(i)
+            tf = fs(i)
+            j = i - 1
+            do while (j >= 1)
+                if (xs(j) <= tx) exit
+                xs(j + 1) = xs(j)
+                fs(j + 1) = fs(j)
+                j = j - 1
+            end do
+            xs(j + 1) = tx
+            fs(j + 1) = tf
+        end do
+        total = trapezoid(fs, xs)
+    end function sorted_trapezoid
+
+    pure real(dp) function trapezoid(f, x) result(total)
+        real(dp), intent(in) :: f(:), x(:)
+        integer :: n
+        n = size(x)
+        total = 0.0_dp
+        if (n > 1) total = 0.5_dp*sum((f(2:n) + f(1:n - 1))*(x(2:n) - x(1:n - 1)))
+    end function trapezoid
+
+    !> Linear interpolation of (xp, fp) at x, xp ascending, constant beyond the ends.
+    pure real(dp) function interpolate(x, xp, fp) result(f)
+        real(dp), intent(in) :: x, xp(:), fp(:)
+        integer :: k
+        f = fp(1)
+        if (x <= xp(1)) return
+        f = fp(size(fp))
+        if (x >= xp(size(xp))) return
+        do k = 2, size(xp)
+            if (xp(k) >= x) exit
+        end do
+        f = fp(k - 1)
+        if (xp(k) > xp(k - 1)) f = fp(k - 1) + (fp(k) - fp(k - 1))*(x - xp(k - 1))/(xp(k) - xp(k - 1))
+    end function interpolate
+
+    !> Elements of `breaks` covered by [lo, hi], partly covered ones by their fraction.
+    pure real(dp) function covered(breaks, lo, hi) result(n)
+        real(dp), intent(in) :: breaks(:), lo, hi
+        integer :: k
+        n = 0.0_dp
+        do k = 1, size(breaks) - 1
+            n = n + max(min(breaks(k + 1), hi) - max(breaks(k), lo), 0.0_dp)/(breaks(k + 1) - breaks(k))
+        end do
+    end function covered
+
+    !> Reference length of the slave element holding parameter `xi`: the polyline
+    !> through its points, scaled from their parameter range to the element's (NaN
+    !> with fewer than two points in it).
+    pure real(dp) function element_size(prof, breaks, xi) result(h)
+        type(profile_t), intent(in) :: prof
+        real(dp), intent(in) :: breaks(:), xi
+        real(dp) :: a, b, length
+        integer :: k, first, last, i
+        k = size(breaks) - 1
+        do i = 1, size(breaks) - 1
+            if (breaks(i + 1) > xi) then
+                k = i
+                exit
+            end if
+        end do
+        a = breaks(k)
+        b = breaks(k + 1)
+        h = ieee_value(1.0_dp, ieee_quiet_nan)
+        first = 0
+        last = 0
+        length = 0.0_dp
+        do i = 1, size(prof%xi)
+            if (prof%xi(i) < a .or. prof%xi(i) > b) cycle
+            if (first == 0) first = i
+            if (last > 0) length = length + norm2(prof%x0(:, i) - prof%x0(:, last))
+            last = i
+        end do
+        if (first == 0 .or. last == first) return
+        if (prof%xi(last) > prof%xi(first)) h = length*(b - a)/(prof%xi(last) - prof%xi(first))
+    end function element_size
+
+    !> Reference distance across the surface element row at the edge parameter `xi`:
+    !> from eta = 1 (the contact edge) to the row's inner boundary.
+    pure real(dp) function normal_size(disc, xi) result(hn)
+        type(discretization_t), intent(in) :: disc
+        real(dp), intent(in) :: xi
+        real(dp), allocatable :: eta(:)
+        real(dp) :: inner, x1(disc%bulk%nsd), x2(disc%bulk%nsd)
+        eta = element_breaks(disc, 2)
+        inner = 0.0_dp
+        if (size(eta) > 1) inner = eta(size(eta) - 1)
+        call patch_eval(disc%bulk, [xi, 1.0_dp], x1)
+        call patch_eval(disc%bulk, [xi, inner], x2)
+        hn = norm2(x1 - x2)
+    end function normal_size
+
+end module voiga_model_accuracy
