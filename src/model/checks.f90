@@ -48,7 +48,7 @@ module voiga_model_checks
     !> One warning (fixed length: arrays of them grow by constructor); `topic`: its
     !> pair and cause in a few words, by which a failure points back to it.
     type :: warning_t
-        character(len=512) :: text = ''
+        character(len=1024) :: text = ''
         character(len=160) :: topic = ''
     end type warning_t
 
@@ -501,14 +501,18 @@ contains
                    fixed_str(100.0_dp*zone_estimate(zone), 2)//' % at step '//str(step)//' (above '// &
                    fixed_str(100.0_dp*warn_estimate, 1)//' %'
             do j = 1, zone%n_edges
-                what = what//'; h/w '//fixed_str(zone%edges(j)%ratio_tangent, 3)//' along and '// &
+                what = what//'; h/w '//fixed_str(zone%edges(j)%ratio_tangent, 3)//' along, '// &
                        fixed_str(zone%edges(j)%ratio_normal, 3)//' across at xi = '//fixed_str(zone%edges(j)%xi, 4)
             end do
         end if
-        list = [list, warning_t(pair_label(pair)//what//', '//fixed_str(zone%elements_across, 1)// &
-                                ' slave elements across): refine the zone (python -m pre refine RESULT.h5, '// &
-                                'or post run CASE --adapt; docs/contact-accuracy.md)', &
-                                topic=pair_label(pair)//'an unresolved contact zone edge')]
+        what = what//', '//fixed_str(zone%elements_across, 1)//' slave elements across): refine the zone '// &
+               '(python -m pre refine RESULT.h5; docs/contact-accuracy.md)'
+        ! a penalty softer than the automatic one smears the edge over more than an element
+        if (pair%law%eps_n < pair%eps_automatic .and. pair%method_name() /= 'alm') &
+            what = what//'; penalty_normal = '//trim(short_str(pair%law%eps_n))//' is softer than the '// &
+                   'automatic '//trim(short_str(pair%eps_automatic))//': its compliance smears the edge too, '// &
+                   'which refinement does not remove (omit or raise it)'
+        list = [list, warning_t(pair_label(pair)//what, topic=pair_label(pair)//'an unresolved contact zone edge')]
     end subroutine accuracy_warning
 
 end module voiga_model_checks
