@@ -3,8 +3,9 @@
 ``warnings``, one line each) while it still runs: bodies overlapping at the start,
 a contact edge on the wrong side of a body, a slave stiffer or coarser than its
 master, a penetration deeper than a tenth of its slave element, a pair that never
-comes into contact, a contact zone whose edge the mesh resolves poorly (issue 39). ``--check`` prints the set-up ones and exits 0 (2 when most of a
-slave edge starts inside its master, which a run refuses too: test_setups.py)."""
+comes into contact, a contact zone whose edge the mesh resolves poorly (issue 39).
+``--check`` prints the set-up ones and exits 0 (2 when most of a slave edge starts
+inside its master, which a run refuses too: test_setups.py)."""
 from __future__ import annotations
 
 import re
