@@ -74,6 +74,10 @@ class EdgeMeasure:
     well the points place the edge."""
     half_width: float = math.nan
     """w of the edge's zone."""
+    vanishing: bool = True
+    """Does the pressure vanish towards the edge (less on average in the edge element
+    than over the fitted points)? Where it does not (a punch's corner, a conforming edge: p rises
+    towards the edge) the square-root model does not hold: ``raw`` is 0, not estimated."""
 
     @property
     def estimate(self) -> float:
@@ -156,17 +160,19 @@ def _covered(breaks: np.ndarray, lo: float, hi: float) -> float:
     return float(np.sum(overlap / spans))
 
 
-def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float]:
+def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float, bool]:
     """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
     pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
     d^2`` to the points with ``h <= d <= band`` (when fewer than three such points, all
     points in contact), and the distance of the fit's edge (its root, NaN when it has
-    none); ``(NaN, NaN)`` for fewer than three points in contact."""
+    none); ``(NaN, NaN)`` for fewer than three points in contact; and whether the
+    pressure vanishes towards the edge (the points in contact within the edge element
+    carry less on average than the fitted ones)."""
     fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
     if np.count_nonzero(fit) < 3:
         fit = p > 0
     if np.count_nonzero(fit) < 3:
-        return math.nan, math.nan
+        return math.nan, math.nan, True
     dd = d[fit]
     design = np.column_stack([np.ones_like(dd), dd, dd**2])
     coef, *_ = np.linalg.lstsq(design, p[fit] ** 2, rcond=None)
@@ -174,11 +180,15 @@ def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple
     ref = np.sqrt(np.clip(q, 0.0, None))
     # no pressure beyond the fit's edge (the root of q nearest the zone)
     root = _first_root(coef, float(dd.min()))
+    # the pressure vanishes towards the edge when the edge element's points carry less
+    # on average than the fitted ones (a punch's corner: a spike there)
+    edge = (d >= 0) & (d < h) & (p > 0)
+    vanishing = bool(p[edge].mean() < p[fit].mean()) if edge.any() else True
     ref[d < root] = 0.0
     near = d < 2 * h
     order = np.argsort(d[near])
     x, r = d[near][order], (p[near] - ref[near])[order]
-    return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root
+    return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root, vanishing
 
 
 def design_at(d: np.ndarray) -> np.ndarray:
@@ -217,15 +227,16 @@ def _measure_edge(result: Result, c: ContactOutput, prof: _Profile, zone: tuple[
     mask = np.zeros(len(xi), dtype=bool)  # the zone's points and those out within 2 h
     mask[zone[0]:zone[1] + 1] = True
     mask[(d < 0) & (d > -2 * h)] = True
-    residual, root = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+    residual, root, vanishing = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
     if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
         xe = float(np.interp(se - side * root, s, xi))
     hn = normal_size(result.body(c.slave), float(xe))
     raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
+    raw = raw if vanishing else 0.0
     return EdgeMeasure(xi=float(xe), side=side, h_tangent=h, h_normal=hn,
                        ratio_tangent=h / w if w > 0 else math.inf,
                        ratio_normal=hn / w if w > 0 else math.inf, raw=raw,
-                       bracket=float(abs(s[j] - s[i])), half_width=float(w))
+                       bracket=float(abs(s[j] - s[i])), half_width=float(w), vanishing=vanishing)
 
 
 def _ratio(h: float, w: float) -> float:
@@ -250,7 +261,8 @@ def recorded_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasur
                              h_tangent=float(a["edge_h_tangent"][e]), h_normal=float(a["edge_h_normal"][e]),
                              ratio_tangent=_ratio(float(a["edge_h_tangent"][e]), w),
                              ratio_normal=_ratio(float(a["edge_h_normal"][e]), w),
-                             raw=float(a["edge_raw"][e]), bracket=float(a["edge_bracket"][e]), half_width=w)
+                             raw=float(a["edge_raw"][e]), bracket=float(a["edge_bracket"][e]), half_width=w,
+                             vanishing=bool(a["edge_vanishing"][e]) if "edge_vanishing" in a else True)
                  for e in np.flatnonzero(owner == z)]
         lo, hi = (float(v) for v in np.asarray(a["xi_range"]).reshape(-1, 2)[z])
         zones.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step, time=st.time,
@@ -320,7 +332,9 @@ def format_zone(m: ZoneMeasure) -> str:
                 f"contact, {m.elements_across:.2g} slave elements: the zone is not resolved")
     several = len(m.edges) > 1
     edges = "; ".join(f"edge at xi = {e.xi:.4g}: h/w = {e.ratio_tangent:.3g} along, "
-                      f"{e.ratio_normal:.3g} across" + (f", {e.estimate:.2%}" if several else "")
+                      f"{e.ratio_normal:.3g} across"
+                      + ("" if e.vanishing else " (not estimated: the pressure rises towards it)")
+                      + (f", {e.estimate:.2%}" if several and e.vanishing else "")
                       for e in m.edges) or "no free edge"
     return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.elements_across:.1f} slave "
             f"elements across the zone (half-width {m.half_width:.4g}); {edges}; "

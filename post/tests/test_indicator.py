@@ -59,11 +59,19 @@ def test_edge_fit_reproduces_a_hertz_profile() -> None:
     d = np.linspace(-0.1, 0.6, 71)  # distance into the zone from the edge
     x = a - d
     p = np.sqrt(np.clip(1 - x**2, 0, None))
-    residual, root = _edge_residual(d, p, h, 0.5)
-    assert residual < 1e-24 and abs(root) < 1e-10
+    residual, root, vanishing = _edge_residual(d, p, h, 0.5)
+    assert residual < 1e-24 and abs(root) < 1e-10 and vanishing
     bumped = p.copy()
     bumped[(d > 0) & (d < h)] *= 1.1  # 10 % off in the edge element
     assert _edge_residual(d, bumped, h, 0.5)[0] > 1e-6
+
+
+def test_edge_of_a_punch_is_not_estimated() -> None:
+    """A flat punch's pressure rises towards its corner, p = 1 / sqrt(1 - x^2): the
+    square-root model of the estimate does not hold there, and the edge says so."""
+    d = np.linspace(0.002, 0.6, 60)
+    p = 1.0 / np.sqrt(1.0 - (1.0 - d) ** 2)
+    assert not _edge_residual(d, p, 0.05, 0.5)[2]
 
 
 def test_indicator_flags_the_coarse_committed_mesh(m4: Path) -> None:

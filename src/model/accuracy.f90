@@ -57,6 +57,11 @@ module voiga_model_accuracy
         !> The uncalibrated estimate, and the reference distance between the points
         !> that bracket the edge.
         real(dp) :: raw = 0.0_dp, bracket = 0.0_dp
+        !> Does the pressure vanish towards the edge (less on average in the edge element
+        !> than over the fitted points)? Where it does not (a punch's corner, a conforming edge: p rises towards the
+        !> edge, or is singular there) the square-root model does not hold and the edge
+        !> is not estimated (raw = 0).
+        logical :: vanishing = .true.
     end type edge_measure_t
 
     !> One zone of a pair at a step.
@@ -163,20 +168,9 @@ contains
         class(contact_pair_t), intent(in) :: pair
         type(profile_t) :: prof
         integer, allocatable :: order(:)
-        integer :: n, i, j, k
+        integer :: n, i
         n = size(pair%out)
-        order = [(i, i=1, n)]
-        ! insertion sort: the points come element by element, nearly sorted
-        do i = 2, n
-            k = order(i)
-            j = i - 1
-            do while (j >= 1)
-                if (pair%xi(order(j)) <= pair%xi(k)) exit
-                order(j + 1) = order(j)
-                j = j - 1
-            end do
-            order(j + 1) = k
-        end do
+        order = stable_order(pair%xi)
         prof%xi = pair%xi(order)
         prof%p = pair%out(order)%pn0
         prof%x0 = reshape([(pair%out(order(i))%x0, i=1, n)], [3, n])
@@ -265,7 +259,7 @@ contains
         allocate (mask(size(d)), source=.false.)
         mask(zone(1):zone(2)) = .true.
         mask = mask .or. (d < 0.0_dp .and. d > -2.0_dp*h)
-        call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root)
+        call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root, edge%vanishing)
         edge%bracket = abs(prof%s(j) - prof%s(i))
         if (abs(root) <= edge%bracket) edge%xi = interpolate(se - side*root, prof%s, prof%xi)
         edge%side = side
@@ -279,20 +273,25 @@ contains
         end if
         edge%raw = ieee_value(1.0_dp, ieee_positive_inf)
         if (norm > 0.0_dp .and. ieee_is_finite(residual)) edge%raw = sqrt(residual/norm)
+        if (.not. edge%vanishing) edge%raw = 0.0_dp
     end function measure_edge
 
     !> The squared L2 residual over the edge elements (d < 2 h) of the pressure `p` at
     !> distances `d` into the zone from the least-squares fit p^2 = c0 + c1 d + c2 d^2
     !> to the points with h <= d <= max(band, 2 h) (fewer than three such points: all
-    !> with p > 0), and the fit's edge (its largest root below the fitted points, -inf
-    !> when none); both NaN with fewer than three points to fit.
-    pure subroutine edge_residual(d, p, h, band, residual, root)
+    !> with p > 0), the fit's edge (its largest root below the fitted points, -inf
+    !> when none), both NaN with fewer than three points to fit, and whether the
+    !> pressure vanishes towards the edge (`vanishing`: the points in contact within
+    !> the edge element carry less on average than the fitted ones).
+    pure subroutine edge_residual(d, p, h, band, residual, root, vanishing)
         real(dp), intent(in) :: d(:), p(:), h, band
         real(dp), intent(out) :: residual, root
+        logical, intent(out) :: vanishing
         logical :: fit(size(d)), near(size(d))
         real(dp) :: c(3), ref(size(d))
         fit = d >= h .and. d <= max(band, 2.0_dp*h) .and. p > 0.0_dp
         if (count(fit) < 3) fit = p > 0.0_dp
+        vanishing = .true.
         if (count(fit) < 3) then
             residual = ieee_value(1.0_dp, ieee_quiet_nan)
             root = residual
@@ -301,6 +300,10 @@ contains
         c = quadratic_fit(pack(d, fit), pack(p, fit)**2)
         ref = sqrt(max(c(1) + c(2)*d + c(3)*d**2, 0.0_dp))
         root = largest_root_below(c, minval(pack(d, fit)))
+        ! the pressure vanishes towards the edge when the edge element's points carry less
+        ! on average than the fitted ones (a punch's corner: a spike there)
+        near = d >= 0.0_dp .and. d < h .and. p > 0.0_dp
+        if (count(near) > 0) vanishing = sum(p, near)/count(near) < sum(p, fit)/count(fit)
         where (d < root) ref = 0.0_dp
         near = d < 2.0_dp*h
         residual = sorted_trapezoid(pack(d, near), pack(p - ref, near)**2)
@@ -363,25 +366,29 @@ contains
     !> The trapezoidal integral of `f` over the points `x` taken in ascending order.
     pure real(dp) function sorted_trapezoid(x, f) result(total)
         real(dp), intent(in) :: x(:), f(:)
-        real(dp) :: xs(size(x)), fs(size(x)), tx, tf
-        integer :: i, j
-        xs = x
-        fs = f
-        do i = 2, size(xs)
-            tx = xs(i)
-            tf = fs(i)
+        integer :: order(size(x))
+        order = stable_order(x)
+        total = trapezoid(f(order), x(order))
+    end function sorted_trapezoid
+
+    !> The permutation that sorts `x` ascending, equal values in their order (insertion:
+    !> the slave points come element by element, nearly sorted).
+    pure function stable_order(x) result(order)
+        real(dp), intent(in) :: x(:)
+        integer :: order(size(x))
+        integer :: i, j, k
+        order = [(i, i=1, size(x))]
+        do i = 2, size(x)
+            k = order(i)
             j = i - 1
             do while (j >= 1)
-                if (xs(j) <= tx) exit
-                xs(j + 1) = xs(j)
-                fs(j + 1) = fs(j)
+                if (x(order(j)) <= x(k)) exit
+                order(j + 1) = order(j)
                 j = j - 1
             end do
-            xs(j + 1) = tx
-            fs(j + 1) = tf
+            order(j + 1) = k
         end do
-        total = trapezoid(fs, xs)
-    end function sorted_trapezoid
+    end function stable_order
 
     pure real(dp) function trapezoid(f, x) result(total)
         real(dp), intent(in) :: f(:), x(:)

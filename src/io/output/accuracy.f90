@@ -57,6 +57,7 @@ contains
         call h5%write(a//'/edge_h_normal', [edges%h_normal])
         call h5%write(a//'/edge_raw', [edges%raw])
         call h5%write(a//'/edge_bracket', [edges%bracket])
+        call h5%write(a//'/edge_vanishing', merge(1, 0, edges%vanishing))
     end subroutine write_zones
 
 end module voiga_io_output_accuracy
