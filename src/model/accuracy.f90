@@ -182,17 +182,16 @@ contains
         end do
     end function profile
 
-    !> The distinct element boundaries of `disc` in parametric direction `d`.
+    !> The element boundaries of `disc` in parametric direction `d` (its elements come
+    !> in the patch's order, direction 1 fastest: the first element of each row).
     pure function element_breaks(disc, d) result(b)
         type(discretization_t), intent(in) :: disc
         integer, intent(in) :: d
-        real(dp), allocatable :: b(:), rest(:)
-        rest = [disc%elements%lo(d), disc%elements%hi(d)]
-        allocate (b(0))
-        do while (size(rest) > 0)
-            b = [b, minval(rest)]
-            rest = pack(rest, rest > b(size(b)))
-        end do
+        real(dp), allocatable :: b(:)
+        integer :: stride, k
+        stride = product(disc%nels(1:d - 1))
+        b = [(disc%elements(1 + k*stride)%lo(d), k=0, disc%nels(d) - 1), &
+             disc%elements(1 + (disc%nels(d) - 1)*stride)%hi(d)]
     end function element_breaks
 
     !> The zone of points i0..i1 of `prof`.
