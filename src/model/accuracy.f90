@@ -37,6 +37,9 @@ module voiga_model_accuracy
     !> The fit of p^2 near an edge uses the points within this fraction of the zone's
     !> half-width from the edge (and at least the two elements nearest it).
     real(dp), parameter :: fit_band = 0.5_dp
+    !> A band `fit_band` w shorter than this many edge elements (a coarse zone) holds too
+    !> few resolved points: the fit takes the zone's points within as many elements.
+    real(dp), parameter :: min_band_elements = 3.0_dp
     !> Scales the raw estimate to the measured L2 error at the edges.
     real(dp), parameter :: calibration = 0.65_dp
     !> A pair whose estimated edge error exceeds this (0.5 %) is warned about.
@@ -275,21 +278,20 @@ contains
         if (.not. edge%vanishing) edge%raw = 0.0_dp
     end function measure_edge
 
-    !> The squared L2 residual over the edge elements (d < 2 h) of the pressure `p` at
-    !> distances `d` into the zone from the least-squares fit p^2 = c0 + c1 d + c2 d^2
-    !> to the points with h <= d <= max(band, 2 h) (fewer than three such points: all
-    !> with p > 0), the fit's edge (its largest root below the fitted points, -inf
-    !> when none), both NaN with fewer than three points to fit, and whether the
-    !> pressure vanishes towards the edge (`vanishing`: the points in contact within
-    !> the edge element carry less on average than the fitted ones).
+    !> The squared L2 residual over the edge elements (d < 2 h, at most to the zone's
+    !> middle) of the pressure `p` at distances `d` into the zone from the least-squares
+    !> fit p^2 = c0 + c1 d + c2 d^2 to the points `fit_points` chooses, the fit's edge
+    !> (its largest root below the fitted points, 0 (the computed edge) when none),
+    !> both NaN with fewer than three points to fit, and whether the pressure vanishes
+    !> towards the edge (`vanishing`: the points in contact within the edge element
+    !> carry less on average than the fitted ones).
     pure subroutine edge_residual(d, p, h, band, residual, root, vanishing)
         real(dp), intent(in) :: d(:), p(:), h, band
         real(dp), intent(out) :: residual, root
         logical, intent(out) :: vanishing
         logical :: fit(size(d)), near(size(d))
-        real(dp) :: c(3), ref(size(d))
-        fit = d >= h .and. d <= max(band, 2.0_dp*h) .and. p > 0.0_dp
-        if (count(fit) < 3) fit = p > 0.0_dp
+        real(dp) :: c(3), ref(size(d)), reach
+        fit = fit_points(d, p, h, band)
         vanishing = .true.
         if (count(fit) < 3) then
             residual = ieee_value(1.0_dp, ieee_quiet_nan)
@@ -298,13 +300,18 @@ contains
         end if
         c = quadratic_fit(pack(d, fit), pack(p, fit)**2)
         ref = sqrt(max(c(1) + c(2)*d + c(3)*d**2, 0.0_dp))
+        ! a fit without a root below the zone describes no free edge: the computed one
         root = largest_root_below(c, minval(pack(d, fit)))
+        if (.not. ieee_is_finite(root)) root = 0.0_dp
         ! the pressure vanishes towards the edge when the edge element's points carry less
         ! on average than the fitted ones (a punch's corner: a spike there)
         near = d >= 0.0_dp .and. d < h .and. p > 0.0_dp
         if (count(near) > 0) vanishing = sum(p, near)/count(near) < sum(p, fit)/count(fit)
         where (d < root) ref = 0.0_dp
-        near = d < 2.0_dp*h
+        ! the two edge elements, never past the middle of the zone (w = band / fit_band)
+        reach = 2.0_dp*h
+        if (band/fit_band < reach) reach = band/fit_band
+        near = d < reach
         residual = sorted_trapezoid(pack(d, near), pack(p - ref, near)**2)
     end subroutine edge_residual
 
@@ -361,6 +368,22 @@ contains
             if (r(k) < start) root = max(root, r(k))
         end do
     end function largest_root_below
+
+    !> The points the fit of p^2 near an edge uses: of the zone's (d > 0, p > 0), those
+    !> with h <= d <= band when the band holds `min_band_elements` edge elements, else (a
+    !> coarse zone) those with d <= `min_band_elements` h, the edge element's too (p^2 is
+    !> close to a quadratic across a smooth zone); all of them when fewer than three.
+    pure function fit_points(d, p, h, band) result(fit)
+        real(dp), intent(in) :: d(:), p(:), h, band
+        logical :: fit(size(d)), zone(size(d))
+        zone = d > 0.0_dp .and. p > 0.0_dp
+        if (band >= min_band_elements*h) then
+            fit = zone .and. d >= h .and. d <= band
+        else
+            fit = zone .and. d <= min_band_elements*h
+        end if
+        if (count(fit) < 3) fit = zone
+    end function fit_points
 
     !> The trapezoidal integral of `f` over the points `x` taken in ascending order.
     pure real(dp) function sorted_trapezoid(x, f) result(total)
