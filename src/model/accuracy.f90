@@ -31,7 +31,7 @@ module voiga_model_accuracy
     implicit none
     private
 
-    public :: edge_measure_t, zone_measure_t, measure_zones, pair_zones, worst_of_pair, zone_estimate
+    public :: edge_measure_t, zone_measure_t, measure_zones, pair_zones, worst_of_pair, face_summary, zone_estimate
     public :: fit_band, calibration, warn_estimate, min_points
 
     !> The fit of p^2 near an edge uses the points within this fraction of the zone's
@@ -61,15 +61,19 @@ module voiga_model_accuracy
         !> that bracket the edge.
         real(dp) :: raw = 0.0_dp, bracket = 0.0_dp
         !> Does the pressure vanish towards the edge (less on average in the edge element
-        !> than over the fitted points)? Where it does not (a punch's corner, a conforming edge: p rises towards the
-        !> edge, or is singular there) the square-root model does not hold and the edge
-        !> is not estimated (raw = 0).
+        !> than over the fitted points)? Where it does not (a punch's corner, a
+        !> conforming edge: p rises towards the edge, or is singular there) the
+        !> square-root model does not hold and the edge is not estimated (raw = 0).
         logical :: vanishing = .true.
     end type edge_measure_t
 
-    !> One zone of a pair at a step.
+    !> One zone of a pair at a step: on an edge a run of points in contact; on a face
+    !> such a run along one line of slave points (constant eta: `direction` 1, or
+    !> constant xi: 2, at the parameter `line`), measured along the line.
     type :: zone_measure_t
-        !> Slave parameters of its first and last points in contact.
+        integer :: direction = 1
+        real(dp) :: line = 0.0_dp
+        !> Slave parameters (along the line) of its first and last points in contact.
         real(dp) :: xi_range(2) = 0.0_dp
         !> w (half the length between two free edges, the whole from a cut to one).
         real(dp) :: half_width = 0.0_dp
@@ -77,29 +81,37 @@ module voiga_model_accuracy
         real(dp) :: elements_across = 0.0_dp
         integer :: n_points = 0, n_edges = 0
         type(edge_measure_t) :: edges(2)
+        !> The squared L2 norm of its pressure (reference; on a face the sum of p^2 times
+        !> the area its points integrate): what a face's estimate sums the lines with.
+        real(dp) :: norm = 0.0_dp
+        !> Estimated relative L2 pressure error made at its edges (`zone_estimate`).
+        real(dp) :: estimate = 0.0_dp
     end type zone_measure_t
 
-    !> A pair's slave points in slave-parameter order: parameter, reference arc length,
-    !> nominal pressure, reference positions.
+    !> Slave points along one line (an edge: all of them) in parameter order: parameter
+    !> along the line, reference arc length, nominal pressure, reference positions; the
+    !> line's direction and parameters (`at`: the other one's value on a face).
     type :: profile_t
         real(dp), allocatable :: xi(:), s(:), p(:), x0(:, :)
         logical, allocatable :: on(:)
+        integer :: direction = 1
+        real(dp) :: at(2) = 0.0_dp
+        !> On a face, the reference area each point integrates (its integrals are the
+        !> points' sums, so that the lines of one direction add up to the face's).
+        real(dp), allocatable :: area(:)
     end type profile_t
 
 contains
 
-    !> Estimated relative L2 pressure error of `zone` made at its edges (the root of the
-    !> sum of its edges' squares; infinite for fewer than `min_points` points).
+    !> Estimated relative L2 pressure error of `zone` made at its edges: on a line the
+    !> root of the sum of its edges' squares (infinite for fewer than `min_points`
+    !> points); a face's summary zone holds the face's (`face_summary`).
     pure real(dp) function zone_estimate(zone) result(e)
         type(zone_measure_t), intent(in) :: zone
-        if (zone%n_points < min_points) then
-            e = ieee_value(1.0_dp, ieee_positive_inf)
-        else
-            e = calibration*sqrt(sum(zone%edges(1:zone%n_edges)%raw**2))
-        end if
+        e = zone%estimate
     end function zone_estimate
 
-    !> The zones of pair `k` of `model` as it was last evaluated (none on a face).
+    !> The zones of pair `k` of `model` as it was last evaluated.
     pure function pair_zones(model, k) result(zones)
         type(model_t), intent(in) :: model
         integer, intent(in) :: k
@@ -109,46 +121,104 @@ contains
         end associate
     end function pair_zones
 
-    !> The zone of pair `k` of `model` with the largest estimate; `found` is false when
-    !> the pair has none (out of contact, or a face).
+    !> What pair `k` of `model` reports: on an edge its zone with the largest estimate,
+    !> on a face the face's summary (`face_summary`); `found` is false when the pair has
+    !> no zone (out of contact).
     pure subroutine worst_of_pair(model, k, zone, found)
         type(model_t), intent(in) :: model
         integer, intent(in) :: k
         type(zone_measure_t), intent(out) :: zone
         logical, intent(out) :: found
         type(zone_measure_t), allocatable :: zones(:)
+        integer :: i, worst
         zones = pair_zones(model, k)
         found = size(zones) > 0
-        if (found) zone = zones(worst_zone(zones))
+        if (.not. found) return
+        if (model%pairs(k)%pair%slave%npar == 2) then
+            zone = face_summary(zones)
+            return
+        end if
+        worst = 1
+        do i = 2, size(zones)
+            if (zones(i)%estimate > zones(worst)%estimate) worst = i
+        end do
+        zone = zones(worst)
     end subroutine worst_of_pair
 
-    !> The index of the zone with the largest estimate (0: none).
-    pure integer function worst_zone(zones) result(k)
+    !> A face's zones (along the lines of both directions) as one: its points in
+    !> contact, the most elements and the largest half-width across along a line, and
+    !> the estimate: per direction, calibration x sqrt(sum of raw^2 norm / sum of norm)
+    !> over its lines' zones (the squared L2 error at the edges and norm over the face,
+    !> as every point lies on one line of each direction), the larger of the two (lines that graze the
+    !> edge see none of it: a polar grid's circles); a line's zone of fewer than
+    !> `min_points` points counts in the norm only; infinite when no zone has as many.
+    pure function face_summary(zones) result(face)
         type(zone_measure_t), intent(in) :: zones(:)
-        integer :: i
-        k = 0
-        do i = 1, size(zones)
-            if (k == 0) then
-                k = i
-            else if (zone_estimate(zones(i)) > zone_estimate(zones(k))) then
-                k = i
-            end if
+        type(zone_measure_t) :: face
+        real(dp) :: error, norm
+        integer :: d, i
+        face%direction = 0
+        face%n_points = sum(zones%n_points, zones%direction == 1)
+        face%elements_across = maxval(zones%elements_across)
+        face%half_width = maxval(zones%half_width)
+        face%estimate = ieee_value(1.0_dp, ieee_positive_inf)
+        if (all(zones%n_points < min_points)) return
+        face%estimate = 0.0_dp
+        do d = 1, 2
+            error = 0.0_dp
+            norm = 0.0_dp
+            do i = 1, size(zones)
+                if (zones(i)%direction /= d) cycle
+                norm = norm + zones(i)%norm
+                if (zones(i)%n_points < min_points) cycle
+                error = error + sum(zones(i)%edges(1:zones(i)%n_edges)%raw**2)*zones(i)%norm
+            end do
+            if (norm > 0.0_dp) face%estimate = max(face%estimate, calibration*sqrt(error/norm))
         end do
-    end function worst_zone
+    end function face_summary
 
     !> The zones of `pair` as it was last evaluated, on the slave discretization
-    !> `disc` (none on a face).
+    !> `disc`: along an edge, or along every line of slave points of a face in both
+    !> directions.
     pure subroutine measure_zones(pair, disc, zones)
         class(contact_pair_t), intent(in) :: pair
         type(discretization_t), intent(in) :: disc
         type(zone_measure_t), allocatable, intent(out) :: zones(:)
-        type(profile_t) :: prof
+        real(dp), allocatable :: other(:)
+        logical, allocatable :: done(:)
+        integer :: n, i, d
+        integer, allocatable :: every(:)
+        allocate (zones(0))
+        n = size(pair%out)
+        if (n == 0) return
+        every = [(i, i=1, n)]
+        if (pair%slave%npar == 1) then
+            zones = line_zones(profile(pair, every, 1), disc)
+            return
+        end if
+        do d = 1, 2
+            ! the lines of direction d: the points sharing the other parameter
+            other = pair%eta
+            if (d == 2) other = pair%xi
+            allocate (done(n), source=.false.)
+            do i = 1, n
+                if (done(i)) cycle
+                done = done .or. other == other(i)
+                zones = [zones, line_zones(profile(pair, pack(every, other == other(i)), d), disc)]
+            end do
+            deallocate (done)
+        end do
+    end subroutine measure_zones
+
+    !> The zones (runs of points in contact) along the line `prof`.
+    pure function line_zones(prof, disc) result(zones)
+        type(profile_t), intent(in) :: prof
+        type(discretization_t), intent(in) :: disc
+        type(zone_measure_t), allocatable :: zones(:)
         real(dp), allocatable :: breaks(:)
         integer :: n, i, i0
         allocate (zones(0))
-        if (pair%slave%npar /= 1 .or. size(pair%out) == 0) return
-        prof = profile(pair)
-        breaks = element_breaks(disc, 1)
+        breaks = element_breaks(disc, prof%direction)
         n = size(prof%xi)
         i = 1
         do while (i <= n)
@@ -164,17 +234,25 @@ contains
             zones = [zones, measure_zone(prof, disc, breaks, i0, i)]
             i = i + 1
         end do
-    end subroutine measure_zones
+    end function line_zones
 
-    !> The slave points of `pair` sorted by parameter (stable).
-    pure function profile(pair) result(prof)
+    !> The slave points `ids` of `pair` along their line of direction `d` (an edge's:
+    !> 1), in parameter order (stable).
+    pure function profile(pair, ids, d) result(prof)
         class(contact_pair_t), intent(in) :: pair
+        integer, intent(in) :: ids(:), d
         type(profile_t) :: prof
-        integer, allocatable :: order(:)
+        integer, allocatable :: perm(:), order(:)
         integer :: n, i
-        n = size(pair%out)
-        order = stable_order(pair%xi)
-        prof%xi = pair%xi(order)
+        n = size(ids)
+        if (d == 1) prof%xi = pair%xi(ids)
+        if (d == 2) prof%xi = pair%eta(ids)
+        perm = stable_order(prof%xi)
+        order = ids(perm)
+        prof%xi = prof%xi(perm)
+        prof%direction = d
+        prof%at(1) = pair%xi(ids(1))
+        if (allocated(pair%eta)) prof%at(2) = pair%eta(ids(1))
         prof%p = pair%out(order)%pn0
         prof%x0 = reshape([(pair%out(order(i))%x0, i=1, n)], [3, n])
         prof%on = pair%out(order)%state /= state_inactive .and. prof%p > 0.0_dp
@@ -183,6 +261,7 @@ contains
         do i = 2, n
             prof%s(i) = prof%s(i - 1) + norm2(prof%x0(:, i) - prof%x0(:, i - 1))
         end do
+        if (pair%slave%npar == 2) prof%area = pair%out(order)%area0
     end function profile
 
     !> The element boundaries of `disc` in parametric direction `d` (its elements come
@@ -223,13 +302,22 @@ contains
         if (i0 > 1 .and. i1 < n) w = 0.5_dp*w
         lo = max(i0 - 1, 1)
         hi = min(i1 + 1, n)
-        norm = trapezoid(prof%p(lo:hi)**2, prof%s(lo:hi))
+        if (allocated(prof%area)) then
+            norm = sum(prof%p(lo:hi)**2*prof%area(lo:hi))
+        else
+            norm = trapezoid(prof%p(lo:hi)**2, prof%s(lo:hi))
+        end if
+        zone%direction = prof%direction
+        zone%line = prof%at(3 - prof%direction)
         zone%xi_range = [prof%xi(i0), prof%xi(i1)]
         zone%half_width = w
         zone%elements_across = covered(breaks, xi_lo, xi_hi)
         zone%n_points = i1 - i0 + 1
+        zone%norm = norm
         if (i0 > 1) call add_edge(zone, measure_edge(prof, disc, breaks, [i0, i1], i0, -1, w, norm))
         if (i1 < n) call add_edge(zone, measure_edge(prof, disc, breaks, [i0, i1], i1, +1, w, norm))
+        zone%estimate = ieee_value(1.0_dp, ieee_positive_inf)
+        if (zone%n_points >= min_points) zone%estimate = calibration*sqrt(sum(zone%edges(1:zone%n_edges)%raw**2))
     end function measure_zone
 
     pure subroutine add_edge(zone, edge)
@@ -261,12 +349,17 @@ contains
         allocate (mask(size(d)), source=.false.)
         mask(zone(1):zone(2)) = .true.
         mask = mask .or. (d < 0.0_dp .and. d > -2.0_dp*h)
-        call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root, edge%vanishing)
+        if (allocated(prof%area)) then
+            call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root, edge%vanishing, &
+                               pack(prof%area, mask))
+        else
+            call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root, edge%vanishing)
+        end if
         edge%bracket = abs(prof%s(j) - prof%s(i))
         if (abs(root) <= edge%bracket) edge%xi = interpolate(se - side*root, prof%s, prof%xi)
         edge%side = side
         edge%h_tangent = h
-        edge%h_normal = normal_size(disc, edge%xi)
+        edge%h_normal = normal_size(disc, prof, edge%xi)
         edge%ratio_tangent = ieee_value(1.0_dp, ieee_positive_inf)
         edge%ratio_normal = edge%ratio_tangent
         if (w > 0.0_dp) then
@@ -285,10 +378,12 @@ contains
     !> both NaN with fewer than three points to fit, and whether the pressure vanishes
     !> towards the edge (`vanishing`: the points in contact within the edge element
     !> carry less on average than the fitted ones).
-    pure subroutine edge_residual(d, p, h, band, residual, root, vanishing)
+    pure subroutine edge_residual(d, p, h, band, residual, root, vanishing, area)
         real(dp), intent(in) :: d(:), p(:), h, band
         real(dp), intent(out) :: residual, root
         logical, intent(out) :: vanishing
+        !> On a face, the area each point integrates: the residual is their sum.
+        real(dp), intent(in), optional :: area(:)
         logical :: fit(size(d)), near(size(d))
         real(dp) :: c(3), ref(size(d)), reach
         fit = fit_points(d, p, h, band)
@@ -312,7 +407,11 @@ contains
         reach = 2.0_dp*h
         if (band/fit_band < reach) reach = band/fit_band
         near = d < reach
-        residual = sorted_trapezoid(pack(d, near), pack(p - ref, near)**2)
+        if (present(area)) then
+            residual = sum((p - ref)**2*area, near)
+        else
+            residual = sorted_trapezoid(pack(d, near), pack(p - ref, near)**2)
+        end if
     end subroutine edge_residual
 
     !> Least-squares coefficients c of c1 + c2 t + c3 t^2 ~ y (Householder QR of the
@@ -476,18 +575,23 @@ contains
         if (prof%xi(last) > prof%xi(first)) h = length*(b - a)/(prof%xi(last) - prof%xi(first))
     end function element_size
 
-    !> Reference distance across the surface element row at the edge parameter `xi`:
-    !> from eta = 1 (the contact edge) to the row's inner boundary.
-    pure real(dp) function normal_size(disc, xi) result(hn)
+    !> Reference distance across the surface element row at the parameter `xi` along
+    !> the line `prof`: from the contact boundary (the last parameter = 1) to the row's
+    !> inner boundary.
+    pure real(dp) function normal_size(disc, prof, xi) result(hn)
         type(discretization_t), intent(in) :: disc
+        type(profile_t), intent(in) :: prof
         real(dp), intent(in) :: xi
-        real(dp), allocatable :: eta(:)
-        real(dp) :: inner, x1(disc%bulk%nsd), x2(disc%bulk%nsd)
-        eta = element_breaks(disc, 2)
-        inner = 0.0_dp
-        if (size(eta) > 1) inner = eta(size(eta) - 1)
-        call patch_eval(disc%bulk, [xi, 1.0_dp], x1)
-        call patch_eval(disc%bulk, [xi, inner], x2)
+        real(dp), allocatable :: across(:)
+        real(dp) :: u(disc%pdim), x1(disc%bulk%nsd), x2(disc%bulk%nsd)
+        across = element_breaks(disc, disc%pdim)
+        u(1:disc%pdim - 1) = prof%at(1:disc%pdim - 1)
+        u(prof%direction) = xi
+        u(disc%pdim) = 1.0_dp
+        call patch_eval(disc%bulk, u, x1)
+        u(disc%pdim) = 0.0_dp
+        if (size(across) > 1) u(disc%pdim) = across(size(across) - 1)
+        call patch_eval(disc%bulk, u, x2)
         hn = norm2(x1 - x2)
     end function normal_size
 

@@ -5,7 +5,7 @@ module voiga_io_output_accuracy
     use voiga_text, only: str
     use voiga_io_hdf5, only: h5file_t
     use voiga_model, only: model_t
-    use voiga_model_accuracy, only: zone_measure_t, edge_measure_t, pair_zones, zone_estimate, calibration, warn_estimate
+    use voiga_model_accuracy, only: zone_measure_t, edge_measure_t, pair_zones, face_summary, calibration, warn_estimate
     implicit none
     private
 
@@ -13,8 +13,8 @@ module voiga_io_output_accuracy
 
 contains
 
-    !> Every edge pair's zones of `model` as last evaluated, under the step group `g`
-    !> (`g`/contact/<k>/accuracy); a face pair has none written (not measured yet).
+    !> Every pair's zones of `model` as last evaluated, under the step group `g`
+    !> (`g`/contact/<k>/accuracy).
     subroutine write_accuracy(h5, g, model)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: g
@@ -22,17 +22,19 @@ contains
         type(zone_measure_t), allocatable :: zones(:)
         integer :: k
         do k = 1, size(model%pairs)
-            if (model%pairs(k)%pair%slave%npar /= 1) cycle
             zones = pair_zones(model, k)
-            call write_zones(h5, g//'/contact/'//str(k)//'/accuracy', zones)
+            call write_zones(h5, g//'/contact/'//str(k)//'/accuracy', zones, model%pairs(k)%pair%slave%npar == 2)
         end do
     end subroutine write_accuracy
 
-    !> The zones as the group `a`: per zone [nz] and per free edge [ne] datasets.
-    subroutine write_zones(h5, a, zones)
+    !> The zones as the group `a`: per zone [nz] and per free edge [ne] datasets; the
+    !> pair's estimate (of a `face`: its summary's) as an attribute.
+    subroutine write_zones(h5, a, zones, face)
         class(h5file_t), intent(inout) :: h5
         character(len=*), intent(in) :: a
         type(zone_measure_t), intent(in) :: zones(:)
+        logical, intent(in) :: face
+        type(zone_measure_t) :: summary
         integer :: i, j
         integer, allocatable :: owner(:)
         type(edge_measure_t), allocatable :: edges(:)
@@ -41,11 +43,19 @@ contains
         call h5%write_attr(a, 'calibration', calibration)
         call h5%write_attr(a, 'warn_estimate', warn_estimate)
         if (size(zones) == 0) return
-        call h5%write_attr(a, 'estimate', maxval([(zone_estimate(zones(i)), i=1, size(zones))]))
+        if (face) then
+            summary = face_summary(zones)
+            call h5%write_attr(a, 'estimate', summary%estimate)
+        else
+            call h5%write_attr(a, 'estimate', maxval(zones%estimate))
+        end if
+        call h5%write(a//'/direction', [zones%direction])
+        call h5%write(a//'/line', [zones%line])
+        call h5%write(a//'/norm', [zones%norm])
         call h5%write(a//'/n_points', [zones%n_points])
         call h5%write(a//'/elements_across', [zones%elements_across])
         call h5%write(a//'/half_width', [zones%half_width])
-        call h5%write(a//'/estimate', [(zone_estimate(zones(i)), i=1, size(zones))])
+        call h5%write(a//'/estimate', [zones%estimate])
         call h5%write(a//'/xi_range', reshape([(zones(i)%xi_range, i=1, size(zones))], [2, size(zones)]))
         owner = [((i, j=1, zones(i)%n_edges), i=1, size(zones))]
         if (size(owner) == 0) return
