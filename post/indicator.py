@@ -356,3 +356,19 @@ def indicator_lines(result: Result) -> list[str]:
                          + f" at step {m.step}, above {WARN_ESTIMATE:.1%}): refine the zone "
                          f"with `python -m pre refine {result.path}` (docs/howto.md)")
     return lines
+
+
+def face_lines(result: Result) -> list[str]:
+    """The summary's lines for a solid's pairs: per pair the step with the largest
+    estimate voiga wrote (on a face, along the lines of slave points; computed by voiga
+    only, docs/contact-accuracy.md); voiga's own warning names a large one."""
+    best: dict[int, tuple[float, int, ContactOutput]] = {}
+    for st in result.steps:
+        for k, c in enumerate(st.contact):
+            if c.accuracy is None or "pair_estimate" not in c.accuracy:
+                continue
+            e = float(c.accuracy["pair_estimate"])
+            if k not in best or e > best[k][0]:
+                best[k] = (e, st.step, c)
+    return [f"  accuracy: contact {c.slave} -> {c.master}, step {step}: estimated edge error {e:.2%} "
+            f"(along the slave face's lines of points)" for e, step, c in best.values()]

@@ -102,6 +102,9 @@ def summary_lines(result: Result) -> list[str]:
     if result.dimension == 2 and any(c.active.any() for s in steps for c in s.contact):
         from .indicator import indicator_lines
         lines += indicator_lines(result)
+    if result.dimension == 3:
+        from .indicator import face_lines
+        lines += face_lines(result)
     if result.scene == "hertz" and last.contact:
         from .hertz import format_hertz, hertz_comparison
         try:

@@ -505,8 +505,13 @@ contains
                        fixed_str(zone%edges(j)%ratio_normal, 3)//' across at xi = '//fixed_str(zone%edges(j)%xi, 4)
             end do
         end if
-        what = what//', '//fixed_str(zone%elements_across, 1)//' slave elements across): refine the zone '// &
-               '(python -m pre refine RESULT.h5; docs/contact-accuracy.md)'
+        what = what//', '//fixed_str(zone%elements_across, 1)//' slave elements across): '
+        if (pair%slave%npar == 1) then
+            what = what//'refine the zone (python -m pre refine RESULT.h5; docs/contact-accuracy.md)'
+        else
+            what = what//"refine the slave face's cells around the zone's edge (knots_xi, knots_eta; a grid whose "// &
+                   'knot lines follow the edge: docs/hertz3d.md)'
+        end if
         ! a penalty softer than the automatic one smears the edge over more than an element
         if (pair%law%eps_n < pair%eps_automatic .and. pair%method_name() /= 'alm') &
             what = what//'; penalty_normal = '//trim(short_str(pair%law%eps_n))//' is softer than the '// &

@@ -161,4 +161,4 @@ def test_coarse_contact_zone(run, tmp_path: Path) -> None:
     assert f"estimated pressure error {float(err):.2f} % at step 1 (above 0.5 %" in w, w
     assert "python -m pre refine" in w and "softer" not in w
     with h5py.File(case.with_suffix(".h5")) as f:
-        assert f["steps/000001/contact/1/accuracy"].attrs["estimate"] == pytest.approx(float(err) / 100, abs=5e-5)
+        assert f["steps/000001/contact/1/accuracy"].attrs["pair_estimate"] == pytest.approx(float(err) / 100, abs=5e-5)

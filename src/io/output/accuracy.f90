@@ -45,9 +45,9 @@ contains
         if (size(zones) == 0) return
         if (face) then
             summary = face_summary(zones)
-            call h5%write_attr(a, 'estimate', summary%estimate)
+            call h5%write_attr(a, 'pair_estimate', summary%estimate)
         else
-            call h5%write_attr(a, 'estimate', maxval(zones%estimate))
+            call h5%write_attr(a, 'pair_estimate', maxval(zones%estimate))
         end if
         call h5%write(a//'/direction', [zones%direction])
         call h5%write(a//'/line', [zones%line])
