@@ -106,14 +106,16 @@ def _run_adapt(args: argparse.Namespace) -> int:
         return 2
     start = time.monotonic()
     try:
-        cycles, code = adapt_case(args.case, args.out, target, args.cycles, args.binary, quiet=True)
+        loop = adapt_case(args.case, args.out, target, args.cycles, args.binary, quiet=True,
+                          overwrite=args.overwrite)
     except AdaptError as err:
         print(f"python -m post run --adapt: {err}", file=sys.stderr)
         return 2
-    if not cycles:
-        print(f"voiga exited with {code} (its message is above); no summary, no figures written",
-              file=sys.stderr)
-        return code
+    cycles = loop.cycles
+    if loop.result is None:
+        print(f"voiga exited with {loop.code} (its message is above); no summary, no figures written"
+              + (f"; the last result is {cycles[-1].result}" if cycles else ""), file=sys.stderr)
+        return loop.code
     last = cycles[-1]
     total = time.monotonic() - start
     met = "met" if last.estimate <= accepted(target) else "not met"
@@ -123,15 +125,15 @@ def _run_adapt(args: argparse.Namespace) -> int:
           f"({last.seconds:.3g} s)")
     from .reader import read_result
 
-    result = read_result(last.result)
+    result = read_result(loop.result)
     print()
     for line in summary_lines(result):
         print(line)
     if not args.no_figures:
         for p in make_figures(result, vtk=not args.no_vtk):
             print(f"  {p}")
-    print(f"result: {last.result}")
-    return code
+    print(f"result: {loop.result} (cycle {len(cycles) - 1}'s, a copy of {last.result})")
+    return loop.code
 
 
 def _cmd_summary(args: argparse.Namespace) -> int:
@@ -593,8 +595,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-figures", action="store_true", help="only solve and summarize")
     s.add_argument("--no-vtk", action="store_true", help="no ParaView files")
     s.add_argument("--overwrite", action="store_true",
-                   help="replace an existing result in the case's own folder (with --out it is "
-                        "always replaced: the folder is this tool's)")
+                   help="replace an existing result in the case's own folder (with --adapt also an "
+                        "earlier loop's <case>-zone<k> folders; with --out they are always "
+                        "replaced: the folder is this tool's)")
     s.add_argument("--adapt", action="store_true",
                    help="solve, estimate the contact-zone edge error, refine the zone and solve "
                         "again until the estimate meets --target (docs/howto.md)")

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from pre.cases import read_case, to_namelist_text
-from pre.files import check_output, write_text
+from pre.files import check_output, new_file, write_text
 from pre.nurbs import evaluate_patch
 from pre.zone_refine import SizeRequest, interior, split_breaks
 
@@ -248,17 +249,18 @@ def source_case(result: Result) -> Path:
                      "is not there")
 
 
-def refine_result(path: str | Path, target: float = DEFAULT_TARGET, out: str | Path | None = None,
-                  force: bool = False) -> RefinedCase:
+def refine_result(path: str | Path | Result, target: float = DEFAULT_TARGET, out: str | Path | None = None,
+                  force: bool = False, measures: list[ZoneMeasure] | None = None) -> RefinedCase:
     """Write the refined case of the result at ``path`` into ``out`` (default: a folder
     ``<next stem>`` beside the result) as ``<next stem>.nml``; its geometry path points at
     the original geometry. AdaptError when the result has no contact or its case is
-    gone; an existing case file is refused unless ``force``."""
-    result = read_result(path)
+    gone; an existing case file is refused unless ``force``. ``path`` may be the result
+    read already, ``measures`` its :func:`~post.indicator.measure` (not measured again)."""
+    result = path if isinstance(path, Result) else read_result(path)
     if not result.steps:
         raise AdaptError(f"{result.path}: no converged step to refine from")
     case = source_case(result)
-    measures = measure(result)
+    measures = measure(result) if measures is None else measures
     if not measures:
         raise AdaptError(f"{result.path}: no contact at any converged step: nothing to refine")
     groups = _groups(case)
@@ -338,30 +340,73 @@ def largest_estimate(result: Result) -> float:
     return max((m.estimate for m in measure(result)), default=0.0)
 
 
+@dataclass
+class AdaptRun:
+    """What :func:`adapt_case` did."""
+
+    cycles: list[Cycle]
+    code: int
+    """voiga's last exit code (0 when every solve succeeded)."""
+    result: Path | None
+    """Where the last cycle's result was copied: the place a plain ``post run`` of the
+    case puts its result (None when no solve succeeded)."""
+
+
+def loop_paths(case: Path, out: Path | None) -> tuple[Path, Path]:
+    """(the result a plain ``post run CASE [--out OUT]`` writes, the folder of the loop's
+    cycles: ``<stem>-zone<k>`` folders beside that result)."""
+    from .solver import read_case_group
+
+    output = read_case_group(case).get("output")
+    if not output:
+        raise AdaptError(f"{case}: &case has no output")
+    folder = out if out is not None else case.parent
+    return folder / str(output), folder
+
+
+def _check_free(case: Path, result: Path, folder: Path, cycles: int) -> None:
+    """AdaptError when the loop would replace an earlier result in the case's own folder:
+    the plain run's result or an earlier loop's ``<stem>-zone<k>`` folders."""
+    taken = [p for p in [result, *(folder / f"{case.stem}-zone{k}" for k in range(cycles + 1))]
+             if p.exists()]
+    if taken:
+        raise AdaptError(f"{', '.join(map(str, taken))} exist(s); nothing solved (--overwrite to "
+                         "replace them, or --out DIR)")
+
+
 def adapt_case(case: str | Path, out: str | Path | None = None, target: float = DEFAULT_TARGET,
                cycles: int = MAX_CYCLES, binary: str | Path | None = None,
-               quiet: bool = True) -> tuple[list[Cycle], int]:
-    """The solve-estimate-refine loop: solve ``case`` (in ``out`` when given, else where
-    it is), and while the largest estimated edge error exceeds ``target`` and fewer than
-    ``cycles`` refinements were made, write the refined case (:func:`refine_result`, in
-    a folder ``<stem>-zone<k>`` beside the result) and solve it. Prints a line per
-    cycle; returns the cycles and voiga's last exit code (the loop stops on any code
-    but 0). The refined cases lie side by side in the folder of the first run."""
+               quiet: bool = True, overwrite: bool = False) -> AdaptRun:
+    """The solve-estimate-refine loop: solve ``case`` (a copy in ``<stem>-zone0``), and
+    while the largest estimated edge error exceeds the accepted one (:func:`accepted`)
+    and fewer than ``cycles`` refinements were made, write the refined case
+    (:func:`refine_result`, in ``<stem>-zone<k>``) and solve it. The ``<stem>-zone<k>``
+    folders lie in ``out`` when given, else beside the case; the last result is then
+    copied to where a plain ``post run`` of the case puts its result (:func:`loop_paths`).
+    In the case's own folder nothing earlier is replaced unless ``overwrite``
+    (AdaptError before any solve). Prints a line per cycle; the loop stops on any
+    exit code of voiga but 0."""
     from .solver import result_path, run_voiga, stage_case, voiga_binary
 
     program = voiga_binary(binary)
-    run = stage_case(Path(case), Path(out)) if out is not None else Path(case)
-    folder = run.parent
+    case = Path(case)
+    final, folder = loop_paths(case, Path(out) if out is not None else None)
+    replace_all = out is not None or overwrite
+    if not replace_all:
+        _check_free(case, final, folder, cycles)
+    run = stage_case(case, folder / f"{case.stem}-zone0")
     done: list[Cycle] = []
     previous: Result | None = None
     while True:
         path = result_path(run)
-        code = run_voiga(program, run, quiet=quiet, overwrite=out is not None or bool(done))
+        code = run_voiga(program, run, quiet=quiet, overwrite=True)
         if code != 0 or not path.is_file():
-            return done, code or 1
+            return AdaptRun(done, code or 1, None)
         result = read_result(path)
         change = pressure_change(previous, result) if previous is not None else math.nan
-        done.append(Cycle(result=path, n_dofs=result.n_dofs, estimate=largest_estimate(result),
+        measures = measure(result)
+        done.append(Cycle(result=path, n_dofs=result.n_dofs,
+                          estimate=max((m.estimate for m in measures), default=0.0),
                           seconds=result.wall_time, change=change))
         previous = result
         c = done[-1]
@@ -369,5 +414,8 @@ def adapt_case(case: str | Path, out: str | Path | None = None, target: float = 
               + (f", pressure change from cycle {len(done) - 2} {c.change:.3%}" if done[:-1] else "")
               + f", solve {c.seconds:.3g} s ({c.result})")
         if c.estimate <= accepted(target) or len(done) > cycles:
-            return done, 0
-        run = refine_result(path, target, folder / next_stem(run.stem), force=True).case
+            break
+        run = refine_result(result, target, folder / next_stem(run.stem), force=True, measures=measures).case
+    with new_file(final) as tmp:
+        shutil.copyfile(done[-1].result, tmp)
+    return AdaptRun(done, 0, final)
