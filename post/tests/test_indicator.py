@@ -217,3 +217,19 @@ def test_edges_within_the_accepted_estimate_keep_their_elements() -> None:
     assert _factor(0.99 * accepted(target), target) == 1.0
     assert _factor(0.9 * target, target) < 1.0  # below the target, above the accepted
     assert _factor(2 * accepted(target), target) == pytest.approx((SAFETY / 2) ** (1 / RATE))
+
+
+def test_loop_result_lands_where_a_plain_run_puts_it(tmp_path: Path) -> None:
+    """`post run CASE --adapt`: the last result goes to the case's &case output beside
+    the case (or in --out), the cycles' folders beside it; in the case's own folder an
+    earlier result or loop is refused before any solve."""
+    from post.adapt import _check_free, loop_paths
+
+    shutil.copy(CASES / "hertz" / "m2-NN2.2.nml", tmp_path / "m2-NN2.2.nml")
+    case = tmp_path / "m2-NN2.2.nml"
+    assert loop_paths(case, None) == (tmp_path / "m2-NN2.2.h5", tmp_path)
+    assert loop_paths(case, tmp_path / "o") == (tmp_path / "o" / "m2-NN2.2.h5", tmp_path / "o")
+    _check_free(case, tmp_path / "m2-NN2.2.h5", tmp_path, 3)  # nothing there yet
+    (tmp_path / "m2-NN2.2-zone2").mkdir()
+    with pytest.raises(AdaptError, match="m2-NN2.2-zone2 exist"):
+        _check_free(case, tmp_path / "m2-NN2.2.h5", tmp_path, 3)
