@@ -219,7 +219,7 @@ def _cmd_refine(args: argparse.Namespace) -> int:
 def _refine_zone(args: argparse.Namespace) -> int:
     """``pre refine RESULT.h5``: the case refined at the contact zone's edges (the
     measurements and the case are the result's: post.adapt)."""
-    from post.adapt import AdaptError, parse_target, refine_result
+    from post.adapt import AdaptError, accepted, parse_target, refine_result
     from post.reader import BadResultError
 
     from .files import OutputError
@@ -230,11 +230,12 @@ def _refine_zone(args: argparse.Namespace) -> int:
     except (AdaptError, BadResultError, OutputError, FileNotFoundError, ValueError) as err:
         print(f"python -m pre refine: {err}", file=sys.stderr)
         return 2
-    print(f"{args.input}: largest estimated edge error {done.estimate:.2%} (target {target:.2%})")
+    print(f"{args.input}: largest estimated edge error {done.estimate:.2%} (target {target:.2%}: "
+          f"edges above {accepted(target):.2%} refined)")
     for name, (n_along, n_across) in done.bodies.items():
         print(f"  {name}: {n_along} elements along the contact edge, {n_across} rows across")
     if not done.bodies:
-        print("  every edge meets the target: the case is written unchanged")
+        print("  every edge is within the accepted estimate: the case is written unchanged")
     print(f"wrote {done.case} ({done.n_dofs} DOFs; from {done.source})")
     return 0
 
