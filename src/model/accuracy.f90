@@ -356,6 +356,7 @@ contains
             call edge_residual(pack(d, mask), pack(prof%p, mask), h, fit_band*w, residual, root, edge%vanishing)
         end if
         edge%bracket = abs(prof%s(j) - prof%s(i))
+        root = edge_position(pack(d, mask), pack(prof%p, mask), h, fit_band*w)
         if (abs(root) <= edge%bracket) edge%xi = interpolate(se - side*root, prof%s, prof%xi)
         edge%side = side
         edge%h_tangent = h
@@ -467,6 +468,22 @@ contains
             if (r(k) < start) root = max(root, r(k))
         end do
     end function largest_root_below
+
+    !> Where the edge is, as a distance into the zone from the computed one: the root
+    !> (largest below the fitted points) of the fit of p^2 to the points the mesh
+    !> resolves, h <= d <= max(band, 2 h) (fewer than three: all with p > 0), continued
+    !> to the edge; -inf without one, NaN with fewer than three points. (Not the
+    !> residual's fit on a coarse zone: that one takes the edge element's own points,
+    !> which the zone's shape needs but which do not place the edge.)
+    pure real(dp) function edge_position(d, p, h, band) result(root)
+        real(dp), intent(in) :: d(:), p(:), h, band
+        logical :: fit(size(d))
+        fit = d >= h .and. d <= max(band, 2.0_dp*h) .and. p > 0.0_dp
+        if (count(fit) < 3) fit = p > 0.0_dp
+        root = ieee_value(1.0_dp, ieee_quiet_nan)
+        if (count(fit) < 3) return
+        root = largest_root_below(quadratic_fit(pack(d, fit), pack(p, fit)**2), minval(pack(d, fit)))
+    end function edge_position
 
     !> The points the fit of p^2 near an edge uses: of the zone's (d > 0, p > 0), those
     !> with h <= d <= band when the band holds `min_band_elements` edge elements, else (a
