@@ -23,7 +23,9 @@ def _solve(voiga_bin: Path, tmp_path: Path, name: str) -> tuple[Path, str]:
     for command in ([sys.executable, "-m", "pre", "geometry", f"{name}.toml"], [str(voiga_bin), f"{name}.nml"]):
         run = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
         assert run.returncode == 0, run.stdout + run.stderr
-        assert "warning" not in run.stderr, run.stderr
+        # a sound set-up: no warning but the contact-zone indicator's on these coarse
+        # meshes (docs/contact-accuracy.md)
+        assert all("contact zone" in line for line in run.stderr.splitlines() if "warning" in line), run.stderr
         # gfortran's "Note: The following floating-point exceptions are signalling" (issue 38, item 2)
         assert "floating-point" not in run.stdout + run.stderr, run.stderr
     summary = subprocess.run([sys.executable, "-m", "post", "summary", f"{name}.h5"], cwd=tmp_path,
