@@ -40,8 +40,15 @@ from .reader import Body, ContactOutput, Result
 from .summary import slave_element_size
 
 FIT_BAND = 0.5
-"""The fit of p^2 near an edge uses the points within this fraction of the zone's
-half-width from the edge (and at least the two elements nearest it)."""
+"""The fit of p^2 near an edge uses the points between one edge element and this
+fraction of the zone's half-width from the edge (when that band is long enough)."""
+MIN_BAND_ELEMENTS = 3.0
+"""A band ``FIT_BAND`` w shorter than this many edge elements h (a coarse zone: fewer
+than 6 elements from a cut to the edge, 12 between two free edges) holds too few
+resolved points beyond the edge element for the quadratic: the fit then takes every
+point of the zone within this many edge elements of the edge, the edge element's too
+(p^2 is close to a quadratic across a smooth zone; Hertz: exactly ``p0^2 (1 -
+x^2/a^2)``)."""
 CALIBRATION = 0.65
 """Scales the raw estimate to the measured L2 error at the edges (docs/contact-accuracy.md)."""
 WARN_ESTIMATE = 0.005
@@ -156,26 +163,47 @@ def _covered(breaks: np.ndarray, lo: float, hi: float) -> float:
     return float(np.sum(overlap / spans))
 
 
+def fit_points(d: np.ndarray, p: np.ndarray, h: float, band: float) -> np.ndarray:
+    """The points the fit of p^2 near an edge uses (``d`` the distance into the zone,
+    ``p`` the pressure, ``h`` the edge element's length, ``band`` = ``FIT_BAND`` w).
+    The zone's points are those with ``d > 0`` and ``p > 0``. When ``band >=
+    MIN_BAND_ELEMENTS h``: those with ``h <= d <= band``; else (a coarse zone) those
+    with ``d <= MIN_BAND_ELEMENTS h``. All of the zone's points when the choice has
+    fewer than three."""
+    zone = (d > 0) & (p > 0)
+    if band >= MIN_BAND_ELEMENTS * h:
+        fit = zone & (d >= h) & (d <= band)
+    else:
+        fit = zone & (d <= MIN_BAND_ELEMENTS * h)
+    return fit if np.count_nonzero(fit) >= 3 else zone
+
+
 def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float]:
-    """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
-    pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
-    d^2`` to the points with ``h <= d <= band`` (when fewer than three such points, all
-    points in contact), and the distance of the fit's edge (its root, NaN when it has
-    none); ``(NaN, NaN)`` for fewer than three points in contact."""
-    fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
-    if np.count_nonzero(fit) < 3:
-        fit = p > 0
+    """The squared L2 residual of the computed pressure ``p`` (at distances ``d`` into
+    the zone from its computed edge, midway between the last point in contact and the
+    first one out) from the reference ``sqrt(c0 + c1 d + c2 d^2)``, least squares in
+    p^2 over the points :func:`fit_points` chooses, and the distance of the fitted edge.
+
+    The fitted edge is the fit's largest root below the nearest fitted point, or the
+    computed edge (0) when the fit has none there (a fit that does not fall to zero
+    describes no free edge: continued over the points out of contact it would count
+    pressure no contact carries); the reference is zero beyond it. The residual is the
+    trapezoidal integral of ``(p - ref)^2`` over the points with ``d < min(2 h, w)``,
+    ``w = band / FIT_BAND`` the zone's half-width: the two edge elements and the points
+    out of contact beyond them, never past the middle of a zone between two free edges
+    (whose other half is the other edge's). ``(NaN, NaN)`` for fewer than three points
+    in contact."""
+    fit = fit_points(d, p, h, band)
     if np.count_nonzero(fit) < 3:
         return math.nan, math.nan
     dd = d[fit]
-    design = np.column_stack([np.ones_like(dd), dd, dd**2])
-    coef, *_ = np.linalg.lstsq(design, p[fit] ** 2, rcond=None)
-    q = design_at(d) @ coef
-    ref = np.sqrt(np.clip(q, 0.0, None))
-    # no pressure beyond the fit's edge (the root of q nearest the zone)
+    coef, *_ = np.linalg.lstsq(design_at(dd), p[fit] ** 2, rcond=None)
+    ref = np.sqrt(np.clip(design_at(d) @ coef, 0.0, None))
     root = _first_root(coef, float(dd.min()))
+    if not np.isfinite(root):
+        root = 0.0
     ref[d < root] = 0.0
-    near = d < 2 * h
+    near = d < min(2 * h, band / FIT_BAND)
     order = np.argsort(d[near])
     x, r = d[near][order], (p[near] - ref[near])[order]
     return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root
