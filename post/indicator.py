@@ -55,6 +55,8 @@ WARN_ESTIMATE = 0.005
 """A pair whose estimated edge error exceeds this (0.5 %) at a step is warned about."""
 MIN_POINTS = 3
 """Fewer points in contact than this: the zone is not resolved at all."""
+EXACT_METHODS = ("alm",)
+"""Contact methods that enforce the contact exactly: no penalty compliance."""
 
 
 @dataclass(frozen=True)
@@ -105,6 +107,15 @@ class ZoneMeasure:
     n_points: int
     """Slave points in contact."""
     edges: list[EdgeMeasure] = field(default_factory=list)
+    penalty_length: float = math.nan
+    """The pair's :func:`penalty_length` (0 for an exact method, NaN when unknown)."""
+
+    @property
+    def penalty_smeared(self) -> bool:
+        """The penalty smears a free edge over more than the element holding it: the
+        estimate then measures the penalty's profile as much as the mesh's, and refining
+        the edge does not lower it (docs/contact-accuracy.md)."""
+        return any(self.penalty_length > e.h_tangent for e in self.edges)
 
     @property
     def resolved(self) -> bool:
@@ -123,6 +134,28 @@ class ZoneMeasure:
 def nominal_pressure(c: ContactOutput) -> np.ndarray:
     """The pressure per reference length (``p_n`` in files without it)."""
     return c.p_n_nominal if c.p_n_nominal is not None else c.p_n
+
+
+def penalty_length(result: Result, c: ContactOutput) -> float:
+    """``E* / penalty_normal``: the length over which the normal penalty's compliance
+    smears a free edge. Under a pressure p a penalty eps lets the bodies overlap by
+    ``p / eps``; the bodies' own deflection over a length l is of order ``p l / E*``;
+    the two are equal at ``l = E* / eps``, so an edge resolved finer than that is the
+    penalty's, not the exact contact's. E* is the plane-strain modulus of the pair in
+    series, ``1/E* = sum (1 - nu^2)/E`` (the slave's alone against a rigid master), as
+    voiga's automatic penalty ``10 E* q / h`` uses it (docs/theory.md), whose length is
+    ``h / (10 q)``: a tenth of the element. 0 for an exact method
+    (:data:`EXACT_METHODS`); NaN when the file lacks the penalty or a modulus."""
+    method = str(c.attrs.get("method", "")).strip()
+    if method in EXACT_METHODS:
+        return 0.0
+    eps = float(c.attrs.get("penalty_normal", math.nan))
+    names = [c.slave] + ([c.master] if c.master in result.bodies else [])
+    compliance = sum((1.0 - result.bodies[n].poisson_ratio ** 2) / result.bodies[n].youngs_modulus
+                     for n in names)
+    if not (eps > 0 and compliance > 0):
+        return math.nan
+    return float(1.0 / compliance / eps)
 
 
 def arc_coordinate(x_ref: np.ndarray) -> np.ndarray:
@@ -266,6 +299,7 @@ def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure
                     p=nominal_pressure(c)[order])
     xi, s, p = prof.xi, prof.s, prof.p
     breaks = element_breaks(result.body(c.slave))
+    delta = penalty_length(result, c)
     n = len(xi)
     out: list[ZoneMeasure] = []
     for i0, i1 in zones(c.active[order] & (p > 0)):
@@ -283,7 +317,7 @@ def measure_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasure
                                time=st.time, xi_range=(float(xi[i0]), float(xi[i1])),
                                half_width=float(w),
                                elements_across=_covered(breaks, xi_lo, xi_hi),
-                               n_points=i1 - i0 + 1, edges=edges))
+                               n_points=i1 - i0 + 1, edges=edges, penalty_length=delta))
     return out
 
 
@@ -314,17 +348,29 @@ def format_zone(m: ZoneMeasure) -> str:
     edges = "; ".join(f"edge at xi = {e.xi:.4g}: h/w = {e.ratio_tangent:.3g} along, "
                       f"{e.ratio_normal:.3g} across" + (f", {e.estimate:.2%}" if several else "")
                       for e in m.edges) or "no free edge"
+    smear = (f" (the penalty smears the edges over E*/penalty_normal = {m.penalty_length:.3g}, "
+             f"{m.penalty_length / min(e.h_tangent for e in m.edges):.3g} edge elements)"
+             if m.penalty_smeared else "")
     return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.elements_across:.1f} slave "
             f"elements across the zone (half-width {m.half_width:.4g}); {edges}; "
-            f"estimated edge error {m.estimate:.2%}")
+            f"estimated edge error {m.estimate:.2%}{smear}")
 
 
 def indicator_lines(result: Result) -> list[str]:
     """The summary's lines: per pair the step with the largest estimate (and its zone),
-    and a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`."""
+    a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`, and one when the
+    penalty smears that zone's edges (:attr:`ZoneMeasure.penalty_smeared`)."""
     lines: list[str] = []
     for m in worst(measure(result)).values():
         lines.append("  accuracy: " + format_zone(m))
+        if m.penalty_smeared:
+            lines.append(f"warning: contact {m.slave} -> {m.master}: penalty_normal smears the "
+                         f"contact zone's edges over E*/penalty_normal = {m.penalty_length:.3g} "
+                         f"({m.penalty_length / m.half_width:.2g} of the zone's half-width) at "
+                         f"step {m.step}, more than the elements that hold them: the estimate "
+                         f"includes that smearing, which refining does not remove; a stiffer "
+                         f"penalty_normal (or none: voiga's automatic one) does "
+                         f"(docs/contact-accuracy.md)")
         if m.estimate > WARN_ESTIMATE:
             lines.append(f"warning: contact {m.slave} -> {m.master}: the mesh resolves the "
                          f"contact zone's edge poorly (estimated pressure error "

@@ -21,11 +21,12 @@ from post.indicator import (
     fit_points,
     indicator_lines,
     measure,
+    penalty_length,
     zones,
 )
 from post.plot import breakpoints
 from post.reader import read_result
-from post.summary import summary_lines
+from post.summary import slave_element_size, summary_lines
 from pre.__main__ import main as pre_main
 from pre.nurbs import evaluate_patch
 from pre.refine import discretize_case
@@ -118,6 +119,35 @@ def test_estimate_tracks_the_error_on_coarse_zones(mesh: str, factor: float,
     for m in ms:
         error = hertz_comparison(result, step=m.step, reference="circle").error.l2
         assert 1 / factor < m.estimate / error < factor, (m.step, m.estimate, error)
+
+
+def test_penalty_length_is_that_of_the_automatic_penalty(m2: Path) -> None:
+    """voiga's automatic penalty is 10 E* q / h for the smallest slave element h and the
+    edge's degree q: its length E*/penalty is h / (10 q), the same E* (in series, plane
+    strain) on both sides."""
+    result = read_result(m2)
+    c = result.steps[0].contact[0]
+    breaks = breakpoints(result.body(c.slave))[0]
+    h = min(slave_element_size(result, c, 0.5 * (a + b)) for a, b in zip(breaks[:-1], breaks[1:], strict=True))
+    tenths = h / penalty_length(result, c) / 10  # the degree q
+    # h is the polyline through the element's points (the arc: 2e-5 longer here)
+    assert round(tenths) in (2, 3, 4) and abs(tenths - round(tenths)) < 1e-4
+    assert not any(m.penalty_smeared for m in measure(result))
+
+
+def test_a_soft_penalty_is_reported(voiga: Path, tmp_path: Path) -> None:
+    """hertz m2 NN2.2 with penalty_normal 30: E*/penalty (0.037) is three edge elements,
+    the penalty shapes the edge (20-33 % off Hertz); the summary says so."""
+    shutil.copy(CASES / "hertz" / "geometry.h5", tmp_path / "geometry.h5")
+    text = (CASES / "hertz" / "m2-NN2.2.nml").read_text()
+    (tmp_path / "m2-NN2.2.nml").write_text(re.sub(r"penalty_normal = [^\n]*", "penalty_normal = 30.0", text))
+    subprocess.run([str(voiga), "m2-NN2.2.nml", "--quiet"], cwd=tmp_path, check=True, timeout=TIMEOUT,
+                   stdin=subprocess.DEVNULL, capture_output=True)
+    result = read_result(tmp_path / "m2-NN2.2.h5")
+    ms = measure(result)
+    assert ms and all(m.penalty_smeared for m in ms)
+    assert all(m.penalty_length > m.edges[0].h_tangent for m in ms)
+    assert any("smears" in line and line.startswith("warning:") for line in indicator_lines(result))
 
 
 def test_indicator_flags_the_coarse_committed_mesh(m4: Path) -> None:
