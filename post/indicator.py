@@ -15,15 +15,21 @@ configuration:
 - an estimate of the relative L2 error of the pressure made at that edge. Near a free
   edge of a smooth contact the pressure squared is smooth, ``p^2 = c1 d + c2 d^2 + ...``
   in the distance ``d`` into the zone (Hertz: exactly so); fitted to the points between
-  one edge element and ``FIT_BAND`` w from the edge, where the mesh resolves the profile,
-  it is extrapolated to the edge, and the L2 difference of the computed pressure from it
-  over the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
+  one edge element and ``FIT_BAND`` w from the edge, where the mesh resolves the profile
+  (on a coarse zone, where that band is shorter than ``MIN_BAND_ELEMENTS`` edge elements,
+  to the zone's points within that many elements of the edge: :func:`fit_points`), it
+  is continued to the edge, and the L2 difference of the computed pressure from it over
+  the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
   estimate. ``CALIBRATION`` scales it to the L2 error the Hertz comparison measures there
-  (docs/contact-accuracy.md gives the fit of the constant).
+  (docs/contact-accuracy.md gives the fit of the constant);
+- the penalty's edge length ``E*/penalty_normal`` (:func:`penalty_length`): when it
+  exceeds the edge's element the penalty, not the mesh, shapes the edge, and the summary
+  says so.
 
 A pair's estimate at a step is the root of the sum of the squares of its edges'
 (the squares of an L2 split add up). The estimate is the part of the error the mesh
-makes at the edges; the interior and the penalty's own compliance are not in it.
+makes at the edges; the interior and the penalty's own compliance are not in it (a
+penalty that smears the edges over more than their elements is, and is reported).
 """
 
 from __future__ import annotations
