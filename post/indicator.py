@@ -15,15 +15,21 @@ configuration:
 - an estimate of the relative L2 error of the pressure made at that edge. Near a free
   edge of a smooth contact the pressure squared is smooth, ``p^2 = c1 d + c2 d^2 + ...``
   in the distance ``d`` into the zone (Hertz: exactly so); fitted to the points between
-  one edge element and ``FIT_BAND`` w from the edge, where the mesh resolves the profile,
-  it is extrapolated to the edge, and the L2 difference of the computed pressure from it
-  over the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
+  one edge element and ``FIT_BAND`` w from the edge, where the mesh resolves the profile
+  (on a coarse zone, where that band is shorter than ``MIN_BAND_ELEMENTS`` edge elements,
+  to the zone's points within that many elements of the edge: :func:`fit_points`), it
+  is continued to the edge, and the L2 difference of the computed pressure from it over
+  the edge's elements, relative to the L2 norm of the zone's pressure, is the raw
   estimate. ``CALIBRATION`` scales it to the L2 error the Hertz comparison measures there
-  (docs/contact-accuracy.md gives the fit of the constant).
+  (docs/contact-accuracy.md gives the fit of the constant);
+- the penalty's edge length ``E*/penalty_normal`` (:func:`penalty_length`): when it
+  exceeds the edge's element the penalty, not the mesh, shapes the edge, and the summary
+  says so.
 
 A pair's estimate at a step is the root of the sum of the squares of its edges'
 (the squares of an L2 split add up). The estimate is the part of the error the mesh
-makes at the edges; the interior and the penalty's own compliance are not in it.
+makes at the edges; the interior and the penalty's own compliance are not in it (a
+penalty that smears the edges over more than their elements is, and is reported).
 """
 
 from __future__ import annotations
@@ -40,14 +46,23 @@ from .reader import Body, ContactOutput, Result
 from .summary import slave_element_size
 
 FIT_BAND = 0.5
-"""The fit of p^2 near an edge uses the points within this fraction of the zone's
-half-width from the edge (and at least the two elements nearest it)."""
+"""The fit of p^2 near an edge uses the points between one edge element and this
+fraction of the zone's half-width from the edge (when that band is long enough)."""
+MIN_BAND_ELEMENTS = 3.0
+"""A band ``FIT_BAND`` w shorter than this many edge elements h (a coarse zone: fewer
+than 6 elements from a cut to the edge, 12 between two free edges) holds too few
+resolved points beyond the edge element for the quadratic: the fit then takes every
+point of the zone within this many edge elements of the edge, the edge element's too
+(p^2 is close to a quadratic across a smooth zone; Hertz: exactly ``p0^2 (1 -
+x^2/a^2)``)."""
 CALIBRATION = 0.65
 """Scales the raw estimate to the measured L2 error at the edges (docs/contact-accuracy.md)."""
 WARN_ESTIMATE = 0.005
 """A pair whose estimated edge error exceeds this (0.5 %) at a step is warned about."""
 MIN_POINTS = 3
 """Fewer points in contact than this: the zone is not resolved at all."""
+EXACT_METHODS = ("alm",)
+"""Contact methods that enforce the contact exactly: no penalty compliance."""
 
 
 @dataclass(frozen=True)
@@ -102,6 +117,15 @@ class ZoneMeasure:
     n_points: int
     """Slave points in contact."""
     edges: list[EdgeMeasure] = field(default_factory=list)
+    penalty_length: float = math.nan
+    """The pair's :func:`penalty_length` (0 for an exact method, NaN when unknown)."""
+
+    @property
+    def penalty_smeared(self) -> bool:
+        """The penalty smears a free edge over more than the element holding it: the
+        estimate then measures the penalty's profile as much as the mesh's, and refining
+        the edge does not lower it (docs/contact-accuracy.md)."""
+        return any(self.penalty_length > e.h_tangent for e in self.edges)
 
     @property
     def resolved(self) -> bool:
@@ -120,6 +144,28 @@ class ZoneMeasure:
 def nominal_pressure(c: ContactOutput) -> np.ndarray:
     """The pressure per reference length (``p_n`` in files without it)."""
     return c.p_n_nominal if c.p_n_nominal is not None else c.p_n
+
+
+def penalty_length(result: Result, c: ContactOutput) -> float:
+    """``E* / penalty_normal``: the length over which the normal penalty's compliance
+    smears a free edge. Under a pressure p a penalty eps lets the bodies overlap by
+    ``p / eps``; the bodies' own deflection over a length l is of order ``p l / E*``;
+    the two are equal at ``l = E* / eps``, so an edge resolved finer than that is the
+    penalty's, not the exact contact's. E* is the plane-strain modulus of the pair in
+    series, ``1/E* = sum (1 - nu^2)/E`` (the slave's alone against a rigid master), as
+    voiga's automatic penalty ``10 E* q / h`` uses it (docs/theory.md), whose length is
+    ``h / (10 q)``: a tenth of the element. 0 for an exact method
+    (:data:`EXACT_METHODS`); NaN when the file lacks the penalty or a modulus."""
+    method = str(c.attrs.get("method", "")).strip()
+    if method in EXACT_METHODS:
+        return 0.0
+    eps = float(c.attrs.get("penalty_normal", math.nan))
+    names = [c.slave] + ([c.master] if c.master in result.bodies else [])
+    compliance = sum((1.0 - result.bodies[n].poisson_ratio ** 2) / result.bodies[n].youngs_modulus
+                     for n in names)
+    if not (eps > 0 and compliance > 0):
+        return math.nan
+    return float(1.0 / compliance / eps)
 
 
 def arc_coordinate(x_ref: np.ndarray) -> np.ndarray:
@@ -160,32 +206,54 @@ def _covered(breaks: np.ndarray, lo: float, hi: float) -> float:
     return float(np.sum(overlap / spans))
 
 
+def fit_points(d: np.ndarray, p: np.ndarray, h: float, band: float) -> np.ndarray:
+    """The points the fit of p^2 near an edge uses (``d`` the distance into the zone,
+    ``p`` the pressure, ``h`` the edge element's length, ``band`` = ``FIT_BAND`` w).
+    The zone's points are those with ``d > 0`` and ``p > 0``. When ``band >=
+    MIN_BAND_ELEMENTS h``: those with ``h <= d <= band``; else (a coarse zone) those
+    with ``d <= MIN_BAND_ELEMENTS h``. All of the zone's points when the choice has
+    fewer than three."""
+    zone = (d > 0) & (p > 0)
+    if band >= MIN_BAND_ELEMENTS * h:
+        fit = zone & (d >= h) & (d <= band)
+    else:
+        fit = zone & (d <= MIN_BAND_ELEMENTS * h)
+    return fit if np.count_nonzero(fit) >= 3 else zone
+
+
 def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple[float, float, bool]:
-    """The squared L2 residual over the edge elements (``d < 2 h``) of the computed
-    pressure ``p`` at distances ``d`` into the zone from the fit ``p^2 = c0 + c1 d + c2
-    d^2`` to the points with ``h <= d <= band`` (when fewer than three such points, all
-    points in contact), and the distance of the fit's edge (its root, NaN when it has
-    none); ``(NaN, NaN)`` for fewer than three points in contact; and whether the
-    pressure vanishes towards the edge (the points in contact within the edge element
-    carry less on average than the fitted ones)."""
-    fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
-    if np.count_nonzero(fit) < 3:
-        fit = p > 0
+    """The squared L2 residual of the computed pressure ``p`` (at distances ``d`` into
+    the zone from its computed edge, midway between the last point in contact and the
+    first one out) from the reference ``sqrt(c0 + c1 d + c2 d^2)``, least squares in
+    p^2 over the points :func:`fit_points` chooses, and the distance of the fitted edge.
+
+    The fitted edge is the fit's largest root below the nearest fitted point, or the
+    computed edge (0) when the fit has none there (a fit that does not fall to zero
+    describes no free edge: continued over the points out of contact it would count
+    pressure no contact carries); the reference is zero beyond it. The residual is the
+    trapezoidal integral of ``(p - ref)^2`` over the points with ``d < min(2 h, w)``,
+    ``w = band / FIT_BAND`` the zone's half-width: the two edge elements and the points
+    out of contact beyond them, never past the middle of a zone between two free edges
+    (whose other half is the other edge's). ``(NaN, NaN)`` for fewer than three points
+    in contact. Third: whether the pressure vanishes towards the edge (the points in
+    contact within the edge element carry less on average than the fitted ones)."""
+    fit = fit_points(d, p, h, band)
     if np.count_nonzero(fit) < 3:
         return math.nan, math.nan, True
     dd = d[fit]
-    design = np.column_stack([np.ones_like(dd), dd, dd**2])
-    coef, *_ = np.linalg.lstsq(design, p[fit] ** 2, rcond=None)
-    q = design_at(d) @ coef
-    ref = np.sqrt(np.clip(q, 0.0, None))
-    # no pressure beyond the fit's edge (the root of q nearest the zone)
+    coef, *_ = np.linalg.lstsq(design_at(dd), p[fit] ** 2, rcond=None)
+    ref = np.sqrt(np.clip(design_at(d) @ coef, 0.0, None))
     root = _first_root(coef, float(dd.min()))
+    if not np.isfinite(root):
+        root = 0.0
     # the pressure vanishes towards the edge when the edge element's points carry less
     # on average than the fitted ones (a punch's corner: a spike there)
+    # (judged where the band resolves the profile: on a coarse zone the edge element's
+    # pressure is the mesh's artefact as often as not)
     edge = (d >= 0) & (d < h) & (p > 0)
-    vanishing = bool(p[edge].mean() < p[fit].mean()) if edge.any() else True
+    vanishing = bool(p[edge].mean() < p[fit].mean()) if edge.any() and band >= MIN_BAND_ELEMENTS * h else True
     ref[d < root] = 0.0
-    near = d < 2 * h
+    near = d < min(2 * h, band / FIT_BAND)
     order = np.argsort(d[near])
     x, r = d[near][order], (p[near] - ref[near])[order]
     return (float(np.trapezoid(r**2, x)) if len(x) > 1 else 0.0), root, vanishing
@@ -194,6 +262,24 @@ def _edge_residual(d: np.ndarray, p: np.ndarray, h: float, band: float) -> tuple
 def design_at(d: np.ndarray) -> np.ndarray:
     """The columns ``1, d, d^2`` of the edge fit at ``d``."""
     return np.column_stack([np.ones_like(d), d, d**2])
+
+
+def edge_position(d: np.ndarray, p: np.ndarray, h: float, band: float) -> float:
+    """Where the edge is, as a distance into the zone from the computed one: the root
+    (:func:`_first_root`) of the fit of p^2 to the points the mesh resolves, ``h <= d
+    <= max(band, 2 h)`` (fewer than three: all with ``p > 0``), continued to the edge;
+    -inf without one, NaN with fewer than three points. Not the residual's fit on a
+    coarse zone, which takes the edge element's own points: the zone's shape needs them,
+    but placed from them the first refinement's knots moved by about a third of the
+    points' spacing and the committed cylinder's loop needed a third cycle
+    (docs/contact-accuracy.md)."""
+    fit = (d >= h) & (d <= max(band, 2 * h)) & (p > 0)
+    if np.count_nonzero(fit) < 3:
+        fit = p > 0
+    if np.count_nonzero(fit) < 3:
+        return math.nan
+    coef, *_ = np.linalg.lstsq(design_at(d[fit]), p[fit] ** 2, rcond=None)
+    return _first_root(coef, float(d[fit].min()))
 
 
 def _first_root(coef: np.ndarray, start: float) -> float:
@@ -227,8 +313,9 @@ def _measure_edge(result: Result, c: ContactOutput, prof: _Profile, zone: tuple[
     mask = np.zeros(len(xi), dtype=bool)  # the zone's points and those out within 2 h
     mask[zone[0]:zone[1] + 1] = True
     mask[(d < 0) & (d > -2 * h)] = True
-    residual, root, vanishing = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
-    if abs(root) <= abs(s[j] - s[i]):  # the fit's edge, when between the points
+    residual, _, vanishing = _edge_residual(d[mask], p[mask], h, FIT_BAND * w)
+    root = edge_position(d[mask], p[mask], h, FIT_BAND * w)
+    if abs(root) <= abs(s[j] - s[i]):  # the fitted edge, when between the points
         xe = float(np.interp(se - side * root, s, xi))
     hn = normal_size(result.body(c.slave), float(xe))
     raw = math.sqrt(residual / norm) if norm > 0 and np.isfinite(residual) else math.inf
@@ -268,7 +355,8 @@ def recorded_pair(result: Result, step_index: int, pair: int) -> list[ZoneMeasur
         zones.append(ZoneMeasure(pair=pair, slave=c.slave, master=c.master, step=st.step, time=st.time,
                                  xi_range=(lo, hi), half_width=w,
                                  elements_across=float(a["elements_across"][z]),
-                                 n_points=int(a["n_points"][z]), edges=edges))
+                                 n_points=int(a["n_points"][z]), edges=edges,
+                                 penalty_length=penalty_length(result, c)))
     return zones
 
 
@@ -286,6 +374,7 @@ def measure_pair(result: Result, step_index: int, pair: int, computed: bool = Fa
                     p=nominal_pressure(c)[order])
     xi, s, p = prof.xi, prof.s, prof.p
     breaks = element_breaks(result.body(c.slave))
+    delta = penalty_length(result, c)
     n = len(xi)
     out: list[ZoneMeasure] = []
     for i0, i1 in zones(c.active[order] & (p > 0)):
@@ -303,7 +392,7 @@ def measure_pair(result: Result, step_index: int, pair: int, computed: bool = Fa
                                time=st.time, xi_range=(float(xi[i0]), float(xi[i1])),
                                half_width=float(w),
                                elements_across=_covered(breaks, xi_lo, xi_hi),
-                               n_points=i1 - i0 + 1, edges=edges))
+                               n_points=i1 - i0 + 1, edges=edges, penalty_length=delta))
     return out
 
 
@@ -336,19 +425,31 @@ def format_zone(m: ZoneMeasure) -> str:
                       + ("" if e.vanishing else " (not estimated: the pressure rises towards it)")
                       + (f", {e.estimate:.2%}" if several and e.vanishing else "")
                       for e in m.edges) or "no free edge"
+    smear = (f" (the penalty smears the edges over E*/penalty_normal = {m.penalty_length:.3g}, "
+             f"{m.penalty_length / min(e.h_tangent for e in m.edges):.3g} edge elements)"
+             if m.penalty_smeared else "")
     return (f"contact {m.slave} -> {m.master}, step {m.step}: {m.elements_across:.1f} slave "
             f"elements across the zone (half-width {m.half_width:.4g}); {edges}; "
-            f"estimated edge error {m.estimate:.2%}")
+            f"estimated edge error {m.estimate:.2%}{smear}")
 
 
 def indicator_lines(result: Result) -> list[str]:
     """The summary's lines: per pair the step with the largest estimate (and its zone),
-    and a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`."""
+    a warning naming the remedy when it exceeds :data:`WARN_ESTIMATE`, and one when the
+    penalty smears that zone's edges (:attr:`ZoneMeasure.penalty_smeared`)."""
     lines: list[str] = []
     # voiga warns itself when it wrote the indicator (the file's warnings, post summary's)
     own = any(c.accuracy is not None for st in result.steps for c in st.contact)
     for m in worst(measure(result)).values():
         lines.append("  accuracy: " + format_zone(m))
+        if m.penalty_smeared and not own:
+            lines.append(f"warning: contact {m.slave} -> {m.master}: penalty_normal smears the "
+                         f"contact zone's edges over E*/penalty_normal = {m.penalty_length:.3g} "
+                         f"({m.penalty_length / m.half_width:.2g} of the zone's half-width) at "
+                         f"step {m.step}, more than the elements that hold them: the estimate "
+                         f"includes that smearing, which refining does not remove; a stiffer "
+                         f"penalty_normal (or none: voiga's automatic one) does "
+                         f"(docs/contact-accuracy.md)")
         if m.estimate > WARN_ESTIMATE and not own:
             lines.append(f"warning: contact {m.slave} -> {m.master}: the mesh resolves the "
                          f"contact zone's edge poorly (estimated pressure error "

@@ -25,10 +25,20 @@ from post.adapt import (
     refine_result,
 )
 from post.hertz import hertz_comparison
-from post.indicator import CALIBRATION, WARN_ESTIMATE, _edge_residual, indicator_lines, measure, zones
+from post.indicator import (
+    CALIBRATION,
+    MIN_BAND_ELEMENTS,
+    WARN_ESTIMATE,
+    _edge_residual,
+    fit_points,
+    indicator_lines,
+    measure,
+    penalty_length,
+    zones,
+)
 from post.plot import breakpoints
 from post.reader import Result, read_result
-from post.summary import summary_lines
+from post.summary import slave_element_size, summary_lines
 from pre.__main__ import main as pre_main
 from pre.nurbs import evaluate_patch
 from pre.refine import discretize_case
@@ -46,6 +56,11 @@ def _hertz(voiga: Path, folder: Path, mesh: str) -> Path:
     subprocess.run([str(voiga), f"{mesh}-NN2.2.nml", "--quiet"], cwd=folder, check=True,
                    timeout=TIMEOUT, stdin=subprocess.DEVNULL, capture_output=True)
     return folder / f"{mesh}-NN2.2.h5"
+
+
+@pytest.fixture(scope="module")
+def m1(voiga: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _hertz(voiga, tmp_path_factory.mktemp("m1"), "m1")
 
 
 @pytest.fixture(scope="module")
@@ -84,6 +99,75 @@ def test_edge_of_a_punch_is_not_estimated() -> None:
     d = np.linspace(0.002, 0.6, 60)
     p = 1.0 / np.sqrt(1.0 - (1.0 - d) ** 2)
     assert not _edge_residual(d, p, 0.05, 0.5)[2]
+
+
+def test_coarse_zone_fits_the_points_near_the_edge() -> None:
+    """A band FIT_BAND w shorter than MIN_BAND_ELEMENTS edge elements: the fit takes the
+    zone's points within that many elements of the edge, the edge element's too; a long
+    enough band leaves the edge element out."""
+    h = 0.1
+    d = np.linspace(-0.2, 1.0, 61)
+    p = np.where(d > 0, 1.0, 0.0)
+    coarse = fit_points(d, p, h, 0.5 * MIN_BAND_ELEMENTS * h)
+    assert coarse.any() and d[coarse].min() < h and d[coarse].max() <= MIN_BAND_ELEMENTS * h
+    assert np.all(d[coarse] > 0)
+    band = fit_points(d, p, h, MIN_BAND_ELEMENTS * h)
+    assert d[band].min() >= h and d[band].max() <= MIN_BAND_ELEMENTS * h
+
+
+def test_edge_fit_without_a_root_keeps_the_computed_edge() -> None:
+    """A fit of p^2 without a root below the zone describes no free edge (hertz m1 at
+    step 1: the pressure rises towards the edge): its reference ends where the computed
+    zone does, so the points out of contact add nothing."""
+    h = 0.1
+    d = np.linspace(-0.19, 0.99, 60)  # no point on the edge
+    p = np.where(d > 0, np.sqrt(1 + (d - 0.5) ** 2), 0.0)  # p^2 convex, no real root
+    residual, root, _ = _edge_residual(d, p, h, 0.5)
+    assert root == 0.0 and residual < 1e-24
+
+
+@pytest.mark.parametrize(("mesh", "factor"), [("m1", 2.5), ("m2", 2.0)])
+def test_estimate_tracks_the_error_on_coarse_zones(mesh: str, factor: float,
+                                                   request: pytest.FixtureRequest) -> None:
+    """hertz m1 and m2 NN2.2 (1.1 to 6.4 slave elements across): the band is too short,
+    the fit takes the zone near the edge; the estimate is within ``factor`` of the whole
+    L2 error (an edge's error spreads over a coarse zone), m1 (1.1 elements across at
+    step 1) within 2.5, m2 within 2 (the band fit: up to 14 times too large)."""
+    result = read_result(request.getfixturevalue(mesh))
+    ms = measure(result)
+    assert len(ms) == 5 and all(m.elements_across < 7 for m in ms)
+    for m in ms:
+        error = hertz_comparison(result, step=m.step, reference="circle").error.l2
+        assert 1 / factor < m.estimate / error < factor, (m.step, m.estimate, error)
+
+
+def test_penalty_length_is_that_of_the_automatic_penalty(m2: Path) -> None:
+    """voiga's automatic penalty is 10 E* q / h for the smallest slave element h and the
+    edge's degree q: its length E*/penalty is h / (10 q), the same E* (in series, plane
+    strain) on both sides."""
+    result = read_result(m2)
+    c = result.steps[0].contact[0]
+    breaks = breakpoints(result.body(c.slave))[0]
+    h = min(slave_element_size(result, c, 0.5 * (a + b)) for a, b in zip(breaks[:-1], breaks[1:], strict=True))
+    tenths = h / penalty_length(result, c) / 10  # the degree q
+    # h is the polyline through the element's points (the arc: 2e-5 longer here)
+    assert round(tenths) in (2, 3, 4) and abs(tenths - round(tenths)) < 1e-4
+    assert not any(m.penalty_smeared for m in measure(result))
+
+
+def test_a_soft_penalty_is_reported(voiga: Path, tmp_path: Path) -> None:
+    """hertz m2 NN2.2 with penalty_normal 30: E*/penalty (0.037) is three edge elements,
+    the penalty shapes the edge (20-33 % off Hertz); the summary says so."""
+    shutil.copy(CASES / "hertz" / "geometry.h5", tmp_path / "geometry.h5")
+    text = (CASES / "hertz" / "m2-NN2.2.nml").read_text()
+    (tmp_path / "m2-NN2.2.nml").write_text(re.sub(r"penalty_normal = [^\n]*", "penalty_normal = 30.0", text))
+    subprocess.run([str(voiga), "m2-NN2.2.nml", "--quiet"], cwd=tmp_path, check=True, timeout=TIMEOUT,
+                   stdin=subprocess.DEVNULL, capture_output=True)
+    result = read_result(tmp_path / "m2-NN2.2.h5")
+    ms = measure(result)
+    assert ms and all(m.penalty_smeared for m in ms)
+    assert all(m.penalty_length > m.edges[0].h_tangent for m in ms)
+    assert any("smears" in line and line.startswith("warning:") for line in indicator_lines(result))
 
 
 def test_indicator_flags_the_coarse_committed_mesh(m4: Path) -> None:

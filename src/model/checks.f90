@@ -29,7 +29,8 @@ module voiga_model_checks
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_contact_law, only: state_inactive
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate, warn_estimate, min_points
+    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate, warn_estimate, min_points, &
+                                    pair_zones, penalty_smeared
     implicit none
     private
 
@@ -67,6 +68,9 @@ module voiga_model_checks
         !> (0: none yet).
         type(zone_measure_t), allocatable :: worst(:)
         integer, allocatable :: worst_step(:)
+        !> Each pair's first zone whose edges the penalty smears, and its step (0: none).
+        type(zone_measure_t), allocatable :: smeared(:)
+        integer, allocatable :: smeared_step(:)
     contains
         procedure :: after_step => watch_after_step
         procedure :: at_end => watch_at_end
@@ -81,8 +85,8 @@ contains
         integer :: ip
         allocate (self%ever_active(size(model%pairs)), source=.false.)
         allocate (self%deep_reported(size(model%pairs)), source=.false.)
-        allocate (self%slave(size(model%pairs)), self%worst(size(model%pairs)))
-        allocate (self%worst_step(size(model%pairs)), source=0)
+        allocate (self%slave(size(model%pairs)), self%worst(size(model%pairs)), self%smeared(size(model%pairs)))
+        allocate (self%worst_step(size(model%pairs)), self%smeared_step(size(model%pairs)), source=0)
         do ip = 1, size(model%pairs)
             self%slave(ip)%h = element_lengths(model%pairs(ip)%pair%slave)
         end do
@@ -459,6 +463,8 @@ contains
         do ip = 1, size(model%pairs)
             if (self%worst_step(ip) > 0) call accuracy_warning(model%pairs(ip)%pair, self%worst(ip), &
                                                                self%worst_step(ip), list)
+            if (self%smeared_step(ip) > 0) call smearing_warning(model%pairs(ip)%pair, self%smeared(ip), &
+                                                                 self%smeared_step(ip), list)
             if (self%ever_active(ip)) cycle
             list = [list, warning_t(pair_label(model%pairs(ip)%pair)//'no point came into contact in '// &
                                     str(n_steps)//' steps: check the loads, the contact edges and the gap '// &
@@ -473,7 +479,18 @@ contains
         type(model_t), intent(in) :: model
         integer, intent(in) :: ip, step
         type(zone_measure_t) :: zone
+        type(zone_measure_t), allocatable :: zones(:)
         logical :: found
+        integer :: i
+        if (self%smeared_step(ip) == 0) then
+            zones = pair_zones(model, ip)
+            do i = 1, size(zones)
+                if (.not. penalty_smeared(zones(i))) cycle
+                self%smeared(ip) = zones(i)
+                self%smeared_step(ip) = step
+                exit
+            end do
+        end if
         call worst_of_pair(model, ip, zone, found)
         if (.not. found) return
         if (self%worst_step(ip) > 0) then
@@ -512,12 +529,25 @@ contains
             what = what//"refine the slave face's cells around the zone's edge (knots_xi, knots_eta; a grid whose "// &
                    'knot lines follow the edge: docs/hertz3d.md)'
         end if
-        ! a penalty softer than the automatic one smears the edge over more than an element
-        if (pair%law%eps_n < pair%eps_automatic .and. pair%method_name() /= 'alm') &
-            what = what//'; penalty_normal = '//trim(short_str(pair%law%eps_n))//' is softer than the '// &
-                   'automatic '//trim(short_str(pair%eps_automatic))//': its compliance smears the edge too, '// &
-                   'which refinement does not remove (omit or raise it)'
         list = [list, warning_t(pair_label(pair)//what, topic=pair_label(pair)//'an unresolved contact zone edge')]
     end subroutine accuracy_warning
+
+    !> A pair whose penalty smears a zone's edges over more than the elements that hold
+    !> them (`penalty_smeared`): the edge error estimate then holds that smearing, which
+    !> refinement does not remove.
+    pure subroutine smearing_warning(pair, zone, step, list)
+        class(contact_pair_t), intent(in) :: pair
+        type(zone_measure_t), intent(in) :: zone
+        integer, intent(in) :: step
+        type(warning_t), allocatable, intent(inout) :: list(:)
+        list = [list, warning_t(pair_label(pair)//'penalty_normal = '//trim(short_str(pair%law%eps_n))// &
+                                " smears the contact zone's edges over E*/penalty_normal = "// &
+                                trim(short_str(zone%penalty_length))//' ('// &
+                                fixed_str(zone%penalty_length/zone%half_width, 2)//" of the zone's half-width) "// &
+                                'from step '//str(step)//', more than the elements that hold them: the edge error '// &
+                                'estimate includes that smearing, which refining does not remove; a stiffer '// &
+                                "penalty_normal (or none: voiga's automatic one) does (docs/contact-accuracy.md)", &
+                                topic=pair_label(pair)//'a penalty that smears the contact zone')]
+    end subroutine smearing_warning
 
 end module voiga_model_checks

@@ -19,7 +19,7 @@ module voiga_model
     implicit none
     private
 
-    public :: model_t, new_model, set_prescribed, reference_coordinates, set_contact_time, contact_reach
+    public :: model_t, new_model, set_prescribed, reference_coordinates, set_contact_time, contact_reach, plane_modulus
 
     !> Everything the solver needs to know of the physics.
     type :: model_t
