@@ -275,4 +275,6 @@ master = "punch"
     run = subprocess.run([str(voiga), str(tmp_path / "punch.nml"), "--quiet"], capture_output=True, text=True,
                          timeout=120)
     assert run.returncode == 0, run.stderr
-    assert "warning" not in run.stderr, run.stderr
+    # a sound set-up: no warning but the contact-zone indicator's (6 block elements under
+    # the punch: too few to resolve its corners, docs/contact-accuracy.md)
+    assert all("contact zone" in line for line in run.stderr.splitlines() if "warning" in line), run.stderr
