@@ -3,7 +3,7 @@
 
     python test/python/loop_changes.py DIR STEM [--steps]
 
-reads the loop's results in DIR (``STEM.h5`` and ``STEM-zone<k>/STEM-zone<k>.h5``, as
+reads the loop's results in DIR (``STEM-zone0/STEM.h5`` and ``STEM-zone<k>/STEM-zone<k>.h5``, as
 `python -m post run CASE --adapt --out DIR` leaves them) and prints per cycle its DOFs,
 its largest estimate and the largest change to the next cycle (``post.adapt``'s
 measure: the relative L2 change of the pressure along the slave parameter), and the
@@ -31,7 +31,9 @@ def cycle_paths(folder: Path, stem: str) -> list[Path]:
     """The loop's results in cycle order."""
     refined = sorted(folder.glob(f"{stem}-zone*/{stem}-zone*.h5"),
                      key=lambda p: int(re.findall(r"zone(\d+)$", p.stem)[0]))
-    return [folder / f"{stem}.h5", *refined]
+    # cycle 0 in STEM-zone0/ (STEM.h5 beside it is the loop's last result, a copy)
+    first = folder / f"{stem}-zone0" / f"{stem}.h5"
+    return [first if first.is_file() else folder / f"{stem}.h5", *refined]
 
 
 def _profile(c: ContactOutput, grid: np.ndarray) -> np.ndarray:
