@@ -33,6 +33,7 @@ program voiga_tests
     use test_projection, only: collect_projection, projection_timing
     use test_contact_3d, only: collect_contact_3d
     use test_alm_faces, only: collect_alm_faces
+    use test_accuracy, only: collect_accuracy
     implicit none
     type(testsuite_t), allocatable :: suites(:)
     character(len=256) :: filter
@@ -68,7 +69,8 @@ program voiga_tests
              new_testsuite('method', collect_method), &
              new_testsuite('projection', collect_projection), &
              new_testsuite('contact_3d', collect_contact_3d), &
-             new_testsuite('alm_faces', collect_alm_faces) &
+             new_testsuite('alm_faces', collect_alm_faces), &
+             new_testsuite('accuracy', collect_accuracy) &
              ]
     filter = ''
     if (command_argument_count() > 0) call get_command_argument(1, filter)
