@@ -17,9 +17,11 @@
 !> zone's L2 norm and times `calibration`, is the estimate (docs/theory.md derives its
 !> order, docs/contact-accuracy.md calibrates it).
 !>
-!> Why only edges: a face's zone has a boundary curve instead of two points; the same
-!> measures are taken along its normal in the face, which is not built yet (a face pair
-!> has no zones here and its result group says so).
+!> On a solid's face the zone's boundary is a curve, not two points: every line of slave
+!> points (constant eta, constant xi) is measured as an edge is, with the points' areas
+!> as the integration weights, and the face's estimate sums the lines of each direction
+!> (`face_summary`). A flat punch's corner, where the pressure rises instead of
+!> vanishing, is not estimated (`edge_measure_t%vanishing`).
 module voiga_model_accuracy
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_quiet_nan, ieee_is_finite
     use voiga_kinds, only: dp
