@@ -473,7 +473,8 @@ contains
         end do
     end subroutine watch_at_end
 
-    !> Keep pair `ip`'s zone at `step` when its estimated edge error is the largest so far.
+    !> Keep pair `ip`'s zone at `step` when its estimated edge error is the largest so far,
+    !> and its first zone whose edges the penalty smears.
     pure subroutine remember_worst(self, model, ip, step)
         type(contact_watch_t), intent(inout) :: self
         type(model_t), intent(in) :: model
