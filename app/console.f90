@@ -13,7 +13,7 @@ module voiga_app_console
     use voiga_text, only: str, fixed_str, real_str
     use voiga_error, only: error_t
     use voiga_model, only: model_t
-    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate
+    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair
     use voiga_solver_records, only: cut_record_t, wall_seconds
     use voiga_solver_progress, only: progress_t, iteration_report_t, fixed_point_report_t, step_report_t
     implicit none
@@ -244,7 +244,7 @@ contains
         do k = 1, size(model%pairs)
             call worst_of_pair(model, k, zone, found)
             if (.not. found) cycle
-            e = zone_estimate(zone)
+            e = zone%estimate
             if (ieee_is_finite(e)) then
                 text = text//'  edge error '//fixed_str(100.0_dp*e, 2)//'%'
             else

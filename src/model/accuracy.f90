@@ -35,7 +35,7 @@ module voiga_model_accuracy
     implicit none
     private
 
-    public :: edge_measure_t, zone_measure_t, measure_zones, pair_zones, worst_of_pair, face_summary, zone_estimate, &
+    public :: edge_measure_t, zone_measure_t, measure_zones, pair_zones, worst_of_pair, pair_summary, face_summary, &
               penalty_smeared
     public :: fit_band, calibration, warn_estimate, min_points
 
@@ -54,8 +54,8 @@ module voiga_model_accuracy
         !> +1: the zone lies at smaller xi (the edge is its upper end); -1: larger.
         integer :: side = 0
         !> Reference length of the slave element holding the edge, and thickness of the
-        !> surface element row there; both over the zone's half-width.
-        real(dp) :: h_tangent = 0.0_dp, h_normal = 0.0_dp, ratio_tangent = 0.0_dp, ratio_normal = 0.0_dp
+        !> surface element row there.
+        real(dp) :: h_tangent = 0.0_dp, h_normal = 0.0_dp
         !> The uncalibrated estimate, and the reference distance between the points
         !> that bracket the edge.
         real(dp) :: raw = 0.0_dp, bracket = 0.0_dp
@@ -83,7 +83,9 @@ module voiga_model_accuracy
         !> The squared L2 norm of its pressure (reference; on a face the sum of p^2 times
         !> the area its points integrate): what a face's estimate sums the lines with.
         real(dp) :: norm = 0.0_dp
-        !> Estimated relative L2 pressure error made at its edges (`zone_estimate`).
+        !> Estimated relative L2 pressure error made at its edges: on a line the root of
+        !> the sum of its edges' squares (infinite for fewer than `min_points` points); a
+        !> face's summary holds the face's (`face_summary`).
         real(dp) :: estimate = 0.0_dp
         !> The pair's E* / penalty_normal: the length over which the penalty's compliance
         !> smears a free edge (0 for ALM, which enforces the contact exactly).
@@ -104,14 +106,6 @@ module voiga_model_accuracy
     end type profile_t
 
 contains
-
-    !> Estimated relative L2 pressure error of `zone` made at its edges: on a line the
-    !> root of the sum of its edges' squares (infinite for fewer than `min_points`
-    !> points); a face's summary zone holds the face's (`face_summary`).
-    pure real(dp) function zone_estimate(zone) result(e)
-        type(zone_measure_t), intent(in) :: zone
-        e = zone%estimate
-    end function zone_estimate
 
     !> The zones of pair `k` of `model` as it was last evaluated.
     pure function pair_zones(model, k) result(zones)
@@ -135,20 +129,27 @@ contains
         penalty_smeared = any(zone%penalty_length > zone%edges(1:zone%n_edges)%h_tangent)
     end function penalty_smeared
 
-    !> What pair `k` of `model` reports: on an edge its zone with the largest estimate,
-    !> on a face the face's summary (`face_summary`); `found` is false when the pair has
-    !> no zone (out of contact).
+    !> What pair `k` of `model` reports (`pair_summary` of its zones); `found` is false
+    !> when the pair has no zone (out of contact).
     pure subroutine worst_of_pair(model, k, zone, found)
         type(model_t), intent(in) :: model
         integer, intent(in) :: k
         type(zone_measure_t), intent(out) :: zone
         logical, intent(out) :: found
         type(zone_measure_t), allocatable :: zones(:)
-        integer :: i, worst
         zones = pair_zones(model, k)
         found = size(zones) > 0
-        if (.not. found) return
-        if (model%pairs(k)%pair%slave%npar == 2) then
+        if (found) zone = pair_summary(zones, model%pairs(k)%pair%slave%npar == 2)
+    end subroutine worst_of_pair
+
+    !> What a pair's `zones` (at least one) report: on an edge the zone with the largest
+    !> estimate, on a `face` the face's summary (`face_summary`).
+    pure function pair_summary(zones, face) result(zone)
+        type(zone_measure_t), intent(in) :: zones(:)
+        logical, intent(in) :: face
+        type(zone_measure_t) :: zone
+        integer :: i, worst
+        if (face) then
             zone = face_summary(zones)
             return
         end if
@@ -157,7 +158,7 @@ contains
             if (zones(i)%estimate > zones(worst)%estimate) worst = i
         end do
         zone = zones(worst)
-    end subroutine worst_of_pair
+    end function pair_summary
 
     !> A face's zones (along the lines of both directions) as one: its points in
     !> contact, the most elements and the largest half-width across along a line, and
@@ -376,12 +377,6 @@ contains
         edge%side = side
         edge%h_tangent = h
         edge%h_normal = normal_size(disc, prof, edge%xi)
-        edge%ratio_tangent = ieee_value(1.0_dp, ieee_positive_inf)
-        edge%ratio_normal = edge%ratio_tangent
-        if (w > 0.0_dp) then
-            edge%ratio_tangent = h/w
-            edge%ratio_normal = edge%h_normal/w
-        end if
         edge%raw = ieee_value(1.0_dp, ieee_positive_inf)
         if (norm > 0.0_dp .and. ieee_is_finite(residual)) edge%raw = sqrt(residual/norm)
         if (.not. edge%vanishing) edge%raw = 0.0_dp

@@ -29,7 +29,7 @@ module voiga_model_checks
     use voiga_contact_master_curve, only: rigid_curve_t
     use voiga_contact_law, only: state_inactive
     use voiga_element_quadrature, only: gauss_legendre
-    use voiga_model_accuracy, only: zone_measure_t, worst_of_pair, zone_estimate, warn_estimate, min_points, &
+    use voiga_model_accuracy, only: zone_measure_t, pair_summary, warn_estimate, min_points, &
                                     pair_zones, penalty_smeared
     implicit none
     private
@@ -481,10 +481,9 @@ contains
         integer, intent(in) :: ip, step
         type(zone_measure_t) :: zone
         type(zone_measure_t), allocatable :: zones(:)
-        logical :: found
         integer :: i
+        zones = pair_zones(model, ip)
         if (self%smeared_step(ip) == 0) then
-            zones = pair_zones(model, ip)
             do i = 1, size(zones)
                 if (.not. penalty_smeared(zones(i))) cycle
                 self%smeared(ip) = zones(i)
@@ -492,10 +491,10 @@ contains
                 exit
             end do
         end if
-        call worst_of_pair(model, ip, zone, found)
-        if (.not. found) return
+        if (size(zones) == 0) return
+        zone = pair_summary(zones, model%pairs(ip)%pair%slave%npar == 2)
         if (self%worst_step(ip) > 0) then
-            if (.not. zone_estimate(zone) > zone_estimate(self%worst(ip))) return
+            if (.not. zone%estimate > self%worst(ip)%estimate) return
         end if
         self%worst(ip) = zone
         self%worst_step(ip) = step
@@ -510,17 +509,18 @@ contains
         type(warning_t), allocatable, intent(inout) :: list(:)
         character(len=:), allocatable :: what
         integer :: j
-        if (.not. zone_estimate(zone) > warn_estimate) return
+        if (.not. zone%estimate > warn_estimate) return
         if (zone%n_points < min_points) then
             what = 'the contact zone is not resolved at step '//str(step)//' ('//str(zone%n_points)// &
                    ' points in contact'
         else
             what = "the mesh resolves the contact zone's edge poorly: estimated pressure error "// &
-                   fixed_str(100.0_dp*zone_estimate(zone), 2)//' % at step '//str(step)//' (above '// &
+                   fixed_str(100.0_dp*zone%estimate, 2)//' % at step '//str(step)//' (above '// &
                    fixed_str(100.0_dp*warn_estimate, 1)//' %'
             do j = 1, zone%n_edges
-                what = what//'; h/w '//fixed_str(zone%edges(j)%ratio_tangent, 3)//' along, '// &
-                       fixed_str(zone%edges(j)%ratio_normal, 3)//' across at xi = '//fixed_str(zone%edges(j)%xi, 4)
+                what = what//'; h/w '//fixed_str(zone%edges(j)%h_tangent/zone%half_width, 3)//' along, '// &
+                       fixed_str(zone%edges(j)%h_normal/zone%half_width, 3)//' across at xi = '// &
+                       fixed_str(zone%edges(j)%xi, 4)
             end do
         end if
         what = what//', '//fixed_str(zone%elements_across, 1)//' slave elements across): '
