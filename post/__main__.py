@@ -145,13 +145,18 @@ def _cmd_summary(args: argparse.Namespace) -> int:
 
 
 def _cmd_indicator(args: argparse.Namespace) -> int:
-    from .indicator import format_zone, measure
+    from .indicator import face_lines, format_zone, measure
 
     result = _result(args)
     if result.dimension != 2:
-        print(f"python -m post indicator: {args.result}: contact output is plane only so far",
-              file=sys.stderr)
-        return 2
+        # a solid's faces: voiga's estimate per pair (its largest step), from the file
+        lines = face_lines(result)
+        for line in lines:
+            print(line.strip())
+        if not lines:
+            print(f"python -m post indicator: {args.result}: no contact accuracy in the file (no contact, "
+                  "or written before voiga measured it)", file=sys.stderr)
+        return 0 if lines else 2
     zones = measure(result)
     if not zones:
         print(f"python -m post indicator: {args.result}: no contact at any converged step",

@@ -5,6 +5,7 @@ step, on a rigid master (hertz) and between deformable bodies (rings)."""
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -82,3 +83,8 @@ def test_face_estimate_tracks_hertz3d(voiga_bin: Path, tmp_path: Path) -> None:
         estimate = float(st.contact[0].accuracy["pair_estimate"])
         l2 = hertz3d_comparison(result, step=st.step).error.l2
         assert 0.8 * estimate < l2 < 2.5 * estimate, (st.step, estimate, l2)
+    # `post indicator` prints the face's estimate from the file (step 1: the largest)
+    shown = subprocess.run([sys.executable, "-m", "post", "indicator", "p2-N2.h5"], cwd=tmp_path, text=True,
+                           capture_output=True, env={**os.environ, "PYTHONPATH": str(REPO)})
+    first = float(result.steps[0].contact[0].accuracy["pair_estimate"])
+    assert shown.returncode == 0 and f"step 1: estimated edge error {first:.2%}" in shown.stdout, shown
